@@ -1,0 +1,50 @@
+"""The dynamics core: models, kinematics, dynamics and payloads. No ROS in here.
+
+    >>> from irb140_dynamics.core import irb140, gravity
+    >>> gravity(irb140(), [0, -1.5707963267948966, 1.5707963267948966, 0, 0, 0]).round(3)
+    array([  0.   , 243.382,  79.156,  -0.   ,   2.43 ,   0.   ])
+"""
+
+from .dynamics import (
+    coriolis,
+    coriolis_batch,
+    coriolis_matrix,
+    forward_dynamics,
+    forward_dynamics_batch,
+    gravity,
+    gravity_batch,
+    mass_matrix,
+    mass_matrix_batch,
+    rnea,
+    rnea_batch,
+)
+from .geometry import irb140
+from .kinematics import dh_transform, flange_jacobian, flange_pose, link_frames
+from .model import DH, Joint, RobotModel, load_model, read_parameter_file
+from .rigid_body import ModelError, RigidBody
+
+__all__ = [
+    "DH",
+    "Joint",
+    "ModelError",
+    "RigidBody",
+    "RobotModel",
+    "coriolis",
+    "coriolis_batch",
+    "coriolis_matrix",
+    "dh_transform",
+    "flange_jacobian",
+    "flange_pose",
+    "forward_dynamics",
+    "forward_dynamics_batch",
+    "gravity",
+    "gravity_batch",
+    "irb140",
+    "link_frames",
+    "load_model",
+    "mass_matrix",
+    "mass_matrix_batch",
+    "read_parameter_file",
+    "rnea",
+    "rnea_batch",
+]

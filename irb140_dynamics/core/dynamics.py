@@ -1,0 +1,133 @@
+"""Inverse and forward dynamics of a RobotModel: the public functions.
+
+    M(q) qdd + C(q, qd) qd + g(q) = tau        (+ the flange wrench, see ``rnea``)
+
+Single-state functions take sequences of n numbers and return NumPy arrays; the
+``*_batch`` forms take arrays shaped (N, n) and give the same numbers for N states at once.
+All run the model's generated kernels (see ``codegen``), compiled on first use.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from .model import RobotModel
+
+ArrayLike = Sequence[float] | np.ndarray
+
+
+def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=None) -> np.ndarray:
+    """Joint torques tau(q, qd, qdd) [N m] by recursive Newton-Euler, gravity and payload included.
+
+    ``f_ext`` (optional, 6 numbers): the wrench (force [N], moment [N m] about the flange
+    origin) that the environment exerts on the flange, in the flange frame. tau balances
+    it: tau = ID(q, qd, qdd) - J(q)^T f_ext, with J the flange Jacobian in the flange frame.
+    """
+    kernels = model.kernels
+    args = (_state(q, model.n, "q"), _state(qd, model.n, "qd"), _state(qdd, model.n, "qdd"))
+    if f_ext is None:
+        return np.array(kernels.rnea.scalar(*args))
+    return np.array(kernels.rnea_wrench.scalar(*args, _state(f_ext, 6, "f_ext")))
+
+
+def gravity(model: RobotModel, q: ArrayLike) -> np.ndarray:
+    """Gravity torques g(q) [N m]: what holds the arm (and payload) still at q."""
+    return np.array(model.kernels.gravity_torques.scalar(_state(q, model.n, "q")))
+
+
+def coriolis(model: RobotModel, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
+    """Coriolis and centrifugal torques C(q, qd) qd [N m]."""
+    return np.array(model.kernels.coriolis.scalar(_state(q, model.n, "q"), _state(qd, model.n, "qd")))
+
+
+def coriolis_matrix(model: RobotModel, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
+    """The Coriolis matrix C(q, qd) of the Christoffel symbols: Mdot - 2C is skew-symmetric."""
+    n = model.n
+    flat = model.kernels.coriolis_matrix.scalar(_state(q, n, "q"), _state(qd, n, "qd"))
+    return np.array(flat).reshape(n, n)
+
+
+def mass_matrix(model: RobotModel, q: ArrayLike) -> np.ndarray:
+    """The joint-space mass matrix M(q) [kg m^2], symmetric positive definite."""
+    n = model.n
+    return _symmetric(np.array(model.kernels.mass_matrix.scalar(_state(q, n, "q"))), n)
+
+
+def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext=None) -> np.ndarray:
+    """Joint accelerations qdd = M(q)^-1 (tau - C(q, qd) qd - g(q)) [rad/s^2]."""
+    bias = rnea(model, q, qd, np.zeros(model.n), f_ext)
+    return np.linalg.solve(mass_matrix(model, q), np.asarray(tau, dtype=float) - bias)
+
+
+# -- many states at once --------------------------------------------------------------
+
+
+def rnea_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
+    """rnea for N states: Q, QD, QDD shaped (N, n) -> tau shaped (N, n)."""
+    n = model.n
+    return _stack(model.kernels.rnea.array(_columns(Q, n, "Q"), _columns(QD, n, "QD"), _columns(QDD, n, "QDD")), len(Q))
+
+
+def gravity_batch(model: RobotModel, Q) -> np.ndarray:
+    """gravity for N states: Q shaped (N, n) -> g shaped (N, n)."""
+    return _stack(model.kernels.gravity_torques.array(_columns(Q, model.n, "Q")), len(Q))
+
+
+def coriolis_batch(model: RobotModel, Q, QD) -> np.ndarray:
+    """coriolis for N states: (N, n) -> C(q, qd) qd shaped (N, n)."""
+    n = model.n
+    return _stack(model.kernels.coriolis.array(_columns(Q, n, "Q"), _columns(QD, n, "QD")), len(Q))
+
+
+def mass_matrix_batch(model: RobotModel, Q) -> np.ndarray:
+    """mass_matrix for N states: Q shaped (N, n) -> M shaped (N, n, n)."""
+    n = model.n
+    upper = _stack(model.kernels.mass_matrix.array(_columns(Q, n, "Q")), len(Q))
+    return _symmetric(upper, n)
+
+
+def forward_dynamics_batch(model: RobotModel, Q, QD, TAU) -> np.ndarray:
+    """forward_dynamics for N states: (N, n) arrays -> QDD shaped (N, n)."""
+    bias = rnea_batch(model, Q, QD, np.zeros_like(np.asarray(Q, dtype=float)))
+    rhs = np.asarray(TAU, dtype=float) - bias
+    return np.linalg.solve(mass_matrix_batch(model, Q), rhs[..., None])[..., 0]
+
+
+# -- conversions ----------------------------------------------------------------------
+
+
+def _state(x, n: int, name: str):
+    """A sequence of n numbers as the kernels want it: a list of Python floats."""
+    if isinstance(x, np.ndarray):
+        if x.shape != (n,):
+            raise ValueError(f"{name}: expected shape ({n},), got {x.shape}")
+        return x.tolist()
+    if len(x) != n:
+        raise ValueError(f"{name}: expected {n} values, got {len(x)}")
+    return x
+
+
+def _columns(X, n: int, name: str) -> np.ndarray:
+    X = np.asarray(X, dtype=float)
+    if X.ndim != 2 or X.shape[1] != n:
+        raise ValueError(f"{name}: expected shape (N, {n}), got {X.shape}")
+    return np.ascontiguousarray(X.T)
+
+
+def _stack(outputs, N: int) -> np.ndarray:
+    """Kernel outputs (arrays, or constants folded at generation) as an (N, k) array."""
+    result = np.empty((N, len(outputs)))
+    for i, column in enumerate(outputs):
+        result[:, i] = column
+    return result
+
+
+def _symmetric(upper: np.ndarray, n: int) -> np.ndarray:
+    """Symmetric (..., n, n) matrices from their upper triangles stored row by row."""
+    M = np.empty(upper.shape[:-1] + (n, n))
+    rows, cols = np.triu_indices(n)
+    M[..., rows, cols] = upper
+    M[..., cols, rows] = upper
+    return M

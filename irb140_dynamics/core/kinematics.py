@@ -1,0 +1,54 @@
+"""Forward kinematics: DH transforms, link frames, the flange pose and Jacobian.
+
+Poses are 4x4 homogeneous transforms from the frame to the base frame 0, in metres.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .model import DH, RobotModel
+
+
+def dh_transform(dh: DH, q: float) -> np.ndarray:
+    """A_i = Rot_z(q + theta_offset) Trans_z(d) Trans_x(a) Rot_x(alpha)."""
+    theta = q + dh.theta_offset
+    ct, st = math.cos(theta), math.sin(theta)
+    ca, sa = math.cos(dh.alpha), math.sin(dh.alpha)
+    return np.array(
+        [
+            [ct, -st * ca, st * sa, dh.a * ct],
+            [st, ct * ca, -ct * sa, dh.a * st],
+            [0.0, sa, ca, dh.d],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
+
+
+def link_frames(model: RobotModel, q) -> np.ndarray:
+    """The poses of frames 0..n in the base frame, shaped (n + 1, 4, 4); frame n is the flange."""
+    if len(q) != model.n:
+        raise ValueError(f"q: expected {model.n} values, got {len(q)}")
+    frames = [np.eye(4)]
+    for joint, q_i in zip(model.joints, q):
+        frames.append(frames[-1] @ dh_transform(joint.dh, float(q_i)))
+    return np.array(frames)
+
+
+def flange_pose(model: RobotModel, q) -> np.ndarray:
+    """The flange (frame n) pose in the base frame, 4x4."""
+    return link_frames(model, q)[-1]
+
+
+def flange_jacobian(model: RobotModel, q) -> np.ndarray:
+    """The 6 x n geometric Jacobian of the flange, rows (v; w), in the base frame."""
+    frames = link_frames(model, q)
+    flange = frames[-1][:3, 3]
+    J = np.empty((6, model.n))
+    for i, frame in enumerate(frames[:-1]):  # joint i+1 turns about z of frame i
+        z, origin = frame[:3, 2], frame[:3, 3]
+        J[:3, i] = np.cross(z, flange - origin)
+        J[3:, i] = z
+    return J

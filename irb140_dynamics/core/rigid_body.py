@@ -1,0 +1,124 @@
+"""Rigid-body inertial parameters and their validation.
+
+Units: kg, m, kg m^2. An inertia is six numbers (Ixx, Iyy, Izz, Ixy, Ixz, Iyz), the
+tensor's entries (Ixy is the tensor entry, i.e. minus the product of inertia integral).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+Vector3 = tuple[float, float, float]
+Inertia6 = tuple[float, float, float, float, float, float]
+
+ZERO3: Vector3 = (0.0, 0.0, 0.0)
+ZERO6: Inertia6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+class ModelError(ValueError):
+    """An invalid model value; ``field`` is the parameter name that holds it."""
+
+    def __init__(self, field: str, reason: str):
+        super().__init__(f"{field}: {reason}")
+        self.field = field
+        self.reason = reason
+
+
+def finite_numbers(field: str, value, length: int | None = None) -> tuple[float, ...]:
+    """``value`` as a tuple of finite floats (of ``length`` when given), or ModelError."""
+    try:
+        numbers = tuple(float(x) for x in np.atleast_1d(np.asarray(value, dtype=float)))
+    except (TypeError, ValueError):
+        raise ModelError(field, f"expected numbers, got {value!r}") from None
+    if length is not None and len(numbers) != length:
+        raise ModelError(field, f"expected {length} numbers, got {len(numbers)}")
+    if not all(math.isfinite(x) for x in numbers):
+        raise ModelError(field, f"must be finite, got {list(numbers)}")
+    return numbers
+
+
+def finite_number(field: str, value) -> float:
+    if isinstance(value, (list, tuple, np.ndarray)) and np.ndim(value) != 0:
+        raise ModelError(field, f"expected one number, got {value!r}")
+    return finite_numbers(field, value, 1)[0]
+
+
+def inertia_matrix(inertia: Sequence[float]) -> np.ndarray:
+    xx, yy, zz, xy, xz, yz = inertia
+    return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+
+
+def validate_inertia(field: str, inertia: Sequence[float]) -> Inertia6:
+    """Six finite numbers forming a physically possible inertia tensor, or ModelError."""
+    inertia = finite_numbers(field, inertia, 6)
+    moments = np.linalg.eigvalsh(inertia_matrix(inertia))
+    tol = 1e-12 * max(1.0, float(np.max(np.abs(moments))))
+    if moments[0] < -tol:
+        raise ModelError(field, f"not positive semi-definite (principal moments {moments.tolist()})")
+    if moments[0] + moments[1] < moments[2] - tol:
+        raise ModelError(
+            field, f"principal moments {moments.tolist()} break the triangle inequality"
+        )
+    return inertia
+
+
+@dataclass(frozen=True)
+class RigidBody:
+    """A rigid body in its own frame: mass, centre of mass, inertia about the centre of mass."""
+
+    mass: float = 0.0
+    com: Vector3 = ZERO3
+    inertia: Inertia6 = ZERO6
+
+    @classmethod
+    def validated(cls, field: str, mass, com=ZERO3, inertia=ZERO6) -> "RigidBody":
+        """Build from raw values; errors name ``field.mass``, ``field.com``, ``field.inertia``."""
+        m = finite_number(f"{field}.mass", mass)
+        if m < 0.0:
+            raise ModelError(f"{field}.mass", f"must be >= 0, got {m}")
+        return cls(m, finite_numbers(f"{field}.com", com, 3), validate_inertia(f"{field}.inertia", inertia))
+
+    def about_origin(self) -> tuple[float, Vector3, Inertia6]:
+        """(m, h, I_o): mass, first moment m*com, and inertia about the frame origin."""
+        return shift_inertia(self.mass, ZERO3, self.inertia, self.com)
+
+
+def shift_inertia(m, h, inertia, r):
+    """Move the reference point of an inertia from O to O' = O - r (r points from O' to O).
+
+    (m, h, I) are mass, first moment and inertia about O; returns (m, h', I') about O'.
+    Works on any scalar type (float, NumPy array, traced symbol).
+    """
+    xx, yy, zz, xy, xz, yz = inertia
+    rx, ry, rz = r
+    hx, hy, hz = h
+    hr2 = 2 * (hx * rx + hy * ry + hz * rz)
+    r2 = rx * rx + ry * ry + rz * rz
+    new_h = (hx + m * rx, hy + m * ry, hz + m * rz)
+    new_inertia = (
+        xx + hr2 - 2 * rx * hx + m * (r2 - rx * rx),
+        yy + hr2 - 2 * ry * hy + m * (r2 - ry * ry),
+        zz + hr2 - 2 * rz * hz + m * (r2 - rz * rz),
+        xy - (rx * hy + hx * ry) - m * rx * ry,
+        xz - (rx * hz + hx * rz) - m * rx * rz,
+        yz - (ry * hz + hy * rz) - m * ry * rz,
+    )
+    return m, new_h, new_inertia
+
+
+def combine(a: RigidBody, b: RigidBody) -> RigidBody:
+    """The rigid union of two bodies given in the same frame."""
+    m = a.mass + b.mass
+    if m == 0.0:
+        return RigidBody(0.0, ZERO3, tuple(x + y for x, y in zip(a.inertia, b.inertia)))
+    _, ha, ia = a.about_origin()
+    _, hb, ib = b.about_origin()
+    com = tuple((x + y) / m for x, y in zip(ha, hb))
+    about_origin = tuple(x + y for x, y in zip(ia, ib))
+    # back from the origin to the combined centre of mass: I_c = I_o - m (|c|^2 1 - c c^T)
+    _, _, shift = shift_inertia(m, ZERO3, ZERO6, com)
+    return RigidBody(m, com, tuple(x - y for x, y in zip(about_origin, shift)))

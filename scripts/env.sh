@@ -1,0 +1,28 @@
+# Sourced by run.sh and test.sh: make .venv and install requirements/$1.txt into it
+# (again only when the requirement files change), then activate it.
+venv=.venv
+python=${PYTHON:-$(command -v python3.11 || command -v python3)}
+if [ ! -x "$venv/bin/python" ]; then
+    if ! "$python" -m venv "$venv" >/dev/null 2>&1; then
+        rm -rf "$venv"
+        if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+            echo "python3 -m venv failed: installing python3-venv" >&2
+            apt-get update -qq && apt-get install -y -qq python3-venv >/dev/null
+            "$python" -m venv "$venv"
+        else
+            echo "error: '$python -m venv' failed; install python3-venv" >&2
+            exit 1
+        fi
+    fi
+fi
+stamp="$venv/.requirements-$1"
+wanted=$(cat requirements/*.txt | sha256sum)
+if [ "$(cat "$stamp" 2>/dev/null)" != "$wanted" ]; then
+    echo "installing requirements/$1.txt into $venv ..." >&2
+    # pip warns "Location ... is ignored" for every ROS wheel: harmless, filtered.
+    { "$venv/bin/python" -m pip install -q --disable-pip-version-check -r "requirements/$1.txt"; } 2>&1 \
+        | { grep -v "is ignored" || true; } >&2
+    echo "$wanted" >"$stamp"
+fi
+# shellcheck disable=SC1091
+source "$venv/bin/activate"

@@ -1,0 +1,29 @@
+from glob import glob
+
+from setuptools import find_packages, setup
+
+package_name = "irb140_dynamics"
+
+setup(
+    name=package_name,
+    version="0.1.0",
+    packages=find_packages(exclude=["test", "bench"]),
+    data_files=[
+        ("share/ament_index/resource_index/packages", [f"resource/{package_name}"]),
+        (f"share/{package_name}", ["package.xml"]),
+        (f"share/{package_name}/config", glob("config/*.yaml")),
+    ],
+    install_requires=["setuptools"],
+    zip_safe=True,
+    maintainer="irb140_dynamics developers",
+    maintainer_email="irb140-dynamics@example.com",
+    description="Live inverse dynamics, gravity compensation and payload checks for the ABB IRB-140",
+    license="Apache-2.0",
+    tests_require=["pytest"],
+    entry_points={
+        "console_scripts": [
+            "id_node = irb140_dynamics.id_node:main",
+            "payload_check_node = irb140_dynamics.payload_check_node:main",
+        ],
+    },
+)
