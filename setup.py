@@ -24,6 +24,7 @@ setup(
         "console_scripts": [
             "id_node = irb140_dynamics.id_node:main",
             "payload_check_node = irb140_dynamics.payload_check_node:main",
+            "demo_node = irb140_dynamics.demo_node:main",
         ],
     },
 )

@@ -72,11 +72,7 @@ class RobotModel:
         object.__setattr__(self, "joints", tuple(_validated_joint(j) for j in self.joints))
         object.__setattr__(self, "gravity", finite_numbers("gravity", self.gravity, 3))
         object.__setattr__(self, "payload", _validated_body("payload", self.payload))
-        if not self.joints:
-            raise ModelError("joint_names", "at least one joint is needed")
-        names = self.joint_names
-        if len(set(names)) != len(names):
-            raise ModelError("joint_names", f"names must be unique, got {list(names)}")
+        check_joint_names(self.joint_names)
 
     @property
     def n(self) -> int:
@@ -136,12 +132,9 @@ class RobotModel:
                 return default
             raise ModelError(name, "missing")
 
-        names = get("joint_names")
-        if isinstance(names, str) or not all(isinstance(x, str) for x in names):
-            raise ModelError("joint_names", f"expected a list of names, got {names!r}")
+        names = check_joint_names(get("joint_names"))
         joints = []
         for name in names:
-            _check_name(name)
             a, alpha, d, offset = finite_numbers(f"{name}.dh", get(f"{name}.dh"), 4)
             link = _body_from_params(f"{name}.link", get)
             joints.append(
@@ -157,12 +150,22 @@ class RobotModel:
         return cls(tuple(joints), tuple(get("gravity")), payload)
 
 
-def _check_name(name):
-    if not isinstance(name, str) or not _NAME.match(name):
-        raise ModelError(
-            "joint_names",
-            f"{name!r} is not a valid joint name (letters, digits, '_'; starts with a letter)",
-        )
+def check_joint_names(names) -> list[str]:
+    """The names as a list, or ModelError: at least one, unique, each usable as a parameter prefix."""
+    if isinstance(names, str) or not all(isinstance(x, str) for x in names):
+        raise ModelError("joint_names", f"expected a list of names, got {names!r}")
+    names = list(names)
+    if not names:
+        raise ModelError("joint_names", "at least one joint is needed")
+    for name in names:
+        if not _NAME.match(name):
+            raise ModelError(
+                "joint_names",
+                f"{name!r} is not a valid joint name (letters, digits, '_'; starts with a letter)",
+            )
+    if len(set(names)) != len(names):
+        raise ModelError("joint_names", f"names must be unique, got {names}")
+    return names
 
 
 def _validated_body(prefix: str, body: RigidBody) -> RigidBody:
@@ -170,7 +173,6 @@ def _validated_body(prefix: str, body: RigidBody) -> RigidBody:
 
 
 def _validated_joint(j: Joint) -> Joint:
-    _check_name(j.name)
     dh = DH(*finite_numbers(f"{j.name}.dh", (j.dh.a, j.dh.alpha, j.dh.d, j.dh.theta_offset), 4))
     lower, upper = finite_numbers(f"{j.name}.position_limits", j.position_limits, 2)
     if lower > upper:

@@ -1,0 +1,206 @@
+"""id_node: live inverse dynamics and gravity compensation.
+
+Subscribes   joint_states          sensor_msgs/JointState (matched by joint name)
+             ~/reference           trajectory_msgs/JointTrajectory (first point: exact feed-forward)
+Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, qdd)
+             gravity_torques       sensor_msgs/JointState, effort = g(q)
+             effort_commands       std_msgs/Float64MultiArray (when enabled), model joint order
+             /diagnostics          diagnostic_msgs/DiagnosticArray, message counts, 1 Hz
+
+Torques are in N m, named and ordered as the model's joints, stamped with the input stamp.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import Counter
+from dataclasses import dataclass
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from rclpy.node import Node
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from trajectory_msgs.msg import JointTrajectory
+
+from .core import RobotModel, gravity, rnea
+from .core.filters import VelocityDifferentiator
+from .ros.messages import BadMessage, JointOrder, joint_efforts, read_joint_state, read_reference
+from .ros.params import Spec, declare_model
+from .ros.spin import run
+
+ACCELERATION_MODES = ("differentiate", "zero")
+EFFORT_SOURCES = ("feedforward", "gravity")
+RELIABILITIES = {"best_effort": ReliabilityPolicy.BEST_EFFORT, "reliable": ReliabilityPolicy.RELIABLE}
+
+NODE_PARAMETERS = [
+    Spec("acceleration.mode", "differentiate",
+         "qdd when no reference gives it: 'differentiate' the joint_states velocities (low-pass filtered) or 'zero'"),
+    Spec("acceleration.cutoff_frequency", 20.0, "cut-off of the velocity differentiation filter", "Hz",
+         minimum=1e-3),
+    Spec("reference_timeout", 0.5, "a ~/reference older than this is no longer used; 0 = never expires", "s",
+         minimum=0.0),
+    Spec("effort_commands.enabled", False, "also publish torques on effort_commands (Float64MultiArray)",
+         read_only=True),
+    Spec("effort_commands.source", "feedforward", "which torques go to effort_commands: 'feedforward' or 'gravity'"),
+    Spec("qos.reliability", "best_effort",
+         "joint_states subscription reliability: 'best_effort' (takes reliable and best-effort publishers) "
+         "or 'reliable'", read_only=True),
+    Spec("qos.depth", 10, "queue depth of the subscriptions and publishers", read_only=True),
+]
+
+
+@dataclass(frozen=True)
+class Settings:
+    """What the node runs on, built and validated from all of its parameters at once."""
+
+    model: RobotModel
+    acceleration_mode: str
+    cutoff_frequency: float
+    reference_timeout: float
+    effort_source: str
+
+
+def build_settings(values: dict) -> Settings:
+    model = RobotModel.from_params(values)
+    _choice("acceleration.mode", values["acceleration.mode"], ACCELERATION_MODES)
+    _choice("effort_commands.source", values["effort_commands.source"], EFFORT_SOURCES)
+    _choice("qos.reliability", values["qos.reliability"], RELIABILITIES)
+    if values["acceleration.cutoff_frequency"] <= 0.0:
+        raise ValueError(f"acceleration.cutoff_frequency: must be > 0 Hz, got {values['acceleration.cutoff_frequency']}")
+    if values["reference_timeout"] < 0.0:
+        raise ValueError(f"reference_timeout: must be >= 0 s, got {values['reference_timeout']}")
+    if values["qos.depth"] < 1:
+        raise ValueError(f"qos.depth: must be >= 1, got {values['qos.depth']}")
+    return Settings(
+        model,
+        values["acceleration.mode"],
+        values["acceleration.cutoff_frequency"],
+        values["reference_timeout"],
+        values["effort_commands.source"],
+    )
+
+
+def _choice(name, value, choices):
+    if value not in choices:
+        raise ValueError(f"{name}: must be one of {', '.join(choices)}; got {value!r}")
+
+
+class IdNode(Node):
+    """Joint states in; feed-forward and gravity torques out."""
+
+    def __init__(self, **kwargs):
+        super().__init__("id_node", **kwargs)
+        self.parameters = declare_model(self, NODE_PARAMETERS, build_settings)
+        self.parameters.on_change(self._use)
+        self.counts: Counter[str] = Counter()
+        self._dropped_before = 0
+        self._reference = None  # (time received [s, monotonic], q, qd, qdd or None)
+        self._use(self.parameters.current)
+
+        names = list(self.settings.model.joint_names)
+        self._order = JointOrder(names)
+        self._feedforward_msg = JointState(name=names)
+        self._gravity_msg = JointState(name=names)
+        self._command_msg = Float64MultiArray()
+
+        depth = self.get_parameter("qos.depth").value
+        reliability = RELIABILITIES[self.get_parameter("qos.reliability").value]
+        self.create_subscription(JointState, "joint_states", self._on_joint_state,
+                                 QoSProfile(depth=depth, reliability=reliability))
+        self.create_subscription(JointTrajectory, "~/reference", self._on_reference, depth)
+        self._feedforward_pub = self.create_publisher(JointState, "feedforward_torques", depth)
+        self._gravity_pub = self.create_publisher(JointState, "gravity_torques", depth)
+        self._command_pub = None
+        if self.get_parameter("effort_commands.enabled").value:
+            self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands", depth)
+        self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
+        self.create_timer(1.0, self._publish_diagnostics)
+        self.get_logger().info(
+            f"ready: {len(names)} joints {names}, payload {self.settings.model.payload.mass} kg"
+        )
+
+    def _use(self, settings: Settings) -> None:
+        """Switch to new settings; compile the model's kernels first, then swap in one step."""
+        model = settings.model
+        _compiled = (model.kernels.rnea, model.kernels.gravity_torques)  # now, not on a message
+        self._differentiator = VelocityDifferentiator(model.n, settings.cutoff_frequency)
+        self.settings = settings
+
+    def _on_joint_state(self, msg: JointState) -> None:
+        self.counts["received"] += 1
+        try:
+            q, qd = read_joint_state(msg, self._order)
+        except BadMessage as error:
+            self._drop("joint_states", error)
+            return
+        settings = self.settings
+        qdd = self._estimated_acceleration(msg, qd, settings)
+        reference = self._fresh_reference(settings)
+        if reference is not None:
+            q_ff, qd_ff, qdd_ref = reference
+            tau = rnea(settings.model, q_ff, qd_ff, qdd if qdd_ref is None else qdd_ref)
+        else:
+            tau = rnea(settings.model, q, qd, qdd)
+        g = gravity(settings.model, q)
+
+        stamp = msg.header.stamp
+        self._feedforward_pub.publish(joint_efforts(self._feedforward_msg, stamp, tau))
+        self._gravity_pub.publish(joint_efforts(self._gravity_msg, stamp, g))
+        if self._command_pub is not None:
+            self._command_msg.data = (tau if settings.effort_source == "feedforward" else g).tolist()
+            self._command_pub.publish(self._command_msg)
+        self.counts["published"] += 1
+
+    def _estimated_acceleration(self, msg: JointState, qd, settings: Settings):
+        if settings.acceleration_mode == "zero":
+            return [0.0] * settings.model.n
+        stamp = msg.header.stamp
+        t = stamp.sec + 1e-9 * stamp.nanosec
+        if t == 0.0:  # an unstamped stream: time of arrival
+            t = self.get_clock().now().nanoseconds * 1e-9
+        return self._differentiator.update(t, qd)
+
+    def _on_reference(self, msg: JointTrajectory) -> None:
+        try:
+            q, qd, qdd = read_reference(msg, self._order)
+        except BadMessage as error:
+            self._drop("reference", error)
+            return
+        self._reference = (time.monotonic(), q, qd, qdd)
+
+    def _fresh_reference(self, settings: Settings):
+        if self._reference is None:
+            return None
+        received, q, qd, qdd = self._reference
+        timeout = settings.reference_timeout
+        if timeout > 0.0 and time.monotonic() - received > timeout:
+            return None
+        return q, qd, qdd
+
+    def _drop(self, topic: str, error: BadMessage) -> None:
+        self.counts[f"dropped_{error.kind}"] += 1
+        self.counts["dropped"] += 1
+        self.get_logger().warning(f"dropped a {topic} message ({error})", throttle_duration_sec=2.0)
+
+    def _publish_diagnostics(self) -> None:
+        status = DiagnosticStatus(
+            name=f"{self.get_name()}: joint_states", hardware_id=self.get_fully_qualified_name()
+        )
+        dropped = self.counts["dropped"]
+        recent = dropped - self._dropped_before
+        self._dropped_before = dropped
+        status.level = DiagnosticStatus.WARN if recent else DiagnosticStatus.OK
+        status.message = f"{self.counts['published']} published, {dropped} dropped ({recent} in the last period)"
+        status.values = [KeyValue(key=key, value=str(value)) for key, value in sorted(self.counts.items())]
+        msg = DiagnosticArray(status=[status])
+        msg.header.stamp = self.get_clock().now().to_msg()
+        self._diagnostics_pub.publish(msg)
+
+
+def main(args=None):
+    raise SystemExit(run("id_node", IdNode, args))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,98 @@
+"""Joint messages <-> arrays in the model's joint order, and the checks a message must pass."""
+
+from __future__ import annotations
+
+import math
+from array import array
+
+from sensor_msgs.msg import JointState
+from trajectory_msgs.msg import JointTrajectory
+
+
+class BadMessage(ValueError):
+    """A message that must not yield torques; ``kind`` is a short tag for counting."""
+
+    def __init__(self, kind: str, detail: str):
+        super().__init__(f"{kind}: {detail}")
+        self.kind = kind
+
+
+class JointOrder:
+    """Where each of the model's joints sits in a message's name list (cached per list)."""
+
+    def __init__(self, joint_names):
+        self.joint_names = tuple(joint_names)
+        self._names: tuple | None = None
+        self._index: list[int] | None = None
+
+    def indices(self, names) -> list[int]:
+        names = tuple(names)
+        if names != self._names:
+            self._index = self._match(names)
+            self._names = names
+        return self._index
+
+    def _match(self, names: tuple) -> list[int]:
+        if not names:
+            raise BadMessage("unnamed", "no joint names and the lengths do not match the model")
+        if len(set(names)) != len(names):
+            raise BadMessage("duplicate_names", f"duplicate joint names in {list(names)}")
+        where = {name: i for i, name in enumerate(names)}
+        missing = [name for name in self.joint_names if name not in where]
+        if missing:
+            raise BadMessage("missing_joints", f"no {', '.join(missing)} in {list(names)}")
+        return [where[name] for name in self.joint_names]
+
+
+def _pick(values, index: list[int], field: str, length: int, required: bool) -> list[float]:
+    """The values of the model's joints, or zeros when the field is empty and optional."""
+    if len(values) == 0 and not required:
+        return [0.0] * len(index)
+    if len(values) != length:
+        raise BadMessage("length_mismatch", f"{field} has {len(values)} values for {length} joints")
+    picked = [values[i] for i in index]
+    if not all(map(math.isfinite, picked)):
+        raise BadMessage("not_finite", f"{field} is not finite: {picked}")
+    return picked
+
+
+def read_joint_state(msg: JointState, order: JointOrder) -> tuple[list[float], list[float]]:
+    """(q, qd) of the model's joints; missing velocities count as zero.
+
+    Joints are matched by name, in any order, others ignored; a message without names is
+    taken positionally only if its length matches the model.
+    """
+    index, length = _index(msg.name, len(msg.position), order)
+    q = _pick(msg.position, index, "position", length, required=True)
+    qd = _pick(msg.velocity, index, "velocity", length, required=False)
+    return q, qd
+
+
+def read_reference(msg: JointTrajectory, order: JointOrder):
+    """(q, qd, qdd or None) of the model's joints from the trajectory's first point.
+
+    Velocities count as zero when empty; accelerations are None when empty (not given).
+    """
+    if not msg.points:
+        raise BadMessage("empty_reference", "the trajectory has no points")
+    point = msg.points[0]
+    index, length = _index(msg.joint_names, len(point.positions), order)
+    q = _pick(point.positions, index, "positions", length, required=True)
+    qd = _pick(point.velocities, index, "velocities", length, required=False)
+    qdd = None
+    if len(point.accelerations):
+        qdd = _pick(point.accelerations, index, "accelerations", length, required=True)
+    return q, qd, qdd
+
+
+def _index(names, n_positions: int, order: JointOrder) -> tuple[list[int], int]:
+    if not names and n_positions == len(order.joint_names):
+        return list(range(n_positions)), n_positions
+    return order.indices(names), len(names)
+
+
+def joint_efforts(msg: JointState, stamp, effort) -> JointState:
+    """Fill a reused JointState (names already set) with a stamp and efforts."""
+    msg.header.stamp = stamp
+    msg.effort = array("d", effort)
+    return msg

@@ -1,0 +1,221 @@
+"""Parameters of the nodes: declared with descriptors, validated whole, swapped atomically.
+
+A node lists its parameters as ``Spec``s and gives a ``build`` function that turns all of
+their values into the configuration it runs on (a RobotModel, options), raising ValueError
+naming the parameter when something is wrong. ``LiveParameters`` declares them, builds the
+first configuration (a failure stops startup), and from then on checks every change by
+building the whole new configuration before it is accepted: a refused change keeps the old
+configuration, an accepted one replaces it in a single assignment.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+import yaml
+from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
+from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+from ..core.model import check_joint_names, read_parameter_file
+
+PACKAGE = "irb140_dynamics"
+CONFIG_NAME = "irb140.yaml"
+
+
+@dataclass(frozen=True)
+class Spec:
+    """One parameter: its name, default (or type when it has none) and descriptor text."""
+
+    name: str
+    default: Any
+    description: str
+    unit: str = ""
+    read_only: bool = False
+    minimum: float | None = None  # for double parameters
+    maximum: float | None = None
+
+    def descriptor(self) -> ParameterDescriptor:
+        unit = f" [{self.unit}]" if self.unit else ""
+        descriptor = ParameterDescriptor(description=self.description + unit, read_only=self.read_only)
+        if self.minimum is not None or self.maximum is not None:
+            descriptor.floating_point_range = [
+                FloatingPointRange(
+                    from_value=-math.inf if self.minimum is None else self.minimum,
+                    to_value=math.inf if self.maximum is None else self.maximum,
+                    step=0.0,
+                )
+            ]
+        return descriptor
+
+
+def default_config_path() -> Path:
+    """The installed config/irb140.yaml (where ros2 run finds it), else the source tree's."""
+    try:
+        from ament_index_python.packages import get_package_share_directory
+
+        return Path(get_package_share_directory(PACKAGE)) / "config" / CONFIG_NAME
+    except (ImportError, LookupError, OSError):  # not installed, or no AMENT_PREFIX_PATH
+        return Path(__file__).resolve().parents[2] / "config" / CONFIG_NAME
+
+
+def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
+    """The model's parameters for these joints; defaults from the default model's file.
+
+    The per-joint defaults apply only when the joints are the default model's own: a
+    params file naming other joints must give every value (nothing is silently borrowed).
+    """
+    own = list(defaults.get("joint_names", [])) == list(joint_names)
+
+    def default(name, kind):
+        return defaults[name] if own and name in defaults else kind
+
+    specs = [
+        Spec("gravity", defaults.get("gravity", [0.0, 0.0, -9.81]), "gravity in the base frame", "m/s^2"),
+        *_body_specs("payload", "the payload on the flange", "flange frame", lambda name, kind: defaults.get(name, kind)),
+    ]
+    for joint in joint_names:
+        specs += [
+            Spec(f"{joint}.dh", default(f"{joint}.dh", Parameter.Type.DOUBLE_ARRAY),
+                 "standard DH row [a, alpha, d, theta_offset]", "m, rad, m, rad"),
+            *_body_specs(f"{joint}.link", f"the link {joint} moves", "its DH frame", default),
+            Spec(f"{joint}.position_limits", default(f"{joint}.position_limits", [-math.pi, math.pi]),
+                 "[lower, upper] joint position", "rad"),
+            Spec(f"{joint}.torque_limit", default(f"{joint}.torque_limit", 0.0),
+                 "joint torque limit, 0 = none given", "N m", minimum=0.0),
+        ]
+    return specs
+
+
+def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
+    zeros3, zeros6 = [0.0] * 3, [0.0] * 6
+    optional = prefix == "payload"
+    return [
+        Spec(f"{prefix}.mass", default(f"{prefix}.mass", 0.0 if optional else Parameter.Type.DOUBLE),
+             f"mass of {what}", "kg", minimum=0.0),
+        Spec(f"{prefix}.com", default(f"{prefix}.com", zeros3 if optional else Parameter.Type.DOUBLE_ARRAY),
+             f"centre of mass of {what}, in {frame}", "m"),
+        Spec(f"{prefix}.inertia", default(f"{prefix}.inertia", zeros6 if optional else Parameter.Type.DOUBLE_ARRAY),
+             f"inertia of {what} about its centre of mass, [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]", "kg m^2"),
+    ]
+
+
+def declare_model(node: Node, extra: list[Spec], build: Callable[[dict], Any]) -> "LiveParameters":
+    """Declare the robot model's parameters and a node's own, with the default model's defaults."""
+    path = default_config_path()
+    if not path.is_file():
+        raise ValueError(f"default model: no {path}; is the package installed? (or give --params-file)")
+    defaults = read_parameter_file(path)
+    node.get_logger().info(f"default model: {path}")
+    names = _declare(
+        node,
+        Spec("joint_names", defaults["joint_names"], "the model's joints, base to flange", read_only=True),
+    )
+    names = check_joint_names(names)  # they become parameter prefixes: check them first
+    return LiveParameters(node, [*model_specs(names, defaults), *extra], build, ["joint_names"])
+
+
+class LiveParameters:
+    """The node's validated configuration, kept in step with its parameters."""
+
+    def __init__(self, node: Node, specs: list[Spec], build: Callable[[dict], Any], declared=()):
+        """``declared``: names of parameters the caller has declared already."""
+        self._node, self._build = node, build
+        self._names = [spec.name for spec in specs] + list(declared)
+        for spec in specs:
+            _declare(node, spec)
+        self.current = build(self.values())
+        self._listeners: list[Callable[[Any], None]] = []
+        node.add_pre_set_parameters_callback(self._coerce_integers)
+        node.add_on_set_parameters_callback(self._check)
+        node.add_post_set_parameters_callback(self._apply)
+
+    def values(self, changes=()) -> dict[str, Any]:
+        """All parameter values by name, with ``changes`` (Parameters) applied on top."""
+        values = {name: self._node.get_parameter_or(name).value for name in self._names}
+        values.update({p.name: p.value for p in changes})
+        return values
+
+    def on_change(self, listener: Callable[[Any], None]) -> None:
+        self._listeners.append(listener)
+
+    def _coerce_integers(self, parameters: list[Parameter]) -> list[Parameter]:
+        """Let `ros2 param set ... payload.mass 3` mean 3.0 for a double parameter."""
+        coerced = []
+        for p in parameters:
+            wanted = self._type_of(p.name)
+            if wanted == Parameter.Type.DOUBLE and p.type_ == Parameter.Type.INTEGER:
+                p = Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
+            elif wanted == Parameter.Type.DOUBLE_ARRAY and p.type_ == Parameter.Type.INTEGER_ARRAY:
+                p = Parameter(p.name, Parameter.Type.DOUBLE_ARRAY, [float(x) for x in p.value])
+            coerced.append(p)
+        return coerced
+
+    def _type_of(self, name: str):
+        if not self._node.has_parameter(name):
+            return None
+        return Parameter.Type(self._node.describe_parameter(name).type)
+
+    def _check(self, parameters: list[Parameter]) -> SetParametersResult:
+        try:
+            self._build(self.values(parameters))
+        except ValueError as error:
+            return SetParametersResult(successful=False, reason=str(error))
+        return SetParametersResult(successful=True)
+
+    def _apply(self, parameters: list[Parameter]) -> None:
+        self.current = self._build(self.values())
+        for listener in self._listeners:
+            listener(self.current)
+
+
+def _declare(node: Node, spec: Spec):
+    try:
+        return node.declare_parameter(spec.name, spec.default, spec.descriptor()).value
+    except InvalidParameterTypeException:
+        kind = spec.default if isinstance(spec.default, Parameter.Type) else Parameter.Type.from_parameter_value(spec.default)
+        hint = "; write doubles with a decimal point, e.g. 2.0" if "DOUBLE" in kind.name else ""
+        raise ValueError(f"{spec.name}: expected a value of type {kind.name.lower()}{hint}") from None
+    except InvalidParameterValueException as error:
+        raise ValueError(f"{spec.name}: {error}") from None
+
+
+def check_parameter_files(args: list[str]) -> None:
+    """Raise ValueError naming the parameter of a --params-file that rcl would refuse.
+
+    rcl rejects a file with a mixed-type list such as [0, 0, -9.81] with only a line
+    number; this says which parameter and what to write instead.
+    """
+    for i, arg in enumerate(args):
+        if arg == "--params-file" and i + 1 < len(args):
+            path = args[i + 1]
+            try:
+                with open(path) as stream:
+                    document = yaml.safe_load(stream) or {}
+            except OSError as error:
+                raise ValueError(f"--params-file {path}: {error.strerror}") from None
+            except yaml.YAMLError as error:
+                raise ValueError(f"--params-file {path}: not valid YAML ({_first_line(error)})") from None
+            for node_key, section in document.items():
+                params = (section or {}).get("ros__parameters", {}) if isinstance(section, dict) else {}
+                _check_lists(params, "", path)
+
+
+def _check_lists(tree, prefix: str, path: str) -> None:
+    for key, value in tree.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            _check_lists(value, f"{name}.", path)
+        elif isinstance(value, list) and len({type(x) for x in value}) > 1:
+            raise ValueError(
+                f"{name} (in {path}): mixed types in {value}; "
+                "write every number of a list as a double, e.g. 0.0 not 0"
+            )
+
+
+def _first_line(error: Exception) -> str:
+    return str(error).strip().splitlines()[0]

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The run command: sets up .venv (ROS 2 Jazzy wheels, NumPy, colcon), builds the package
+# with colcon into ./install (the layout ros2 run uses), and starts id_node and
+# payload_check_node with the default IRB-140 model.
+#
+#   ./scripts/run.sh                  the two nodes
+#   ./scripts/run.sh --demo           also a moving demo joint-state stream, torques printed live
+#   ./scripts/run.sh [--demo] ARGS    ARGS go to both nodes after --ros-args, e.g.
+#                                     --params-file my_robot.yaml -p payload.mass:=2.0
+set -euo pipefail
+cd "$(dirname "$0")/.."
+demo=false
+if [ "${1:-}" = "--demo" ]; then demo=true; shift; fi
+source scripts/env.sh run
+colcon --log-base build/log build --paths . --build-base build --install-base install >build.log 2>&1 \
+    || { cat build.log >&2; exit 1; }
+set +u  # colcon's setup scripts read unset variables
+# shellcheck disable=SC1091
+source install/setup.bash
+set -u
+ros_args=()
+if [ $# -gt 0 ]; then ros_args=(--ros-args "$@"); fi
+bin=install/irb140_dynamics/lib/irb140_dynamics
+trap 'kill $(jobs -p) 2>/dev/null; wait' INT TERM EXIT
+"$bin/id_node" "${ros_args[@]}" &
+"$bin/payload_check_node" "${ros_args[@]}" &
+if $demo; then "$bin/demo_node" & fi
+wait -n
