@@ -21,17 +21,35 @@ from .dynamics import (
 from .geometry import irb140
 from .kinematics import dh_transform, flange_jacobian, flange_pose, link_frames
 from .model import DH, Joint, RobotModel, load_model, read_parameter_file
+from .payload import (
+    RATED_PAYLOAD,
+    MaxPayload,
+    PayloadCheck,
+    TorqueLimits,
+    WorkspaceLoad,
+    check_payload,
+    derive_torque_limits,
+    max_payload_at,
+    workspace_load,
+)
 from .rigid_body import ModelError, RigidBody
 
 __all__ = [
     "DH",
     "Joint",
+    "MaxPayload",
     "ModelError",
+    "PayloadCheck",
+    "RATED_PAYLOAD",
     "RigidBody",
     "RobotModel",
+    "TorqueLimits",
+    "WorkspaceLoad",
+    "check_payload",
     "coriolis",
     "coriolis_batch",
     "coriolis_matrix",
+    "derive_torque_limits",
     "dh_transform",
     "flange_jacobian",
     "flange_pose",
@@ -44,7 +62,9 @@ __all__ = [
     "load_model",
     "mass_matrix",
     "mass_matrix_batch",
+    "max_payload_at",
     "read_parameter_file",
     "rnea",
     "rnea_batch",
+    "workspace_load",
 ]

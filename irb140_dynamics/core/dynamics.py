@@ -9,6 +9,7 @@ All run the model's generated kernels (see ``codegen``), compiled on first use.
 
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import Sequence
 
 import numpy as np
@@ -67,25 +68,24 @@ def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayL
 def rnea_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
     """rnea for N states: Q, QD, QDD shaped (N, n) -> tau shaped (N, n)."""
     n = model.n
-    return _stack(model.kernels.rnea.array(_columns(Q, n, "Q"), _columns(QD, n, "QD"), _columns(QDD, n, "QDD")), len(Q))
+    return _evaluate(model.kernels.rnea.array, _columns(Q, n, "Q"), _columns(QD, n, "QD"), _columns(QDD, n, "QDD"))
 
 
 def gravity_batch(model: RobotModel, Q) -> np.ndarray:
     """gravity for N states: Q shaped (N, n) -> g shaped (N, n)."""
-    return _stack(model.kernels.gravity_torques.array(_columns(Q, model.n, "Q")), len(Q))
+    return _evaluate(model.kernels.gravity_torques.array, _columns(Q, model.n, "Q"))
 
 
 def coriolis_batch(model: RobotModel, Q, QD) -> np.ndarray:
     """coriolis for N states: (N, n) -> C(q, qd) qd shaped (N, n)."""
     n = model.n
-    return _stack(model.kernels.coriolis.array(_columns(Q, n, "Q"), _columns(QD, n, "QD")), len(Q))
+    return _evaluate(model.kernels.coriolis.array, _columns(Q, n, "Q"), _columns(QD, n, "QD"))
 
 
 def mass_matrix_batch(model: RobotModel, Q) -> np.ndarray:
     """mass_matrix for N states: Q shaped (N, n) -> M shaped (N, n, n)."""
     n = model.n
-    upper = _stack(model.kernels.mass_matrix.array(_columns(Q, n, "Q")), len(Q))
-    return _symmetric(upper, n)
+    return _symmetric(_evaluate(model.kernels.mass_matrix.array, _columns(Q, n, "Q")), n)
 
 
 def forward_dynamics_batch(model: RobotModel, Q, QD, TAU) -> np.ndarray:
@@ -116,18 +116,32 @@ def _columns(X, n: int, name: str) -> np.ndarray:
     return np.ascontiguousarray(X.T)
 
 
-def _stack(outputs, N: int) -> np.ndarray:
-    """Kernel outputs (arrays, or constants folded at generation) as an (N, k) array."""
-    result = np.empty((N, len(outputs)))
-    for i, column in enumerate(outputs):
-        result[:, i] = column
+_CHUNK = 8192  # states per pass: the kernels' intermediates then stay in the CPU caches
+
+
+def _evaluate(kernel, *columns: np.ndarray) -> np.ndarray:
+    """An array kernel over states given as (n, N) columns, chunk by chunk: (N, outputs)."""
+    N = columns[0].shape[1]
+    result = None
+    for start in range(0, max(N, 1), _CHUNK):
+        chunk = slice(start, start + _CHUNK)
+        outputs = kernel(*(c[:, chunk] for c in columns))
+        if result is None:
+            result = np.empty((N, len(outputs)))
+        for i, values in enumerate(outputs):  # constants folded at generation broadcast
+            result[chunk, i] = values
     return result
 
 
 def _symmetric(upper: np.ndarray, n: int) -> np.ndarray:
     """Symmetric (..., n, n) matrices from their upper triangles stored row by row."""
-    M = np.empty(upper.shape[:-1] + (n, n))
+    return upper[..., _upper_to_full(n)]
+
+
+@lru_cache(maxsize=None)
+def _upper_to_full(n: int) -> np.ndarray:
+    """For each entry of an n x n matrix, its index in the row-by-row upper triangle."""
+    index = np.empty((n, n), dtype=np.intp)
     rows, cols = np.triu_indices(n)
-    M[..., rows, cols] = upper
-    M[..., cols, rows] = upper
-    return M
+    index[rows, cols] = index[cols, rows] = np.arange(len(rows))
+    return index

@@ -142,17 +142,17 @@ class RobotModel:
                     name,
                     DH(a, alpha, d, offset),
                     link,
-                    tuple(get(f"{name}.position_limits", (-math.pi, math.pi))),
+                    finite_numbers(f"{name}.position_limits", get(f"{name}.position_limits", (-math.pi, math.pi)), 2),
                     get(f"{name}.torque_limit", 0.0),
                 )
             )
         payload = _body_from_params("payload", get, optional=True)
-        return cls(tuple(joints), tuple(get("gravity")), payload)
+        return cls(tuple(joints), finite_numbers("gravity", get("gravity"), 3), payload)
 
 
 def check_joint_names(names) -> list[str]:
     """The names as a list, or ModelError: at least one, unique, each usable as a parameter prefix."""
-    if isinstance(names, str) or not all(isinstance(x, str) for x in names):
+    if not isinstance(names, (list, tuple)) or not all(isinstance(x, str) for x in names):
         raise ModelError("joint_names", f"expected a list of names, got {names!r}")
     names = list(names)
     if not names:

@@ -31,7 +31,10 @@ class ModelError(ValueError):
 def finite_numbers(field: str, value, length: int | None = None) -> tuple[float, ...]:
     """``value`` as a tuple of finite floats (of ``length`` when given), or ModelError."""
     try:
-        numbers = tuple(float(x) for x in np.atleast_1d(np.asarray(value, dtype=float)))
+        array = np.atleast_1d(np.asarray(value))
+        if array.dtype.kind not in "iuf":  # no strings, booleans or other objects
+            raise TypeError
+        numbers = tuple(float(x) for x in array.astype(float))
     except (TypeError, ValueError):
         raise ModelError(field, f"expected numbers, got {value!r}") from None
     if length is not None and len(numbers) != length:

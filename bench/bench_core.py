@@ -1,0 +1,271 @@
+"""Benchmark of the dynamics core against Pinocchio on the same IRB-140 model.
+
+    .venv/bin/python bench/bench_core.py
+
+Prints one table (ours, baseline, ratio ours/baseline, target) and writes the raw figures
+to bench/results/core.json. Sections:
+
+- single state: per-call cost of the public functions on NumPy (6,) arrays against
+  Pinocchio's; the raw generated kernels on Python lists (the public functions less
+  their conversions); a textbook NumPy RNEA, the approach the generated code avoids.
+- batch: states per second of the ``*_batch`` functions on N random states against a
+  Python loop of the Pinocchio call over the same states.
+- kernel generation: the one-off cost of tracing and compiling each kernel of a fresh model.
+
+Every pair is checked to give the same numbers before it is timed.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from common import (  # first: puts the checkout on sys.path
+    REPO,
+    Figure,
+    Row,
+    Target,
+    machine_info,
+    print_table,
+    seconds_per_call,
+    write_results,
+)
+
+import pinocchio as pin
+from irb140_dynamics.core import (
+    gravity,
+    gravity_batch,
+    irb140,
+    mass_matrix,
+    mass_matrix_batch,
+    rnea,
+    rnea_batch,
+)
+from irb140_dynamics.core.rigid_body import inertia_matrix
+
+BATCH_STATES = 100_000
+BATCH_CHECKED = 1_000  # states of the batch compared with Pinocchio
+BATCH_REPEATS = 7
+FRESH_MODELS = 3  # kernel generation is timed on this many fresh models
+KERNELS = ("rnea", "rnea_wrench", "gravity_torques", "coriolis", "mass_matrix", "coriolis_matrix")
+TOLERANCE = dict(rtol=1e-9, atol=1e-9)
+SEED = 140
+
+
+# -- the baselines ----------------------------------------------------------------------
+
+
+def pinocchio_model(model) -> pin.Model:
+    """The same arm as a Pinocchio model: one revolute z joint per DH row.
+
+    Joint i sits in the previous body frame, turned by Rz(theta_offset_i); body (DH frame)
+    i is SE3(Rx(alpha_i), [a_i, 0, d_i]) in joint i's frame and holds link i's inertia.
+    """
+    pm = pin.Model()
+    parent, body_frame = 0, pin.SE3.Identity()
+    for joint, body in zip(model.joints, model.bodies):
+        offset = pin.SE3(pin.utils.rotate("z", joint.dh.theta_offset), np.zeros(3))
+        parent = pm.addJoint(parent, pin.JointModelRZ(), body_frame * offset, joint.name)
+        body_frame = pin.SE3(pin.utils.rotate("x", joint.dh.alpha), np.array([joint.dh.a, 0.0, joint.dh.d]))
+        inertia = pin.Inertia(body.mass, np.array(body.com), inertia_matrix(body.inertia))
+        pm.appendBodyToJoint(parent, inertia, body_frame)
+    pm.gravity = pin.Motion(np.array(model.gravity), np.zeros(3))
+    return pm
+
+
+def rot_z(theta: float) -> np.ndarray:
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def rot_x(alpha: float) -> np.ndarray:
+    c, s = math.cos(alpha), math.sin(alpha)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+class TextbookRnea:
+    """The textbook recursive Newton-Euler (Luh, Walker, Paul) on NumPy 3-vectors.
+
+    Everything of link i in frame i; R_i = Rz(q_i + offset_i) Rx(alpha_i) turns frame i
+    into frame i-1; p_i = o_{i-1} -> o_i and c_i = o_i -> centre of mass, in frame i.
+    """
+
+    def __init__(self, model):
+        self.links = []
+        for joint, body in zip(model.joints, model.bodies):
+            a, alpha, d = joint.dh.a, joint.dh.alpha, joint.dh.d
+            p = np.array([a, d * math.sin(alpha), d * math.cos(alpha)])
+            self.links.append((joint.dh, p, body.mass, np.array(body.com), inertia_matrix(body.inertia)))
+        self.gravity = np.array(model.gravity)
+
+    def __call__(self, q, qd, qdd) -> np.ndarray:
+        z = np.array([0.0, 0.0, 1.0])
+        w, dw, a = np.zeros(3), np.zeros(3), -self.gravity
+        forward = []
+        for (dh, p, m, c, inertia), q_i, qd_i, qdd_i in zip(self.links, q, qd, qdd):
+            R = rot_z(q_i + dh.theta_offset) @ rot_x(dh.alpha)
+            dw = R.T @ (dw + z * qdd_i + np.cross(w, z * qd_i))
+            w = R.T @ (w + z * qd_i)
+            a = R.T @ a + np.cross(dw, p) + np.cross(w, np.cross(w, p))
+            a_com = a + np.cross(dw, c) + np.cross(w, np.cross(w, c))
+            force, moment = m * a_com, inertia @ dw + np.cross(w, inertia @ w)
+            forward.append((R, p, c, force, moment))
+
+        tau = np.empty(len(self.links))
+        f, n, R_child = np.zeros(3), np.zeros(3), np.eye(3)
+        for i in reversed(range(len(self.links))):
+            R, p, c, force, moment = forward[i]
+            f_child, n_child = R_child @ f, R_child @ n
+            f = f_child + force
+            n = n_child + np.cross(p, f_child) + np.cross(p + c, force) + moment
+            tau[i] = n @ (R.T @ z)
+            R_child = R
+        return tau
+
+
+# -- the benchmarks -----------------------------------------------------------------------
+
+
+def random_states(model, count: int, rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """q uniform within the joint limits, qd in +-2 rad/s, qdd in +-5 rad/s^2."""
+    lower, upper = np.array([j.position_limits for j in model.joints]).T
+    q = rng.uniform(lower, upper, (count, model.n))
+    return q, rng.uniform(-2.0, 2.0, q.shape), rng.uniform(-5.0, 5.0, q.shape)
+
+
+def symmetric_from_upper(M: np.ndarray) -> np.ndarray:
+    """Symmetric matrices (..., n, n) from the upper triangles (all that crba guarantees)."""
+    return np.triu(M) + np.swapaxes(np.triu(M, 1), -1, -2)
+
+
+def check_same(label: str, ours, theirs) -> None:
+    np.testing.assert_allclose(ours, theirs, **TOLERANCE, err_msg=label)
+
+
+def single_state(model, pm, data) -> list[Row]:
+    """Per-call cost of one state: public functions, raw kernels and the textbook RNEA."""
+    q, qd, qdd = (x[0] for x in random_states(model, 1, np.random.default_rng(SEED)))
+    lists = q.tolist(), qd.tolist(), qdd.tolist()
+    kernels = model.kernels
+    textbook = TextbookRnea(model)
+
+    tau = rnea(model, q, qd, qdd)
+    check_same("rnea vs pin.rnea", tau, pin.rnea(pm, data, q, qd, qdd))
+    check_same("rnea vs textbook", tau, textbook(q, qd, qdd))
+    check_same("rnea vs its kernel", tau, kernels.rnea.scalar(*lists))
+    check_same("gravity", gravity(model, q), pin.computeGeneralizedGravity(pm, data, q))
+    check_same("mass_matrix", mass_matrix(model, q), symmetric_from_upper(pin.crba(pm, data, q)))
+
+    pin_rnea = lambda: pin.rnea(pm, data, q, qd, qdd)  # noqa: E731
+    pin_gravity = lambda: pin.computeGeneralizedGravity(pm, data, q)  # noqa: E731
+    pin_crba = lambda: pin.crba(pm, data, q)  # noqa: E731
+    ours_rnea = lambda: rnea(model, q, qd, qdd)  # noqa: E731
+    cases = [  # name, ours, baseline, target
+        ("rnea vs pin.rnea", ours_rnea, pin_rnea, Target(8)),
+        ("rnea kernel (lists) vs pin.rnea", lambda: kernels.rnea.scalar(*lists), pin_rnea, None),
+        ("rnea vs textbook NumPy RNEA", ours_rnea, lambda: textbook(q, qd, qdd), None),
+        ("gravity vs computeGeneralizedGravity", lambda: gravity(model, q), pin_gravity, Target(8)),
+        ("gravity kernel (list) vs computeGeneralizedGravity",
+         lambda: kernels.gravity_torques.scalar(lists[0]), pin_gravity, None),
+        ("mass_matrix vs pin.crba", lambda: mass_matrix(model, q), pin_crba, Target(15)),
+        ("mass_matrix kernel (list) vs pin.crba",
+         lambda: kernels.mass_matrix.scalar(lists[0]), pin_crba, None),
+    ]
+    group = "single state, per call"
+    return [
+        Row(group, name, Figure.cost(seconds_per_call(ours)), Figure.cost(seconds_per_call(baseline)), target)
+        for name, ours, baseline, target in cases
+    ]
+
+
+def batch(model, pm, data) -> list[Row]:
+    """States per second of the batch functions and of a Python loop of Pinocchio calls."""
+    Q, QD, QDD = random_states(model, BATCH_STATES, np.random.default_rng(SEED + 1))
+
+    def loop(call, shape, count=BATCH_STATES):
+        """A Python loop of ``call(i)`` over the first ``count`` states, results stored."""
+
+        def run():
+            out = np.empty((count, *shape))
+            for i in range(count):
+                out[i] = call(i)
+            return out
+
+        return run
+
+    vector, matrix = (model.n,), (model.n, model.n)
+    unchanged = lambda x: x  # noqa: E731
+    cases = [  # name, ours, baseline call on state i, its result shape, for the check, target
+        ("rnea_batch vs loop of pin.rnea", lambda: rnea_batch(model, Q, QD, QDD),
+         lambda i: pin.rnea(pm, data, Q[i], QD[i], QDD[i]), vector, unchanged, Target(2, at_least=True)),
+        ("gravity_batch vs loop of computeGeneralizedGravity", lambda: gravity_batch(model, Q),
+         lambda i: pin.computeGeneralizedGravity(pm, data, Q[i]), vector, unchanged, None),
+        ("mass_matrix_batch vs loop of pin.crba", lambda: mass_matrix_batch(model, Q),
+         lambda i: pin.crba(pm, data, Q[i]), matrix, symmetric_from_upper, None),
+    ]
+    group = f"batch of {BATCH_STATES:,} states"
+    rows = []
+    for name, ours, call, shape, prepare, target in cases:
+        check_same(name, ours()[:BATCH_CHECKED], prepare(loop(call, shape, BATCH_CHECKED)()))
+        ours_rate, loop_rate = (
+            Figure.rate(seconds_per_call(fn, blocks=BATCH_REPEATS, number=1), BATCH_STATES)
+            for fn in (ours, loop(call, shape))
+        )
+        rows.append(Row(group, name, ours_rate, loop_rate, target))
+    return rows
+
+
+def kernel_generation() -> tuple[list[Row], dict]:
+    """Trace-and-compile time of each kernel on fresh models, and the first rnea() call."""
+    times = {name: [] for name in ("kernels setup", *KERNELS, "first rnea() call")}
+    for _ in range(FRESH_MODELS):
+        kernels = _timed(times["kernels setup"], lambda: irb140().kernels)
+        for name in KERNELS:
+            _timed(times[name], lambda: getattr(kernels, name))
+        fresh = irb140()
+        zeros = np.zeros(fresh.n)
+        _timed(times["first rnea() call"], lambda: rnea(fresh, zeros, zeros, zeros))
+    group = "kernel generation, fresh model"
+    rows = [Row(group, name, Figure.cost(samples, "ms")) for name, samples in times.items()]
+    source_lines = {name: getattr(kernels, name).source.count("\n") for name in KERNELS}
+    return rows, source_lines
+
+
+def _timed(samples: list[float], fn):
+    start = time.perf_counter()
+    result = fn()
+    samples.append(time.perf_counter() - start)
+    return result
+
+
+def main() -> None:
+    started = time.perf_counter()
+    model = irb140()
+    pm = pinocchio_model(model)
+    data = pm.createData()
+    generation, source_lines = kernel_generation()  # first: on fresh models, before any warm-up
+    rows = single_state(model, pm, data) + batch(model, pm, data) + generation
+    print_table(rows, "irb140_dynamics core vs Pinocchio (ratio = ours / baseline)")
+    path = write_results(
+        "core",
+        {
+            "benchmark": "core",
+            "machine": machine_info(("numpy", "pinocchio")),
+            "settings": {
+                "batch_states": BATCH_STATES,
+                "batch_repeats": BATCH_REPEATS,
+                "fresh_models": FRESH_MODELS,
+                "seed": SEED,
+            },
+            "rows": [row.as_dict() for row in rows],
+            "kernel_source_lines": source_lines,
+            "runtime_s": time.perf_counter() - started,
+        },
+    )
+    print(f"raw figures: {path.relative_to(REPO)} ({time.perf_counter() - started:.0f} s)")
+
+
+if __name__ == "__main__":
+    main()
