@@ -49,8 +49,8 @@ class DemoNode(Node):
         if feedforward is None or gravity is None:
             print(f"t={self._elapsed():6.1f} s  waiting for id_node ...", flush=True)
             return
-        ff = " ".join(f"{x:8.2f}" for x in feedforward.effort)
-        g = " ".join(f"{x:8.2f}" for x in gravity.effort)
+        ff = " ".join(f"{x + 0.0:8.2f}" for x in feedforward.effort)
+        g = " ".join(f"{x + 0.0:8.2f}" for x in gravity.effort)
         print(f"t={self._elapsed():6.1f} s  feed-forward [N m] {ff}   gravity [N m] {g}", flush=True)
 
 

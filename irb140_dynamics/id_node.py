@@ -18,20 +18,18 @@ from dataclasses import dataclass
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
 from .core import RobotModel, gravity, rnea
 from .core.filters import VelocityDifferentiator
-from .ros.messages import BadMessage, JointOrder, joint_efforts, read_joint_state, read_reference
-from .ros.params import Spec, declare_model
+from .ros.messages import BadMessage, JointOrder, count_and_warn, joint_efforts, read_joint_state, read_reference
+from .ros.params import QOS_PARAMETERS, Spec, check_choice, check_qos, declare_model, joint_states_qos
 from .ros.spin import run
 
 ACCELERATION_MODES = ("differentiate", "zero")
 EFFORT_SOURCES = ("feedforward", "gravity")
-RELIABILITIES = {"best_effort": ReliabilityPolicy.BEST_EFFORT, "reliable": ReliabilityPolicy.RELIABLE}
 
 NODE_PARAMETERS = [
     Spec("acceleration.mode", "differentiate",
@@ -43,10 +41,7 @@ NODE_PARAMETERS = [
     Spec("effort_commands.enabled", False, "also publish torques on effort_commands (Float64MultiArray)",
          read_only=True),
     Spec("effort_commands.source", "feedforward", "which torques go to effort_commands: 'feedforward' or 'gravity'"),
-    Spec("qos.reliability", "best_effort",
-         "joint_states subscription reliability: 'best_effort' (takes reliable and best-effort publishers) "
-         "or 'reliable'", read_only=True),
-    Spec("qos.depth", 10, "queue depth of the subscriptions and publishers", read_only=True),
+    *QOS_PARAMETERS,
 ]
 
 
@@ -63,15 +58,13 @@ class Settings:
 
 def build_settings(values: dict) -> Settings:
     model = RobotModel.from_params(values)
-    _choice("acceleration.mode", values["acceleration.mode"], ACCELERATION_MODES)
-    _choice("effort_commands.source", values["effort_commands.source"], EFFORT_SOURCES)
-    _choice("qos.reliability", values["qos.reliability"], RELIABILITIES)
+    check_choice("acceleration.mode", values["acceleration.mode"], ACCELERATION_MODES)
+    check_choice("effort_commands.source", values["effort_commands.source"], EFFORT_SOURCES)
     if values["acceleration.cutoff_frequency"] <= 0.0:
         raise ValueError(f"acceleration.cutoff_frequency: must be > 0 Hz, got {values['acceleration.cutoff_frequency']}")
     if values["reference_timeout"] < 0.0:
         raise ValueError(f"reference_timeout: must be >= 0 s, got {values['reference_timeout']}")
-    if values["qos.depth"] < 1:
-        raise ValueError(f"qos.depth: must be >= 1, got {values['qos.depth']}")
+    check_qos(values)
     return Settings(
         model,
         values["acceleration.mode"],
@@ -79,11 +72,6 @@ def build_settings(values: dict) -> Settings:
         values["reference_timeout"],
         values["effort_commands.source"],
     )
-
-
-def _choice(name, value, choices):
-    if value not in choices:
-        raise ValueError(f"{name}: must be one of {', '.join(choices)}; got {value!r}")
 
 
 class IdNode(Node):
@@ -105,9 +93,7 @@ class IdNode(Node):
         self._command_msg = Float64MultiArray()
 
         depth = self.get_parameter("qos.depth").value
-        reliability = RELIABILITIES[self.get_parameter("qos.reliability").value]
-        self.create_subscription(JointState, "joint_states", self._on_joint_state,
-                                 QoSProfile(depth=depth, reliability=reliability))
+        self.create_subscription(JointState, "joint_states", self._on_joint_state, joint_states_qos(self))
         self.create_subscription(JointTrajectory, "~/reference", self._on_reference, depth)
         self._feedforward_pub = self.create_publisher(JointState, "feedforward_torques", depth)
         self._gravity_pub = self.create_publisher(JointState, "gravity_torques", depth)
@@ -132,7 +118,7 @@ class IdNode(Node):
         try:
             q, qd = read_joint_state(msg, self._order)
         except BadMessage as error:
-            self._drop("joint_states", error)
+            count_and_warn(self.get_logger(), self.counts, "joint_states", error)
             return
         settings = self.settings
         qdd = self._estimated_acceleration(msg, qd, settings)
@@ -165,7 +151,7 @@ class IdNode(Node):
         try:
             q, qd, qdd = read_reference(msg, self._order)
         except BadMessage as error:
-            self._drop("reference", error)
+            count_and_warn(self.get_logger(), self.counts, "reference", error)
             return
         self._reference = (time.monotonic(), q, qd, qdd)
 
@@ -177,11 +163,6 @@ class IdNode(Node):
         if timeout > 0.0 and time.monotonic() - received > timeout:
             return None
         return q, qd, qdd
-
-    def _drop(self, topic: str, error: BadMessage) -> None:
-        self.counts[f"dropped_{error.kind}"] += 1
-        self.counts["dropped"] += 1
-        self.get_logger().warning(f"dropped a {topic} message ({error})", throttle_duration_sec=2.0)
 
     def _publish_diagnostics(self) -> None:
         status = DiagnosticStatus(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from array import array
+from collections import Counter
 
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
@@ -15,6 +16,13 @@ class BadMessage(ValueError):
     def __init__(self, kind: str, detail: str):
         super().__init__(f"{kind}: {detail}")
         self.kind = kind
+
+
+def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> None:
+    """Count a dropped message by kind, and warn about it (every 2 s at most)."""
+    counts[f"dropped_{error.kind}"] += 1
+    counts["dropped"] += 1
+    logger.warning(f"dropped a {topic} message ({error})", throttle_duration_sec=2.0)
 
 
 class JointOrder:

@@ -20,6 +20,7 @@ from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParam
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from ..core.model import check_joint_names, read_parameter_file
 
@@ -51,6 +52,32 @@ class Spec:
                 )
             ]
         return descriptor
+
+
+RELIABILITIES = {"best_effort": ReliabilityPolicy.BEST_EFFORT, "reliable": ReliabilityPolicy.RELIABLE}
+QOS_PARAMETERS = [
+    Spec("qos.reliability", "best_effort",
+         "joint_states subscription reliability: 'best_effort' (takes reliable and best-effort publishers) "
+         "or 'reliable'", read_only=True),
+    Spec("qos.depth", 10, "queue depth of the subscriptions and publishers", read_only=True),
+]
+
+
+def check_choice(name: str, value, choices) -> None:
+    if value not in choices:
+        raise ValueError(f"{name}: must be one of {', '.join(choices)}; got {value!r}")
+
+
+def check_qos(values: dict) -> None:
+    check_choice("qos.reliability", values["qos.reliability"], RELIABILITIES)
+    if values["qos.depth"] < 1:
+        raise ValueError(f"qos.depth: must be >= 1, got {values['qos.depth']}")
+
+
+def joint_states_qos(node: Node) -> QoSProfile:
+    """The joint_states subscription's QoS from the node's qos.* parameters."""
+    reliability = RELIABILITIES[node.get_parameter("qos.reliability").value]
+    return QoSProfile(depth=node.get_parameter("qos.depth").value, reliability=reliability)
 
 
 def default_config_path() -> Path:
