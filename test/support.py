@@ -20,6 +20,14 @@ def loaded_irb140() -> RobotModel:
     return irb140(payload=OFFSET_PAYLOAD)
 
 
+def model_makers(seed: int, sizes=(2, 7)) -> dict:
+    """Model makers by name: the IRB-140, it with an offset payload, random models of ``sizes``."""
+    models = {"irb140": irb140, "irb140_offset_payload": loaded_irb140}
+    for n in sizes:
+        models[f"random_n{n}"] = lambda n=n: random_model(np.random.default_rng(seed + n), n)
+    return models
+
+
 def random_rotation(rng) -> np.ndarray:
     """A random proper rotation matrix."""
     Q, R = np.linalg.qr(rng.normal(size=(3, 3)))

@@ -9,14 +9,9 @@ import pytest
 from irb140_dynamics.core import coriolis, coriolis_matrix, gravity, irb140, mass_matrix, rnea
 from irb140_dynamics.core import algorithms
 
-from .support import loaded_irb140, random_model, random_states
+from .support import model_makers, loaded_irb140, random_model, random_states
 
-MODELS = {
-    "irb140": irb140,
-    "irb140_offset_payload": loaded_irb140,
-    "random_n2": lambda: random_model(np.random.default_rng(302), 2),
-    "random_n7": lambda: random_model(np.random.default_rng(307), 7),
-}
+MODELS = model_makers(seed=300, sizes=(2, 7))
 
 
 @pytest.fixture(scope="module", params=list(MODELS), ids=list(MODELS))

@@ -20,14 +20,9 @@ from irb140_dynamics.core import (
     rnea_batch,
 )
 
-from .support import assert_close, loaded_irb140, random_model, random_states
+from .support import model_makers, assert_close, loaded_irb140, random_model, random_states
 
-MODELS = {
-    "irb140": irb140,
-    "irb140_offset_payload": loaded_irb140,
-    "random_n3": lambda: random_model(np.random.default_rng(203), 3),
-    "random_n7": lambda: random_model(np.random.default_rng(207), 7),
-}
+MODELS = model_makers(seed=200, sizes=(3, 7))
 
 
 @pytest.fixture(scope="module", params=list(MODELS), ids=list(MODELS))
