@@ -6,13 +6,14 @@ Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, q
              gravity_torques       sensor_msgs/JointState, effort = g(q)
              effort_commands       std_msgs/Float64MultiArray (when enabled), model joint order
              /diagnostics          diagnostic_msgs/DiagnosticArray, message counts, 1 Hz
+             (an empty ~/reference trajectory lets the held reference go)
 
 Torques are in N m, named and ordered as the model's joints, stamped with the input stamp.
 """
 
 from __future__ import annotations
 
-import time
+import math
 from collections import Counter
 from dataclasses import dataclass
 
@@ -24,20 +25,30 @@ from trajectory_msgs.msg import JointTrajectory
 
 from .core import RobotModel, gravity, rnea
 from .core.filters import VelocityDifferentiator
-from .ros.messages import BadMessage, JointOrder, count_and_warn, joint_efforts, read_joint_state, read_reference
+from .ros.messages import (
+    BadMessage,
+    JointOrder,
+    NotForThisModel,
+    count_and_warn,
+    joint_efforts,
+    read_joint_state,
+    read_reference,
+)
 from .ros.params import QOS_PARAMETERS, Spec, check_choice, check_qos, declare_model, joint_states_qos
 from .ros.spin import run
 
-ACCELERATION_MODES = ("differentiate", "zero")
+ACCELERATION_MODES = ("zero", "differentiate")
 EFFORT_SOURCES = ("feedforward", "gravity")
 
 NODE_PARAMETERS = [
-    Spec("acceleration.mode", "differentiate",
-         "qdd when no reference gives it: 'differentiate' the joint_states velocities (low-pass filtered) or 'zero'"),
+    Spec("acceleration.mode", "zero",
+         "qdd when no ~/reference gives it: 'zero', or 'differentiate' the measured velocities (low-pass "
+         "filtered; for monitoring: as a command it would feed the measured acceleration back, "
+         "so effort_commands never use it)"),
     Spec("acceleration.cutoff_frequency", 20.0, "cut-off of the velocity differentiation filter", "Hz",
          minimum=1e-3),
-    Spec("reference_timeout", 0.5, "a ~/reference older than this is no longer used; 0 = never expires", "s",
-         minimum=0.0),
+    Spec("reference_timeout", 0.5, "a ~/reference older than this (node clock) is no longer used; 0 = never",
+         "s", minimum=0.0),
     Spec("effort_commands.enabled", False, "also publish torques on effort_commands (Float64MultiArray)",
          read_only=True),
     Spec("effort_commands.source", "feedforward", "which torques go to effort_commands: 'feedforward' or 'gravity'"),
@@ -57,14 +68,12 @@ class Settings:
 
 
 def build_settings(values: dict) -> Settings:
+    """Validate everything, and compile the model's kernels here, not on a message."""
     model = RobotModel.from_params(values)
     check_choice("acceleration.mode", values["acceleration.mode"], ACCELERATION_MODES)
     check_choice("effort_commands.source", values["effort_commands.source"], EFFORT_SOURCES)
-    if values["acceleration.cutoff_frequency"] <= 0.0:
-        raise ValueError(f"acceleration.cutoff_frequency: must be > 0 Hz, got {values['acceleration.cutoff_frequency']}")
-    if values["reference_timeout"] < 0.0:
-        raise ValueError(f"reference_timeout: must be >= 0 s, got {values['reference_timeout']}")
     check_qos(values)
+    _compiled = (model.kernels.rnea, model.kernels.gravity_torques)
     return Settings(
         model,
         values["acceleration.mode"],
@@ -82,8 +91,8 @@ class IdNode(Node):
         self.parameters = declare_model(self, NODE_PARAMETERS, build_settings)
         self.parameters.on_change(self._use)
         self.counts: Counter[str] = Counter()
-        self._dropped_before = 0
-        self._reference = None  # (time received [s, monotonic], q, qd, qdd or None)
+        self._reported = Counter()  # the counts at the last diagnostics
+        self._reference = None  # (time received [ns, node clock], q, qd, qdd or None)
         self._use(self.parameters.current)
 
         names = list(self.settings.model.joint_names)
@@ -107,34 +116,42 @@ class IdNode(Node):
         )
 
     def _use(self, settings: Settings) -> None:
-        """Switch to new settings; compile the model's kernels first, then swap in one step."""
-        model = settings.model
-        _compiled = (model.kernels.rnea, model.kernels.gravity_torques)  # now, not on a message
-        self._differentiator = VelocityDifferentiator(model.n, settings.cutoff_frequency)
+        """Switch to new (validated, compiled) settings."""
+        self._differentiator = VelocityDifferentiator(settings.model.n, settings.cutoff_frequency)
         self.settings = settings
 
     def _on_joint_state(self, msg: JointState) -> None:
         self.counts["received"] += 1
         try:
             q, qd = read_joint_state(msg, self._order)
+        except NotForThisModel:
+            self.counts["ignored"] += 1
+            return
         except BadMessage as error:
             count_and_warn(self.get_logger(), self.counts, "joint_states", error)
             return
         settings = self.settings
-        qdd = self._estimated_acceleration(msg, qd, settings)
-        reference = self._fresh_reference(settings)
-        if reference is not None:
-            q_ff, qd_ff, qdd_ref = reference
-            tau = rnea(settings.model, q_ff, qd_ff, qdd if qdd_ref is None else qdd_ref)
-        else:
-            tau = rnea(settings.model, q, qd, qdd)
-        g = gravity(settings.model, q)
+        model = settings.model
+        estimate = self._estimated_acceleration(msg, qd, settings)
+        q_ff, qd_ff, qdd_ref = self._fresh_reference(settings) or (q, qd, None)
+        tau = rnea(model, q_ff, qd_ff, estimate if qdd_ref is None else qdd_ref)
+        g = gravity(model, q)
+        if not all(map(math.isfinite, tau)) or not all(map(math.isfinite, g)):
+            count_and_warn(self.get_logger(), self.counts, "joint_states",
+                           BadMessage("non_finite_torques", f"the model gives {tau.tolist()}, {g.tolist()}"))
+            return
 
         stamp = msg.header.stamp
         self._feedforward_pub.publish(joint_efforts(self._feedforward_msg, stamp, tau))
         self._gravity_pub.publish(joint_efforts(self._gravity_msg, stamp, g))
         if self._command_pub is not None:
-            self._command_msg.data = (tau if settings.effort_source == "feedforward" else g).tolist()
+            if settings.effort_source == "gravity":
+                command = g
+            elif qdd_ref is None and settings.acceleration_mode == "differentiate":
+                command = rnea(model, q_ff, qd_ff, [0.0] * model.n)  # never a measured qdd
+            else:
+                command = tau
+            self._command_msg.data = command.tolist()
             self._command_pub.publish(self._command_msg)
         self.counts["published"] += 1
 
@@ -148,31 +165,40 @@ class IdNode(Node):
         return self._differentiator.update(t, qd)
 
     def _on_reference(self, msg: JointTrajectory) -> None:
+        """Hold the first point of a trajectory; an empty trajectory lets the reference go."""
+        if not msg.points:
+            self._reference = None
+            return
         try:
             q, qd, qdd = read_reference(msg, self._order)
         except BadMessage as error:
             count_and_warn(self.get_logger(), self.counts, "reference", error)
             return
-        self._reference = (time.monotonic(), q, qd, qdd)
+        self._reference = (self.get_clock().now().nanoseconds, q, qd, qdd)
 
     def _fresh_reference(self, settings: Settings):
         if self._reference is None:
             return None
         received, q, qd, qdd = self._reference
         timeout = settings.reference_timeout
-        if timeout > 0.0 and time.monotonic() - received > timeout:
+        if timeout > 0.0 and (self.get_clock().now().nanoseconds - received) * 1e-9 > timeout:
             return None
         return q, qd, qdd
 
     def _publish_diagnostics(self) -> None:
-        status = DiagnosticStatus(
-            name=f"{self.get_name()}: joint_states", hardware_id=self.get_fully_qualified_name()
-        )
-        dropped = self.counts["dropped"]
-        recent = dropped - self._dropped_before
-        self._dropped_before = dropped
-        status.level = DiagnosticStatus.WARN if recent else DiagnosticStatus.OK
-        status.message = f"{self.counts['published']} published, {dropped} dropped ({recent} in the last period)"
+        """Message counts; WARN while messages are dropped or joint_states stop coming."""
+        recent = self.counts - self._reported
+        self._reported = self.counts.copy()
+        status = DiagnosticStatus(name=f"{self.get_name()}: messages", hardware_id=self.get_fully_qualified_name())
+        if recent["dropped"]:
+            status.level = DiagnosticStatus.WARN
+            status.message = f"{recent['dropped']} messages dropped in the last second"
+        elif self.counts["received"] and not recent["received"]:
+            status.level = DiagnosticStatus.WARN
+            status.message = "no joint_states in the last second"
+        else:
+            status.level = DiagnosticStatus.OK
+            status.message = f"{recent['published']} torque messages in the last second"
         status.values = [KeyValue(key=key, value=str(value)) for key, value in sorted(self.counts.items())]
         msg = DiagnosticArray(status=[status])
         msg.header.stamp = self.get_clock().now().to_msg()

@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
@@ -163,6 +164,8 @@ def test_atomic_set_applies_all_or_none(node):
         (joint_state(STRETCHED, names=NAMES[:5] + ["joint_5"]), "duplicate_names"),
         (joint_state(STRETCHED[:5], names=NAMES[:5]), "missing_joints"),
         (joint_state(STRETCHED[:5], names=[]), "unnamed"),
+        (JointState(name=NAMES, position=STRETCHED, effort=[1.0, 2.0]), "length_mismatch"),
+        (joint_state(STRETCHED, qd=[1e200] * 6), "non_finite_torques"),
     ],
 )
 def test_bad_message_is_dropped_and_counted(node, msg, kind):
@@ -207,3 +210,101 @@ def test_effort_commands_carry_the_feedforward_in_model_order():
         pub.publish(joint_state(q, qd))
         assert harness.spin_until(lambda: commands)
         np.testing.assert_allclose(commands[0].data, rnea(irb140(), q, qd, np.zeros(6)), rtol=1e-12, atol=1e-12)
+
+
+def test_messages_about_other_joints_only_are_ignored_quietly(node):
+    gripper = JointState(name=["gripper_left", "gripper_right"], position=[0.01, 0.01])
+    send(node, gripper, expect=0)
+    assert node.node.counts["ignored"] == 1 and node.node.counts["dropped"] == 0
+    msg = joint_state(STRETCHED)
+    msg.effort = [math.nan] * 6  # effort is not used: its values do not matter
+    _, g = send(node, msg)
+    np.testing.assert_allclose(g.effort, [0, 243.382, 79.1556, 0, 2.43004, 0], atol=1e-3)
+
+
+def reference_point(q, qd=(), qdd=()):
+    return JointTrajectory(joint_names=NAMES, points=[JointTrajectoryPoint(
+        positions=list(q), velocities=list(qd), accelerations=list(qdd))])
+
+
+def test_reference_expires_and_an_empty_one_lets_it_go():
+    overrides = [Parameter("reference_timeout", value=0.3)]
+    with running(IdNode, parameter_overrides=overrides) as harness:
+        harness.feedforward = harness.listen(JointState, "feedforward_torques")
+        harness.gravity = harness.listen(JointState, "gravity_torques")
+        harness.joint_states = harness.publisher(JointState, "joint_states")
+        reference = harness.publisher(JointTrajectory, "/id_node/reference")
+        model, zeros = irb140(), np.zeros(6)
+        q_ref, q = [0.3, -0.9, 1.1, 0.0, 0.4, 0.0], [0.0, -0.5, 0.5, 0.0, 0.0, 0.0]
+        for clear in (False, True):
+            harness.node._reference = None
+            reference.publish(reference_point(q_ref))  # no accelerations given: qdd = 0 (mode zero)
+            assert harness.spin_until(lambda: harness.node._reference is not None)
+            ff, _ = send(harness, joint_state(q))
+            np.testing.assert_allclose(ff.effort, rnea(model, q_ref, zeros, zeros), rtol=1e-12, atol=1e-12)
+            if clear:
+                reference.publish(JointTrajectory())
+                assert harness.spin_until(lambda: harness.node._reference is None)
+            else:
+                harness.spin_for(0.4)
+            ff, _ = send(harness, joint_state(q))
+            np.testing.assert_allclose(ff.effort, rnea(model, q, zeros, zeros), rtol=1e-12, atol=1e-12)
+
+
+def test_a_bad_reference_is_dropped_and_the_held_one_kept(node):
+    reference = node.publisher(JointTrajectory, "/id_node/reference")
+    q_ref = [0.3, -0.9, 1.1, 0.0, 0.4, 0.0]
+    reference.publish(reference_point(q_ref))
+    assert node.spin_until(lambda: node.node._reference is not None)
+    reference.publish(JointTrajectory(joint_names=NAMES[:5], points=[JointTrajectoryPoint(positions=[0.0] * 5)]))
+    assert node.spin_until(lambda: node.node.counts["dropped_missing_joints"] == 1)
+    ff, _ = send(node, joint_state(STRETCHED))
+    np.testing.assert_allclose(ff.effort, rnea(irb140(), q_ref, np.zeros(6), np.zeros(6)), rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "mode, source, expected",
+    [
+        ("zero", "gravity", lambda q, qd: gravity(irb140(), q)),
+        # a measured acceleration never reaches a command: it would feed the arm's own motion back
+        ("differentiate", "feedforward", lambda q, qd: rnea(irb140(), q, qd, np.zeros(6))),
+    ],
+)
+def test_effort_commands_sources(mode, source, expected):
+    overrides = [Parameter("effort_commands.enabled", value=True), Parameter("acceleration.mode", value=mode),
+                 Parameter("effort_commands.source", value=source)]
+    with running(IdNode, parameter_overrides=overrides) as harness:
+        commands = harness.listen(Float64MultiArray, "effort_commands")
+        feedforward = harness.listen(JointState, "feedforward_torques")
+        pub = harness.publisher(JointState, "joint_states")
+        q = np.array([0.2, -1.0, 1.1, 0.4, -0.6, 0.3])
+        for k in range(5):  # accelerating, so that a differentiated qdd is not zero
+            qd = 2.0 * k * 0.01 * np.ones(6)
+            pub.publish(joint_state(q, qd, sec=1, nanosec=k * 10_000_000))
+            assert harness.spin_until(lambda: len(commands) > k and len(feedforward) > k)
+        np.testing.assert_allclose(commands[-1].data, expected(q, qd), rtol=1e-12, atol=1e-12)
+        if mode == "differentiate":
+            assert not np.allclose(feedforward[-1].effort, commands[-1].data)
+
+
+def test_reliable_subscription_when_asked():
+    overrides = [Parameter("qos.reliability", value="reliable")]
+    with running(IdNode, parameter_overrides=overrides) as harness:
+        gravity_torques = harness.listen(JointState, "gravity_torques")
+        reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+        harness.publisher(JointState, "joint_states", reliable).publish(joint_state(STRETCHED))
+        assert harness.spin_until(lambda: gravity_torques)
+        assert harness.node.get_parameter("qos.reliability").value == "reliable"
+
+
+def test_diagnostics_warn_about_dropped_messages(node):
+    diagnostics = node.listen(DiagnosticArray, "/diagnostics")
+    send(node, joint_state([math.nan] * 6), expect=0)
+
+    def warned():
+        return any(s.level == DiagnosticStatus.WARN for d in diagnostics for s in d.status)
+
+    assert node.spin_until(warned, timeout=5.0)
+    status = [s for d in diagnostics for s in d.status if s.level == DiagnosticStatus.WARN][0]
+    assert status.name == "id_node: messages" and "dropped" in status.message
+    assert {kv.key: kv.value for kv in status.values}["dropped_not_finite"] == "1"

@@ -41,7 +41,7 @@ def config_with(old: str, new: str, tmp_path) -> str:
         (lambda tmp: ["--params-file", config_with("com: [-0.18, 0.0, 0.0]", "com: [-0.18, 0.0]", tmp)],
          "joint_2.link.com"),
         (lambda tmp: ["--params-file", bad_file(tmp, "/**:\n  ros__parameters:\n    gravity: [0.0, 0.0\n")],
-         "not valid YAML"),
+         "bad.yaml:3: Error parsing"),
         (lambda tmp: ["--params-file", str(tmp / "missing.yaml")], "missing.yaml"),
         (lambda tmp: ["-p", "joint_4.link.inertia:=[1.0, 1.0, 3.0, 0.0, 0.0, 0.0]"], "joint_4.link.inertia"),
         (lambda tmp: ["-p", "payload.mass:=-2.0"], "payload.mass"),

@@ -11,8 +11,9 @@ class VelocityDifferentiator:
     y_k = y_{k-1} + alpha (raw_k - y_{k-1}),  raw_k = (qd_k - qd_{k-1}) / dt,
     alpha = dt / (dt + 1 / (2 pi f_c)), f_c the cut-off frequency [Hz].
 
-    The estimate starts again from zero after a gap longer than ``max_gap`` [s] or a
-    time that does not move forward.
+    A sample whose time does not move forward (a repeated or older stamp, e.g. from a
+    second publisher) is skipped; after a gap longer than ``max_gap`` [s] the estimate
+    starts again from zero.
     """
 
     def __init__(self, n: int, cutoff_hz: float, max_gap: float = 0.5):
@@ -29,7 +30,9 @@ class VelocityDifferentiator:
 
     def update(self, t: float, qd) -> list[float]:
         """Take the velocities at time t [s]; return the filtered accelerations."""
-        if self._t is None or not 0.0 < t - self._t <= self.max_gap:
+        if self._t is not None and t <= self._t:
+            return self.qdd
+        if self._t is None or t - self._t > self.max_gap:
             self.reset()
         else:
             dt = t - self._t

@@ -18,6 +18,10 @@ class BadMessage(ValueError):
         self.kind = kind
 
 
+class NotForThisModel(BadMessage):
+    """A message about none of the model's joints (a gripper's, another arm's): ignored."""
+
+
 def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> None:
     """Count a dropped message by kind, and warn about it (every 2 s at most)."""
     counts[f"dropped_{error.kind}"] += 1
@@ -26,19 +30,26 @@ def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> No
 
 
 class JointOrder:
-    """Where each of the model's joints sits in a message's name list (cached per list)."""
+    """Where each of the model's joints sits in a message's name list.
+
+    Cached per name list: streams from a few publishers (arm, gripper) each keep theirs.
+    """
+
+    _CACHE_SIZE = 16
 
     def __init__(self, joint_names):
         self.joint_names = tuple(joint_names)
-        self._names: tuple | None = None
-        self._index: list[int] | None = None
+        self._cache: dict[tuple, list[int]] = {}
 
     def indices(self, names) -> list[int]:
         names = tuple(names)
-        if names != self._names:
-            self._index = self._match(names)
-            self._names = names
-        return self._index
+        index = self._cache.get(names)
+        if index is None:
+            index = self._match(names)
+            if len(self._cache) >= self._CACHE_SIZE:
+                self._cache.clear()
+            self._cache[names] = index
+        return index
 
     def _match(self, names: tuple) -> list[int]:
         if not names:
@@ -47,6 +58,8 @@ class JointOrder:
             raise BadMessage("duplicate_names", f"duplicate joint names in {list(names)}")
         where = {name: i for i, name in enumerate(names)}
         missing = [name for name in self.joint_names if name not in where]
+        if len(missing) == len(self.joint_names):
+            raise NotForThisModel("other_joints", f"none of the model's joints in {list(names)}")
         if missing:
             raise BadMessage("missing_joints", f"no {', '.join(missing)} in {list(names)}")
         return [where[name] for name in self.joint_names]
@@ -68,21 +81,22 @@ def read_joint_state(msg: JointState, order: JointOrder) -> tuple[list[float], l
     """(q, qd) of the model's joints; missing velocities count as zero.
 
     Joints are matched by name, in any order, others ignored; a message without names is
-    taken positionally only if its length matches the model.
+    taken positionally only if its length matches the model. ``effort`` is not used, but
+    its length must fit too. Raises NotForThisModel for a message about other joints only.
     """
     index, length = _index(msg.name, len(msg.position), order)
     q = _pick(msg.position, index, "position", length, required=True)
     qd = _pick(msg.velocity, index, "velocity", length, required=False)
+    if len(msg.effort) not in (0, length):
+        raise BadMessage("length_mismatch", f"effort has {len(msg.effort)} values for {length} joints")
     return q, qd
 
 
 def read_reference(msg: JointTrajectory, order: JointOrder):
-    """(q, qd, qdd or None) of the model's joints from the trajectory's first point.
+    """(q, qd, qdd or None) of the model's joints from the first point of a non-empty trajectory.
 
     Velocities count as zero when empty; accelerations are None when empty (not given).
     """
-    if not msg.points:
-        raise BadMessage("empty_reference", "the trajectory has no points")
     point = msg.points[0]
     index, length = _index(msg.joint_names, len(point.positions), order)
     q = _pick(point.positions, index, "positions", length, required=True)

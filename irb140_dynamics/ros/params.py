@@ -2,7 +2,8 @@
 
 A node lists its parameters as ``Spec``s and gives a ``build`` function that turns all of
 their values into the configuration it runs on (a RobotModel, options), raising ValueError
-naming the parameter when something is wrong. ``LiveParameters`` declares them, builds the
+naming the parameter when something is wrong. Everything that can fail, and everything
+slow (compiling kernels), belongs in ``build``: a configuration that was built is used. ``LiveParameters`` declares them, builds the
 first configuration (a failure stops startup), and from then on checks every change by
 building the whole new configuration before it is accepted: a refused change keeps the old
 configuration, an accepted one replaces it in a single assignment.
@@ -15,7 +16,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-import yaml
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.node import Node
@@ -59,7 +59,7 @@ QOS_PARAMETERS = [
     Spec("qos.reliability", "best_effort",
          "joint_states subscription reliability: 'best_effort' (takes reliable and best-effort publishers) "
          "or 'reliable'", read_only=True),
-    Spec("qos.depth", 10, "queue depth of the subscriptions and publishers", read_only=True),
+    Spec("qos.depth", 10, "queue depth of joint_states, ~/reference and the torque topics", read_only=True),
 ]
 
 
@@ -156,6 +156,7 @@ class LiveParameters:
         for spec in specs:
             _declare(node, spec)
         self.current = build(self.values())
+        self._pending = None  # (values, configuration) checked, not yet applied
         self._listeners: list[Callable[[Any], None]] = []
         node.add_pre_set_parameters_callback(self._coerce_integers)
         node.add_on_set_parameters_callback(self._check)
@@ -188,14 +189,21 @@ class LiveParameters:
         return Parameter.Type(self._node.describe_parameter(name).type)
 
     def _check(self, parameters: list[Parameter]) -> SetParametersResult:
+        """Build the whole new configuration; refuse the change if that fails."""
+        values = self.values(parameters)
         try:
-            self._build(self.values(parameters))
+            self._pending = (values, self._build(values))
         except ValueError as error:
+            self._pending = None
             return SetParametersResult(successful=False, reason=str(error))
         return SetParametersResult(successful=True)
 
     def _apply(self, parameters: list[Parameter]) -> None:
-        self.current = self._build(self.values())
+        """Swap in the configuration built by _check for exactly these values."""
+        pending, self._pending = self._pending, None
+        if pending is None or pending[0] != self.values():  # not the change just checked
+            return
+        self.current = pending[1]
         for listener in self._listeners:
             listener(self.current)
 
@@ -209,40 +217,3 @@ def _declare(node: Node, spec: Spec):
         raise ValueError(f"{spec.name}: expected a value of type {kind.name.lower()}{hint}") from None
     except InvalidParameterValueException as error:
         raise ValueError(f"{spec.name}: {error}") from None
-
-
-def check_parameter_files(args: list[str]) -> None:
-    """Raise ValueError naming the parameter of a --params-file that rcl would refuse.
-
-    rcl rejects a file with a mixed-type list such as [0, 0, -9.81] with only a line
-    number; this says which parameter and what to write instead.
-    """
-    for i, arg in enumerate(args):
-        if arg == "--params-file" and i + 1 < len(args):
-            path = args[i + 1]
-            try:
-                with open(path) as stream:
-                    document = yaml.safe_load(stream) or {}
-            except OSError as error:
-                raise ValueError(f"--params-file {path}: {error.strerror}") from None
-            except yaml.YAMLError as error:
-                raise ValueError(f"--params-file {path}: not valid YAML ({_first_line(error)})") from None
-            for node_key, section in document.items():
-                params = (section or {}).get("ros__parameters", {}) if isinstance(section, dict) else {}
-                _check_lists(params, "", path)
-
-
-def _check_lists(tree, prefix: str, path: str) -> None:
-    for key, value in tree.items():
-        name = f"{prefix}{key}"
-        if isinstance(value, dict):
-            _check_lists(value, f"{name}.", path)
-        elif isinstance(value, list) and len({type(x) for x in value}) > 1:
-            raise ValueError(
-                f"{name} (in {path}): mixed types in {value}; "
-                "write every number of a list as a double, e.g. 0.0 not 0"
-            )
-
-
-def _first_line(error: Exception) -> str:
-    return str(error).strip().splitlines()[0]

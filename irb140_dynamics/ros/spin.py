@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import sys
 from typing import Callable
 
@@ -10,7 +11,6 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 
-from .params import check_parameter_files
 
 
 def run(name: str, make_node: Callable[[], Node], args: list[str] | None = None) -> int:
@@ -22,10 +22,9 @@ def run(name: str, make_node: Callable[[], Node], args: list[str] | None = None)
     args = sys.argv if args is None else args
     logger = rclpy.logging.get_logger(name)
     try:
-        check_parameter_files(args)
         rclpy.init(args=args)
-    except (ValueError, rclpy_implementation.RCLError) as error:
-        logger.fatal(f"cannot start: {_one_line(error)}")
+    except rclpy_implementation.RCLError as error:
+        logger.fatal(f"cannot start: {init_error(error)}")
         return 1
     try:
         node = make_node()
@@ -44,5 +43,32 @@ def run(name: str, make_node: Callable[[], Node], args: list[str] | None = None)
 
 
 def _one_line(error: Exception) -> str:
-    """rcl's messages carry ', at file:line' trails; keep the sentence."""
-    return str(error).split(", at /")[0].replace("\n", " ")
+    return str(error).replace("\n", " ")
+
+
+_PARAMS_FILE_ERROR = re.compile(
+    r"params file: '--params-file (?P<path>.+?)'\. Error: (?P<reason>.+?)"
+    r"(?: (?:at line_num|near line) (?P<line>\d+))?(?:, at /|$)"
+)
+
+
+def init_error(error: Exception) -> str:
+    """rcl's refusal of the arguments in one line; for a params file, the line it refuses."""
+    text = str(error)
+    found = _PARAMS_FILE_ERROR.search(text)
+    if not found:
+        return text.split(", at /")[0]
+    path, reason, line = found["path"], found["reason"].rstrip(". "), found["line"]
+    if line is None:
+        return f"{path}: {reason}"
+    source = _line(path, int(line))
+    hint = "; write every number of a list as a double, e.g. 0.0 not 0" if "same type" in reason else ""
+    return f"{path}:{line}: {reason} in `{source}`{hint}"
+
+
+def _line(path: str, number: int) -> str:
+    try:
+        with open(path) as stream:
+            return stream.read().splitlines()[number - 1].strip()
+    except (OSError, IndexError):
+        return "?"
