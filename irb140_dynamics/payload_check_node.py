@@ -9,7 +9,8 @@ Publishes    /diagnostics   diagnostic_msgs/DiagnosticArray: one status per join
                             the payload, after each check and every diagnostics.period
 
 Torque limits: <joint>.torque_limit when > 0, else derived as in the report: the worst
-static torque of the rated payload over the joint ranges; none for a joint gravity cannot load.
+static torque of the rated payload over the joint ranges; none for a joint it cannot load.
+A joint state older than STALE_AFTER (node clock) is still used, and the check says so.
 """
 
 from __future__ import annotations
@@ -23,9 +24,9 @@ from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
 from .core import RigidBody, RobotModel
-from .core.payload import check_payload, derive_torque_limits, workspace_load
+from .core.payload import TorqueLimits, WorkspaceLoad, check_payload, derive_torque_limits, workspace_load
 from .ros.diagnostics import payload_statuses
-from .ros.messages import BadMessage, JointOrder, count_and_warn, read_joint_state
+from .ros.messages import BadMessage, JointOrder, NotForThisModel, count_and_warn, read_joint_state
 from .ros.params import QOS_PARAMETERS, Spec, check_qos, declare_model, joint_states_qos
 from .ros.spin import run
 
@@ -39,36 +40,31 @@ NODE_PARAMETERS = [
          "s", minimum=0.0, read_only=True),
     *QOS_PARAMETERS,
 ]
+STALE_AFTER = 1.0  # s: a joint state older than this is reported as stale
 
 
 @dataclass(frozen=True)
 class Settings:
+    """What a check needs that depends only on the parameters, the workspace sweep included."""
+
     model: RobotModel  # with the payload under test
     rated_payload: RigidBody
     warn_use: float
+    limits: TorqueLimits
+    workspace: WorkspaceLoad  # the payload's worst static loads and largest mass
 
 
 def build_settings(values: dict) -> Settings:
+    """Validate everything, derive the limits and sweep the workspace: a change that fails
+    here is refused, and these settings are the ones applied."""
     model = RobotModel.from_params(values)
     rated = RigidBody.validated("rated_payload", values["rated_payload.mass"], values["rated_payload.com"])
     if not values["diagnostics.warn_use"] >= 0.0:
         raise ValueError(f"diagnostics.warn_use: must be >= 0 %, got {values['diagnostics.warn_use']}")
     check_qos(values)
-    return Settings(model, rated, values["diagnostics.warn_use"])
-
-
-@dataclass(frozen=True)
-class Analysis:
-    """What a check needs that depends only on the settings: the limits, the workspace load."""
-
-    settings: Settings
-    limits: object
-    workspace: object
-
-    @classmethod
-    def of(cls, settings: Settings) -> "Analysis":
-        limits = derive_torque_limits(settings.model, settings.rated_payload)
-        return cls(settings, limits, workspace_load(settings.model, settings.model.payload, limits))
+    limits = derive_torque_limits(model, rated)
+    workspace = workspace_load(model, model.payload, limits)
+    return Settings(model, rated, values["diagnostics.warn_use"], limits, workspace)
 
 
 class PayloadCheckNode(Node):
@@ -78,8 +74,8 @@ class PayloadCheckNode(Node):
         self.parameters.on_change(self._use)
         self.counts: Counter[str] = Counter()
         self._use(self.parameters.current)
-        self._order = JointOrder(self.analysis.settings.model.joint_names)
-        self._state = None  # (q, qd) of the latest good joint state
+        self._order = JointOrder(self.settings.model.joint_names)
+        self._state = None  # (q, qd, time received [node clock]) of the latest good joint state
 
         self.create_subscription(JointState, "joint_states", self._on_joint_state, joint_states_qos(self))
         self.create_service(Trigger, "~/check", self._on_check)
@@ -87,38 +83,50 @@ class PayloadCheckNode(Node):
         period = self.get_parameter("diagnostics.period").value
         if period > 0.0:
             self.create_timer(period, self.check)
-        payload = self.analysis.settings.model.payload
+        payload = self.settings.model.payload
         self.get_logger().info(f"ready: ~/check for a {payload.mass} kg payload at {list(payload.com)} m")
 
     def _use(self, settings: Settings) -> None:
-        """New settings: derive the limits and sweep the workspace now, then swap in one step."""
-        self.analysis = Analysis.of(settings)
+        """Switch to new settings (built, limits and workspace sweep included, when checked)."""
+        self.settings = settings
 
     def _on_joint_state(self, msg: JointState) -> None:
         try:
-            self._state = read_joint_state(msg, self._order)
+            q, qd = read_joint_state(msg, self._order)
+        except NotForThisModel:
+            return
         except BadMessage as error:
             count_and_warn(self.get_logger(), self.counts, "joint_states", error)
+            return
+        self._state = (q, qd, self.get_clock().now())
 
     def check(self):
-        """Check the payload (at the current state, if known) and publish /diagnostics."""
-        analysis, state = self.analysis, self._state
-        settings = analysis.settings
-        q, qd = state if state is not None else (None, None)
+        """Check the payload (at the latest state, if any) and publish /diagnostics:
+        (the PayloadCheck, how old the state is in words if older than STALE_AFTER, else None)."""
+        settings, state = self.settings, self._state
+        q, qd, received = state if state is not None else (None, None, None)
         result = check_payload(
-            settings.model, settings.model.payload, analysis.limits, q, qd, workspace=analysis.workspace
+            settings.model, settings.model.payload, settings.limits, q, qd, workspace=settings.workspace
         )
-        diagnostics = DiagnosticArray(status=payload_statuses(result, self.get_name(), settings.warn_use))
+        stale = None if received is None else self._stale(received)
+        statuses = payload_statuses(result, self.get_name(), settings.warn_use, stale)
+        diagnostics = DiagnosticArray(status=statuses)
         diagnostics.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(diagnostics)
-        return result
+        return result, stale
+
+    def _stale(self, received) -> str | None:
+        age = (self.get_clock().now() - received).nanoseconds * 1e-9
+        return f"joint_states received {age:.1f} s ago" if age > STALE_AFTER else None
 
     def _on_check(self, request, response):
-        result = self.check()
+        result, stale = self.check()
         response.success = result.ok
         response.message = result.report()
         if result.torque is None:
             response.message += "\n(no joint_states received yet: checked over the workspace only)"
+        elif stale is not None:
+            response.message += f"\nnote: {stale}"
         return response
 
 

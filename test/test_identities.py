@@ -114,3 +114,57 @@ def test_batch_forms_equal_single_states(robot):
         assert batch.shape == (len(Q),) + singles[0].shape, name
         for k, single in enumerate(singles):
             assert_close(batch[k], single, 1e-12, 1e-14, f"{name} state {k}")
+
+
+# -- arguments: one bad value is an error naming the argument, never a plausible torque -------------
+
+NAN, INF = float("nan"), float("inf")
+
+
+@pytest.mark.parametrize("bad", [NAN, INF, -INF])
+def test_a_non_finite_state_value_is_refused(bad):
+    model = irb140()
+    good, wrong = [0.1] * 6, [bad, 0.0, 0.0, 0.0, 0.0, 0.0]  # nan * 0 would fold away in gravity
+    calls = {
+        "q": [lambda x: gravity(model, x), lambda x: mass_matrix(model, x), lambda x: rnea(model, x, good, good),
+              lambda x: coriolis(model, np.array(x), good), lambda x: coriolis_matrix(model, x, good)],
+        "qd": [lambda x: rnea(model, good, x, good), lambda x: coriolis(model, good, x)],
+        "qdd": [lambda x: rnea(model, good, good, np.array(x))],
+        "f_ext": [lambda x: rnea(model, good, good, good, x)],
+        "tau": [lambda x: forward_dynamics(model, good, good, x)],
+    }
+    for name, functions in calls.items():
+        for function in functions:
+            with pytest.raises(ValueError, match=f"^{name}: must be finite"):
+                function(wrong)
+
+
+def test_huge_finite_values_are_not_mistaken_for_non_finite():
+    """The quick check sums the values; a sum that overflows is checked value by value."""
+    assert rnea(irb140(), [0.0] * 6, [0.0] * 6, [1e308, 1e308, 0.0, 0.0, 0.0, 0.0]).shape == (6,)
+
+
+def test_a_non_finite_batch_value_is_refused():
+    model = irb140()
+    Q = np.zeros((50, 6))
+    bad = Q.copy()
+    bad[17, 0] = np.nan
+    with pytest.raises(ValueError, match=r"^Q: must be finite \(state 17"):
+        gravity_batch(model, bad)
+    with pytest.raises(ValueError, match="^QDD: must be finite"):
+        rnea_batch(model, Q, Q, bad)
+    with pytest.raises(ValueError, match="^TAU: must be finite"):
+        forward_dynamics_batch(model, Q, Q, np.where(np.isnan(bad), np.inf, 0.0))
+
+
+def test_batch_arguments_of_different_lengths_are_refused():
+    model = irb140()
+    Q = np.zeros((100, 6))
+    with pytest.raises(ValueError, match="^QD: expected 100 states like Q, got 99$"):
+        rnea_batch(model, Q, Q[:99], Q)
+    with pytest.raises(ValueError, match="^QDD: expected 100 states like Q, got 1$"):
+        rnea_batch(model, Q, Q, Q[:1])  # would broadcast
+    with pytest.raises(ValueError, match="^QD: expected 100 states like Q, got 101$"):
+        coriolis_batch(model, Q, np.zeros((101, 6)))
+    with pytest.raises(ValueError, match="^TAU: expected 100 states like Q, got 1$"):
+        forward_dynamics_batch(model, Q, Q, Q[:1])

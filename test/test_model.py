@@ -6,7 +6,18 @@ import numpy as np
 import pytest
 import yaml
 
-from irb140_dynamics.core import DH, Joint, ModelError, RigidBody, RobotModel, irb140, load_model
+from irb140_dynamics.core import (
+    DH,
+    Joint,
+    ModelError,
+    RigidBody,
+    RobotModel,
+    forward_dynamics,
+    irb140,
+    load_model,
+    mass_matrix,
+    rnea,
+)
 from irb140_dynamics.core.model import read_parameter_file
 
 from .support import OFFSET_PAYLOAD, random_model, random_rotation
@@ -237,3 +248,38 @@ def test_with_payload_merges_into_the_last_link_only():
     assert merged.mass == pytest.approx(mass, rel=1e-15)
     np.testing.assert_allclose(merged.com, com, rtol=1e-14, atol=1e-16)
     np.testing.assert_allclose(merged.inertia, inertia[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]], rtol=1e-13, atol=1e-16)
+
+
+# -- sanity caps: no parameter value that passes may overflow the algorithms ----------------------
+
+
+@pytest.mark.parametrize(
+    "key, value, reason",
+    [
+        ("payload.com", [1e200, 0.0, 0.0], "|com| must be <= 1000 m"),
+        ("payload.mass", 1e200, "must be <= 1e+06 kg"),
+        ("payload.mass", 1e308, "must be <= 1e+06 kg"),
+        ("joint_2.link.mass", 2e6, "must be <= 1e+06 kg"),
+        ("joint_4.link.com", [0.0, 1e3, 1.0], "|com| must be <= 1000 m"),
+        ("payload.inertia", [1e7, 1e7, 1e7, 0.0, 0.0, 0.0], "|entry| must be <= 1e+06 kg m^2"),
+        ("joint_3.dh", [0.0, 0.0, 1e200, 0.0], "|a| and |d| must be <= 1000 m"),
+        ("gravity", [0.0, 0.0, -1e200], "|g| must be <= 1000 m/s^2"),
+    ],
+)
+def test_values_beyond_the_sanity_caps_are_refused(key, value, reason):
+    assert_rejected(changed(key, value), key, reason)
+
+
+def test_a_model_at_the_caps_stays_finite():
+    """Every cap reached at once: the kernels compile (no inf or nan constant) and the
+    torques, mass matrix and accelerations are finite at a brisk state."""
+    heavy = RigidBody(1e6, (0.0, 0.0, 1e3), (1e6, 1e6, 1e6, 0.0, 0.0, 0.0))
+    joints = tuple(Joint(f"j{i}", DH(a=1e3, alpha=math.pi / 2, d=1e3), heavy) for i in range(6))
+    model = RobotModel(joints, (0.0, 0.0, -1e3), heavy)
+    for body in model.bodies:  # the last one with the payload merged in
+        m, h, inertia = body.about_origin()
+        assert all(math.isfinite(x) for x in (m, *h, *inertia))
+    q, qd, qdd = np.full(6, 0.7), np.full(6, 100.0), np.full(6, 1e4)
+    assert np.isfinite(rnea(model, q, qd, qdd)).all()
+    assert np.isfinite(mass_matrix(model, q)).all()
+    assert np.isfinite(forward_dynamics(model, q, qd, np.zeros(6))).all()

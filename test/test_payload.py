@@ -2,17 +2,17 @@
 exact largest payloads, checked against the dynamics core and brute-force sampling."""
 
 import math
-import time
 
 import numpy as np
 import pytest
 
-from irb140_dynamics.core import RigidBody, RobotModel, gravity, gravity_batch, irb140, rnea
+from irb140_dynamics.core import ModelError, RigidBody, RobotModel, gravity, gravity_batch, irb140, rnea
 from irb140_dynamics.core.payload import (
     RTOL,
     check_payload,
     derive_torque_limits,
     max_payload_at,
+    payload_family,
     workspace_load,
 )
 from irb140_dynamics.core.workspace import harmonic_argmax, quasi_random
@@ -238,8 +238,57 @@ def test_workspace_part_alone_and_reused(model, limits):
     assert "-" in no_state.report().splitlines()[3].split()[1]
 
 
-def test_default_check_time(model):
-    check_payload(model, RigidBody(6.0), q=STRETCHED)  # kernels compiled
-    start = time.perf_counter()
-    check_payload(model, RigidBody(6.0), q=STRETCHED)
-    print(f"default check: {1e3 * (time.perf_counter() - start):.1f} ms")
+def test_report_rows_are_the_figures(model, limits):
+    """One source: each report row is its joint's figures, the summary the payload's."""
+    check = check_payload(model, RigidBody(2.0, (0.0, 0.05, 0.1)), limits, q=STATES[1][0], qd=STATES[1][1])
+    lines = check.report().splitlines()
+    for j in range(6):
+        figures = check.joint_figures(j)
+        assert list(figures) == ["torque now [N m]", "limit [N m]", "use now", "worst static torque [N m]",
+                                 "worst use", "worst pose [deg]", "limit source"]
+        row = lines[2 + j]
+        assert row.split()[1:6] == list(figures.values())[:5]
+        assert row.endswith("  " + figures["worst pose [deg]"])
+        assert figures["limit source"] in lines[8]
+    payload = check.payload_figures()
+    assert lines[0].startswith(f"payload {payload['payload mass [kg]']} kg at {payload['payload com [m]']} m: ")
+    here = f"{payload['max payload here [kg]']} kg ({payload['max payload here: limited by']}) here"
+    everywhere = (f"{payload['max payload over the workspace [kg]']} kg "
+                  f"({payload['max payload over the workspace: limited by']} at "
+                  f"{payload['max payload over the workspace: pose [deg]']} deg) over the workspace")
+    assert lines[9] == f"max payload: {here}, {everywhere}"
+
+
+def test_a_payload_loading_a_joint_without_limit_gets_a_note(model, limits):
+    """3 kg 0.1 m off the flange axis turns joint 6, which the rated payload never loads."""
+    check = check_payload(model, RigidBody(3.0, (0.1, 0.0, 0.0)), limits, q=STATES[1][0])
+    assert limits.reason(5) == "none: the rated payload cannot load it"
+    assert abs(check.workspace.torque[5]) == pytest.approx(3.0 * 9.81 * 0.1, rel=1e-9)
+    assert check.loaded_without_limit == [5]  # not joint 1: a payload never turns it statically
+    assert check.ok  # the limits decide, the note only warns
+    assert check.report().splitlines()[-1] == (
+        "note: joint_6 has no limit, yet this payload loads it (2.943 N m in its worst pose): "
+        "set joint_6.torque_limit"
+    )
+    centred = check_payload(model, RigidBody(6.0), limits, q=STRETCHED)
+    assert centred.loaded_without_limit == [] and "note" not in centred.report()
+
+
+def test_payload_family_takes_the_payload_as_validated(model, limits, monkeypatch):
+    """The payload of a model is valid: no re-validation per call; a new shape is checked
+    once, by the models of its family."""
+    family = payload_family(model, RigidBody(2.0, (0.0, 0.0, 0.1)))
+    carrying = model.with_payload(RigidBody(1.0))
+
+    def validated(*args):
+        raise AssertionError("validated again")
+
+    monkeypatch.setattr(RigidBody, "validated", validated)
+    assert payload_family(model, RigidBody(5.0, (0.0, 0.0, 0.1))) is family  # any mass
+    assert payload_family(carrying, RigidBody(2.0, [0.0, 0.0, 0.1])) is family  # any payload the arm carries
+    check_payload(model, RigidBody(5.0, (0.0, 0.0, 0.1)), limits, q=STRETCHED)
+    monkeypatch.undo()
+    with pytest.raises(ModelError, match="^payload.com: must be finite"):
+        payload_family(model, RigidBody(1.0, (math.nan, 0.0, 0.0)))
+    with pytest.raises(ModelError, match="^payload.inertia: "):
+        payload_family(model, RigidBody(1.0, (0.0, 0.0, 0.0), (1.0, 1.0, 3.0, 0.0, 0.0, 0.0)))

@@ -5,12 +5,15 @@ import re
 
 import numpy as np
 import pytest
+from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
-from irb140_dynamics.core import RigidBody, irb140, rnea
+from irb140_dynamics.core import RigidBody, irb140, rnea, workspace_load
+from irb140_dynamics import payload_check_node as module
 from irb140_dynamics.payload_check_node import PayloadCheckNode
 
 from .ros_harness import running
@@ -95,10 +98,10 @@ def test_max_payload_here_puts_the_limiting_joint_at_its_limit(node, com, q):
     rows = parse_report(check(node).message)
     mass, joint = rows["here"]
     j = NAMES.index(joint)
-    limit = node.node.analysis.limits.values[j]
+    limit = node.node.settings.limits.values[j]
     tau = rnea(irb140(payload=RigidBody(mass, tuple(com))), q, np.zeros(6), np.zeros(6))
     assert abs(tau[j]) == pytest.approx(limit, rel=2e-3 / mass)  # the reply prints mass to 1 g
-    exact = node.node.check().max_payload_here.mass
+    exact = node.node.check()[0].max_payload_here.mass
     tau = rnea(irb140(payload=RigidBody(exact, tuple(com))), q, np.zeros(6), np.zeros(6))
     assert abs(tau[j]) == pytest.approx(limit, rel=1e-9)
 
@@ -146,8 +149,8 @@ def test_diagnostics_carry_the_figures_of_the_reply(node):
         assert float(values["torque now [N m]"]) == row["now"]
         assert float(values["worst static torque [N m]"]) == row["worst"]
         assert _number(values["limit [N m]"]) == row["limit"]
-        assert _number(values["use now [%]"]) == row["use"]
-        assert _number(values["worst use [%]"]) == row["worst_use"]
+        assert _number(values["use now"]) == row["use"]
+        assert _number(values["worst use"]) == row["worst_use"]
     levels = {joint: statuses[joint].level for joint in NAMES}
     assert levels["joint_1"] == DiagnosticStatus.OK and levels["joint_2"] == DiagnosticStatus.WARN  # 100 % >= 90 %
     summary = {kv.key: kv.value for kv in statuses["payload"].values}
@@ -161,3 +164,105 @@ def test_without_joint_states_it_checks_the_workspace_only(node):
     assert reply.success
     assert "workspace only" in reply.message
     assert parse_report(reply.message)["here"] is None
+
+
+def statuses_after(harness, trigger) -> tuple:
+    """(trigger(), the /diagnostics statuses it published by joint or "payload")."""
+    count = len(harness.diagnostics)
+    result = trigger()
+    assert harness.spin_until(lambda: len(harness.diagnostics) > count)
+    return result, {s.name.split(": ", 1)[1]: s for s in harness.diagnostics[-1].status}
+
+
+def test_a_payload_loading_a_joint_without_limit_is_noted_and_warned(node):
+    """3 kg 0.1 m off the flange axis loads joint 6, which the rated payload does not."""
+    at_pose(node, [0.3, -1.0, 1.2, 0.5, 0.2, 0.1])
+    assert all(r.successful for r in node.set_parameters(
+        [Parameter("payload.mass", value=3.0), Parameter("payload.com", value=[0.1, 0.0, 0.0])]
+    ))
+    reply, statuses = statuses_after(node, lambda: check(node))
+    assert reply.success, reply.message  # the limits decide
+    notes = [line for line in reply.message.splitlines() if line.startswith("note:")]
+    assert notes == ["note: joint_6 has no limit, yet this payload loads it (2.943 N m in its worst pose): "
+                     "set joint_6.torque_limit"]
+    assert "joint_1, joint_6: none: the rated payload cannot load it" in reply.message
+    assert statuses["joint_6"].level == DiagnosticStatus.WARN
+    assert "set joint_6.torque_limit" in statuses["joint_6"].message
+    assert statuses["joint_1"].level == DiagnosticStatus.OK
+    assert statuses["joint_1"].message == "none: the rated payload cannot load it"
+    assert statuses["payload"].level == DiagnosticStatus.WARN
+
+    # given a limit, joint 6 is checked like the others
+    assert all(r.successful for r in node.set_parameters([Parameter("joint_6.torque_limit", value=10.0)]))
+    reply, statuses = statuses_after(node, lambda: check(node))
+    assert "note:" not in reply.message
+    assert parse_report(reply.message)["joint_6"]["limit"] == 10.0
+    assert statuses["joint_6"].level == DiagnosticStatus.OK
+
+
+def test_a_failure_deriving_the_limits_or_sweeping_refuses_the_change(node, monkeypatch):
+    """The limits and the workspace sweep are part of building the settings: a failure
+    there is a refused change, the old settings stay, and nothing is built twice."""
+    at_pose(node, STRETCHED)
+    before, settings = check(node).message, node.node.settings
+
+    def failing(*args, **kwargs):
+        raise ValueError("payload.com: the sweep failed")
+
+    monkeypatch.setattr(module, "workspace_load", failing)
+    [result] = node.set_parameters([Parameter("payload.mass", value=2.0)])
+    assert not result.successful and "the sweep failed" in result.reason
+    assert node.node.settings is settings and check(node).message == before
+
+    built = []
+
+    def sweep(*args):
+        built.append(workspace_load(*args))
+        return built[-1]
+
+    monkeypatch.setattr(module, "workspace_load", sweep)
+    assert [r.successful for r in node.set_parameters([Parameter("payload.mass", value=2.0)])] == [True]
+    assert len(built) == 1 and node.node.settings.workspace is built[0]  # built once, when checked
+    assert node.node.settings.model.payload.mass == 2.0
+
+
+def test_fresh_joint_states_carry_no_age_note(node):
+    at_pose(node, STRETCHED)
+    reply, statuses = statuses_after(node, lambda: check(node))
+    assert "received" not in reply.message
+    assert "stale" not in statuses["payload"].message
+
+
+@pytest.fixture
+def sim_node():
+    """The node on simulated time, the probe publishing /clock."""
+    overrides = [Parameter("use_sim_time", value=True), Parameter("diagnostics.period", value=0.0)]
+    with running(PayloadCheckNode, parameter_overrides=overrides) as harness:
+        harness.diagnostics = harness.listen(DiagnosticArray, "/diagnostics")
+        harness.joint_states = harness.publisher(JointState, "joint_states")
+        harness.clock = harness.publisher(Clock, "/clock")
+        harness.client = harness.probe.create_client(Trigger, "/payload_check_node/check")
+        assert harness.client.wait_for_service(timeout_sec=10)
+        yield harness
+
+
+def set_time(harness, sec: int, nanosec: int = 0) -> None:
+    harness.clock.publish(Clock(clock=Time(sec=sec, nanosec=nanosec)))
+    stamp = sec * 10**9 + nanosec
+    assert harness.spin_until(lambda: harness.node.get_clock().now().nanoseconds == stamp)
+
+
+def test_an_old_joint_state_is_used_and_reported_stale(sim_node):
+    set_time(sim_node, 100)
+    at_pose(sim_node, STRETCHED)
+    set_time(sim_node, 100, 900_000_000)  # 0.9 s: fresh enough
+    reply, statuses = statuses_after(sim_node, lambda: check(sim_node))
+    assert "received" not in reply.message and statuses["payload"].level == DiagnosticStatus.OK
+
+    set_time(sim_node, 112, 300_000_000)
+    reply, statuses = statuses_after(sim_node, lambda: check(sim_node))
+    assert reply.message.splitlines()[-1] == "note: joint_states received 12.3 s ago"
+    assert parse_report(reply.message)["joint_2"]["now"] == pytest.approx(243.382, abs=1e-3)  # that state, no payload
+    summary = statuses["payload"]
+    assert summary.level == DiagnosticStatus.WARN and "stale joint_states" in summary.message
+    assert {kv.key: kv.value for kv in summary.values}["stale joint_states"] == "joint_states received 12.3 s ago"

@@ -17,6 +17,9 @@ parameter to fix:
     <joint>.link.mass / .com / .inertia
     <joint>.position_limits     [lower, upper]
     <joint>.torque_limit        N m, 0 = none given
+
+Besides being finite, masses, lengths, inertias and gravity are within sanity caps (see
+``rigid_body``) that keep every number the algorithms derive from them finite.
 """
 
 from __future__ import annotations
@@ -28,9 +31,12 @@ from functools import cached_property
 from typing import Any, Mapping
 
 from .rigid_body import (
+    MAX_GRAVITY,
+    MAX_LENGTH,
     ZERO3,
     ModelError,
     RigidBody,
+    capped,
     combine,
     finite_number,
     finite_numbers,
@@ -71,6 +77,7 @@ class RobotModel:
     def __post_init__(self):
         object.__setattr__(self, "joints", tuple(_validated_joint(j) for j in self.joints))
         object.__setattr__(self, "gravity", finite_numbers("gravity", self.gravity, 3))
+        capped("gravity", "|g|", math.hypot(*self.gravity), MAX_GRAVITY, "m/s^2")
         object.__setattr__(self, "payload", _validated_body("payload", self.payload))
         check_joint_names(self.joint_names)
 
@@ -174,6 +181,7 @@ def _validated_body(prefix: str, body: RigidBody) -> RigidBody:
 
 def _validated_joint(j: Joint) -> Joint:
     dh = DH(*finite_numbers(f"{j.name}.dh", (j.dh.a, j.dh.alpha, j.dh.d, j.dh.theta_offset), 4))
+    capped(f"{j.name}.dh", "|a| and |d|", max(abs(dh.a), abs(dh.d)), MAX_LENGTH, "m")
     lower, upper = finite_numbers(f"{j.name}.position_limits", j.position_limits, 2)
     if lower > upper:
         raise ModelError(f"{j.name}.position_limits", f"lower {lower} > upper {upper}")

@@ -66,17 +66,20 @@ class PayloadFamily:
 
 
 def payload_family(model: RobotModel, payload: RigidBody) -> PayloadFamily:
-    """``payload`` at any mass on ``model``; built (and its kernels compiled) once per shape."""
-    payload = RigidBody.validated("payload", payload.mass, payload.com, payload.inertia)
-    return _family(model.with_payload(RigidBody()), payload.com, payload.inertia)
+    """``payload``'s shape at any mass on ``model`` (whatever payload ``model`` carries).
+
+    Built once per arm and shape: the two models validate the CoM and inertia (ModelError
+    naming ``payload.com`` or ``payload.inertia``) and compile their kernels then.
+    """
+    return _family(model.joints, model.gravity, tuple(payload.com), tuple(payload.inertia))
 
 
 @lru_cache(maxsize=16)
-def _family(model: RobotModel, com, inertia) -> PayloadFamily:
-    return PayloadFamily(
-        model.with_payload(RigidBody(0.0, com, inertia)),
-        model.with_payload(RigidBody(1.0, com, inertia)),
-    )
+def _family(joints, gravity, com, inertia) -> PayloadFamily:
+    def carrying(mass):
+        return RobotModel(joints, gravity, RigidBody(mass, com, inertia))
+
+    return PayloadFamily(carrying(0.0), carrying(1.0))
 
 
 def mass_bounds(tau0, dtau, limits) -> tuple[np.ndarray, np.ndarray]:
@@ -106,6 +109,13 @@ def max_mass(tau0, dtau, limits) -> tuple[np.ndarray, np.ndarray]:
     joint = np.argmax(_at_most(upper, m[..., None]), axis=-1)
     fits = np.maximum(0.0, np.max(lower, axis=-1)) <= m
     return np.where(fits, m, np.nan), joint
+
+
+def loads(torque) -> np.ndarray:
+    """Per joint: is the (worst) static torque more than rounding noise, i.e. does the load
+    reach the joint at all? Noise: RTOL of the largest, or of 1 N m."""
+    worst = np.abs(torque)
+    return worst > RTOL * max(worst.max(), 1.0)
 
 
 def _at_most(x, m):
@@ -151,7 +161,7 @@ class TorqueLimits:
             "given": "given (torque_limit)",
             "derived": f"worst static torque of the rated payload, "
             f"{rated.mass:.3f} kg at {_vector(rated.com)} m",
-            "none": "none, gravity cannot load it",
+            "none": "none: the rated payload cannot load it",
         }[self.source[j]]
 
 
@@ -186,14 +196,13 @@ def _largest(values: np.ndarray, poses: np.ndarray) -> tuple[np.ndarray, np.ndar
 
 def derive_torque_limits(model: RobotModel, rated_payload: RigidBody = RATED_PAYLOAD) -> TorqueLimits:
     """Each joint's limit: its given torque_limit if > 0, else the worst static torque of
-    the rated payload over the joint ranges; none (inf) for a joint gravity cannot load."""
+    the rated payload over the joint ranges; none (inf) for a joint it cannot load."""
     rated = payload_family(model, rated_payload).static_torque(rated_payload.mass)
     torque, pose = _largest(*static_extremes(rated, JointRanges.of(model)))
-    worst = np.abs(torque)
-    unloaded = worst <= RTOL * max(worst.max(), 1.0)
+    loaded = loads(torque)
     given = np.array(model.torque_limits) > 0
-    source = np.where(given, "given", np.where(unloaded, "none", "derived"))
-    limits = np.where(given, model.torque_limits, np.where(unloaded, np.inf, worst))
+    source = np.where(given, "given", np.where(loaded, "derived", "none"))
+    limits = np.where(given, model.torque_limits, np.where(loaded, np.abs(torque), np.inf))
     return TorqueLimits(tuple(limits.tolist()), tuple(source.tolist()), rated_payload, torque, pose)
 
 
@@ -300,29 +309,64 @@ class PayloadCheck:
     def ok(self) -> bool:
         return bool(self.within.all())
 
+    @property
+    def over(self) -> list[str]:
+        """The names of the joints over their limit."""
+        return [name for name, ok in zip(self.joint_names, self.within) if not ok]
+
+    @property
+    def loaded_without_limit(self) -> list[int]:
+        """The joints that have no limit and yet this payload loads (statically): their
+        limit rule did not see this load, so nothing checks it."""
+        return [int(j) for j in np.flatnonzero(np.isinf(self.limit) & loads(self.workspace.torque))]
+
+    def no_limit_note(self, j: int) -> str:
+        """Why joint j (of loaded_without_limit) wants a given torque limit."""
+        name = self.joint_names[j]
+        return (f"{name} has no limit, yet this payload loads it ({self.workspace.torque[j]:.3f} N m "
+                f"in its worst pose): set {name}.torque_limit")
+
+    # -- the figures, formatted once for the report and /diagnostics --------------------
+
+    def joint_figures(self, j: int) -> dict[str, str]:
+        """Joint j's figures by label, in the order of the report's columns."""
+        L, load, now = self.limit[j], self.workspace, self.torque is not None
+        return {
+            "torque now [N m]": f"{self.torque[j]:.3f}" if now else "-",
+            "limit [N m]": "none" if L == math.inf else f"{L:.3f}",
+            "use now": _percent(self.use[j], L) if now else "-",
+            "worst static torque [N m]": f"{load.torque[j]:.3f}",
+            "worst use": _percent(self.worst_use[j], L),
+            "worst pose [deg]": _degrees(load.pose[j]),
+            "limit source": self.limits.reason(j),
+        }
+
+    def payload_figures(self) -> dict[str, str]:
+        """The payload and its largest masses by label ("here" only with a state)."""
+        figures = {"payload mass [kg]": f"{self.payload.mass:.3f}", "payload com [m]": _vector(self.payload.com)}
+        for where, best in (("here", self.max_payload_here), ("over the workspace", self.workspace.max_payload)):
+            if best is not None:
+                mass, joint, pose = _max_payload_figures(best, self.joint_names)
+                label = f"max payload {where}"
+                figures.update({f"{label} [kg]": mass, f"{label}: limited by": joint, f"{label}: pose [deg]": pose})
+        return figures
+
     def report(self) -> str:
-        """The check as short text: one line per joint, then the largest payloads."""
-        names, load, L = self.joint_names, self.workspace, self.limit
-        over = [name for name, ok in zip(names, self.within) if not ok]
-        status = "OK" if not over else "OVER THE LIMIT at " + ", ".join(over)
+        """The check as short text: one line per joint, the largest payloads, then notes."""
+        status = "OVER THE LIMIT at " + ", ".join(self.over) if self.over else "OK"
+        payload = self.payload_figures()
         lines = [
-            f"payload {self.payload.mass:.3f} kg at {_vector(self.payload.com)} m: {status}",
+            f"payload {payload['payload mass [kg]']} kg at {payload['payload com [m]']} m: {status}",
             f"{'joint':<10}{'now [N m]':>11}{'limit [N m]':>13}{'use':>8}"
             f"{'worst [N m]':>13}{'use':>8}  worst pose [deg]",
         ]
-        for j, name in enumerate(names):
-            now, use = "-", "-"
-            if self.torque is not None:
-                now, use = f"{self.torque[j]:.3f}", _percent(self.use[j], L[j])
-            worst, worst_use = f"{load.torque[j]:.3f}", _percent(self.worst_use[j], L[j])
-            lines.append(
-                f"{name:<10}{now:>11}{_limit(L[j]):>13}{use:>8}{worst:>13}{worst_use:>8}"
-                f"  {_degrees(load.pose[j])}"
-            )
+        for j, name in enumerate(self.joint_names):
+            now, limit, use, worst, worst_use, pose, _ = self.joint_figures(j).values()
+            lines.append(f"{name:<10}{now:>11}{limit:>13}{use:>8}{worst:>13}{worst_use:>8}  {pose}")
         lines.append("limits: " + self._limits_note())
-        here = "" if self.max_payload_here is None else f"{_mass(self.max_payload_here, names)} here, "
-        everywhere = _mass(load.max_payload, names, pose=True)
-        lines.append(f"max payload: {here}{everywhere} over the workspace")
+        here = "" if self.max_payload_here is None else f"{_max_payload_text(payload, 'here')} here, "
+        lines.append(f"max payload: {here}{_max_payload_text(payload, 'over the workspace')} over the workspace")
+        lines += [f"note: {self.no_limit_note(j)}" for j in self.loaded_without_limit]
         return "\n".join(lines)
 
     def _limits_note(self) -> str:
@@ -362,7 +406,7 @@ def check_payload(
     return PayloadCheck(model.joint_names, payload, limits, workspace, q, qd, torque, here)
 
 
-# -- text -----------------------------------------------------------------------------------------
+# -- text ------------------------------------------------------------------------------------------
 
 
 def _vector(x) -> str:
@@ -373,18 +417,27 @@ def _degrees(q) -> str:
     return "(" + ", ".join(f"{round(v, 1) + 0.0:g}" for v in np.degrees(q)) + ")"
 
 
-def _limit(L: float) -> str:
-    return "none" if L == math.inf else f"{L:.3f}"
-
-
 def _percent(use: float, L: float) -> str:
     return "-" if L == math.inf else f"{use:.1f}%"
 
 
-def _mass(best: MaxPayload, names, pose=False) -> str:
-    if math.isnan(best.mass):
-        return f"none ({names[best.joint]} over its limit)"
+def _max_payload_figures(best: MaxPayload, names) -> tuple[str, str, str]:
+    """(mass [kg]: a number, "none" or "unbounded"; the joint at or over its limit; the
+    pose [deg]), "-" where there is none."""
     if best.mass == math.inf:
-        return "unbounded"
-    where = f" at {_degrees(best.q)} deg" if pose else ""
-    return f"{best.mass:.3f} kg ({names[best.joint]}{where})"
+        return "unbounded", "-", "-"
+    mass = "none" if math.isnan(best.mass) else f"{best.mass:.3f}"
+    return mass, names[best.joint], _degrees(best.q)
+
+
+def _max_payload_text(figures: dict[str, str], where: str) -> str:
+    """A largest payload of payload_figures in words: "6.000 kg (joint_2)", with the pose
+    over the workspace."""
+    label = f"max payload {where}"
+    mass, joint, pose = (figures[f"{label}{key}"] for key in (" [kg]", ": limited by", ": pose [deg]"))
+    if mass == "unbounded":
+        return mass
+    if mass == "none":
+        return f"none ({joint} over its limit)"
+    at = f" at {pose} deg" if where != "here" else ""
+    return f"{mass} kg ({joint}{at})"

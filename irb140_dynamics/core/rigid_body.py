@@ -2,6 +2,13 @@
 
 Units: kg, m, kg m^2. An inertia is six numbers (Ixx, Iyy, Izz, Ixy, Ixz, Iyz), the
 tensor's entries (Ixy is the tensor entry, i.e. minus the product of inertia integral).
+
+Sanity caps: a mass is at most MAX_MASS, a centre of mass at most MAX_LENGTH from its
+frame's origin, an inertia entry at most MAX_INERTIA in size (and the model caps DH lengths
+and gravity, see ``model``). They are far beyond any arm, and they keep every quantity the
+algorithms derive finite: m c <= 1e9 kg m, the inertia about a joint origin <= 2.1e12 kg m^2
+(payload merged into the last link included), and so the torques at any state of sane
+speeds. Without them 1e200 kg, or a CoM 1e200 m out, would overflow to inf or nan.
 """
 
 from __future__ import annotations
@@ -17,6 +24,11 @@ Inertia6 = tuple[float, float, float, float, float, float]
 
 ZERO3: Vector3 = (0.0, 0.0, 0.0)
 ZERO6: Inertia6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+MAX_MASS = 1e6  # kg
+MAX_LENGTH = 1e3  # m: |CoM|, and the DH lengths |a|, |d|
+MAX_INERTIA = 1e6  # kg m^2: each entry of an inertia about the CoM
+MAX_GRAVITY = 1e3  # m/s^2: |g|
 
 
 class ModelError(ValueError):
@@ -50,6 +62,12 @@ def finite_number(field: str, value) -> float:
     return finite_numbers(field, value, 1)[0]
 
 
+def capped(field: str, what: str, size: float, cap: float, unit: str) -> None:
+    """ModelError unless size <= cap (one of the sanity caps above)."""
+    if size > cap:
+        raise ModelError(field, f"{what} must be <= {cap:g} {unit} (sanity cap), got {size:g}".lstrip())
+
+
 def inertia_matrix(inertia: Sequence[float]) -> np.ndarray:
     xx, yy, zz, xy, xz, yz = inertia
     return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
@@ -58,6 +76,7 @@ def inertia_matrix(inertia: Sequence[float]) -> np.ndarray:
 def validate_inertia(field: str, inertia: Sequence[float]) -> Inertia6:
     """Six finite numbers forming a physically possible inertia tensor, or ModelError."""
     inertia = finite_numbers(field, inertia, 6)
+    capped(field, "each |entry|", max(map(abs, inertia)), MAX_INERTIA, "kg m^2")
     moments = np.linalg.eigvalsh(inertia_matrix(inertia))
     tol = 1e-12 * max(1.0, float(np.max(np.abs(moments))))
     if moments[0] < -tol:
@@ -83,7 +102,10 @@ class RigidBody:
         m = finite_number(f"{field}.mass", mass)
         if m < 0.0:
             raise ModelError(f"{field}.mass", f"must be >= 0, got {m}")
-        return cls(m, finite_numbers(f"{field}.com", com, 3), validate_inertia(f"{field}.inertia", inertia))
+        capped(f"{field}.mass", "", m, MAX_MASS, "kg")
+        c = finite_numbers(f"{field}.com", com, 3)
+        capped(f"{field}.com", "|com|", math.hypot(*c), MAX_LENGTH, "m")
+        return cls(m, c, validate_inertia(f"{field}.inertia", inertia))
 
     def about_origin(self) -> tuple[float, Vector3, Inertia6]:
         """(m, h, I_o): mass, first moment m*com, and inertia about the frame origin."""

@@ -1,89 +1,63 @@
-"""A payload check as diagnostic_msgs statuses, for rqt_robot_monitor and aggregators."""
+"""A payload check as diagnostic_msgs statuses, for rqt_robot_monitor and aggregators.
+
+The key-values are the check's own figures (PayloadCheck.joint_figures, payload_figures):
+the same strings as in the ~/check report.
+"""
 
 from __future__ import annotations
 
 import math
 
-import numpy as np
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 
-from ..core.payload import MaxPayload, PayloadCheck
+from ..core.payload import PayloadCheck
 
 OK, WARN, ERROR = DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR
 
 
-def payload_statuses(check: PayloadCheck, node_name: str, warn_use: float) -> list[DiagnosticStatus]:
-    """One status per joint (OK / WARN from ``warn_use`` % / ERROR over its limit), then one
-    for the payload with the largest payloads. Figures as in the check's report."""
+def payload_statuses(
+    check: PayloadCheck, node_name: str, warn_use: float, stale: str | None = None
+) -> list[DiagnosticStatus]:
+    """One status per joint (OK; WARN from ``warn_use`` % or when the payload loads a joint
+    without a limit; ERROR over its limit), then one for the payload with the largest
+    payloads, WARN at least when ``stale`` (how old the joint state is) is given."""
     statuses = [_joint_status(check, j, node_name, warn_use) for j in range(len(check.joint_names))]
+    figures = check.payload_figures()
+    verdict = "over the limit at " + ", ".join(check.over) if check.over else "OK"
+    message = f"{figures['payload mass [kg]']} kg: {verdict}"
     level = max(status.level for status in statuses)
-    names = check.joint_names
-    over = [name for name, ok in zip(names, check.within) if not ok]
+    if stale is not None:
+        level, message = max(level, WARN), f"{message}; stale joint_states"
+        figures["stale joint_states"] = stale
     summary = DiagnosticStatus(
-        level=level,
-        name=f"{node_name}: payload",
-        hardware_id=node_name,
-        message=f"{check.payload.mass:.3f} kg: " + ("OK" if not over else "over the limit at " + ", ".join(over)),
-        values=[
-            KeyValue(key="payload mass [kg]", value=f"{check.payload.mass:.3f}"),
-            KeyValue(key="payload com [m]", value=_numbers(check.payload.com, 3)),
-            *_max_payload_values("max payload here", check.max_payload_here, names),
-            *_max_payload_values("max payload over the workspace", check.workspace.max_payload, names),
-        ],
+        level=level, name=f"{node_name}: payload", hardware_id=node_name, message=message,
+        values=_key_values(figures),
     )
     return statuses + [summary]
 
 
 def _joint_status(check: PayloadCheck, j: int, node_name: str, warn_use: float) -> DiagnosticStatus:
+    figures = check.joint_figures(j)
     limit = check.limit[j]
-    uses = [check.worst_use[j]] + ([] if check.use is None else [check.use[j]])
+    uses = {"worst use": check.worst_use[j], **({} if check.use is None else {"use now": check.use[j]})}
+    most = max(uses, key=uses.get)
     if not check.within[j]:
         level = ERROR
-    elif math.isfinite(limit) and max(uses) >= warn_use:
-        level = WARN
+    elif math.isfinite(limit):
+        level = WARN if uses[most] >= warn_use else OK
     else:
-        level = OK
+        level = WARN if j in check.loaded_without_limit else OK
     if math.isfinite(limit):
-        message = f"{max(uses):.1f}% of its {limit:.3f} N m limit"
+        message = f"{figures[most]} of its {figures['limit [N m]']} N m limit"
+    elif level == WARN:
+        message = check.no_limit_note(j)
     else:
-        message = f"no limit: {check.limits.reason(j)}"
-    values = [
-        KeyValue(key="limit [N m]", value="none" if not math.isfinite(limit) else f"{limit:.3f}"),
-        KeyValue(key="limit source", value=check.limits.reason(j)),
-        KeyValue(key="worst static torque [N m]", value=f"{check.workspace.torque[j]:.3f}"),
-        KeyValue(key="worst use [%]", value=_percent(check.worst_use[j], limit)),
-        KeyValue(key="worst pose [deg]", value=_numbers(np.degrees(check.workspace.pose[j]), 1)),
-    ]
-    if check.torque is not None:
-        values += [
-            KeyValue(key="torque now [N m]", value=f"{check.torque[j]:.3f}"),
-            KeyValue(key="use now [%]", value=_percent(check.use[j], limit)),
-        ]
+        message = figures["limit source"]
     return DiagnosticStatus(
         level=level, name=f"{node_name}: {check.joint_names[j]}", hardware_id=node_name,
-        message=message, values=values,
+        message=message, values=_key_values(figures),
     )
 
 
-def _max_payload_values(label: str, best: MaxPayload | None, names) -> list[KeyValue]:
-    if best is None:
-        return []
-    if math.isnan(best.mass):
-        mass = "none"
-    elif math.isinf(best.mass):
-        mass = "unbounded"
-    else:
-        mass = f"{best.mass:.3f}"
-    values = [KeyValue(key=f"{label} [kg]", value=mass)]
-    if best.joint is not None:
-        values.append(KeyValue(key=f"{label}: limited by", value=names[best.joint]))
-        values.append(KeyValue(key=f"{label}: pose [deg]", value=_numbers(np.degrees(best.q), 1)))
-    return values
-
-
-def _percent(use: float, limit: float) -> str:
-    return f"{use:.1f}" if math.isfinite(limit) else "-"
-
-
-def _numbers(values, digits: int) -> str:
-    return "[" + ", ".join(f"{v + 0.0:.{digits}f}" for v in values) + "]"
+def _key_values(figures: dict[str, str]) -> list[KeyValue]:
+    return [KeyValue(key=key, value=value) for key, value in figures.items()]
