@@ -74,20 +74,26 @@ class Figure:
 
 @dataclass(frozen=True)
 class Target:
-    """The ratio ours / baseline a figure must reach: at most ``limit``, or at least."""
+    """The ratio ours / baseline a figure must reach: at most ``limit``, or at least.
+
+    ``absolute``: the limit is on our figure itself (its best value), not on the ratio,
+    e.g. ``Target(0, absolute=True)``: no message lost.
+    """
 
     limit: float
     at_least: bool = False
+    absolute: bool = False
 
-    def met(self, ratio: float) -> bool:
-        return ratio >= self.limit if self.at_least else ratio <= self.limit
+    def met(self, value: float) -> bool:
+        """``value``: the ratio, or our figure for an absolute target."""
+        return value >= self.limit if self.at_least else value <= self.limit
 
     def shortfall(self, ratio: float) -> float:
         """How many times worse than the target the ratio is (1 or less: met)."""
         return self.limit / ratio if self.at_least else ratio / self.limit
 
     def __str__(self) -> str:
-        return f"{'>=' if self.at_least else '<='} {self.limit:g}x"
+        return f"{'>=' if self.at_least else '<='} {self.limit:g}{'' if self.absolute else 'x'}"
 
 
 @dataclass(frozen=True)
@@ -102,23 +108,32 @@ class Row:
 
     @property
     def ratio(self) -> float | None:
-        """ours / baseline on the best values."""
-        return None if self.baseline is None else self.ours.best / self.baseline.best
+        """ours / baseline on the best values (None without a baseline or when it is 0)."""
+        return None if self.baseline is None else _divide(self.ours.best, self.baseline.best)
 
     @property
     def met(self) -> bool | None:
-        return None if self.target is None else self.target.met(self.ratio)
+        if self.target is None:
+            return None
+        value = self.ours.best if self.target.absolute else self.ratio
+        return None if value is None else self.target.met(value)
 
     def as_dict(self) -> dict:
         row = {"group": self.group, "name": self.name, "ours": vars(self.ours)}
         if self.baseline is not None:
             row["baseline"] = vars(self.baseline)
             row["ratio"] = self.ratio
-            row["ratio_of_medians"] = self.ours.median / self.baseline.median
+            row["ratio_of_medians"] = _divide(self.ours.median, self.baseline.median)
         if self.target is not None:
             row["target"] = {"limit": self.target.limit, "at_least": self.target.at_least}
+            if self.target.absolute:
+                row["target"]["absolute"] = True
             row["met"] = self.met
         return row
+
+
+def _divide(a: float | None, b: float | None) -> float | None:
+    return None if a is None or b is None or b == 0 else a / b
 
 
 # -- reporting --------------------------------------------------------------------------
@@ -144,20 +159,23 @@ def print_table(rows: Iterable[Row], title: str) -> None:
     print(rule)
     missed = [row for row in rows if row.met is False]
     for row in missed:
+        if row.target.absolute:
+            print(f"MISSED: {row.name}: {row.ours}, target {row.target}")
+            continue
         print(
             f"MISSED: {row.name}: ratio {_ratio(row.ratio)}, target {row.target}, "
             f"{row.target.shortfall(row.ratio):.2f}x off"
         )
-    checked = sum(row.target is not None for row in rows)
+    checked = sum(row.met is not None for row in rows)
     print(f"{checked - len(missed)} of {checked} targets met")
 
 
 def _cells(row: Row) -> tuple[str, ...]:
-    if row.baseline is None:
-        return (row.name, str(row.ours), "-", "-", "-", "-")
     result = "-" if row.met is None else ("met" if row.met else "MISSED")
     target = "-" if row.target is None else str(row.target)
-    return (row.name, str(row.ours), str(row.baseline), _ratio(row.ratio), target, result)
+    baseline = "-" if row.baseline is None else str(row.baseline)
+    ratio = "-" if row.ratio is None else _ratio(row.ratio)
+    return (row.name, str(row.ours), baseline, ratio, target, result)
 
 
 def _number(x: float) -> str:
@@ -172,7 +190,7 @@ def _number(x: float) -> str:
 
 
 def _ratio(ratio: float) -> str:
-    return f"1/{1 / ratio:.0f}x" if ratio < 0.1 else f"{ratio:.2f}x"
+    return f"1/{1 / ratio:.0f}x" if 0 < ratio < 0.1 else f"{ratio:.2f}x"
 
 
 def machine_info(modules: Sequence[str] = ("numpy",)) -> dict:
