@@ -44,6 +44,7 @@ from irb140_dynamics.core import (
     rnea_batch,
 )
 from irb140_dynamics.core.rigid_body import inertia_matrix
+from test.pinocchio_model import build as pinocchio_model, rot_x, rot_z  # noqa: E402
 
 BATCH_STATES = 100_000
 BATCH_CHECKED = 1_000  # states of the batch compared with Pinocchio
@@ -55,34 +56,6 @@ SEED = 140
 
 
 # -- the baselines ----------------------------------------------------------------------
-
-
-def pinocchio_model(model) -> pin.Model:
-    """The same arm as a Pinocchio model: one revolute z joint per DH row.
-
-    Joint i sits in the previous body frame, turned by Rz(theta_offset_i); body (DH frame)
-    i is SE3(Rx(alpha_i), [a_i, 0, d_i]) in joint i's frame and holds link i's inertia.
-    """
-    pm = pin.Model()
-    parent, body_frame = 0, pin.SE3.Identity()
-    for joint, body in zip(model.joints, model.bodies):
-        offset = pin.SE3(pin.utils.rotate("z", joint.dh.theta_offset), np.zeros(3))
-        parent = pm.addJoint(parent, pin.JointModelRZ(), body_frame * offset, joint.name)
-        body_frame = pin.SE3(pin.utils.rotate("x", joint.dh.alpha), np.array([joint.dh.a, 0.0, joint.dh.d]))
-        inertia = pin.Inertia(body.mass, np.array(body.com), inertia_matrix(body.inertia))
-        pm.appendBodyToJoint(parent, inertia, body_frame)
-    pm.gravity = pin.Motion(np.array(model.gravity), np.zeros(3))
-    return pm
-
-
-def rot_z(theta: float) -> np.ndarray:
-    c, s = math.cos(theta), math.sin(theta)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def rot_x(alpha: float) -> np.ndarray:
-    c, s = math.cos(alpha), math.sin(alpha)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
 class TextbookRnea:
@@ -243,7 +216,7 @@ def _timed(samples: list[float], fn):
 def main() -> None:
     started = time.perf_counter()
     model = irb140()
-    pm = pinocchio_model(model)
+    pm = pinocchio_model(model)  # the builder the tests check against our core
     data = pm.createData()
     generation, source_lines = kernel_generation()  # first: on fresh models, before any warm-up
     rows = single_state(model, pm, data) + batch(model, pm, data) + generation
