@@ -11,41 +11,46 @@ Publishes    /diagnostics   diagnostic_msgs/DiagnosticArray: one status per join
 Torque limits: <joint>.torque_limit when > 0, else derived as in the report: the worst
 static torque of the rated payload over the joint ranges; none for a joint it cannot load.
 A joint state older than STALE_AFTER (node clock) is still used, and the check says so.
+The limits and the workspace analysis are computed off the executor after each accepted
+change (and at startup, up to STARTUP_WAIT before the node comes up); until they are
+done, ~/check answers success false, "pending", at once.
 """
 
 from __future__ import annotations
 
-from collections import Counter
+import time
 from dataclasses import dataclass
 
-from diagnostic_msgs.msg import DiagnosticArray
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
-from .core import RigidBody, RobotModel
+from .core import RigidBody, RobotModel, gravity, rnea
 from .core.payload import TorqueLimits, WorkspaceLoad, check_payload, derive_torque_limits, workspace_load
 from .ros.diagnostics import payload_statuses
-from .ros.messages import BadMessage, JointOrder, NotForThisModel, count_and_warn, read_joint_state
-from .ros.params import QOS_PARAMETERS, Spec, check_qos, declare_model, joint_states_qos
+from .ros.guard import Tally, guarded
+from .ros.messages import BadMessage, JointOrder, NotForThisModel, finite_torques, read_joint_state
+from .ros.node_parameters import MAX_DIAGNOSTICS_PERIOD, MAX_WARN_USE, MIN_DIAGNOSTICS_PERIOD, PAYLOAD_CHECK_NODE
+from .ros.params import check_number, check_qos, declare_model, joint_states_qos
 from .ros.spin import run
 
-NODE_PARAMETERS = [
-    Spec("rated_payload.mass", 6.0, "the rated payload the torque limits are derived from", "kg",
-         minimum=0.0),
-    Spec("rated_payload.com", [0.0, 0.0, 0.0], "its centre of mass, in the flange frame", "m"),
-    Spec("diagnostics.warn_use", 90.0, "a joint using more of its limit than this is a WARN", "%",
-         minimum=0.0),
-    Spec("diagnostics.period", 1.0, "check and publish /diagnostics this often; 0 = only on ~/check",
-         "s", minimum=0.0, read_only=True),
-    *QOS_PARAMETERS,
-]
 STALE_AFTER = 1.0  # s: a joint state older than this is reported as stale
+STARTUP_WAIT = 2.0  # s: at most this long for the first analysis before the node is ready
+
+
+@dataclass(frozen=True)
+class Draft:
+    """The validated parameters a check depends on, before the analysis."""
+
+    model: RobotModel  # with the payload under test
+    rated_payload: RigidBody
+    warn_use: float
 
 
 @dataclass(frozen=True)
 class Settings:
-    """What a check needs that depends only on the parameters, the workspace sweep included."""
+    """What a check needs that depends only on the parameters, the workspace analysis included."""
 
     model: RobotModel  # with the payload under test
     rated_payload: RigidBody
@@ -54,49 +59,97 @@ class Settings:
     workspace: WorkspaceLoad  # the payload's worst static loads and largest mass
 
 
-def build_settings(values: dict) -> Settings:
-    """Validate everything, derive the limits and sweep the workspace: a change that fails
-    here is refused, and these settings are the ones applied."""
+def check_settings(values: dict) -> Draft:
+    """Validate every parameter (quick, within the parameter call)."""
     model = RobotModel.from_params(values)
     rated = RigidBody.validated("rated_payload", values["rated_payload.mass"], values["rated_payload.com"])
-    if not values["diagnostics.warn_use"] >= 0.0:
-        raise ValueError(f"diagnostics.warn_use: must be >= 0 %, got {values['diagnostics.warn_use']}")
+    warn_use = check_number("diagnostics.warn_use", values["diagnostics.warn_use"], 0.0, MAX_WARN_USE, "%")
+    period = values["diagnostics.period"]
+    if period != 0.0 and not MIN_DIAGNOSTICS_PERIOD <= period <= MAX_DIAGNOSTICS_PERIOD:
+        raise ValueError(f"diagnostics.period: must be 0 (only on ~/check) or between {MIN_DIAGNOSTICS_PERIOD:g} "
+                         f"and {MAX_DIAGNOSTICS_PERIOD:g} s, got {period}")
     check_qos(values)
-    limits = derive_torque_limits(model, rated)
-    workspace = workspace_load(model, model.payload, limits)
-    return Settings(model, rated, values["diagnostics.warn_use"], limits, workspace)
+    return Draft(model, rated, warn_use)
+
+
+def finish_settings(draft: Draft, previous: Settings | None) -> Settings:
+    """Derive the limits and analyse the workspace (seconds for a large model: runs off the
+    executor); what the previous settings computed for the same arm is reused."""
+    model, rated = draft.model, draft.rated_payload
+    same_arm = previous is not None and (previous.model.joints, previous.model.gravity, previous.rated_payload) == (
+        model.joints, model.gravity, rated)
+    limits = previous.limits if same_arm else derive_torque_limits(model, rated)
+    if same_arm and previous.model.payload == model.payload:
+        workspace = previous.workspace
+    else:
+        workspace = workspace_load(model, model.payload, limits)
+    return Settings(model, rated, draft.warn_use, limits, workspace)
+
+
+def _failed_check(request, response, error):
+    response.success = False
+    response.message = f"not checked: internal error {type(error).__name__}: {error}"
+    return response
 
 
 class PayloadCheckNode(Node):
     def __init__(self, **kwargs):
         super().__init__("payload_check_node", **kwargs)
-        self.parameters = declare_model(self, NODE_PARAMETERS, build_settings)
-        self.parameters.on_change(self._use)
-        self.counts: Counter[str] = Counter()
-        self._use(self.parameters.current)
-        self._order = JointOrder(self.settings.model.joint_names)
+        self.tally = Tally(self.get_logger())
+        self.counts = self.tally.counts
+        self.settings: Settings | None = None
         self._state = None  # (q, qd, time received [node clock]) of the latest good joint state
+        self.parameters = declare_model(self, PAYLOAD_CHECK_NODE, check_settings, finish_settings, STARTUP_WAIT)
+        if self.parameters.current is not None:
+            self._use(self.parameters.current)
+        self.parameters.on_change(self._use)
+        self._order = JointOrder(self.get_parameter("joint_names").value)
 
         self.create_subscription(JointState, "joint_states", self._on_joint_state, joint_states_qos(self))
         self.create_service(Trigger, "~/check", self._on_check)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         period = self.get_parameter("diagnostics.period").value
         if period > 0.0:
-            self.create_timer(period, self.check)
-        payload = self.settings.model.payload
-        self.get_logger().info(f"ready: ~/check for a {payload.mass} kg payload at {list(payload.com)} m")
+            self.create_timer(period, self._on_timer)
+        mass, com = self.get_parameter("payload.mass").value, list(self.get_parameter("payload.com").value)
+        later = "" if self.settings is not None else " (its workspace analysis still running: ~/check says pending)"
+        self.get_logger().info(f"ready: ~/check for a {mass} kg payload at {com} m{later}")
 
     def _use(self, settings: Settings) -> None:
-        """Switch to new settings (built, limits and workspace sweep included, when checked)."""
+        """Switch to new settings (limits and workspace analysis done); a held joint state
+        they give no finite torques for is let go."""
         self.settings = settings
+        problem = None if self._state is None else self._finite_problem(*self._state[:2])
+        if problem is not None:
+            self.tally.drop("joint_states", problem)
+            self._state = None
 
+    def _finite_problem(self, q, qd) -> BadMessage | None:
+        """Why the model in force gives no finite torques at (q, qd), qdd = 0 (as id_node), or None."""
+        if self.settings is None:
+            return None  # checked when the first settings arrive
+        model = self.settings.model
+        try:
+            finite_torques(rnea, model, q, qd, [0.0] * model.n)
+            finite_torques(gravity, model, q)
+        except BadMessage as error:
+            return error
+        return None
+
+    @guarded("joint_states")
     def _on_joint_state(self, msg: JointState) -> None:
+        self.counts["joint_states.received"] += 1
         try:
             q, qd = read_joint_state(msg, self._order)
         except NotForThisModel:
+            self.counts["joint_states.ignored"] += 1
             return
         except BadMessage as error:
-            count_and_warn(self.get_logger(), self.counts, "joint_states", error)
+            self.tally.drop("joint_states", error)
+            return
+        problem = self._finite_problem(q, qd)
+        if problem is not None:
+            self.tally.drop("joint_states", problem)
             return
         self._state = (q, qd, self.get_clock().now())
 
@@ -109,17 +162,45 @@ class PayloadCheckNode(Node):
             settings.model, settings.model.payload, settings.limits, q, qd, workspace=settings.workspace
         )
         stale = None if received is None else self._stale(received)
-        statuses = payload_statuses(result, self.get_name(), settings.warn_use, stale)
+        self._publish(payload_statuses(result, self.get_name(), settings.warn_use, stale))
+        return result, stale
+
+    def _not_ready(self) -> str | None:
+        """None when the parameters in force have been analysed; else why ~/check cannot answer."""
+        status = self.parameters.status()
+        if status is None and self.settings is not None:
+            return None
+        if self.parameters.failure is not None:
+            return f"cannot check: {status}"
+        since = self.parameters.pending_since
+        running = "" if since is None else f" (for {time.monotonic() - since:.1f} s)"
+        return f"pending: the limits and workspace analysis of the new parameters are running{running}; ask again shortly"
+
+    def _publish(self, statuses) -> None:
         diagnostics = DiagnosticArray(status=statuses)
         diagnostics.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(diagnostics)
-        return result, stale
 
     def _stale(self, received) -> str | None:
         age = (self.get_clock().now() - received).nanoseconds * 1e-9
         return f"joint_states received {age:.1f} s ago" if age > STALE_AFTER else None
 
+    @guarded("diagnostics")
+    def _on_timer(self) -> None:
+        why = self._not_ready()
+        if why is None:
+            self.check()
+            return
+        level = DiagnosticStatus.ERROR if self.parameters.failure is not None else DiagnosticStatus.WARN
+        name = self.get_name()
+        self._publish([DiagnosticStatus(level=level, name=f"{name}: payload", hardware_id=name, message=why)])
+
+    @guarded("check", fallback=_failed_check)
     def _on_check(self, request, response):
+        why = self._not_ready()
+        if why is not None:
+            response.success, response.message = False, why
+            return response
         result, stale = self.check()
         response.success = result.ok
         response.message = result.report()

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 from array import array
-from collections import Counter
 
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
@@ -22,11 +21,17 @@ class NotForThisModel(BadMessage):
     """A message about none of the model's joints (a gripper's, another arm's): ignored."""
 
 
-def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> None:
-    """Count a dropped message by kind, and warn about it (every 2 s at most)."""
-    counts[f"dropped_{error.kind}"] += 1
-    counts["dropped"] += 1
-    logger.warning(f"dropped a {topic} message ({error})", throttle_duration_sec=2.0)
+def finite_torques(function, model, *state):
+    """``function(model, *state)`` (rnea, gravity) when all its torques are finite, else
+    BadMessage non_finite_torques (an absurd but finite state can overflow the model's
+    sums; the core may return the non-finite torques or refuse them with ValueError)."""
+    try:
+        tau = function(model, *state)
+    except ValueError as error:
+        raise BadMessage("non_finite_torques", str(error)) from None
+    if not (math.isfinite(sum(tau)) or all(map(math.isfinite, tau))):
+        raise BadMessage("non_finite_torques", f"the model gives {list(tau)}")
+    return tau
 
 
 class JointOrder:

@@ -7,11 +7,10 @@ import sys
 from typing import Callable
 
 import rclpy
+import rclpy.logging
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
-
-
 
 EXECUTORS = ("events", "single_threaded")
 
@@ -20,19 +19,12 @@ def run(name: str, make_node: Callable[[], Node], args: list[str] | None = None,
     """Init rclpy, build the node, spin until Ctrl-C or shutdown; 0 on a clean exit.
 
     A model or parameter error at startup prints one line naming the bad field and
-    returns 1 (no traceback). ``executor``: see ``spin``.
+    returns 1 (no traceback); so does Ctrl-C before the node is ready. ``executor``: see
+    ``spin``.
     """
     args = sys.argv if args is None else args
-    logger = rclpy.logging.get_logger(name)
-    try:
-        rclpy.init(args=args)
-    except rclpy_implementation.RCLError as error:
-        logger.fatal(f"cannot start: {init_error(error)}")
-        return 1
-    try:
-        node = make_node()
-    except ValueError as error:
-        logger.fatal(f"cannot start: {_one_line(error)}")
+    node = _start(make_node, args, rclpy.logging.get_logger(name))
+    if node is None:
         rclpy.try_shutdown()
         return 1
     try:
@@ -43,6 +35,31 @@ def run(name: str, make_node: Callable[[], Node], args: list[str] | None = None,
         node.destroy_node()
         rclpy.try_shutdown()
     return 0
+
+
+INTERRUPTED = "cannot start: interrupted (Ctrl-C) before the node was ready"
+
+
+def _start(make_node: Callable[[], Node], args: list[str], logger) -> Node | None:
+    """The node, or None after one FATAL line: rcl refused the arguments, a parameter is
+    bad (ValueError), or Ctrl-C came first (rclpy then shuts the context down, and the
+    next rclpy call of the half-built node fails)."""
+    try:
+        try:
+            rclpy.init(args=args)
+        except rclpy_implementation.RCLError as error:
+            logger.fatal(f"cannot start: {init_error(error)}")
+            return None
+        try:
+            return make_node()
+        except Exception as error:  # noqa: BLE001  (sorted here: ours, or Ctrl-C half-way)
+            if rclpy.ok() and not isinstance(error, ValueError):
+                raise
+            logger.fatal(f"cannot start: {_one_line(error)}" if rclpy.ok() else INTERRUPTED)
+            return None
+    except KeyboardInterrupt:  # before rclpy's own signal handler was in place
+        logger.fatal(INTERRUPTED)
+        return None
 
 
 def spin(node: Node, executor: str = "events") -> None:
@@ -94,8 +111,9 @@ def init_error(error: Exception) -> str:
 
 
 def _line(path: str, number: int) -> str:
+    """Line ``number`` of the file, undecodable bytes shown as \\xNN (a binary file)."""
     try:
-        with open(path) as stream:
+        with open(path, encoding="utf-8", errors="backslashreplace") as stream:
             return stream.read().splitlines()[number - 1].strip()
     except (OSError, IndexError):
         return "?"

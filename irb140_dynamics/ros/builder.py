@@ -1,0 +1,99 @@
+"""Slow work off the executor: a worker thread builds, the executor thread swaps the result in.
+
+A node's executor thread serves its messages; building a new configuration (compiling
+kernels, sweeping the workspace) there would stall them. ``Builder.submit`` hands the
+work to a worker thread, started when there is work and ended when there is none; the
+result comes back to the executor thread through a timer polling every POLL_PERIOD while
+a build is under way (the EventsExecutor takes no guard conditions), whose callback hands
+it to ``deliver``. Only the newest job waiting is kept: jobs submitted while one is being
+built collapse into the latest, and every job finished is delivered (in order), so the
+newest always follows within two builds.
+
+While a build runs, the executor thread must still get the interpreter lock quickly:
+``submit`` lowers the interpreter's switch interval to SWITCH_INTERVAL (process-wide; it
+only matters while two threads want to run Python, i.e. during builds).
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from typing import Any, Callable
+
+SWITCH_INTERVAL = 2e-4  # s: how long the message thread may wait for the interpreter lock
+POLL_PERIOD = 0.002  # s: how soon a finished build is swapped in
+
+
+@dataclass(frozen=True)
+class Failed:
+    """A build that raised ``error``."""
+
+    error: BaseException
+
+
+class Builder:
+    """Runs ``build(job, previous)`` in a worker thread; ``deliver(generation, result)`` on
+    the node's executor thread (``previous``: the last result built, None at first; a
+    result is a Failed when the build raised)."""
+
+    def __init__(self, node, build: Callable[[Any, Any], Any], deliver: Callable[[int, Any], None], name: str):
+        self._node, self._build, self._deliver, self._name = node, build, deliver, name
+        self._lock = threading.Lock()
+        self._job: tuple[int, Any] | None = None  # the newest job not yet started
+        self._worker: threading.Thread | None = None
+        self._finished: tuple[int, Any] | None = None  # the newest result not yet delivered
+        self._done = threading.Event()  # set whenever a result is waiting to be delivered
+        self.previous = None  # the last result built (the worker's)
+        self._poll = None  # the timer, while a build is under way
+
+    def submit(self, generation: int, job: Any) -> None:
+        """Build ``job`` (called on the executor thread, or before it spins)."""
+        if self._poll is None:
+            self._poll = self._node.create_timer(POLL_PERIOD, self.deliver_finished)
+        with self._lock:
+            self._job = (generation, job)
+            if self._worker is None:
+                if sys.getswitchinterval() > SWITCH_INTERVAL:
+                    sys.setswitchinterval(SWITCH_INTERVAL)
+                self._worker = threading.Thread(target=self._work, name=self._name, daemon=True)
+                self._worker.start()
+
+    def wait(self, timeout: float, still_wanted: Callable[[], bool]) -> bool:
+        """Wait (on the caller's thread, before spinning) up to ``timeout`` s for a result
+        and deliver it; stop early when ``still_wanted()`` turns false. True if delivered."""
+        deadline = time.monotonic() + timeout
+        while not self._done.wait(timeout=0.05):
+            if time.monotonic() > deadline or not still_wanted():
+                return False
+        self.deliver_finished()
+        return True
+
+    def deliver_finished(self) -> None:
+        """On the executor thread: deliver the newest result, if any; the poll ends with the work."""
+        with self._lock:
+            finished, self._finished = self._finished, None
+            self._done.clear()
+            idle = self._worker is None
+        if idle and self._poll is not None:
+            self._node.destroy_timer(self._poll)
+            self._poll = None
+        if finished is not None:
+            self._deliver(*finished)
+
+    def _work(self) -> None:
+        while True:
+            with self._lock:
+                if self._job is None:
+                    self._worker = None
+                    return
+                (generation, job), self._job = self._job, None
+            try:
+                result = self._build(job, self.previous)
+                self.previous = result
+            except Exception as error:  # noqa: BLE001  (reported to the node, not raised in a thread)
+                result = Failed(error)
+            with self._lock:
+                self._finished = (generation, result)
+                self._done.set()
