@@ -74,13 +74,20 @@ def check_settings(values: dict) -> Settings:
     )
 
 
+KERNELS = ("rnea", "gravity_torques")  # what a message uses
+
+
 def finish_settings(settings: Settings, previous: Settings | None) -> Settings:
-    """Compile the kernels the messages use (off the executor), here and not on a message;
-    the same model as before keeps its compiled kernels."""
+    """Compile the kernels the messages use, here and not on a message (off the executor
+    unless they exist already: a payload or gravity change shares the arm's code)."""
     if previous is not None and previous.model == settings.model:
         return replace(settings, model=previous.model)
-    _compiled = (settings.model.kernels.rnea, settings.model.kernels.gravity_torques)
+    _compiled = [getattr(settings.model.kernels, name) for name in KERNELS]
     return settings
+
+
+def compiled(settings: Settings, previous: Settings | None) -> bool:
+    return settings.model.kernels.compiled(*KERNELS)
 
 
 class IdNode(Node):
@@ -94,7 +101,7 @@ class IdNode(Node):
         self._reference = None  # (time received [ns, node clock], q, qd, qdd or None)
         self._differentiator = None
         self.settings: Settings | None = None
-        self.parameters = declare_model(self, ID_NODE, check_settings, finish_settings)
+        self.parameters = declare_model(self, ID_NODE, check_settings, finish_settings, quick=compiled)
         self._use(self.parameters.current)
         self.parameters.on_change(self._use)
 

@@ -76,14 +76,23 @@ def finish_settings(draft: Draft, previous: Settings | None) -> Settings:
     """Derive the limits and analyse the workspace (seconds for a large model: runs off the
     executor); what the previous settings computed for the same arm is reused."""
     model, rated = draft.model, draft.rated_payload
-    same_arm = previous is not None and (previous.model.joints, previous.model.gravity, previous.rated_payload) == (
-        model.joints, model.gravity, rated)
-    limits = previous.limits if same_arm else derive_torque_limits(model, rated)
-    if same_arm and previous.model.payload == model.payload:
+    limits = previous.limits if _same_arm(draft, previous) else derive_torque_limits(model, rated)
+    if analysed(draft, previous):
         workspace = previous.workspace
     else:
         workspace = workspace_load(model, model.payload, limits)
     return Settings(model, rated, draft.warn_use, limits, workspace)
+
+
+def _same_arm(draft: Draft, previous: Settings | None) -> bool:
+    """The same torque limits as before: the same joints, gravity and rated payload."""
+    return previous is not None and (previous.model.joints, previous.model.gravity, previous.rated_payload) == (
+        draft.model.joints, draft.model.gravity, draft.rated_payload)
+
+
+def analysed(draft: Draft, previous: Settings | None) -> bool:
+    """Nothing to analyse: the previous settings had the same arm and payload."""
+    return _same_arm(draft, previous) and previous.model.payload == draft.model.payload
 
 
 def _failed_check(request, response, error):
@@ -99,7 +108,8 @@ class PayloadCheckNode(Node):
         self.counts = self.tally.counts
         self.settings: Settings | None = None
         self._state = None  # (q, qd, time received [node clock]) of the latest good joint state
-        self.parameters = declare_model(self, PAYLOAD_CHECK_NODE, check_settings, finish_settings, STARTUP_WAIT)
+        self.parameters = declare_model(self, PAYLOAD_CHECK_NODE, check_settings, finish_settings, STARTUP_WAIT,
+                                        quick=analysed)
         if self.parameters.current is not None:
             self._use(self.parameters.current)
         self.parameters.on_change(self._use)

@@ -60,6 +60,14 @@ class Builder:
                 self._worker = threading.Thread(target=self._work, name=self._name, daemon=True)
                 self._worker.start()
 
+    def build_here(self, generation: int, job: Any) -> None:
+        """Build ``job`` on this (the executor) thread and deliver it: for quick builds."""
+        try:
+            result = self.previous = self._build(job, self.previous)
+        except Exception as error:  # noqa: BLE001  (reported to the node like a worker's)
+            result = Failed(error)
+        self._deliver(generation, result)
+
     def wait(self, timeout: float, still_wanted: Callable[[], bool]) -> bool:
         """Wait (on the caller's thread, before spinning) up to ``timeout`` s for a result
         and deliver it; stop early when ``still_wanted()`` turns false. True if delivered."""

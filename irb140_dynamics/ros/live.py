@@ -43,9 +43,11 @@ class LiveParameters:
     """
 
     def __init__(self, node: Node, specs: list, check: Callable[[dict], Any], finish: Callable[[Any, Any], Any],
-                 declared=(), startup_wait: float | None = None):
-        """``declared``: names of parameters the caller has declared already."""
-        self._node, self._check_values = node, check
+                 declared=(), startup_wait: float | None = None, quick: Callable[[Any, Any], bool] | None = None):
+        """``declared``: names of parameters the caller has declared already; ``quick(draft,
+        previous)``: True when finish will be quick (nothing to compile): then it runs at
+        once, and the change is in force when the call returns."""
+        self._node, self._check_values, self._quick = node, check, quick
         self._names = [spec.name for spec in specs] + list(declared)
         for spec in specs:
             declare(node, spec)
@@ -90,6 +92,12 @@ class LiveParameters:
 
     def _coerce_integers(self, parameters: list[Parameter]) -> list[Parameter]:
         """Let `ros2 param set ... payload.mass 3` mean 3.0 for a double parameter."""
+        try:
+            return self._coerced(parameters)
+        except Exception:  # noqa: BLE001  (leave them as they are: the checks that follow refuse what is wrong)
+            return parameters
+
+    def _coerced(self, parameters: list[Parameter]) -> list[Parameter]:
         coerced = []
         for p in parameters:
             wanted = self._type_of(p.name)
@@ -125,14 +133,23 @@ class LiveParameters:
         return SetParametersResult(successful=True)
 
     def _apply(self, parameters: list[Parameter]) -> None:
-        """Build the configuration checked by _check for exactly these values, off the executor."""
+        """Build the configuration checked by _check for exactly these values: at once if
+        that is quick, else off the executor."""
         checked, self._checked = self._checked, None
         if checked is None or checked[0] != self.values():  # not the change just checked
             return
         self._accepted += 1
         if self.pending_since is None:
             self.pending_since = time.monotonic()
-        self._builder.submit(self._accepted, checked[1])
+        draft = checked[1]
+        try:
+            quick = self._quick is not None and self._quick(draft, self._builder.previous)
+        except Exception:  # noqa: BLE001  (then the worker finds out)
+            quick = False
+        if quick:
+            self._builder.build_here(self._accepted, draft)
+        else:
+            self._builder.submit(self._accepted, draft)
 
     def _deliver(self, generation: int, result) -> None:
         """On the executor thread: swap in a finished configuration, or note its failure."""

@@ -144,9 +144,9 @@ def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
 
 
 def declare_model(node: Node, extra: list[Spec], check: Callable[[dict], Any], finish: Callable[[Any, Any], Any],
-                  startup_wait: float | None = None) -> LiveParameters:
+                  startup_wait: float | None = None, quick: Callable[[Any, Any], bool] | None = None) -> LiveParameters:
     """Declare the robot model's parameters and a node's own, with the default model's defaults
-    (see LiveParameters for ``check``, ``finish`` and ``startup_wait``)."""
+    (see LiveParameters for ``check``, ``finish``, ``startup_wait`` and ``quick``)."""
     path = default_config_path()
     if not path.is_file():
         raise ValueError(f"default model: no {path}; is the package installed? (or give --params-file)")
@@ -158,7 +158,7 @@ def declare_model(node: Node, extra: list[Spec], check: Callable[[dict], Any], f
     )
     names = check_joint_names(names)  # they become parameter prefixes: check them first
     specs = [*model_specs(names, defaults), *extra]
-    return LiveParameters(node, specs, check, finish, ["joint_names"], startup_wait)
+    return LiveParameters(node, specs, check, finish, ["joint_names"], startup_wait, quick)
 
 
 def check_number(name: str, value, minimum: float, maximum: float, unit: str = "") -> float:
