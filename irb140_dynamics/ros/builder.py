@@ -33,37 +33,71 @@ class Failed:
     error: BaseException
 
 
+class _Work:
+    """What the worker thread shares with the executor thread. It holds no node: a thread
+    still building must not keep a node alive (a failed start destroys it at once)."""
+
+    def __init__(self, build: Callable[[Any, Any], Any]):
+        self.build = build
+        self.lock = threading.Lock()
+        self.job: tuple[int, Any] | None = None  # the newest job not yet started
+        self.running = False  # a worker thread is under way
+        self.finished: tuple[int, Any] | None = None  # the newest result not yet delivered
+        self.done = threading.Event()  # set whenever a result is waiting to be delivered
+        self.previous = None  # the last result built
+
+    def run(self) -> None:
+        """The worker thread: build jobs until there are none."""
+        while True:
+            with self.lock:
+                if self.job is None:
+                    self.running = False
+                    return
+                (generation, job), self.job = self.job, None
+            try:
+                result = self.previous = self.build(job, self.previous)
+            except Exception as error:  # noqa: BLE001  (reported to the node, not raised in a thread)
+                result = Failed(error)
+            with self.lock:
+                self.finished = (generation, result)
+                self.done.set()
+
+
 class Builder:
     """Runs ``build(job, previous)`` in a worker thread; ``deliver(generation, result)`` on
     the node's executor thread (``previous``: the last result built, None at first; a
     result is a Failed when the build raised)."""
 
     def __init__(self, node, build: Callable[[Any, Any], Any], deliver: Callable[[int, Any], None], name: str):
-        self._node, self._build, self._deliver, self._name = node, build, deliver, name
-        self._lock = threading.Lock()
-        self._job: tuple[int, Any] | None = None  # the newest job not yet started
-        self._worker: threading.Thread | None = None
-        self._finished: tuple[int, Any] | None = None  # the newest result not yet delivered
-        self._done = threading.Event()  # set whenever a result is waiting to be delivered
-        self.previous = None  # the last result built (the worker's)
+        self._node, self._deliver, self._name = node, deliver, name
+        self._work = _Work(build)
         self._poll = None  # the timer, while a build is under way
+
+    @property
+    def previous(self):
+        return self._work.previous
+
+    @previous.setter
+    def previous(self, value) -> None:
+        self._work.previous = value
 
     def submit(self, generation: int, job: Any) -> None:
         """Build ``job`` (called on the executor thread, or before it spins)."""
         if self._poll is None:
             self._poll = self._node.create_timer(POLL_PERIOD, self.deliver_finished)
-        with self._lock:
-            self._job = (generation, job)
-            if self._worker is None:
+        work = self._work
+        with work.lock:
+            work.job = (generation, job)
+            if not work.running:
                 if sys.getswitchinterval() > SWITCH_INTERVAL:
                     sys.setswitchinterval(SWITCH_INTERVAL)
-                self._worker = threading.Thread(target=self._work, name=self._name, daemon=True)
-                self._worker.start()
+                work.running = True
+                threading.Thread(target=work.run, name=self._name, daemon=True).start()
 
     def build_here(self, generation: int, job: Any) -> None:
         """Build ``job`` on this (the executor) thread and deliver it: for quick builds."""
         try:
-            result = self.previous = self._build(job, self.previous)
+            result = self.previous = self._work.build(job, self.previous)
         except Exception as error:  # noqa: BLE001  (reported to the node like a worker's)
             result = Failed(error)
         self._deliver(generation, result)
@@ -72,7 +106,7 @@ class Builder:
         """Wait (on the caller's thread, before spinning) up to ``timeout`` s for a result
         and deliver it; stop early when ``still_wanted()`` turns false. True if delivered."""
         deadline = time.monotonic() + timeout
-        while not self._done.wait(timeout=0.05):
+        while not self._work.done.wait(timeout=0.05):
             if time.monotonic() > deadline or not still_wanted():
                 return False
         self.deliver_finished()
@@ -80,28 +114,13 @@ class Builder:
 
     def deliver_finished(self) -> None:
         """On the executor thread: deliver the newest result, if any; the poll ends with the work."""
-        with self._lock:
-            finished, self._finished = self._finished, None
-            self._done.clear()
-            idle = self._worker is None
+        work = self._work
+        with work.lock:
+            finished, work.finished = work.finished, None
+            work.done.clear()
+            idle = not work.running
         if idle and self._poll is not None:
             self._node.destroy_timer(self._poll)
             self._poll = None
         if finished is not None:
             self._deliver(*finished)
-
-    def _work(self) -> None:
-        while True:
-            with self._lock:
-                if self._job is None:
-                    self._worker = None
-                    return
-                (generation, job), self._job = self._job, None
-            try:
-                result = self._build(job, self.previous)
-                self.previous = result
-            except Exception as error:  # noqa: BLE001  (reported to the node, not raised in a thread)
-                result = Failed(error)
-            with self._lock:
-                self._finished = (generation, result)
-                self._done.set()

@@ -20,6 +20,7 @@ from rclpy.parameter import Parameter
 
 from .builder import Builder, Failed
 from .overrides import warn_unknown_overrides
+from .parameter_services import guard_parameter_services
 
 
 class LiveParameters:
@@ -72,6 +73,7 @@ class LiveParameters:
         node.add_on_set_parameters_callback(self._check)
         node.add_post_set_parameters_callback(self._apply)
         node._check_undeclared_parameters = self._refuse_undeclared  # rclpy's lets '' through, names none
+        guard_parameter_services(node)
 
     def values(self, changes=()) -> dict[str, Any]:
         """All parameter values by name, with ``changes`` (Parameters) applied on top."""

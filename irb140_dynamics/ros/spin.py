@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import re
 import sys
 from typing import Callable
@@ -43,7 +44,7 @@ INTERRUPTED = "cannot start: interrupted (Ctrl-C) before the node was ready"
 def _start(make_node: Callable[[], Node], args: list[str], logger) -> Node | None:
     """The node, or None after one FATAL line: rcl refused the arguments, a parameter is
     bad (ValueError), or Ctrl-C came first (rclpy then shuts the context down, and the
-    next rclpy call of the half-built node fails)."""
+    next rclpy call of the half-built node fails, or KeyboardInterrupt is raised)."""
     try:
         try:
             rclpy.init(args=args)
@@ -55,11 +56,14 @@ def _start(make_node: Callable[[], Node], args: list[str], logger) -> Node | Non
         except Exception as error:  # noqa: BLE001  (sorted here: ours, or Ctrl-C half-way)
             if rclpy.ok() and not isinstance(error, ValueError):
                 raise
-            logger.fatal(f"cannot start: {_one_line(error)}" if rclpy.ok() else INTERRUPTED)
-            return None
-    except KeyboardInterrupt:  # before rclpy's own signal handler was in place
-        logger.fatal(INTERRUPTED)
-        return None
+            why = f"cannot start: {_one_line(error)}" if rclpy.ok() else INTERRUPTED
+    except KeyboardInterrupt:
+        why = INTERRUPTED
+    # out of the except blocks: the half-built node is gone with the traceback, and with it
+    # its /rosout publisher, which would complain of the shut-down context
+    gc.collect()
+    logger.fatal(why)
+    return None
 
 
 def spin(node: Node, executor: str = "events") -> None:
@@ -103,7 +107,7 @@ def init_error(error: Exception) -> str:
     if not found:
         return text.split(", at /")[0]
     path, reason, line = found["path"], found["reason"].rstrip(". "), found["line"]
-    if line is None:
+    if line is None or int(line) < 1:  # rcl gives line 0 for some errors (a binary file)
         return f"{path}: {reason}"
     source = _line(path, int(line))
     hint = "; write every number of a list as a double, e.g. 0.0 not 0" if "same type" in reason else ""
