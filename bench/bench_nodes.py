@@ -2,6 +2,8 @@
 
     .venv/bin/python bench/bench_nodes.py [--duration 10] [--rates 1000 2000]
         [--executor events [single_threaded]] [--no-event-handlers] [--profile] [--no-payload] [--no-stream]
+        [--change-period 0.1] [--no-changes]
+    .venv/bin/python bench/bench_nodes.py --soak MINUTES
 
 Prints one table and writes the raw figures to bench/results/nodes.json. Sections:
 
@@ -14,6 +16,10 @@ Prints one table and writes the raw figures to bench/results/nodes.json. Section
   sends the message itself): delay = the DDS reception time of the output - the stamp.
   Lost = published in the measured window - received. CPU per message = the node
   process's user + system time over the window / messages published.
+- parameter changes: the relay and id_node again at 1 kHz while payload.mass is set every
+  ``--change-period`` s through the SetParameters service (bench/parameter_changes.py).
+- soak (``--soak MINUTES``, alone): id_node and the relay side by side under the same load,
+  their RSS growth (bench/soak.py, bench/results/soak.json).
 - payload check: check_payload() cold (first call in a fresh process, kernel compilation
   included) and warm, its two halves (derive_torque_limits, workspace_load) alone, and the
   round trip of a ``~/check`` service call on a running payload_check_node.

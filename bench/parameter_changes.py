@@ -31,7 +31,7 @@ class ParameterChanger(threading.Thread):
         self.period, self.name, self.first, self.step = period, name, first, step
         self.context = Context()
         rclpy.init(context=self.context)
-        self.node = Node("bench_parameter_changer", context=self.context)
+        self.node = Node(f"bench_changer_{node_name.strip('/').replace('/', '_')}", context=self.context)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.client = AsyncParameterClient(self.node, node_name)

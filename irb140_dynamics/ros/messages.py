@@ -30,7 +30,7 @@ def finite_torques(function, model, *state):
     except ValueError as error:
         raise BadMessage("non_finite_torques", str(error)) from None
     if not (math.isfinite(sum(tau)) or all(map(math.isfinite, tau))):
-        raise BadMessage("non_finite_torques", f"the model gives {list(tau)}")
+        raise BadMessage("non_finite_torques", f"the model gives {[float(x) for x in tau]}")
     return tau
 
 
