@@ -103,6 +103,8 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
 
     specs = [
         Spec("gravity", defaults.get("gravity", [0.0, 0.0, -9.81]), "gravity in the base frame", "m/s^2"),
+        Spec("friction.smoothing_velocity", defaults.get("friction.smoothing_velocity", 0.01),
+             "Coulomb friction is coulomb * tanh(qd / this)", "rad/s", minimum=1e-9),
         *_body_specs("payload", "the payload on the flange", "flange frame", lambda name, kind: defaults.get(name, kind)),
     ]
     for joint in joint_names:
@@ -114,6 +116,16 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
                  "[lower, upper] joint position", "rad"),
             Spec(f"{joint}.torque_limit", default(f"{joint}.torque_limit", 0.0),
                  "joint torque limit, 0 = none given", "N m", minimum=0.0),
+            Spec(f"{joint}.velocity_limit", default(f"{joint}.velocity_limit", 0.0),
+                 "joint speed limit, 0 = none given", "rad/s", minimum=0.0),
+            Spec(f"{joint}.acceleration_limit", default(f"{joint}.acceleration_limit", 0.0),
+                 "joint acceleration limit, 0 = none given", "rad/s^2", minimum=0.0),
+            Spec(f"{joint}.friction.viscous", default(f"{joint}.friction.viscous", 0.0),
+                 "viscous friction coefficient", "N m s/rad", minimum=0.0),
+            Spec(f"{joint}.friction.coulomb", default(f"{joint}.friction.coulomb", 0.0),
+                 "Coulomb friction level (smoothed, see friction.smoothing_velocity)", "N m", minimum=0.0),
+            Spec(f"{joint}.armature", default(f"{joint}.armature", 0.0),
+                 "rotor inertia reflected through the gear, added to M's diagonal", "kg m^2", minimum=0.0),
         ]
     return specs
 
