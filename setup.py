@@ -25,6 +25,8 @@ setup(
             "id_node = irb140_dynamics.id_node:main",
             "payload_check_node = irb140_dynamics.payload_check_node:main",
             "demo_node = irb140_dynamics.demo_node:main",
+            "identify = irb140_dynamics.tools.identify:main",
+            "excitation = irb140_dynamics.tools.excitation:main",
         ],
     },
 )

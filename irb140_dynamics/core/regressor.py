@@ -29,7 +29,7 @@ from .algorithms import (
     scale,
     turns,
 )
-from .dynamics import _columns, _evaluate, _state
+from .dynamics import _CHUNK, _columns, _state
 from .joints import Friction
 from .model import RobotModel
 from .rigid_body import ModelError, RigidBody, inertia_matrix
@@ -108,7 +108,15 @@ def regressor_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
     columns = _columns(n, Q=Q, QD=QD, QDD=QDD)
     N = columns[0].shape[1]
     Y = np.zeros((N, n, 13 * n))
-    Y[:, :, : 10 * n] = _evaluate(model.kernels.regressor.array, *columns).reshape(N, n, 10 * n)
+    flat = Y.reshape(N, 13 * n * n)
+    # kernel output i * 10n + c is Y[:, i, c]: written straight into Y, its zeros skipped
+    # (about half of the entries: link k moves no joint after k)
+    where = [i * 13 * n + c for i in range(n) for c in range(10 * n)]
+    for start in range(0, N, _CHUNK):
+        chunk = slice(start, start + _CHUNK)
+        for index, values in zip(where, model.kernels.regressor.array(*(c[:, chunk] for c in columns))):
+            if isinstance(values, np.ndarray) or values != 0.0:
+                flat[chunk, index] = values
     _joint_columns(model, Y, columns[1].T, columns[2].T)
     return Y
 
