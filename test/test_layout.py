@@ -12,6 +12,7 @@ from .node_process import run_to_exit, run_until_ready
 from .paths import CONFIG, ROOT
 
 EXECUTABLES = ["id_node", "payload_check_node"]
+TOOLS = ["identify", "excitation"]
 
 
 @pytest.fixture(scope="module")
@@ -46,7 +47,7 @@ def test_executables_are_where_ros2_run_looks(install):
     prefix = Path(sourced(install, f"{sys.executable} -c "
                           "'from ament_index_python import get_package_prefix as p; print(p(\"irb140_dynamics\"))'"))
     assert prefix == install / "irb140_dynamics"
-    for name in EXECUTABLES:
+    for name in EXECUTABLES + TOOLS:
         executable = prefix / "lib" / "irb140_dynamics" / name
         assert executable.is_file() and os.access(executable, os.X_OK), executable
 
@@ -67,3 +68,19 @@ def test_installed_nodes_run_on_the_installed_config(install, name):
     assert code == 0, output
     code, output = run_to_exit([executable, "--ros-args", "-p", "joint_6.link.mass:=-1.0"], env=env)
     assert code == 1 and "joint_6.link.mass" in output, output
+
+
+@pytest.mark.parametrize("name", TOOLS)
+def test_installed_tools_run(install, name):
+    executable = str(install / "irb140_dynamics" / "lib" / "irb140_dynamics" / name)
+    code, output = run_to_exit([executable, "--help"], env=installed_env(install))
+    assert code == 0 and f"usage: {name}" in output and "--out" in output, output
+
+
+def test_installed_excitation_uses_the_installed_model(install, tmp_path):
+    executable = str(install / "irb140_dynamics" / "lib" / "irb140_dynamics" / "excitation")
+    out = tmp_path / "excitation.yaml"
+    command = [executable, "--out", str(out), "--iterations", "0", "--period", "2", "--harmonics", "2", "--rate", "5"]
+    code, output = run_to_exit(command, env=installed_env(install))
+    assert code == 0 and f"model: {install / 'irb140_dynamics' / 'share'}" in output, output
+    assert out.read_text().count("time_from_start") == 11

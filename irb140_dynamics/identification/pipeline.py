@@ -107,7 +107,7 @@ def identify(prior: RobotModel, path, settings: Settings = Settings(), validate=
             raise RecordingError(tally.path, _nothing_usable(tally))
     estimate = weighted_least_squares(train, base, tallies[0].design.noise_correlation())
     fit = consistent_parameters(prior, base, estimate, settings.prior_weight)
-    source = str(validate) if validate is not None else f"the last {settings.held_out:.0%} of the recording"
+    source = str(validate) if validate is not None else f"the last {100 * settings.held_out:g} % of the recording"
     return Result(prior, fit.model, base, estimate, fit, train, held_out, tallies, keeper.points(), source)
 
 

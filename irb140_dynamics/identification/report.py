@@ -73,7 +73,7 @@ def base_parameter_lines(result: Result) -> list[str]:
     lines = []
     for text, value, std in zip(result.base.describe(), estimate.beta, estimate.std):
         label, _, combination = text.partition(" = ")
-        lines.append(f"{label.strip()} = {value: .6g} +- {std:.2g}: {combination}")
+        lines.append(f"{label.strip()} = {value: .8g} +- {std:.3g}: {combination}")
     return lines
 
 
