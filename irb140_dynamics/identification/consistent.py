@@ -176,7 +176,7 @@ def consistent_parameters(
     upper = np.concatenate([np.tile(THETA_UPPER, n), np.full(3 * n, np.inf)])
     x0 = np.clip(x0, lower, upper)
     result = least_squares(residuals, x0, jac=jacobian, bounds=(lower, upper), method="trf", x_scale="jac",
-                           max_nfev=max_evaluations, ftol=1e-5)
+                           max_nfev=max_evaluations, ftol=1e-4)
     pi, _ = evaluate(result.x)
     pi[10 * n :] = np.maximum(pi[10 * n :], 0.0)
     deviation = (K @ pi - estimate.beta) / estimate.std
