@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -37,7 +38,21 @@ REGRESSOR_STATES = 20_000
 REGRESSOR_REPEATS = 5
 BLOCK_SECONDS = 60.0  # the bag is written a minute at a time
 
-DESERIALISE_ONLY = """
+# Each measured process reports its own peak resident set at exit: VmHWM of /proc/self/status,
+# which starts afresh at exec (ru_maxrss would include the benchmark's own size at the fork).
+PEAK_AT_EXIT = """
+import atexit, sys
+def _peak():
+    for line in open("/proc/self/status"):
+        if line.startswith("VmHWM:"):
+            print("peak_kb", line.split()[1], file=sys.stderr)
+atexit.register(_peak)
+"""
+IDENTIFY = PEAK_AT_EXIT + """
+from irb140_dynamics.tools.identify import main
+sys.exit(main(sys.argv[1:]))
+"""
+DESERIALISE_ONLY = PEAK_AT_EXIT + """
 import sys
 from pathlib import Path
 from rosbags.highlevel import AnyReader
@@ -100,29 +115,29 @@ def write_long_bag(path: Path, minutes: float, rate: float) -> None:
     print(file=sys.stderr)
 
 
-def run_measured(command: list[str]) -> tuple[float, float, str]:
-    """(wall seconds, peak resident memory in MB, output) of a command in its own process."""
+def run_measured(script: str, *args: str) -> tuple[float, float, str]:
+    """(wall seconds, peak resident memory in MB, output) of a Python script in its own process."""
     environment = {**os.environ, "PYTHONPATH": str(REPO)}
     started = time.perf_counter()
-    process = subprocess.Popen(command, env=environment, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    output = process.stdout.read()
-    _, status, usage = os.wait4(process.pid, 0)
+    result = subprocess.run([sys.executable, "-c", script, *args], env=environment, capture_output=True, text=True)
     elapsed = time.perf_counter() - started
-    process.returncode = os.waitstatus_to_exitcode(status)
-    if process.returncode != 0:
-        raise RuntimeError(f"{command[:3]} failed ({process.returncode}):\n{output}")
-    return elapsed, usage.ru_maxrss / 1024.0, output
+    if result.returncode != 0:
+        raise RuntimeError(f"{args} failed ({result.returncode}):\n{result.stdout}{result.stderr}")
+    peak_kb = int(re.search(r"^peak_kb (\d+)$", result.stderr, flags=re.M).group(1))
+    return elapsed, peak_kb / 1024.0, result.stdout
 
 
 def recording_rows(bag: Path, minutes: float, rate: float) -> tuple[list[Row], dict]:
     if not bag.exists():
         write_long_bag(bag, minutes, rate)
-    python = sys.executable
-    baseline_s, baseline_mb, baseline_out = run_measured([python, "-c", DESERIALISE_ONLY, str(bag)])
+    for file in bag.iterdir():  # into the page cache, so that neither process pays the disk
+        with open(file, "rb") as stream:
+            while stream.read(1 << 24):
+                pass
+    baseline_s, baseline_mb, baseline_out = run_measured(DESERIALISE_ONLY, str(bag))
     with tempfile.TemporaryDirectory() as work:
-        out = Path(work) / "identified.yaml"
-        ours_s, ours_mb, ours_out = run_measured(
-            [python, "-m", "irb140_dynamics.tools.identify", str(bag), "--out", str(out), "--quiet"])
+        ours_s, ours_mb, ours_out = run_measured(IDENTIFY, str(bag), "--out", str(Path(work) / "identified.yaml"),
+                                                 "--quiet")
     messages = int(baseline_out.split()[0])
     group = f"recording: {messages:,} JointState messages ({minutes:g} min at {rate:g} Hz)"
     rows = [

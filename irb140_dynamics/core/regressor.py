@@ -46,7 +46,7 @@ _UNIT_VECTORS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 def rigid_body_regressor(links, cs, qd, qdd, gravity):
     """The n x 10n rigid-body regressor (rows of columns), written on scalars like ``rnea``."""
     rots = turns(links, cs)
-    motion = forward_motion(links, rots, qd, qdd, gravity)
+    motion = forward_motion(links, rots, qd, qdd, gravity, at_joints=True)
     n = len(links)
     Y = [[0.0] * (10 * n) for _ in range(n)]
     for k in range(n):
@@ -60,8 +60,7 @@ def rigid_body_regressor(links, cs, qd, qdd, gravity):
 
 
 def _in_joint_frame(link: Link, w, dw, a):
-    """Link motion moved from o_i in frame i to the joint origin o'_i in the joint frame."""
-    a = add(a, scale(-1.0, add(cross(dw, link.p), cross(w, cross(w, link.p)))))
+    """Link motion (a at the joint origin o'_i) in frame i, in the joint frame."""
     if link.R1 is None:
         return w, dw, a
     return rotate(link.R1, w), rotate(link.R1, dw), rotate(link.R1, a)

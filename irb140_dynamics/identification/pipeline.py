@@ -98,13 +98,16 @@ def identify(prior: RobotModel, path, settings: Settings = Settings(), validate=
     tallies = []
     for k, recording in enumerate(recordings):
         if validate is None:
+            if recording.total <= 0:
+                raise RecordingError(recording.path, "it does not tell how many messages it holds, so its last "
+                                     f"{100 * settings.held_out:g} % cannot be held out: validate with --validate")
             split = int(round(recording.total * (1.0 - settings.held_out)))
         else:
             split = np.iinfo(np.int64).max if k == 0 else 0
         tallies.append(_accumulate(prior, recording, split, (train, held_out), min_speed, settings, keeper, progress))
-    for tally, equations in ((tallies[0], train), (tallies[-1], held_out)):
+    for tally, equations, use in ((tallies[0], train, "to fit"), (tallies[-1], held_out, "to validate")):
         if equations.rows.sum() == 0:
-            raise RecordingError(tally.path, _nothing_usable(tally))
+            raise RecordingError(tally.path, _nothing_usable(tally, use))
     estimate = weighted_least_squares(train, base, tallies[0].design.noise_correlation())
     fit = consistent_parameters(prior, base, estimate, settings.prior_weight)
     source = str(validate) if validate is not None else f"the last {100 * settings.held_out:g} % of the recording"
@@ -157,13 +160,13 @@ def _rate(recording: Recording, chunk) -> float:
     return 1.0 / float(np.median(steps))
 
 
-def _nothing_usable(tally: Tally) -> str:
+def _nothing_usable(tally: Tally, use: str) -> str:
     if tally.read == 0:
         reasons = ", ".join(f"{count} {kind.replace('_', ' ')}" for kind, count in tally.skipped.items())
         return f"no usable joint states of the model's joints ({reasons or 'no messages'})"
     if tally.invalid == tally.read:
         return "no sample has efforts (and positions) for every joint of the model"
-    return (f"no torque rows left to fit: {tally.read} samples, {tally.invalid} without effort, {tally.edges} at "
+    return (f"no torque rows left {use}: {tally.read} samples, {tally.invalid} without effort, {tally.edges} at "
             f"gaps and ends, the rest too slow; record a longer, faster motion")
 
 

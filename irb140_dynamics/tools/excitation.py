@@ -27,6 +27,8 @@ from ..identification.excitation import (
 from ..identification.files import joint_trajectory_text, write_text
 from .common import ToolError, prior_model, run
 
+SHELL_ARGUMENT_LIMIT = 128 * 1024  # bytes: Linux's MAX_ARG_STRLEN
+
 
 def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="excitation", description=__doc__.split("\n\n")[0].split(": ", 1)[1])
@@ -71,13 +73,17 @@ def main(argv=None) -> int:
             f"{len(times)} points; starts and ends at rest at the first point",
             "Move the arm to the first point first. Publish it, e.g.:",
             "  ros2 topic pub --once /joint_trajectory_controller/joint_trajectory "
-            "trajectory_msgs/msg/JointTrajectory --yaml-file FILE",
+            "trajectory_msgs/msg/JointTrajectory \"$(cat FILE)\"   (or --yaml-file FILE)",
             "and record: ros2 bag record /joint_states",
         ]
-        write_text(args.out, joint_trajectory_text(model.joint_names, times, Q, QD, QDD, comments))
+        text = joint_trajectory_text(model.joint_names, times, Q, QD, QDD, comments)
+        write_text(args.out, text)
         print(f"condition number: {result.condition_number:.2f} (random start {result.start_condition_number:.2f})")
         print(f"wrote {args.out}: {len(times)} points over {times[-1]:g} s; start at "
               f"[{', '.join(f'{x:.4f}' for x in Q[0])}] rad")
+        if len(text) > SHELL_ARGUMENT_LIMIT:
+            print(f"note: {len(text) // 1024} kB is too long for one shell argument (\"$(cat {args.out})\"): "
+                  "publish it with --yaml-file, or lower --rate")
         return 0
 
     return run("excitation", body)
