@@ -25,6 +25,7 @@ setup(
             "id_node = irb140_dynamics.id_node:main",
             "payload_check_node = irb140_dynamics.payload_check_node:main",
             "demo_node = irb140_dynamics.demo_node:main",
+            "sim_node = irb140_dynamics.sim_node:main",
         ],
     },
 )

@@ -1,0 +1,50 @@
+"""Real-time pacing of a fixed-step simulation: which steps are due, and which ran late.
+
+Step k (k = 1, 2, ...) is due at start + k * period (start: the first call, so that step 1 is
+due then). A call at ``now`` runs every step due by then (half a period of grace for timer
+jitter), catching up when a call came late. A step that runs more than one period after
+it was due is *late*. When the schedule is behind by more than ``max_lag``, the steps in
+between are *skipped* instead: the schedule moves on (simulated time then runs behind wall
+time by the skipped steps) rather than racing through a burst of catch-up steps.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass
+class StepSchedule:
+    period: float  # s
+    max_lag: float = 0.05  # s: behind by more than this, skip rather than catch up
+    start: float | None = None  # s, the clock of ``due``'s ``now`` (monotonic)
+    steps: int = 0  # steps run (handed out by ``due``)
+    late: int = 0  # of them, run more than one period after they were due
+    skipped: int = 0  # steps never run: the schedule moved on
+
+    def __post_init__(self):
+        if not (math.isfinite(self.period) and self.period > 0.0):
+            raise ValueError(f"period: must be > 0, got {self.period}")
+
+    def due(self, now: float) -> int:
+        """How many steps to run at ``now`` (0 when the next is not yet due)."""
+        if self.start is None:
+            self.start = now - self.period
+        count = math.floor((now - self.start) / self.period + 0.5) - self.steps
+        if count <= 0:
+            return 0
+        behind = now - self.due_time(self.steps + 1)
+        if behind > self.max_lag:
+            self.skipped += count - 1
+            self.start += (count - 1) * self.period
+            count = 1
+        # steps k of this batch with due_time(k) < now - period are late
+        last_on_time = math.floor((now - self.period - self.start) / self.period)
+        self.late += max(0, min(last_on_time, self.steps + count) - self.steps)
+        self.steps += count
+        return count
+
+    def due_time(self, k: int) -> float:
+        """When step k is due, on the clock of ``now``."""
+        return self.start + k * self.period
