@@ -17,7 +17,6 @@ warned about, never applied.
 
 from __future__ import annotations
 
-import math
 import time
 from collections import Counter
 from dataclasses import dataclass
@@ -124,7 +123,8 @@ class SimNode(Node):
         self._rng = np.random.default_rng()
         period = 1.0 / self.get_parameter("rate").value
         self.schedule = StepSchedule(period)
-        self._stamp_offset = self.get_clock().now().nanoseconds * 1e-9 - time.monotonic()
+        self._stamp_offset = self.get_clock().now().nanoseconds - time.monotonic_ns()  # node clock - monotonic
+        self.last_stamp = 0  # ns, node clock: of the last joint state published
         self._held_until = 0.0
         self.reset()
 
@@ -200,10 +200,10 @@ class SimNode(Node):
             self._publish_state(self.schedule.due_time(k))
 
     def _publish_state(self, t: float) -> None:
+        """Publish the arm's state, stamped with the node clock's time of ``t`` (monotonic)."""
         msg, settings, arm = self._state_msg, self.settings, self.arm
-        seconds = self._stamp_offset + t
-        msg.header.stamp.sec = math.floor(seconds)
-        msg.header.stamp.nanosec = min(999_999_999, round((seconds - math.floor(seconds)) * 1e9))
+        self.last_stamp = self._stamp_offset + round(t * 1e9)
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(self.last_stamp, 1_000_000_000)
         q, effort = arm.data.qpos, arm.applied
         if settings.position_noise > 0.0:
             q = q + self._rng.normal(0.0, settings.position_noise, arm.n)
