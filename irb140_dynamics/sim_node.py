@@ -17,6 +17,7 @@ warned about, never applied.
 
 from __future__ import annotations
 
+import threading
 import time
 from collections import Counter
 from dataclasses import dataclass
@@ -36,7 +37,7 @@ from .ros.params import Spec, check_choice, declare_model
 from .ros.spin import run
 from .sim.engine import DEFAULT_INTEGRATOR, SimulatedArm, SimulationError
 from .sim.mjcf import INTEGRATORS
-from .sim.realtime import StepSchedule
+from .sim.realtime import RealTimeLoop
 
 WARN_LATE_SHARE = 0.01  # /diagnostics WARN when more of the last period's steps were late
 
@@ -48,8 +49,8 @@ NODE_PARAMETERS = [
     Spec("integrator", DEFAULT_INTEGRATOR, f"MuJoCo's integrator: {', '.join(INTEGRATORS)}", read_only=True),
     Spec("command_timeout", 0.1, "zero torque once the last command is older than this; 0 = never", "s",
          minimum=0.0),
-    Spec("initial_positions", Parameter.Type.DOUBLE_ARRAY, "where the arm starts and ~/reset puts it, model joint order; "
-         "not given or empty = all zero", "rad"),
+    Spec("initial_positions", Parameter.Type.DOUBLE_ARRAY,
+         "where the arm starts and ~/reset puts it, model joint order; not given or empty = all zero", "rad"),
     Spec("reset_hold", 0.0, "after startup and each ~/reset the arm is held still (brakes on, no torque) "
          "this long", "s", minimum=0.0),
     Spec("noise.position", 0.0, "std dev of the noise added to the published positions", "rad", minimum=0.0),
@@ -114,7 +115,7 @@ class SimNode(Node):
         super().__init__("sim_node", **kwargs)
         self.parameters = declare_model(self, NODE_PARAMETERS, build_settings)
         self.settings = self.parameters.current
-        self.arm = self.settings.engine  # the engine: tests may drive it directly
+        self.arm = self.settings.engine  # the engine, stepped by self.loop under self._lock
         self.parameters.on_change(self._use)
         self.counts: Counter[str] = Counter()
         self._reported = Counter()  # the counts at the last diagnostics
@@ -122,7 +123,7 @@ class SimNode(Node):
         self._command_stale = True
         self._rng = np.random.default_rng()
         period = 1.0 / self.get_parameter("rate").value
-        self.schedule = StepSchedule(period)
+        self._lock = threading.Lock()  # the arm and settings: the stepping thread against callbacks
         self._stamp_offset = self.get_clock().now().nanoseconds - time.monotonic_ns()  # node clock - monotonic
         self.last_stamp = 0  # ns, node clock: of the last joint state published
         self._held_until = 0.0
@@ -137,22 +138,30 @@ class SimNode(Node):
         self.create_service(Trigger, "~/reset", self._on_reset)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self.create_timer(1.0, self._publish_diagnostics)
-        self.create_timer(period, self._tick)
+        self.loop = RealTimeLoop(period, self._step, self._on_step_error)
+        self.schedule = self.loop.schedule
+        self.loop.start()
         self.get_logger().info(
             f"ready: {len(names)} joints {names}, {1.0 / period:g} Hz, payload {self.settings.model.payload.mass} kg"
         )
 
+    def destroy_node(self):
+        self.loop.stop()
+        return super().destroy_node()
+
     def _use(self, settings: Settings) -> None:
         """Switch to new settings; a new model continues from the current state."""
-        if settings.model != self.settings.model:
-            settings.engine.take_state_of(self.arm)
-            self.arm = settings.engine
-        self.settings = settings
+        with self._lock:
+            if settings.model != self.settings.model:
+                settings.engine.take_state_of(self.arm)
+                self.arm = settings.engine
+            self.settings = settings
 
     def reset(self) -> None:
         """The arm back at initial_positions, at rest, held for reset_hold."""
-        self.arm.reset(self.settings.initial_positions)
-        self._held_until = time.monotonic() + self.settings.reset_hold
+        with self._lock:
+            self.arm.reset(self.settings.initial_positions)
+            self._held_until = time.monotonic() + self.settings.reset_hold
         self.counts["resets"] += 1
 
     def _on_reset(self, request, response):
@@ -184,33 +193,36 @@ class SimNode(Node):
             return np.zeros(self.arm.n)
         return tau
 
-    def _tick(self) -> None:
-        """Run the steps due by now, publishing the state after each."""
-        now = time.monotonic()
-        due = self.schedule.due(now)
-        for k in range(self.schedule.steps - due + 1, self.schedule.steps + 1):
+    def _step(self, k: int, t: float) -> None:
+        """Step k of the stepping thread, due at t (monotonic): apply the held command for one
+        period (none while held after a reset), then publish the state."""
+        if not self.context.ok():
+            return
+        with self._lock:
+            arm, settings = self.arm, self.settings
+            now = time.monotonic()
             if now < self._held_until:
-                self.arm.applied = np.zeros(self.arm.n)
+                arm.applied = np.zeros(arm.n)
             else:
-                try:
-                    self.arm.step(self._held_command(now))
-                except SimulationError as error:
-                    self.counts["diverged"] += 1
-                    self.get_logger().warning(str(error), throttle_duration_sec=2.0)
-            self._publish_state(self.schedule.due_time(k))
-
-    def _publish_state(self, t: float) -> None:
-        """Publish the arm's state, stamped with the node clock's time of ``t`` (monotonic)."""
-        msg, settings, arm = self._state_msg, self.settings, self.arm
-        self.last_stamp = self._stamp_offset + round(t * 1e9)
-        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(self.last_stamp, 1_000_000_000)
-        q, effort = arm.data.qpos, arm.applied
+                arm.step(self._held_command(now))
+            q, qd, effort = arm.q, arm.qd, arm.applied
         if settings.position_noise > 0.0:
-            q = q + self._rng.normal(0.0, settings.position_noise, arm.n)
+            q += self._rng.normal(0.0, settings.position_noise, arm.n)
         if settings.effort_noise > 0.0:
             effort = effort + self._rng.normal(0.0, settings.effort_noise, arm.n)
-        msg.position, msg.velocity, msg.effort = q.tolist(), arm.data.qvel.tolist(), effort.tolist()
+        msg = self._state_msg
+        self.last_stamp = self._stamp_offset + round(t * 1e9)  # node clock, ns
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(self.last_stamp, 1_000_000_000)
+        msg.position, msg.velocity, msg.effort = q.tolist(), qd.tolist(), effort.tolist()
         self._state_pub.publish(msg)
+
+    def _on_step_error(self, error: Exception) -> None:
+        if isinstance(error, SimulationError):
+            self.counts["diverged"] += 1
+            self.get_logger().warning(str(error), throttle_duration_sec=2.0)
+        elif self.context.ok():
+            self.counts["step_errors"] += 1
+            self.get_logger().error(f"step failed: {error!r}", throttle_duration_sec=2.0)
 
     def _publish_diagnostics(self) -> None:
         """Step counts; WARN when steps ran late or were skipped, or commands were dropped."""
@@ -220,18 +232,18 @@ class SimNode(Node):
         self._reported = self.counts.copy()
         status = DiagnosticStatus(name=f"{self.get_name()}: simulation", hardware_id=self.get_fully_qualified_name())
         steps = recent["steps"]
-        status.level = DiagnosticStatus.WARN
+        problems = []
         if recent["late_steps"] > WARN_LATE_SHARE * steps or recent["skipped_steps"]:
-            status.message = (f"cannot keep real time: {recent['late_steps']} of {steps} steps late, "
-                              f"{recent['skipped_steps']} skipped in the last period")
-        elif recent["dropped"]:
-            status.message = f"{recent['dropped']} effort commands dropped in the last period"
-        elif recent["diverged"]:
-            status.message = "the simulation diverged and was reset"
-        else:
-            status.level = DiagnosticStatus.OK
-            command = "no command: zero torque" if self._command_stale else "command held"
-            status.message = f"{steps} steps in the last period; {command}"
+            problems.append(f"cannot keep real time: {recent['late_steps']} of {steps} steps late, "
+                            f"{recent['skipped_steps']} skipped")
+        if recent["dropped"]:
+            problems.append(f"{recent['dropped']} effort commands dropped")
+        if recent["diverged"]:
+            problems.append("the simulation diverged and was reset")
+        command = "no command: zero torque" if self._command_stale else "command held"
+        status.level = DiagnosticStatus.WARN if problems else DiagnosticStatus.OK
+        status.message = ("; ".join(problems) + " in the last period" if problems
+                          else f"{steps} steps in the last period; {command}")
         status.values = [KeyValue(key=key, value=str(value)) for key, value in sorted(self.counts.items())]
         msg = DiagnosticArray(status=[status])
         msg.header.stamp = self.get_clock().now().to_msg()

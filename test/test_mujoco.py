@@ -109,8 +109,8 @@ def test_massless_links_get_the_minimal_inertia_and_nothing_else_changes():
 
 def test_joint_extras_and_limits_are_carried_over():
     robot = viscous_only(random_urdf_model(np.random.default_rng(5), 4, friction=True), np.random.default_rng(2))
-    joints = tuple(dataclasses.replace(j, friction=Friction(j.friction.viscous, 1.5 + i), position_limits=(-1.0 - i, 2.0))
-                   for i, j in enumerate(robot.joints))
+    joints = tuple(dataclasses.replace(j, friction=Friction(j.friction.viscous, 1.5 + i),
+                                       position_limits=(-1.0 - i, 2.0)) for i, j in enumerate(robot.joints))
     robot = dataclasses.replace(robot, joints=joints)
     m = mujoco_model(robot, timestep=0.0005)
     np.testing.assert_array_equal(m.dof_armature, [j.armature for j in robot.joints])

@@ -1,7 +1,8 @@
 """The simulated arm (MuJoCo, no ROS): it integrates our physics, stops at the limits, holds by
-dry friction, saturates the drives, resets when it blows up; and the real-time schedule."""
+dry friction, saturates the drives, resets when it blows up; and the real-time schedule and loop."""
 
 import dataclasses
+import time
 
 import numpy as np
 import pytest
@@ -9,7 +10,7 @@ from scipy.integrate import solve_ivp
 
 from irb140_dynamics.core import Friction, RigidBody, forward_dynamics, gravity, irb140
 from irb140_dynamics.sim.engine import SimulatedArm, SimulationError
-from irb140_dynamics.sim.realtime import StepSchedule
+from irb140_dynamics.sim.realtime import RealTimeLoop, StepSchedule
 
 from .support import loaded_irb140
 
@@ -169,3 +170,24 @@ def test_schedule_skips_when_far_behind():
     assert (schedule.steps, schedule.skipped, schedule.late) == (2, 199, 0)
     assert schedule.due(1.201) == 1  # and on time from there
     assert schedule.due_time(3) == pytest.approx(1.201)
+
+
+def test_the_loop_steps_in_real_time_and_survives_errors():
+    calls, errors = [], []
+
+    def step(k, t):
+        calls.append((k, t, time.monotonic()))
+        if k == 5:
+            raise RuntimeError("boom")
+
+    loop = RealTimeLoop(0.002, step, errors.append)
+    loop.start()
+    time.sleep(0.3)
+    loop.stop()
+    count = len(calls)
+    time.sleep(0.01)
+    assert len(calls) == count  # stopped
+    assert 100 <= count <= 151  # 0.3 s at 500 Hz, give or take the start
+    assert [k for k, _, _ in calls] == list(range(1, count + 1))
+    assert all(ran >= t - 0.001 for _, t, ran in calls)  # never early (half a period of grace)
+    assert [str(e) for e in errors] == ["boom"]
