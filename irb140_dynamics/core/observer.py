@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .algorithms import Dual, add, cross, dot, inertia_times, scale, to_child, turns
+from .algorithms import add, cross, dot, inertia_times, scale, to_child, turns
+from .dual import dual_angles, partial
 from .dynamics import _state, gravity
 from .model import RobotModel
 
@@ -42,13 +43,8 @@ def kinetic_energy(links, cs, qd):
 
 def energy_gradient(links, cs, qd):
     """dT/dq = C(q, qd)^T qd, exact: T on dual numbers carrying d/dq_k."""
-    n = len(links)
-    dual_cs = [
-        (Dual(c, tuple(-s if i == k else 0.0 for i in range(n))), Dual(s, tuple(c if i == k else 0.0 for i in range(n))))
-        for k, (c, s) in enumerate(cs)
-    ]
-    T = kinetic_energy(links, dual_cs, qd)
-    return list(T.d) if isinstance(T, Dual) else [0.0] * n
+    T = kinetic_energy(links, dual_angles(cs), qd)
+    return [partial(T, k) for k in range(len(links))]
 
 
 class MomentumObserver:
