@@ -4,6 +4,8 @@ Serves       ~/check        std_srvs/Trigger: the configured payload (payload.* 
                             against the joint torque limits, at the current joint state (if
                             joint_states was received) and in each joint's worst static pose
                             over the joint ranges; the reply's message is the report
+             ~/estimate_payload, ~/clear_samples   std_srvs/Trigger: payload estimation from the
+                            efforts at rest (see ros.estimation)
 Subscribes   joint_states   sensor_msgs/JointState (matched by joint name, as in id_node)
 Publishes    /diagnostics   diagnostic_msgs/DiagnosticArray: one status per joint and one for
                             the payload, after each check and every diagnostics.period
@@ -26,7 +28,8 @@ from std_srvs.srv import Trigger
 from .core import RigidBody, RobotModel
 from .core.payload import TorqueLimits, WorkspaceLoad, check_payload, derive_torque_limits, workspace_load
 from .ros.diagnostics import payload_statuses
-from .ros.messages import BadMessage, JointOrder, NotForThisModel, count_and_warn, read_joint_state
+from .ros.estimation import ESTIMATION_PARAMETERS, PayloadEstimator, check_estimation
+from .ros.messages import BadMessage, JointOrder, NotForThisModel, count_and_warn, read_effort, read_joint_state
 from .ros.params import QOS_PARAMETERS, Spec, check_qos, declare_model, joint_states_qos
 from .ros.spin import run
 
@@ -38,6 +41,7 @@ NODE_PARAMETERS = [
          minimum=0.0),
     Spec("diagnostics.period", 1.0, "check and publish /diagnostics this often; 0 = only on ~/check",
          "s", minimum=0.0, read_only=True),
+    *ESTIMATION_PARAMETERS,
     *QOS_PARAMETERS,
 ]
 STALE_AFTER = 1.0  # s: a joint state older than this is reported as stale
@@ -52,6 +56,8 @@ class Settings:
     warn_use: float
     limits: TorqueLimits
     workspace: WorkspaceLoad  # the payload's worst static loads and largest mass
+    rest_velocity: float  # rad/s, payload estimation
+    rest_time: float  # s
 
 
 def build_settings(values: dict) -> Settings:
@@ -62,9 +68,13 @@ def build_settings(values: dict) -> Settings:
     if not values["diagnostics.warn_use"] >= 0.0:
         raise ValueError(f"diagnostics.warn_use: must be >= 0 %, got {values['diagnostics.warn_use']}")
     check_qos(values)
+    check_estimation(values)
     limits = derive_torque_limits(model, rated)
     workspace = workspace_load(model, model.payload, limits)
-    return Settings(model, rated, values["diagnostics.warn_use"], limits, workspace)
+    return Settings(
+        model, rated, values["diagnostics.warn_use"], limits, workspace,
+        values["estimation.rest_velocity"], values["estimation.rest_time"],
+    )
 
 
 class PayloadCheckNode(Node):
@@ -73,6 +83,7 @@ class PayloadCheckNode(Node):
         self.parameters = declare_model(self, NODE_PARAMETERS, build_settings)
         self.parameters.on_change(self._use)
         self.counts: Counter[str] = Counter()
+        self.estimator = PayloadEstimator(self, lambda: self.settings.model)
         self._use(self.parameters.current)
         self._order = JointOrder(self.settings.model.joint_names)
         self._state = None  # (q, qd, time received [node clock]) of the latest good joint state
@@ -89,6 +100,7 @@ class PayloadCheckNode(Node):
     def _use(self, settings: Settings) -> None:
         """Switch to new settings (built, limits and workspace sweep included, when checked)."""
         self.settings = settings
+        self.estimator.use(settings.rest_velocity, settings.rest_time)
 
     def _on_joint_state(self, msg: JointState) -> None:
         try:
@@ -98,7 +110,16 @@ class PayloadCheckNode(Node):
         except BadMessage as error:
             count_and_warn(self.get_logger(), self.counts, "joint_states", error)
             return
-        self._state = (q, qd, self.get_clock().now())
+        now = self.get_clock().now()
+        self._state = (q, qd, now)
+        try:
+            effort = read_effort(msg, self._order)
+        except BadMessage as error:
+            count_and_warn(self.get_logger(), self.counts, "joint_states effort", error)
+            effort = None
+        stamp = msg.header.stamp
+        t = stamp.sec + 1e-9 * stamp.nanosec
+        self.estimator.update(t if t != 0.0 else now.nanoseconds * 1e-9, q, qd, effort)
 
     def check(self):
         """Check the payload (at the latest state, if any) and publish /diagnostics:
@@ -110,7 +131,7 @@ class PayloadCheckNode(Node):
         )
         stale = None if received is None else self._stale(received)
         statuses = payload_statuses(result, self.get_name(), settings.warn_use, stale)
-        diagnostics = DiagnosticArray(status=statuses)
+        diagnostics = DiagnosticArray(status=statuses + [self.estimator.status(self.get_name())])
         diagnostics.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(diagnostics)
         return result, stale
