@@ -25,13 +25,12 @@ from __future__ import annotations
 
 import argparse
 import os
-import random
 import sys
 import time
 
 import numpy as np
 
-from bench_nodes import (OTHERS_WARNING, NodeProcess, Receiver, Value, machine_busy, node_environment,
+from bench_nodes import (OTHERS_WARNING, NodeProcess, Receiver, Value, isolated_domain, machine_busy,
                          percentiles, wait_for)
 from common import REPO, Row, Target, machine_info, print_table, write_results
 
@@ -179,11 +178,7 @@ def main(argv=None) -> None:
     parser.add_argument("--domain-id", type=int, default=None, help="ROS_DOMAIN_ID (default: random in 50..99)")
     args = parser.parse_args(argv)
     started = time.perf_counter()
-    domain_id = random.randint(50, 99) if args.domain_id is None else args.domain_id
-    os.environ["ROS_DOMAIN_ID"] = str(domain_id)  # before rclpy.init, for this process too
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    env = node_environment(domain_id)
-    print(f"ROS_DOMAIN_ID={domain_id}", flush=True)
+    domain_id, env = isolated_domain(args.domain_id)
 
     import rclpy
 
