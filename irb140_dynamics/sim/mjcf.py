@@ -88,7 +88,7 @@ def mjcf(
         if joint.link.mass > 0.0:
             lines.append(f"{indent}{_inertial(joint.link)}")
     if model.payload.mass > 0.0:
-        lines.append(f'{indent}<body name="payload" {_placement(model.flange.matrix())}>')
+        lines.append(f"{indent}<body {_placement(model.flange.matrix())}>")  # unnamed: no clash with a link
         lines.append(f"{indent}  {_inertial(model.payload)}")
         lines.append(f"{indent}</body>")
     for _ in model.joints:
