@@ -9,6 +9,7 @@ it: the drives saturate, and ``applied`` says what was applied.
 
 from __future__ import annotations
 
+import logging
 import math
 
 import mujoco
@@ -36,6 +37,8 @@ class SimulatedArm:
             raise ValueError(f"period: must be > 0, got {period}")
         if int(substeps) != substeps or substeps < 1:
             raise ValueError(f"substeps: must be an integer >= 1, got {substeps}")
+        if mujoco.get_mju_user_warning() is None:  # else MuJoCo prints and writes MUJOCO_LOG.TXT
+            mujoco.set_mju_user_warning(_log_warning)
         self.model, self.period, self.substeps = model, period, int(substeps)
         self.mj_model = mujoco_model(model, timestep=period / self.substeps, integrator=integrator)
         self.mj_model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET  # we reset, and say so
@@ -114,6 +117,10 @@ class SimulatedArm:
         if not np.isfinite(x).all():
             raise ValueError(f"{name}: must be finite, got {x.tolist()}")
         return x.copy()
+
+
+def _log_warning(message: str) -> None:
+    logging.getLogger(__name__).warning("MuJoCo: %s", message)
 
 
 def data_warning(data: mujoco.MjData, kind) -> int:
