@@ -67,6 +67,7 @@ class RobotDescription:
         text, path, base, tip = (_declare(node, spec) for spec in DESCRIPTION_PARAMETERS)
         self._chain_ends = (base or None, tip or None)
         self.urdf: LoadedUrdf | None = None  # the URDF's chain of the model in use
+        self.refused, self.last_refusal = 0, ""  # URDFs refused on the topic, and why the last one was
         origin = "robot_description parameter" if text else f"model.urdf_file {path}"
         if text or path:
             self.urdf = self._load(text or _read(path), origin)
@@ -112,11 +113,11 @@ class RobotDescription:
         try:
             urdf = self._load(msg.data, "robot_description topic")
             configuration = self._build_with(urdf, self.parameters.values())
-        except ValueError as error:
-            logger.error(f"refused a robot_description ({keeping}): {_one_line(error)}")
-            return
         except Exception as error:  # noqa: BLE001: nothing of ours may leave a callback
-            logger.error(f"refused a robot_description ({keeping}): {type(error).__name__}: {_one_line(error)}")
+            self.refused += 1
+            kind = "" if isinstance(error, ValueError) else f"{type(error).__name__}: "
+            self.last_refusal = f"{kind}{_one_line(error)}"
+            logger.error(f"refused a robot_description ({keeping}): {self.last_refusal}")
             return
         self.urdf = urdf
         self.parameters.replace(configuration)
