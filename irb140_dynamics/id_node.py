@@ -5,7 +5,10 @@ Subscribes   joint_states          sensor_msgs/JointState (matched by joint name
 Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, qdd)
              gravity_torques       sensor_msgs/JointState, effort = g(q)
              effort_commands       std_msgs/Float64MultiArray (when enabled), model joint order
-             /diagnostics          diagnostic_msgs/DiagnosticArray, message counts, 1 Hz
+             external_torques      sensor_msgs/JointState, effort = external torques by the momentum
+                                   observer (for joint states that carry efforts; see ros.collision)
+             collision             std_msgs/Bool (transient local), any over its collision_threshold
+             /diagnostics          diagnostic_msgs/DiagnosticArray, message counts and collision, 1 Hz
              (an empty ~/reference trajectory lets the held reference go)
 
 Torques are in N m, named and ordered as the model's joints, stamped with the input stamp.
@@ -31,8 +34,16 @@ from .ros.messages import (
     NotForThisModel,
     count_and_warn,
     joint_efforts,
+    read_effort,
     read_joint_state,
     read_reference,
+)
+from .ros.collision import (
+    COLLISION_PARAMETERS,
+    CollisionMonitor,
+    CollisionSettings,
+    build_collision_settings,
+    collision_threshold_specs,
 )
 from .ros.model_source import declare_model_source
 from .ros.params import QOS_PARAMETERS, Spec, check_choice, check_qos, joint_states_qos
@@ -53,6 +64,7 @@ NODE_PARAMETERS = [
     Spec("effort_commands.enabled", False, "also publish torques on effort_commands (Float64MultiArray)",
          read_only=True),
     Spec("effort_commands.source", "feedforward", "which torques go to effort_commands: 'feedforward' or 'gravity'"),
+    *COLLISION_PARAMETERS,
     *QOS_PARAMETERS,
 ]
 
@@ -66,6 +78,7 @@ class Settings:
     cutoff_frequency: float
     reference_timeout: float
     effort_source: str
+    collision: CollisionSettings
 
 
 def build_settings(values: dict) -> Settings:
@@ -81,6 +94,7 @@ def build_settings(values: dict) -> Settings:
         values["acceleration.cutoff_frequency"],
         values["reference_timeout"],
         values["effort_commands.source"],
+        build_collision_settings(values, model.joint_names),
     )
 
 
@@ -91,11 +105,12 @@ class IdNode(Node):
         super().__init__("id_node", **kwargs)
         self.settings: Settings | None = None  # None: waiting for the model (robot_description topic)
         self._started = False
-        self.parameters = declare_model_source(self, NODE_PARAMETERS, build_settings)
+        self.parameters = declare_model_source(self, NODE_PARAMETERS, build_settings, collision_threshold_specs)
         self.parameters.on_change(self._use)
         self.counts: Counter[str] = Counter()
         self._reported = Counter()  # the counts at the last diagnostics
         self._reference = None  # (time received [ns, node clock], q, qd, qdd or None)
+        self.collision = CollisionMonitor(self, [], self.get_parameter("qos.depth").value)  # joints: by _use
         self._command_msg = Float64MultiArray()
         if self.parameters.current is not None:
             self._use(self.parameters.current)
@@ -123,6 +138,7 @@ class IdNode(Node):
             self._gravity_msg = JointState(name=names)
             self._reference = None
         self._differentiator = VelocityDifferentiator(settings.model.n, settings.cutoff_frequency)
+        self.collision.use(settings.model, settings.collision)
         self.settings = settings
         if first and self._started:  # the model came after startup
             self._log_ready()
@@ -168,15 +184,35 @@ class IdNode(Node):
             self._command_msg.data = command.tolist()
             self._command_pub.publish(self._command_msg)
         self.counts["published"] += 1
+        self._observe(msg, q, qd, g)
+
+    def _observe(self, msg: JointState, q, qd, g) -> None:
+        """Efforts in the message: run the momentum observer (external torques, collision)."""
+        try:
+            effort = read_effort(msg, self._order)
+        except BadMessage as error:
+            self.collision.reset()
+            self.counts[error.kind] += 1
+            self.get_logger().warning(f"observer skipped a joint state ({error})", throttle_duration_sec=2.0)
+            return
+        if effort is None:
+            return
+        try:
+            self.collision.update(self._time_of(msg), q, qd, effort, g, msg.header.stamp)
+        except ValueError as error:
+            self.counts["observer_reset"] += 1
+            self.get_logger().warning(f"observer reset ({error})", throttle_duration_sec=2.0)
 
     def _estimated_acceleration(self, msg: JointState, qd, settings: Settings):
         if settings.acceleration_mode == "zero":
             return [0.0] * settings.model.n
+        return self._differentiator.update(self._time_of(msg), qd)
+
+    def _time_of(self, msg: JointState) -> float:
+        """The message's stamp [s]; for an unstamped stream, the time of arrival."""
         stamp = msg.header.stamp
         t = stamp.sec + 1e-9 * stamp.nanosec
-        if t == 0.0:  # an unstamped stream: time of arrival
-            t = self.get_clock().now().nanoseconds * 1e-9
-        return self._differentiator.update(t, qd)
+        return t if t != 0.0 else self.get_clock().now().nanoseconds * 1e-9
 
     def _on_reference(self, msg: JointTrajectory) -> None:
         """Hold the first point of a trajectory; an empty trajectory lets the reference go."""
@@ -217,7 +253,8 @@ class IdNode(Node):
             status.level = DiagnosticStatus.OK
             status.message = f"{recent['published']} torque messages in the last second"
         status.values = [KeyValue(key=key, value=str(value)) for key, value in sorted(self.counts.items())]
-        msg = DiagnosticArray(status=[status])
+        collision = self.collision.status(self.get_name(), self.get_fully_qualified_name())
+        msg = DiagnosticArray(status=[status, collision])
         msg.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(msg)
 

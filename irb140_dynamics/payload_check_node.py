@@ -4,6 +4,8 @@ Serves       ~/check        std_srvs/Trigger: the configured payload (payload.* 
                             against the joint torque limits, at the current joint state (if
                             joint_states was received) and in each joint's worst static pose
                             over the joint ranges; the reply's message is the report
+             ~/estimate_payload, ~/clear_samples   std_srvs/Trigger: payload estimation from the
+                            efforts at rest (see ros.estimation)
 Subscribes   joint_states   sensor_msgs/JointState (matched by joint name, as in id_node)
 Publishes    /diagnostics   diagnostic_msgs/DiagnosticArray: one status per joint and one for
                             the payload, after each check and every diagnostics.period
@@ -24,9 +26,11 @@ from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
 from .core import RigidBody, RobotModel
+from .core.payload_estimation import EstimationError
 from .core.payload import TorqueLimits, WorkspaceLoad, check_payload, derive_torque_limits, workspace_load
 from .ros.diagnostics import payload_statuses
-from .ros.messages import BadMessage, JointOrder, NotForThisModel, count_and_warn, read_joint_state
+from .ros.estimation import ESTIMATION_PARAMETERS, PayloadEstimator, check_estimation
+from .ros.messages import BadMessage, JointOrder, NotForThisModel, count_and_warn, read_effort, read_joint_state
 from .ros.model_source import declare_model_source
 from .ros.params import QOS_PARAMETERS, Spec, check_qos, joint_states_qos
 from .ros.spin import run
@@ -39,6 +43,7 @@ NODE_PARAMETERS = [
          minimum=0.0),
     Spec("diagnostics.period", 1.0, "check and publish /diagnostics this often; 0 = only on ~/check",
          "s", minimum=0.0, read_only=True),
+    *ESTIMATION_PARAMETERS,
     *QOS_PARAMETERS,
 ]
 STALE_AFTER = 1.0  # s: a joint state older than this is reported as stale
@@ -53,6 +58,8 @@ class Settings:
     warn_use: float
     limits: TorqueLimits
     workspace: WorkspaceLoad  # the payload's worst static loads and largest mass
+    rest_velocity: float  # rad/s, payload estimation
+    rest_time: float  # s
 
 
 def build_settings(values: dict) -> Settings:
@@ -63,9 +70,13 @@ def build_settings(values: dict) -> Settings:
     if not values["diagnostics.warn_use"] >= 0.0:
         raise ValueError(f"diagnostics.warn_use: must be >= 0 %, got {values['diagnostics.warn_use']}")
     check_qos(values)
+    check_estimation(values)
     limits = derive_torque_limits(model, rated)
     workspace = workspace_load(model, model.payload, limits)
-    return Settings(model, rated, values["diagnostics.warn_use"], limits, workspace)
+    return Settings(
+        model, rated, values["diagnostics.warn_use"], limits, workspace,
+        values["estimation.rest_velocity"], values["estimation.rest_time"],
+    )
 
 
 class PayloadCheckNode(Node):
@@ -77,6 +88,7 @@ class PayloadCheckNode(Node):
         self.parameters = declare_model_source(self, NODE_PARAMETERS, build_settings)
         self.parameters.on_change(self._use)
         self.counts: Counter[str] = Counter()
+        self.estimator = PayloadEstimator(self, self._model)
         if self.parameters.current is not None:
             self._use(self.parameters.current)
 
@@ -96,13 +108,21 @@ class PayloadCheckNode(Node):
         if first or names != self.settings.model.joint_names:
             self._order = JointOrder(names)
             self._state = None
+            self.estimator.detector.clear()  # rest samples of other joints
         self.settings = settings
+        self.estimator.use(settings.rest_velocity, settings.rest_time)
         if first and self._started:  # the model came after startup
             self._log_ready()
 
     def _log_ready(self) -> None:
         payload = self.settings.model.payload
         self.get_logger().info(f"ready: ~/check for a {payload.mass} kg payload at {list(payload.com)} m")
+
+    def _model(self) -> RobotModel:
+        """The model in force, for the payload estimate."""
+        if self.settings is None:
+            raise EstimationError("no model yet: waiting for a URDF on the robot_description topic")
+        return self.settings.model
 
     def _on_joint_state(self, msg: JointState) -> None:
         if self.settings is None:
@@ -114,7 +134,16 @@ class PayloadCheckNode(Node):
         except BadMessage as error:
             count_and_warn(self.get_logger(), self.counts, "joint_states", error)
             return
-        self._state = (q, qd, self.get_clock().now())
+        now = self.get_clock().now()
+        self._state = (q, qd, now)
+        try:
+            effort = read_effort(msg, self._order)
+        except BadMessage as error:
+            count_and_warn(self.get_logger(), self.counts, "joint_states effort", error)
+            effort = None
+        stamp = msg.header.stamp
+        t = stamp.sec + 1e-9 * stamp.nanosec
+        self.estimator.update(t if t != 0.0 else now.nanoseconds * 1e-9, q, qd, effort)
 
     def check(self):
         """Check the payload (at the latest state, if any) and publish /diagnostics:
@@ -129,7 +158,7 @@ class PayloadCheckNode(Node):
         )
         stale = None if received is None else self._stale(received)
         statuses = payload_statuses(result, self.get_name(), settings.warn_use, stale)
-        diagnostics = DiagnosticArray(status=statuses)
+        diagnostics = DiagnosticArray(status=statuses + [self.estimator.status(self.get_name())])
         diagnostics.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(diagnostics)
         return result, stale

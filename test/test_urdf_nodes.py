@@ -186,3 +186,15 @@ def test_payload_check_node_waits_then_checks_on_the_urdf_model():
         assert "shoulder_lift_joint" in reply.message
         result, _ = harness.node.check()
         assert result.limit.tolist() == [150.0, 150.0, 150.0, 28.0, 28.0, 28.0]  # the URDF's effort limits
+
+
+def test_per_joint_node_parameters_are_declared_when_the_urdf_comes():
+    overrides = from_urdf("tool0") + [Parameter("elbow_joint.collision_threshold", value=5.0)]
+    with node_and_description_publisher(IdNode, overrides) as harness:
+        assert not harness.node.has_parameter("elbow_joint.collision_threshold")
+        harness.description.publish(String(data=arm_text("ur5")))
+        assert harness.spin_until(lambda: harness.node.settings is not None)
+        assert harness.node.get_parameter("elbow_joint.collision_threshold").value == 5.0
+        assert harness.node.settings.collision.thresholds.tolist() == [0.0, 0.0, 5.0, 0.0, 0.0, 0.0]
+        [result] = harness.set_parameters([Parameter("wrist_1_joint.collision_threshold", value=2.0)])
+        assert result.successful and harness.node.settings.collision.thresholds[3] == 2.0

@@ -98,3 +98,16 @@ class Kernels:
             return [x for row in rigid_body_regressor(self.links, cs, qd, qdd, self.gravity) for x in row]
 
         return self._kernel("regressor", flat, qd=self.n, qdd=self.n)
+
+    @cached_property
+    def momentum(self) -> Kernel:
+        """(q, qd) -> [M qd, C^T qd]: the generalized momentum and dT/dq (see observer)."""
+        from .observer import energy_gradient
+
+        zeros = [0.0] * self.n
+
+        def terms(cs, qd):
+            p = algorithms.rnea(self.links, cs, zeros, qd, (0.0, 0.0, 0.0))  # M qd
+            return [*p, *energy_gradient(self.links, cs, qd)]
+
+        return self._kernel("momentum", terms, qd=self.n)

@@ -29,6 +29,7 @@ from ..core import Joint, RigidBody, RobotModel
 from ..core.urdf import LoadedUrdf, load_urdf
 from .params import LiveParameters, Spec, _declare, check_choice, declare_model, model_specs
 
+PerJoint = Callable[[list[str]], list[Spec]]  # a node's parameters for each joint of a model
 SOURCES = ("parameters", "robot_description")
 DESCRIPTION_QOS = QoSProfile(
     depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
@@ -48,22 +49,25 @@ DESCRIPTION_PARAMETERS = [
 ]
 
 
-def declare_model_source(node: Node, extra: list[Spec], build: Callable[[dict], Any]) -> LiveParameters:
+def declare_model_source(
+    node: Node, extra: list[Spec], build: Callable[[dict], Any], per_joint: PerJoint | None = None
+) -> LiveParameters:
     """Declare ``model.source`` and the model's parameters of that source, and a node's own
-    (``extra``); ``build`` as for LiveParameters. With the robot_description topic the
-    returned parameters' ``current`` is None until a model arrives."""
+    (``extra``, and ``per_joint`` specs made for the model's joint names); ``build`` as for
+    LiveParameters. With the robot_description topic the returned parameters' ``current``
+    is None until a model arrives, and the per-joint specs are declared as models come."""
     source = _declare(node, SOURCE)
     check_choice("model.source", source, SOURCES)
     if source == "parameters":
-        return declare_model(node, extra, build)
-    return RobotDescription(node, extra, build).parameters
+        return declare_model(node, extra, build, per_joint)
+    return RobotDescription(node, extra, build, per_joint or (lambda names: [])).parameters
 
 
 class RobotDescription:
     """The model of a node from a URDF: parameter, file or topic (see the module)."""
 
-    def __init__(self, node: Node, extra: list[Spec], build: Callable[[dict], Any]):
-        self._node, self._build_node = node, build
+    def __init__(self, node: Node, extra: list[Spec], build: Callable[[dict], Any], per_joint: PerJoint):
+        self._node, self._build_node, self._per_joint = node, build, per_joint
         text, path, base, tip = (_declare(node, spec) for spec in DESCRIPTION_PARAMETERS)
         self._chain_ends = (base or None, tip or None)
         self.urdf: LoadedUrdf | None = None  # the URDF's chain of the model in use
@@ -71,7 +75,8 @@ class RobotDescription:
         origin = "robot_description parameter" if text else f"model.urdf_file {path}"
         if text or path:
             self.urdf = self._load(text or _read(path), origin)
-        self.parameters = LiveParameters(node, [*model_specs([], {}), *extra], self._build)
+        own = per_joint(self.urdf.model.joint_names) if self.urdf is not None else []
+        self.parameters = LiveParameters(node, [*model_specs([], {}), *extra, *own], self._build)
         if self.urdf is not None:
             self._announce(origin)
             return
@@ -99,7 +104,8 @@ class RobotDescription:
         """The node's configuration from the URDF's model and the parameter values. Until a
         URDF has come: None, the parameters checked on a stand-in one-joint arm."""
         if self.urdf is None:
-            self._build_node({**STAND_IN.to_params(), **values})
+            stand_in_defaults = {spec.name: spec.default for spec in self._per_joint(STAND_IN.joint_names)}
+            self._build_node({**STAND_IN.to_params(), **stand_in_defaults, **values})
             return None
         return self._build_with(self.urdf, values)
 
@@ -112,6 +118,7 @@ class RobotDescription:
         keeping = "still waiting" if self.urdf is None else f"keeping the model of {self.urdf.model.n} joints"
         try:
             urdf = self._load(msg.data, "robot_description topic")
+            self.parameters.declare(self._per_joint(urdf.model.joint_names))
             configuration = self._build_with(urdf, self.parameters.values())
         except Exception as error:  # noqa: BLE001: nothing of ours may leave a callback
             self.refused += 1

@@ -145,8 +145,11 @@ def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
     ]
 
 
-def declare_model(node: Node, extra: list[Spec], build: Callable[[dict], Any]) -> "LiveParameters":
-    """Declare the robot model's parameters and a node's own, with the default model's defaults."""
+def declare_model(
+    node: Node, extra: list[Spec], build: Callable[[dict], Any], per_joint: Callable[[list[str]], list[Spec]] = None
+) -> "LiveParameters":
+    """Declare the robot model's parameters and a node's own (``extra``, and ``per_joint``
+    specs made for the model's joint names), with the default model's defaults."""
     path = default_config_path()
     if not path.is_file():
         raise ValueError(f"default model: no {path}; is the package installed? (or give --params-file)")
@@ -157,7 +160,8 @@ def declare_model(node: Node, extra: list[Spec], build: Callable[[dict], Any]) -
         Spec("joint_names", defaults["joint_names"], "the model's joints, base to flange", read_only=True),
     )
     names = check_joint_names(names)  # they become parameter prefixes: check them first
-    return LiveParameters(node, [*model_specs(names, defaults), *extra], build, ["joint_names"])
+    own = per_joint(names) if per_joint else []
+    return LiveParameters(node, [*model_specs(names, defaults), *extra, *own], build, ["joint_names"])
 
 
 class LiveParameters:
@@ -184,6 +188,13 @@ class LiveParameters:
 
     def on_change(self, listener: Callable[[Any], None]) -> None:
         self._listeners.append(listener)
+
+    def declare(self, specs: list[Spec]) -> None:
+        """Declare more parameters (a new model's per-joint ones); those declared already stay."""
+        for spec in specs:
+            if not self._node.has_parameter(spec.name):
+                _declare(self._node, spec)
+                self._names.append(spec.name)
 
     def _coerce_integers(self, parameters: list[Parameter]) -> list[Parameter]:
         """Let `ros2 param set ... payload.mass 3` mean 3.0 for a double parameter."""
