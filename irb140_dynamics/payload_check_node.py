@@ -7,6 +7,7 @@ Serves       ~/check        std_srvs/Trigger: the configured payload (payload.* 
              ~/estimate_payload, ~/clear_samples   std_srvs/Trigger: payload estimation from the
                             efforts at rest (see ros.estimation)
 Subscribes   joint_states   sensor_msgs/JointState (matched by joint name, as in id_node)
+             robot_description  std_msgs/String: the model, as in id_node (see ros.model_source)
 Publishes    /diagnostics   diagnostic_msgs/DiagnosticArray: one status per joint and one for
                             the payload, after each check and every diagnostics.period
 
