@@ -90,7 +90,7 @@ def test_flange_is_the_tip_link_frame(case):
     frame = case.pin_model.getFrameId(case.tip)
     for q in case.Q[:20]:
         pin.framesForwardKinematics(case.pin_model, case.data, pin_configuration(case.pin_model, q))
-        assert_close(flange_pose(case.robot, q), case.data.oMf[frame].homogeneous, 1e-12, 1e-12, f"q={q}")
+        assert_close(flange_pose(case.robot, q), case.data.oMf[frame].homogeneous, RTOL, ATOL, f"q={q}")
 
 
 def test_panda_limits_friction_and_held_fingers():
@@ -127,3 +127,10 @@ def test_continuous_joint_gets_the_wide_default_range():
     model = load_urdf(text, tip_link="tip").model
     assert model.joints[2].position_limits == CONTINUOUS_LIMITS
     assert model.joints[0].position_limits == (-2.5, 2.5)
+
+
+def test_angles_written_to_eleven_digits_are_right_angles():
+    """The UR5 writes pi/2 as 1.57079632679: the origin is exactly a quarter turn."""
+    shoulder_lift = load_urdf(arm_text("ur5"), tip_link="tool0").model.joints[1]
+    assert shoulder_lift.origin.rpy == (0.0, math.pi / 2, 0.0)
+    assert load_urdf(arm_text("ur5").replace("1.57079632679", "1.5708"), tip_link="tool0").model.joints[1].origin.rpy[1] == 1.5708

@@ -15,6 +15,7 @@ from ..joints import Placement
 from ..rigid_body import ModelError, RigidBody, Vector3, placed
 
 KINDS = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+RIGHT_ANGLE_TOLERANCE = 1e-9  # rad: an <origin rpy> angle this close to a multiple of pi/2 is taken as it
 
 
 class UrdfError(ModelError):
@@ -155,7 +156,18 @@ def number(element: ET.Element | None, attribute: str, where: str, default: floa
 def origin(parent: ET.Element, where: str) -> Placement:
     element = parent.find("origin")
     where = f"{where} <origin>"
-    return Placement(numbers(element, "xyz", 3, where, (0.0,) * 3), numbers(element, "rpy", 3, where, (0.0,) * 3))
+    rpy = numbers(element, "rpy", 3, where, (0.0,) * 3)
+    return Placement(numbers(element, "xyz", 3, where, (0.0,) * 3), tuple(map(right_angle_snapped, rpy)))
+
+
+def right_angle_snapped(angle: float) -> float:
+    """A multiple of pi/2 if ``angle`` is within RIGHT_ANGLE_TOLERANCE of it, else ``angle``.
+
+    Files write pi/2 as 1.57079632679 (5e-12 off): taken as exact, its cosine is 0 and the
+    generated kernels drop the terms it multiplies (about 10 % of the UR5's RNEA)."""
+    quarter_turns = round(angle / (math.pi / 2))
+    exact = quarter_turns * (math.pi / 2)
+    return exact if abs(angle - exact) < RIGHT_ANGLE_TOLERANCE else angle
 
 
 def _inertial(link: ET.Element, name: str) -> RigidBody | None:
