@@ -36,10 +36,12 @@ def from_urdf(tip=None, **values):
 
 def gravity_of(harness, names, q):
     """Publish one joint state; the gravity_torques message it yields."""
-    inbox = harness.received.get("gravity_torques") or harness.listen(JointState, "gravity_torques")
+    if "gravity_torques" not in harness.received:
+        harness.listen(JointState, "gravity_torques")
+        harness.joint_states = harness.publisher(JointState, "joint_states")
+    inbox = harness.received["gravity_torques"]
     count = len(inbox)
-    harness.received.setdefault("publisher", harness.publisher(JointState, "joint_states"))
-    harness.received["publisher"].publish(JointState(name=list(names), position=[float(x) for x in q]))
+    harness.joint_states.publish(JointState(name=list(names), position=[float(x) for x in q]))
     assert harness.spin_until(lambda: len(inbox) > count), "no gravity torques"
     return inbox[-1]
 
@@ -110,8 +112,8 @@ def test_topic_after_start_waits_then_swaps_whole_models_and_refuses_bad_ones():
         node = harness.node
         assert node.settings is None and node.parameters.current is None
         inbox = harness.listen(JointState, "gravity_torques")
-        states = harness.publisher(JointState, "joint_states")
-        states.publish(JointState(name=["shoulder_pan_joint"], position=[0.0]))
+        harness.joint_states = harness.publisher(JointState, "joint_states")
+        harness.joint_states.publish(JointState(name=["shoulder_pan_joint"], position=[0.0]))
         assert harness.spin_until(lambda: node.counts["no_model_yet"] == 1)
         harness.spin_for(0.2)
         assert not inbox, "published torques without a model"
