@@ -15,7 +15,7 @@ from ..joints import Placement
 from ..rigid_body import ModelError, RigidBody, Vector3, placed
 
 KINDS = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
-RIGHT_ANGLE_TOLERANCE = 1e-9  # rad: an <origin rpy> angle this close to a multiple of pi/2 is taken as it
+RIGHT_ANGLE_TOLERANCE = 1e-10  # rad: an <origin rpy> angle this close to a multiple of pi/2 is taken as it
 
 
 class UrdfError(ModelError):
