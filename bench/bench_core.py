@@ -11,7 +11,7 @@ to bench/results/core.json. Sections:
 - batch: states per second of the ``*_batch`` functions on N random states against a
   Python loop of the Pinocchio call over the same states.
 - kernel generation: the one-off cost of tracing and compiling each kernel of a fresh model.
-- UR5 from its URDF: the UR5 read by our URDF loader (test/data/urdf/ur5.urdf) against
+- UR5 from its URDF: the UR5 read by our URDF loader (shared/urdf/ur5.urdf) against
   Pinocchio's URDF parser on the same file, per call.
 
 Every pair is checked to give the same numbers before it is timed.
