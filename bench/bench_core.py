@@ -56,7 +56,7 @@ FRESH_MODELS = 3  # kernel generation is timed on this many fresh models
 KERNELS = ("rnea", "rnea_wrench", "gravity_torques", "coriolis", "mass_matrix", "coriolis_matrix")
 TOLERANCE = dict(rtol=1e-9, atol=1e-9)
 SEED = 140
-UR5 = REPO / "test" / "data" / "urdf" / "ur5.urdf"
+UR5 = REPO.parent / "shared" / "urdf" / "ur5.urdf"  # the public description beside the repository
 
 
 # -- the baselines ----------------------------------------------------------------------
