@@ -2,6 +2,8 @@
 
 Subscribes   joint_states          sensor_msgs/JointState (matched by joint name)
              ~/reference           trajectory_msgs/JointTrajectory (first point: exact feed-forward)
+             robot_description     std_msgs/String (transient local): the model, with model.source
+                                   robot_description and no URDF parameter or file (see ros.model_source)
 Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, qdd)
              gravity_torques       sensor_msgs/JointState, effort = g(q)
              effort_commands       std_msgs/Float64MultiArray (when enabled), model joint order
@@ -45,7 +47,8 @@ from .ros.collision import (
     build_collision_settings,
     collision_threshold_specs,
 )
-from .ros.params import QOS_PARAMETERS, Spec, check_choice, check_qos, declare_model, joint_states_qos
+from .ros.model_source import declare_model_source
+from .ros.params import QOS_PARAMETERS, Spec, check_choice, check_qos, joint_states_qos
 from .ros.spin import run
 
 ACCELERATION_MODES = ("zero", "differentiate")
@@ -102,19 +105,17 @@ class IdNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__("id_node", **kwargs)
-        self.parameters = declare_model(self, NODE_PARAMETERS, build_settings, collision_threshold_specs)
+        self.settings: Settings | None = None  # None: waiting for the model (robot_description topic)
+        self._started = False
+        self.parameters = declare_model_source(self, NODE_PARAMETERS, build_settings, collision_threshold_specs)
         self.parameters.on_change(self._use)
         self.counts: Counter[str] = Counter()
         self._reported = Counter()  # the counts at the last diagnostics
         self._reference = None  # (time received [ns, node clock], q, qd, qdd or None)
-        names = list(self.parameters.current.model.joint_names)
-        self.collision = CollisionMonitor(self, names, self.get_parameter("qos.depth").value)
-        self._use(self.parameters.current)
-
-        self._order = JointOrder(names)
-        self._feedforward_msg = JointState(name=names)
-        self._gravity_msg = JointState(name=names)
+        self.collision = CollisionMonitor(self, [], self.get_parameter("qos.depth").value)  # joints: by _use
         self._command_msg = Float64MultiArray()
+        if self.parameters.current is not None:
+            self._use(self.parameters.current)
 
         depth = self.get_parameter("qos.depth").value
         self.create_subscription(JointState, "joint_states", self._on_joint_state, joint_states_qos(self))
@@ -126,18 +127,33 @@ class IdNode(Node):
             self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands", depth)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self.create_timer(1.0, self._publish_diagnostics)
-        self.get_logger().info(
-            f"ready: {len(names)} joints {names}, payload {self.settings.model.payload.mass} kg"
-        )
+        self._started = True
+        if self.settings is not None:
+            self._log_ready()
 
     def _use(self, settings: Settings) -> None:
-        """Switch to new (validated, compiled) settings."""
+        """Switch to new (validated, compiled) settings; new joints come with a new model."""
+        first, names = self.settings is None, list(settings.model.joint_names)
+        if first or names != list(self.settings.model.joint_names):
+            self._order = JointOrder(names)
+            self._feedforward_msg = JointState(name=names)
+            self._gravity_msg = JointState(name=names)
+            self._reference = None
         self._differentiator = VelocityDifferentiator(settings.model.n, settings.cutoff_frequency)
         self.collision.use(settings.model, settings.collision)
         self.settings = settings
+        if first and self._started:  # the model came after startup
+            self._log_ready()
+
+    def _log_ready(self) -> None:
+        names = list(self.settings.model.joint_names)
+        self.get_logger().info(f"ready: {len(names)} joints {names}, payload {self.settings.model.payload.mass} kg")
 
     def _on_joint_state(self, msg: JointState) -> None:
         self.counts["received"] += 1
+        if self.settings is None:
+            self.counts["no_model_yet"] += 1
+            return
         try:
             q, qd = read_joint_state(msg, self._order)
         except NotForThisModel:
@@ -202,7 +218,7 @@ class IdNode(Node):
 
     def _on_reference(self, msg: JointTrajectory) -> None:
         """Hold the first point of a trajectory; an empty trajectory lets the reference go."""
-        if not msg.points:
+        if not msg.points or self.settings is None:
             self._reference = None
             return
         try:
@@ -226,7 +242,10 @@ class IdNode(Node):
         recent = self.counts - self._reported
         self._reported = self.counts.copy()
         status = DiagnosticStatus(name=f"{self.get_name()}: messages", hardware_id=self.get_fully_qualified_name())
-        if recent["dropped"]:
+        if self.settings is None:
+            status.level = DiagnosticStatus.WARN
+            status.message = "waiting for the model (robot_description topic)"
+        elif recent["dropped"]:
             status.level = DiagnosticStatus.WARN
             status.message = f"{recent['dropped']} messages dropped in the last second"
         elif self.counts["received"] and not recent["received"]:

@@ -70,7 +70,11 @@ class CollisionMonitor:
         self._publish_flag(False)
 
     def use(self, model, settings: CollisionSettings) -> None:
-        """A new model or new gains: the observer starts again."""
+        """A new model or new gains: the observer starts again (named as the model's joints)."""
+        if list(model.joint_names) != self._names:
+            self._names = list(model.joint_names)
+            self._external_msg = JointState(name=self._names)
+            self._residual = None
         self._observer = MomentumObserver(model, settings.gain, OBSERVER_GAP)
         self._thresholds = settings.thresholds
 

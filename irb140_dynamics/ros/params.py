@@ -3,7 +3,9 @@
 A node lists its parameters as ``Spec``s and gives a ``build`` function that turns all of
 their values into the configuration it runs on (a RobotModel, options), raising ValueError
 naming the parameter when something is wrong. Everything that can fail, and everything
-slow (compiling kernels), belongs in ``build``: a configuration that was built is used. ``LiveParameters`` declares them, builds the
+slow (compiling kernels), belongs in ``build``: a configuration that was built is used
+(``build`` may return None while an input from elsewhere, a URDF, has yet to come).
+``LiveParameters`` declares them, builds the
 first configuration (a failure stops startup), and from then on checks every change by
 building the whole new configuration before it is accepted: a refused change keeps the old
 configuration, an accepted one replaces it in a single assignment.
@@ -187,6 +189,13 @@ class LiveParameters:
     def on_change(self, listener: Callable[[Any], None]) -> None:
         self._listeners.append(listener)
 
+    def declare(self, specs: list[Spec]) -> None:
+        """Declare more parameters (a new model's per-joint ones); those declared already stay."""
+        for spec in specs:
+            if not self._node.has_parameter(spec.name):
+                _declare(self._node, spec)
+                self._names.append(spec.name)
+
     def _coerce_integers(self, parameters: list[Parameter]) -> list[Parameter]:
         """Let `ros2 param set ... payload.mass 3` mean 3.0 for a double parameter."""
         coerced = []
@@ -219,9 +228,15 @@ class LiveParameters:
         pending, self._pending = self._pending, None
         if pending is None or pending[0] != self.values():  # not the change just checked
             return
-        self.current = pending[1]
-        for listener in self._listeners:
-            listener(self.current)
+        self.replace(pending[1])
+
+    def replace(self, configuration) -> None:
+        """Swap in a configuration built from the current values (and an input from outside
+        the parameters, such as a new robot_description). None: nothing to run on yet."""
+        self.current = configuration
+        if configuration is not None:
+            for listener in self._listeners:
+                listener(configuration)
 
 
 def _declare(node: Node, spec: Spec):
