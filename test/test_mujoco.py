@@ -1,4 +1,5 @@
-"""The core against MuJoCo, an independent engine, on the MJCF the simulator generates:
+"""The core against MuJoCo, an independent engine, on the MJCF the simulator generates (the
+IRB-140, random DH and URDF-form models, the public UR5 and Panda URDFs):
 inverse dynamics (mj_inverse), bias forces at rest (gravity), the mass matrix and forward
 dynamics (mj_forward's qacc). Viscous friction (MuJoCo's damping) and armature are on;
 Coulomb friction is off (MuJoCo's frictionloss is a dry-friction constraint, not our tanh),
@@ -13,7 +14,10 @@ import pytest
 from irb140_dynamics.core import Friction, forward_dynamics, gravity, irb140, mass_matrix, rnea
 from irb140_dynamics.sim.mjcf import MINIMAL_INERTIA, mjcf, mujoco_model
 
-from .support import assert_close, loaded_irb140, random_model, random_states, random_urdf_model
+from irb140_dynamics.core.urdf import load_urdf
+
+from .support import OFFSET_PAYLOAD, assert_close, loaded_irb140, random_model, random_states, random_urdf_model
+from .urdf_support import ARMS, arm_text
 
 STATES = 100
 TORQUE_ATOL = 1e-8  # N m, the issue's figure; the agreement is ~1e-11
@@ -26,6 +30,17 @@ def viscous_only(model, rng):
     return dataclasses.replace(model, joints=joints)
 
 
+def without_coulomb(model):
+    joints = tuple(dataclasses.replace(j, friction=Friction(j.friction.viscous, 0.0)) for j in model.joints)
+    return dataclasses.replace(model, joints=joints)
+
+
+def public_arm(name):
+    """A public URDF's arm (its own damping; Coulomb friction off) with an offset payload at the tip."""
+    loaded = load_urdf(arm_text(name), tip_link=ARMS[name][1])
+    return without_coulomb(loaded.model).with_payload(OFFSET_PAYLOAD)
+
+
 MODELS = {
     "irb140": irb140,
     "irb140_offset_payload": loaded_irb140,
@@ -36,8 +51,9 @@ MODELS = {
                                                              np.random.default_rng(n)))
         for n in (1, 3, 6, 7)
     },
+    "ur5": lambda: public_arm("ur5"),
+    "panda": lambda: public_arm("panda"),
 }
-# TODO(urdf): ../shared/urdf/ur5.urdf and panda.urdf once irb140_dynamics.core.urdf is on main.
 
 
 class Case:
