@@ -33,7 +33,8 @@ from std_srvs.srv import Trigger
 
 from .core import RobotModel
 from .ros.messages import BadMessage, count_and_warn
-from .ros.params import Spec, check_choice, declare_model
+from .ros.model_source import STAND_IN, declare_model_source
+from .ros.params import Spec, check_choice
 from .ros.spin import run
 from .sim.engine import DEFAULT_INTEGRATOR, SimulatedArm, SimulationError
 from .sim.mjcf import INTEGRATORS
@@ -75,13 +76,14 @@ class Settings:
 def build_settings(values: dict) -> Settings:
     """Validate everything and compile the MuJoCo model here, not on a step."""
     model = RobotModel.from_params(values)
+    waiting = model.joint_names == STAND_IN.joint_names  # checked on a stand-in until a URDF comes
     check_choice("integrator", values["integrator"], INTEGRATORS)
     if values["substeps"] < 1:
         raise ValueError(f"substeps: must be >= 1, got {values['substeps']}")
     if values["qos.depth"] < 1:
         raise ValueError(f"qos.depth: must be >= 1, got {values['qos.depth']}")
     engine = SimulatedArm(model, 1.0 / values["rate"], values["substeps"], values["integrator"])
-    initial = initial_positions(model, values["initial_positions"])
+    initial = np.zeros(model.n) if waiting else initial_positions(model, values["initial_positions"])
     return Settings(model, engine, initial, values["command_timeout"], values["reset_hold"],
                     values["noise.position"], values["noise.effort"])
 
@@ -113,24 +115,20 @@ class SimNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__("sim_node", **kwargs)
-        self.parameters = declare_model(self, NODE_PARAMETERS, build_settings)
-        self.settings = self.parameters.current
-        self.arm = self.settings.engine  # the engine, stepped by self.loop under self._lock
+        self.settings: Settings | None = None  # None: waiting for the model (robot_description topic)
+        self.arm: SimulatedArm | None = None  # the engine, stepped by self.loop under self._lock
+        self._lock = threading.Lock()  # the arm and settings: the stepping thread against callbacks
+        self.parameters = declare_model_source(self, NODE_PARAMETERS, build_settings)
         self.parameters.on_change(self._use)
         self.counts: Counter[str] = Counter()
         self._reported = Counter()  # the counts at the last diagnostics
         self._command = None  # (time received [s, monotonic], torques)
         self._command_stale = True
         self._rng = np.random.default_rng()
-        period = 1.0 / self.get_parameter("rate").value
-        self._lock = threading.Lock()  # the arm and settings: the stepping thread against callbacks
         self._stamp_offset = self.get_clock().now().nanoseconds - time.monotonic_ns()  # node clock - monotonic
         self.last_stamp = 0  # ns, node clock: of the last joint state published
         self._held_until = 0.0
-        self.reset()
 
-        names = list(self.settings.model.joint_names)
-        self._state_msg = JointState(name=names)
         depth = self.get_parameter("qos.depth").value
         self._state_pub = self.create_publisher(JointState, "joint_states", depth)
         commands_qos = QoSProfile(depth=depth, reliability=ReliabilityPolicy.BEST_EFFORT)
@@ -138,42 +136,63 @@ class SimNode(Node):
         self.create_service(Trigger, "~/reset", self._on_reset)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self.create_timer(1.0, self._publish_diagnostics)
-        self.loop = RealTimeLoop(period, self._step, self._on_step_error)
+        self.loop = RealTimeLoop(1.0 / self.get_parameter("rate").value, self._step, self._on_step_error)
         self.schedule = self.loop.schedule
-        self.loop.start()
-        self.get_logger().info(
-            f"ready: {len(names)} joints {names}, {1.0 / period:g} Hz, payload {self.settings.model.payload.mass} kg"
-        )
+        if self.parameters.current is not None:
+            self._use(self.parameters.current)
 
     def destroy_node(self):
         self.loop.stop()
         return super().destroy_node()
 
     def _use(self, settings: Settings) -> None:
-        """Switch to new settings; a new model continues from the current state."""
+        """Switch to new settings: a new model of the same joints continues from the current
+        state; other joints (a new URDF) start at initial_positions. The first starts the loop."""
+        names = list(settings.model.joint_names)
         with self._lock:
-            if settings.model != self.settings.model:
-                settings.engine.take_state_of(self.arm)
+            first = self.arm is None
+            new_joints = first or names != list(self.arm.model.joint_names)
+            if new_joints or settings.model != self.arm.model:
+                if not new_joints:
+                    settings.engine.take_state_of(self.arm)
                 self.arm = settings.engine
             self.settings = settings
+            if new_joints:
+                self._state_msg = JointState(name=names)
+                self._command = None
+                self._reset()
+        if first:
+            self.loop.start()
+            self.get_logger().info(f"ready: {len(names)} joints {names}, {1.0 / self.schedule.period:g} Hz, "
+                                   f"payload {settings.model.payload.mass} kg")
 
-    def reset(self) -> None:
-        """The arm back at initial_positions, at rest, held for reset_hold."""
+    def reset(self) -> bool:
+        """The arm back at initial_positions, at rest, held for reset_hold; False without a model."""
         with self._lock:
-            self.arm.reset(self.settings.initial_positions)
-            self._held_until = time.monotonic() + self.settings.reset_hold
+            if self.arm is None:
+                return False
+            self._reset()
+        return True
+
+    def _reset(self) -> None:
+        self.arm.reset(self.settings.initial_positions)
+        self._held_until = time.monotonic() + self.settings.reset_hold
         self.counts["resets"] += 1
 
     def _on_reset(self, request, response):
-        self.reset()
-        response.success = True
-        response.message = f"reset to {self.settings.initial_positions.tolist()} rad"
+        response.success = self.reset()
+        response.message = (f"reset to {self.settings.initial_positions.tolist()} rad" if response.success
+                            else "no model yet: waiting for robot_description")
         return response
 
     def _on_command(self, msg: Float64MultiArray) -> None:
         self.counts["commands"] += 1
+        arm = self.arm
+        if arm is None:
+            self.counts["no_model_yet"] += 1
+            return
         try:
-            tau = read_command(msg, self.arm.n)
+            tau = read_command(msg, arm.n)
         except BadMessage as error:
             count_and_warn(self.get_logger(), self.counts, "effort_commands", error)
             return
@@ -232,18 +251,17 @@ class SimNode(Node):
         self._reported = self.counts.copy()
         status = DiagnosticStatus(name=f"{self.get_name()}: simulation", hardware_id=self.get_fully_qualified_name())
         steps = recent["steps"]
-        problems = []
+        problems = [] if self.settings is not None else ["waiting for the model (robot_description)"]
         if recent["late_steps"] > WARN_LATE_SHARE * steps or recent["skipped_steps"]:
             problems.append(f"cannot keep real time: {recent['late_steps']} of {steps} steps late, "
-                            f"{recent['skipped_steps']} skipped")
+                            f"{recent['skipped_steps']} skipped in the last period")
         if recent["dropped"]:
-            problems.append(f"{recent['dropped']} effort commands dropped")
+            problems.append(f"{recent['dropped']} effort commands dropped in the last period")
         if recent["diverged"]:
             problems.append("the simulation diverged and was reset")
         command = "no command: zero torque" if self._command_stale else "command held"
         status.level = DiagnosticStatus.WARN if problems else DiagnosticStatus.OK
-        status.message = ("; ".join(problems) + " in the last period" if problems
-                          else f"{steps} steps in the last period; {command}")
+        status.message = "; ".join(problems) or f"{steps} steps in the last period; {command}"
         status.values = [KeyValue(key=key, value=str(value)) for key, value in sorted(self.counts.items())]
         msg = DiagnosticArray(status=[status])
         msg.header.stamp = self.get_clock().now().to_msg()
