@@ -1,6 +1,6 @@
 """Benchmark of sim_node: does the simulated arm keep real time at 1 kHz beside id_node?
 
-    .venv/bin/python bench/bench_sim.py [--duration 10] [--rate 1000]
+    .venv/bin/python bench/bench_sim.py [--duration 10] [--rate 1000] [--priority 50]
 
 Prints one table and writes the raw figures to bench/results/sim.json. Two runs, each in
 fresh processes with a namespace of their own, as bench_nodes.py starts its nodes:
@@ -51,7 +51,7 @@ def counts_of(msg, hardware_id: str) -> dict | None:
     return None
 
 
-def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, index: int) -> dict:
+def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, index: int, priority: int = 0) -> dict:
     """Start sim_node (and id_node when ``loop``), measure a window, return the raw figures."""
     import rclpy
     from diagnostic_msgs.msg import DiagnosticArray
@@ -64,7 +64,7 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
     namespace = f"/bench_sim_{os.getpid()}_{index}"
     ros_args = ["--ros-args", "-r", f"__ns:={namespace}"]
     sim = NodeProcess([sys.executable, "-m", "irb140_dynamics.sim_node", *ros_args, "-p", f"rate:={rate}",
-                       "-p", f"initial_positions:={POSE}"], env)
+                       "-p", f"initial_positions:={POSE}", "-p", f"thread_priority:={priority}"], env)
     controller = None
     if loop:
         controller = NodeProcess([sys.executable, "-m", "irb140_dynamics.id_node", *ros_args,
@@ -130,6 +130,7 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
     return {
         "loop": "beside id_node" if loop else "alone",
         "rate_hz": rate,
+        "thread_priority": priority,
         "window_s": seconds,
         "steps": steps,
         "late_steps": c1["late_steps"] - c0["late_steps"],
@@ -151,7 +152,9 @@ def _ns(stamp) -> int:
 
 
 def rows_of(alone: dict, loop: dict) -> list[Row]:
-    group = f"sim_node at {loop['rate_hz']:g} Hz for {loop['window_s']:.0f} s beside id_node (baseline: sim_node alone)"
+    priority = f", thread_priority {loop['thread_priority']}" if loop["thread_priority"] else ""
+    group = (f"sim_node at {loop['rate_hz']:g} Hz for {loop['window_s']:.0f} s beside id_node{priority} "
+             "(baseline: sim_node alone)")
     rows = [
         Row(group, f"late steps (of {loop['steps']})", Value.of(loop["late_percent"], "%"),
             Value.of(alone["late_percent"], "%"), LATE_TARGET),
@@ -175,6 +178,8 @@ def main(argv=None) -> None:
     parser.add_argument("--duration", type=float, default=DURATION, help="measured seconds per run (default 10)")
     parser.add_argument("--warmup", type=float, default=WARMUP, help="seconds before measuring (default 2)")
     parser.add_argument("--rate", type=float, default=RATE, help="sim_node's rate, Hz (default 1000)")
+    parser.add_argument("--priority", type=int, default=0,
+                        help="sim_node's thread_priority (SCHED_FIFO 1..99; default 0: ordinary scheduling)")
     parser.add_argument("--domain-id", type=int, default=None, help="ROS_DOMAIN_ID (default: random in 50..99)")
     args = parser.parse_args(argv)
     started = time.perf_counter()
@@ -188,7 +193,7 @@ def main(argv=None) -> None:
         for index, loop in enumerate((False, True)):
             print(f"  sim_node {'beside id_node' if loop else 'alone'} at {args.rate:g} Hz: "
                   f"{args.warmup + args.duration:g} s ...", flush=True)
-            runs.append(run(loop, args.rate, args.duration, args.warmup, env, index))
+            runs.append(run(loop, args.rate, args.duration, args.warmup, env, index, args.priority))
             r = runs[-1]
             print(f"    {r['late_steps']} of {r['steps']} steps late ({r['late_percent']:.3f} %), "
                   f"{r['skipped_steps']} skipped, CPU {r['sim_cpu_us_per_step']:.0f} us/step", flush=True)
@@ -204,6 +209,7 @@ def main(argv=None) -> None:
         "benchmark": "sim",
         "machine": machine_info(("numpy", "rclpy", "mujoco")),
         "settings": {"duration_s": args.duration, "warmup_s": args.warmup, "rate_hz": args.rate,
+                     "thread_priority": args.priority,
                      "ros_domain_id": domain_id,
                      "rmw": os.environ.get("RMW_IMPLEMENTATION", "default (rmw_fastrtps_cpp)")},
         "rows": [row.as_dict() for row in rows],

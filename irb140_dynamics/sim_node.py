@@ -56,6 +56,8 @@ NODE_PARAMETERS = [
          "this long", "s", minimum=0.0),
     Spec("noise.position", 0.0, "std dev of the noise added to the published positions", "rad", minimum=0.0),
     Spec("noise.effort", 0.0, "std dev of the noise added to the published efforts", "N m", minimum=0.0),
+    Spec("thread_priority", 0, "SCHED_FIFO priority (1..99) of the stepping thread, as ros2_control's "
+         "controller manager; 0 = ordinary scheduling", read_only=True),
     Spec("qos.depth", 10, "queue depth of joint_states and effort_commands", read_only=True),
 ]
 
@@ -80,6 +82,8 @@ def build_settings(values: dict) -> Settings:
     check_choice("integrator", values["integrator"], INTEGRATORS)
     if values["substeps"] < 1:
         raise ValueError(f"substeps: must be >= 1, got {values['substeps']}")
+    if not 0 <= values["thread_priority"] <= 99:
+        raise ValueError(f"thread_priority: must be 0..99, got {values['thread_priority']}")
     if values["qos.depth"] < 1:
         raise ValueError(f"qos.depth: must be >= 1, got {values['qos.depth']}")
     engine = SimulatedArm(model, 1.0 / values["rate"], values["substeps"], values["integrator"])
@@ -126,7 +130,8 @@ class SimNode(Node):
         self._command_stale = True
         self._rng = np.random.default_rng()
         self._stamp_offset = self.get_clock().now().nanoseconds - time.monotonic_ns()  # node clock - monotonic
-        self.last_stamp = 0  # ns, node clock: of the last joint state published
+        self.last_stamp = 0  # ns, node clock: of the last state stepped (and published)
+        self.reset_stamp = 0  # ns, node clock: states stamped later were stepped after the last reset
         self._held_until = 0.0
 
         depth = self.get_parameter("qos.depth").value
@@ -162,7 +167,9 @@ class SimNode(Node):
                 self._command = None
                 self._reset()
         if first:
-            self.loop.start()
+            refused = self.loop.start(self.get_parameter("thread_priority").value)
+            if refused:
+                self.get_logger().warning(f"thread_priority refused ({refused}): ordinary scheduling")
             self.get_logger().info(f"ready: {len(names)} joints {names}, {1.0 / self.schedule.period:g} Hz, "
                                    f"payload {settings.model.payload.mass} kg")
 
@@ -176,6 +183,7 @@ class SimNode(Node):
 
     def _reset(self) -> None:
         self.arm.reset(self.settings.initial_positions)
+        self.reset_stamp = self.last_stamp
         self._held_until = time.monotonic() + self.settings.reset_hold
         self.counts["resets"] += 1
 
@@ -225,13 +233,13 @@ class SimNode(Node):
             else:
                 arm.step(self._held_command(now))
             q, qd, effort = arm.q, arm.qd, arm.applied
+            stamp = self.last_stamp = self._stamp_offset + round(t * 1e9)  # node clock, ns
         if settings.position_noise > 0.0:
             q += self._rng.normal(0.0, settings.position_noise, arm.n)
         if settings.effort_noise > 0.0:
             effort = effort + self._rng.normal(0.0, settings.effort_noise, arm.n)
         msg = self._state_msg
-        self.last_stamp = self._stamp_offset + round(t * 1e9)  # node clock, ns
-        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(self.last_stamp, 1_000_000_000)
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp, 1_000_000_000)
         msg.position, msg.velocity, msg.effort = q.tolist(), qd.tolist(), effort.tolist()
         self._state_pub.publish(msg)
 

@@ -2,6 +2,8 @@
 dry friction, saturates the drives, resets when it blows up; and the real-time schedule and loop."""
 
 import dataclasses
+import os
+import threading
 import time
 
 import numpy as np
@@ -191,3 +193,25 @@ def test_the_loop_steps_in_real_time_and_survives_errors():
     assert [k for k, _, _ in calls] == list(range(1, count + 1))
     assert all(ran >= t - 0.001 for _, t, ran in calls)  # never early (half a period of grace)
     assert [str(e) for e in errors] == ["boom"]
+
+
+def test_the_loop_runs_under_sched_fifo_when_asked_and_allowed():
+    loop = RealTimeLoop(0.001, lambda k, t: None, lambda error: None)
+    outcome = {}
+
+    def starter():  # start() raises its caller's priority too: not the test's own thread
+        outcome["refused"] = loop.start(priority=5)
+        outcome["caller"] = os.sched_getscheduler(0)
+
+    helper = threading.Thread(target=starter)
+    helper.start()
+    helper.join(5.0)
+    try:
+        if outcome["refused"] is None:
+            assert os.sched_getscheduler(loop._thread.native_id) == os.SCHED_FIFO
+            assert os.sched_getparam(loop._thread.native_id).sched_priority == 5
+            assert outcome["caller"] == os.SCHED_FIFO
+        else:  # no CAP_SYS_NICE here: a reason, and ordinary scheduling
+            assert os.sched_getscheduler(loop._thread.native_id) == os.SCHED_OTHER
+    finally:
+        loop.stop()

@@ -57,8 +57,8 @@ def stamp(msg) -> int:
 
 def states_after_reset(sim, count: int):
     """Reset the arm, and the first ``count`` joint states after it."""
-    reset_at = sim.node.last_stamp
     sim.node.reset()
+    reset_at = sim.node.reset_stamp
     assert sim.spin_until(lambda: sum(stamp(msg) > reset_at for msg in sim.states[-count:]) == count)
     return sim.states[-count:]
 
@@ -178,6 +178,7 @@ def test_runtime_changes_apply_and_bad_ones_are_refused(sim):
     ({"initial_positions": [0.0] * 3}, "initial_positions"),
     ({"integrator": "leapfrog"}, "integrator"),
     ({"substeps": 0}, "substeps"),
+    ({"thread_priority": 100}, "thread_priority"),
 ])
 def test_a_bad_start_is_one_clear_error(overrides, field):
     with pytest.raises(ValueError, match=field):

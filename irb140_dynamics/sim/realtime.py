@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import gc
 import math
+import os
 import sys
 import threading
 import time
@@ -71,13 +72,27 @@ class RealTimeLoop:
         self._stopping = threading.Event()
         self._thread = threading.Thread(target=self._run, name="real_time_loop", daemon=True)
 
-    def start(self) -> None:
+    def start(self, priority: int = 0) -> str | None:
+        """Start stepping; ``priority`` > 0: the thread, and the calling one, run under
+        SCHED_FIFO at that priority (1..99; Linux), as ros2_control's controller manager runs
+        its loop. Returns why the priority was refused (no CAP_SYS_NICE or rtprio limit), None
+        when granted or not asked."""
         # a thread that wants the GIL gets it within this (default 5 ms: a batch of late steps)
         sys.setswitchinterval(min(sys.getswitchinterval(), SWITCH_INTERVAL))
         # the objects alive now (modules, models, the node) are never scanned again: a full
         # garbage collection of a sim_node process then takes microseconds instead of 20-60 ms
         gc.freeze()
         self._thread.start()
+        if priority <= 0:
+            return None
+        try:
+            # the calling thread too (it runs the executor): the stepping thread needs the GIL,
+            # and a holder of ordinary priority preempted by other processes would hold it up
+            for thread_id in (self._thread.native_id, 0):
+                os.sched_setscheduler(thread_id, os.SCHED_FIFO, os.sched_param(priority))
+        except (OSError, AttributeError) as error:  # AttributeError: not Linux
+            return str(error)
+        return None
 
     def stop(self, timeout: float = 2.0) -> None:
         self._stopping.set()
