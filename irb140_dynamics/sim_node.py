@@ -7,12 +7,12 @@ Publishes    joint_states      sensor_msgs/JointState every step: position, velo
              /diagnostics      diagnostic_msgs/DiagnosticArray, 1 Hz: steps, late steps, commands
 Serves       ~/reset           std_srvs/Trigger: back to initial_positions, at rest
 
-The true arm is the model of the parameters (the same file format as every node's) and may
-differ from the model a controller uses. A command is held (zero-order hold) until the next;
-once it is older than command_timeout, zero torque is applied. The engine steps at ``rate``
-in real time (sub-steps allowed), catching up late steps (counted) and skipping when far
-behind (counted). Bad commands (wrong length, NaN or infinite) are dropped, counted and
-warned about, never applied.
+The true arm is the model of the parameters or of a URDF (``model.source``, as every node's)
+and may differ from the model a controller uses. A command is held (zero-order hold) until
+the next; once it is older than command_timeout, zero torque is applied. The engine steps
+at ``rate`` in real time (sub-steps allowed) in a thread of its own, catching up late steps
+(counted) and skipping when far behind (counted). Bad commands (wrong length, NaN or
+infinite) are dropped, counted and warned about, never applied. See docs/sim.md.
 """
 
 from __future__ import annotations
@@ -56,8 +56,8 @@ NODE_PARAMETERS = [
          "this long", "s", minimum=0.0),
     Spec("noise.position", 0.0, "std dev of the noise added to the published positions", "rad", minimum=0.0),
     Spec("noise.effort", 0.0, "std dev of the noise added to the published efforts", "N m", minimum=0.0),
-    Spec("thread_priority", 0, "SCHED_FIFO priority (1..99) of the stepping thread, as ros2_control's "
-         "controller manager; 0 = ordinary scheduling", read_only=True),
+    Spec("thread_priority", 0, "SCHED_FIFO priority (1..99) of the stepping and executor threads, as "
+         "ros2_control's controller manager runs its loop; 0 = ordinary scheduling", read_only=True),
     Spec("qos.depth", 10, "queue depth of joint_states and effort_commands", read_only=True),
 ]
 
@@ -232,13 +232,12 @@ class SimNode(Node):
                 arm.applied = np.zeros(arm.n)
             else:
                 arm.step(self._held_command(now))
-            q, qd, effort = arm.q, arm.qd, arm.applied
+            q, qd, effort, msg = arm.q, arm.qd, arm.applied, self._state_msg
             stamp = self.last_stamp = self._stamp_offset + round(t * 1e9)  # node clock, ns
         if settings.position_noise > 0.0:
             q += self._rng.normal(0.0, settings.position_noise, arm.n)
         if settings.effort_noise > 0.0:
             effort = effort + self._rng.normal(0.0, settings.effort_noise, arm.n)
-        msg = self._state_msg
         msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp, 1_000_000_000)
         msg.position, msg.velocity, msg.effort = q.tolist(), qd.tolist(), effort.tolist()
         self._state_pub.publish(msg)
