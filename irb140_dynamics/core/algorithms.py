@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .dual import Dual, dual_angles, partial  # noqa: F401 (Dual: part of this module's interface)
 from .joints import snap
 from .rigid_body import ZERO3, Vector3, Inertia6, shift_inertia
 
@@ -280,11 +281,8 @@ def christoffel_coriolis(links, cs, qd):
     of M are exact: crba runs on dual numbers carrying d/dq of each scalar.
     """
     n = len(links)
-    dual_cs = [
-        (Dual(c, _unit(n, k, -s)), Dual(s, _unit(n, k, c))) for k, (c, s) in enumerate(cs)
-    ]
-    M = crba(links, dual_cs)
-    dM = [[[_partial(M[i][j], k) for k in range(n)] for j in range(n)] for i in range(n)]
+    M = crba(links, dual_angles(cs))
+    dM = [[[partial(M[i][j], k) for k in range(n)] for j in range(n)] for i in range(n)]
     return [
         [
             sum(0.5 * (dM[i][j][k] + dM[i][k][j] - dM[j][k][i]) * qd[k] for k in range(n))
@@ -292,46 +290,3 @@ def christoffel_coriolis(links, cs, qd):
         ]
         for i in range(n)
     ]
-
-
-class Dual:
-    """A scalar with its partial derivatives d/dq_k (forward-mode differentiation)."""
-
-    __slots__ = ("value", "d")
-
-    def __init__(self, value, d):
-        self.value, self.d = value, d
-
-    def __add__(self, other):
-        if isinstance(other, Dual):
-            return Dual(self.value + other.value, tuple(x + y for x, y in zip(self.d, other.d)))
-        return Dual(self.value + other, self.d)
-
-    __radd__ = __add__
-
-    def __neg__(self):
-        return Dual(-self.value, tuple(-x for x in self.d))
-
-    def __sub__(self, other):
-        return self + (-other)
-
-    def __rsub__(self, other):
-        return (-self) + other
-
-    def __mul__(self, other):
-        if isinstance(other, Dual):
-            return Dual(
-                self.value * other.value,
-                tuple(x * other.value + self.value * y for x, y in zip(self.d, other.d)),
-            )
-        return Dual(self.value * other, tuple(x * other for x in self.d))
-
-    __rmul__ = __mul__
-
-
-def _unit(n, k, value):
-    return tuple(value if i == k else 0.0 for i in range(n))
-
-
-def _partial(x, k):
-    return x.d[k] if isinstance(x, Dual) else 0.0

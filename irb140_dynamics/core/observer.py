@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .algorithms import Dual, add, cross, dot, inertia_times, scale, to_child, turns
+from .algorithms import add, cross, dot, inertia_times, scale, to_child, turns
+from .dual import dual_angles, partial
 from .dynamics import _state, gravity
 from .model import RobotModel
 
@@ -42,13 +43,8 @@ def kinetic_energy(links, cs, qd):
 
 def energy_gradient(links, cs, qd):
     """dT/dq = C(q, qd)^T qd, exact: T on dual numbers carrying d/dq_k."""
-    n = len(links)
-    dual_cs = [
-        (Dual(c, tuple(-s if i == k else 0.0 for i in range(n))), Dual(s, tuple(c if i == k else 0.0 for i in range(n))))
-        for k, (c, s) in enumerate(cs)
-    ]
-    T = kinetic_energy(links, dual_cs, qd)
-    return list(T.d) if isinstance(T, Dual) else [0.0] * n
+    T = kinetic_energy(links, dual_angles(cs), qd)
+    return [partial(T, k) for k in range(len(links))]
 
 
 class MomentumObserver:
@@ -65,14 +61,15 @@ class MomentumObserver:
         self.r = np.zeros(self.model.n)
         self._t = None
 
-    def update(self, t: float, q, qd, tau) -> np.ndarray:
+    def update(self, t: float, q, qd, tau, g=None) -> np.ndarray:
         """The residual after the sample (t [s], q, qd, tau measured): r, or zeros after a reset.
 
-        ValueError (and a reset) if a value is not finite.
+        ``g``: gravity(model, q) if the caller has it already. ValueError (and a reset) if a
+        value is not finite.
         """
         n = self.model.n
         q, qd, tau = _state(q, n, "q"), _state(qd, n, "qd"), np.asarray(_state(tau, n, "tau"))
-        p, beta = self._momentum_terms(q, qd)
+        p, beta = self._momentum_terms(q, qd, g)
         drive = tau + beta
         if self._t is None or not 0.0 < t - self._t <= self.max_gap:
             self.r = np.zeros(n)
@@ -87,11 +84,11 @@ class MomentumObserver:
         self._t, self._integral, self._drive, self.r = t, integral, drive, r
         return r.copy()
 
-    def _momentum_terms(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
+    def _momentum_terms(self, q, qd, g=None) -> tuple[np.ndarray, np.ndarray]:
         """p = M qd and C^T qd - g - tau_f: what the observer integrates besides tau and r."""
         model = self.model
         p, ct_qd = np.split(np.array(model.kernels.momentum.scalar(q, qd)), 2)
-        beta = ct_qd - gravity(model, q)
+        beta = ct_qd - (gravity(model, q) if g is None else g)
         if model.friction is not None:
             beta -= model.friction.torques(qd)
         return p, beta

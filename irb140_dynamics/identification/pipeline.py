@@ -27,6 +27,7 @@ from .recording import CHUNK_SIZE, DEFAULT_TOPIC, Recording, RecordingError
 from .signals import DEFAULT_CUTOFF, Differentiator, FilterDesign, FitPoints, _joined
 
 SLOW_SPEEDS = 3.0  # min_speed in smoothing velocities
+FIT_BATCH = 8192  # fit points gathered before the regressor and the sums run: few, large array operations
 
 
 @dataclass(frozen=True)
@@ -87,6 +88,8 @@ def identify(prior: RobotModel, path, settings: Settings = Settings(), validate=
     """Identify ``prior``'s parameters from the recording at ``path`` (see the module's docstring)."""
     if not 0.0 < settings.held_out < 1.0 and validate is None:
         raise ValueError(f"held_out: must be within (0, 1), got {settings.held_out}")
+    if not settings.prior_weight > 0.0 or not (settings.min_speed is None or settings.min_speed >= 0.0):
+        raise ValueError(f"prior_weight must be > 0 and min_speed >= 0, got {settings.prior_weight}, {settings.min_speed}")
     base = find_base_parameters(prior)
     P = 13 * prior.n
     train, held_out = NormalEquations(prior.n, P), NormalEquations(prior.n, P)
@@ -116,7 +119,7 @@ def identify(prior: RobotModel, path, settings: Settings = Settings(), validate=
 
 def _accumulate(prior, recording, split, where, min_speed, settings, keeper, progress) -> Tally:
     tally = Tally(str(recording.path), recording.total, slow_rows=np.zeros(prior.n, dtype=np.int64))
-    differentiator = None
+    differentiator, pending = None, []
     if progress:
         progress(tally.path, 0, tally.expected)
     for chunk in recording.chunks():
@@ -128,9 +131,14 @@ def _accumulate(prior, recording, split, where, min_speed, settings, keeper, pro
             keeper.expect(max(recording.total - min(split, recording.total), 0) / design.stride)
         points = differentiator.push(chunk)
         if points is not None:
-            _add(prior, points, split, where, min_speed, tally, keeper)
+            pending.append(points)
+            if sum(len(p) for p in pending) >= FIT_BATCH:
+                _add(prior, _joined(pending), split, where, min_speed, tally, keeper)
+                pending = []
         if progress:
             progress(tally.path, tally.read + sum(recording.skipped.values()), tally.expected)
+    if pending:
+        _add(prior, _joined(pending), split, where, min_speed, tally, keeper)
     if differentiator is not None:
         differentiator.finish()
         tally.invalid, tally.edges = differentiator.invalid_samples, differentiator.edge_samples

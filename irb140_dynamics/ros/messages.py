@@ -11,7 +11,8 @@ from trajectory_msgs.msg import JointTrajectory
 
 from ..core.joint_order import BadMessage, JointOrder, NotForThisModel
 
-__all__ = ["BadMessage", "JointOrder", "NotForThisModel", "count_and_warn", "joint_efforts", "read_joint_state", "read_reference"]
+__all__ = ["BadMessage", "JointOrder", "NotForThisModel", "count_and_warn", "joint_efforts", "read_effort", "read_joint_state",
+           "read_reference"]
 
 
 def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> None:
@@ -46,6 +47,18 @@ def read_joint_state(msg: JointState, order: JointOrder) -> tuple[list[float], l
     if len(msg.effort) not in (0, length):
         raise BadMessage("length_mismatch", f"effort has {len(msg.effort)} values for {length} joints")
     return q, qd
+
+
+def read_effort(msg: JointState, order: JointOrder) -> list[float] | None:
+    """The efforts of the model's joints, None when the message has none (BadMessage
+    ``effort_not_finite`` for a NaN or infinite one). Call after read_joint_state."""
+    if len(msg.effort) == 0:
+        return None
+    index, length = _index(msg.name, len(msg.position), order)
+    try:
+        return _pick(msg.effort, index, "effort", length, required=True)
+    except BadMessage as error:
+        raise BadMessage("effort_not_finite", str(error)) from None
 
 
 def read_reference(msg: JointTrajectory, order: JointOrder):
