@@ -214,3 +214,16 @@ def test_excitation_refuses_bad_options(tmp_path, capsys):
     assert excitation_tool.main(["--out", str(tmp_path / "t.yaml"), "--rate", "0"]) == 1
     assert "excitation: error: --rate must be > 0" in capsys.readouterr().err
     assert not (tmp_path / "t.yaml").exists()
+
+
+def test_progress_bar_ends_at_100_percent_on_its_own_line():
+    from irb140_dynamics.tools.common import ProgressBar
+
+    stream = io.StringIO()
+    bar = ProgressBar(stream, interval=3600.0)
+    for done in (0, 400, 700, 1000):
+        bar("/data/run.mcap", done, 1000)
+    frames = stream.getvalue().split("\r")[1:]
+    assert len(frames) == 2  # the first and the last: the others fall within the interval
+    assert frames[0].startswith("reading run.mcap: [") and " 0 % 0/1,000 samples" in frames[0]
+    assert "[" + "#" * 30 + "] 100 % 1,000/1,000 samples" in frames[1] and frames[1].endswith("\n")

@@ -82,10 +82,11 @@ class _Chunker:
     def __init__(self, recording: Recording):
         self.recording = recording
         self.first = 0
-        self._clear()
+        self.times, self.positions, self.velocities, self.efforts = [], [], [], []  # cleared in place
 
     def _clear(self):
-        self.times, self.positions, self.velocities, self.efforts = [], [], [], []
+        for samples in (self.times, self.positions, self.velocities, self.efforts):
+            samples.clear()
 
     def __len__(self):
         return len(self.times)
@@ -127,7 +128,10 @@ class _BagSource:
     def chunks(self) -> Iterator[RawChunk]:
         recording, skipped = self.recording, self.recording.skipped
         deserialize = self.reader.typestore.deserialize_cdr
-        chunker = _Chunker(recording)
+        chunker, chunk_size = _Chunker(recording), recording.chunk_size
+        times = chunker.times
+        add_time, add_position = times.append, chunker.positions.append  # the loop's hot calls, bound once
+        add_velocity, add_effort = chunker.velocities.append, chunker.efforts.append
         missing = np.full(recording.n, np.nan)
         names_seen, index, length, bad = None, None, -1, None
         try:
@@ -150,11 +154,11 @@ class _BagSource:
                     velocity = velocity[index] if len(velocity) else velocity
                     effort = effort[index] if len(effort) else effort
                 stamp = msg.header.stamp
-                chunker.times.append(stamp.sec + stamp.nanosec * 1e-9 if stamp.sec or stamp.nanosec else receive_time * 1e-9)
-                chunker.positions.append(position)
-                chunker.velocities.append(velocity if len(velocity) else missing)
-                chunker.efforts.append(effort if len(effort) else missing)
-                if len(chunker) >= recording.chunk_size:
+                add_time(stamp.sec + stamp.nanosec * 1e-9 if stamp.sec or stamp.nanosec else receive_time * 1e-9)
+                add_position(position)
+                add_velocity(velocity if len(velocity) else missing)
+                add_effort(effort if len(effort) else missing)
+                if len(times) >= chunk_size:
                     yield chunker.take()
             chunk = chunker.take()
             if chunk is not None:

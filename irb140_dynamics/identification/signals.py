@@ -138,7 +138,8 @@ class Differentiator:
         centres = np.arange(self._next, len(index) - half, stride)
         if len(centres) == 0:
             return None
-        windows = sliding_window_view(values, self.design.window, axis=0)[centres - half]  # (K, channels, window)
+        start = centres[0] - half  # the windows (K, channels, window): a strided view, no copy
+        windows = sliding_window_view(values, self.design.window, axis=0)[start : centres[-1] - half + 1 : stride]
         position, effort = windows[:, :n], windows[:, n : 2 * n]
         if self.has_velocity:
             velocity = windows[:, 2 * n :]
