@@ -57,7 +57,7 @@ from common import (  # first: puts the checkout on sys.path
     write_results,
 )
 from irb140_dynamics.ros.spin import EXECUTORS  # noqa: E402  (events: what every node's main() uses)
-from node_processes import QOS_DEPTH, NodeProcess, node_environment, node_command, wait_for  # noqa: E402
+from node_processes import QOS_DEPTH, NodeProcess, isolated_domain, node_command, wait_for  # noqa: E402
 from parameter_changes import ParameterChanger  # noqa: E402
 from soak import print_soak, soak  # noqa: E402
 
@@ -604,11 +604,7 @@ def parse_args(argv=None) -> argparse.Namespace:
 def main(argv=None) -> None:
     args = parse_args(argv)
     started = time.perf_counter()
-    domain_id = random.randint(50, 99) if args.domain_id is None else args.domain_id
-    os.environ["ROS_DOMAIN_ID"] = str(domain_id)  # before rclpy.init, for this process too
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    env = node_environment(domain_id)
-    print(f"ROS_DOMAIN_ID={domain_id}", flush=True)
+    domain_id, env = isolated_domain(args.domain_id)
     if args.soak is not None:
         results = soak(args.soak, CHANGE_RATE, env)
         print_soak(results)

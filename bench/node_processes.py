@@ -7,6 +7,7 @@ discovery); its output goes to a temporary file, shown when it fails.
 from __future__ import annotations
 
 import os
+import random
 import signal
 import subprocess
 import sys
@@ -29,6 +30,16 @@ def node_environment(domain_id: int) -> dict:
         "ROS_DOMAIN_ID": str(domain_id),
         "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
     }
+
+
+def isolated_domain(domain_id: int | None) -> tuple[int, dict]:
+    """A DDS domain of the run's own (``domain_id``, else random in 50..99) on localhost, set
+    for this process (call before rclpy.init); returns it and the nodes' environment."""
+    domain_id = random.randint(50, 99) if domain_id is None else domain_id
+    os.environ["ROS_DOMAIN_ID"] = str(domain_id)
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    print(f"ROS_DOMAIN_ID={domain_id}", flush=True)
+    return domain_id, node_environment(domain_id)
 
 
 class NodeProcess:

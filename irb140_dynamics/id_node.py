@@ -2,10 +2,15 @@
 
 Subscribes   joint_states          sensor_msgs/JointState (matched by joint name)
              ~/reference           trajectory_msgs/JointTrajectory (first point: exact feed-forward)
+             robot_description     std_msgs/String (transient local): the model, with model.source
+                                   robot_description and no URDF parameter or file (see ros.model_source)
 Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, qdd)
              gravity_torques       sensor_msgs/JointState, effort = g(q)
              effort_commands       std_msgs/Float64MultiArray (when enabled), model joint order
-             /diagnostics          diagnostic_msgs/DiagnosticArray, message counts, 1 Hz
+             external_torques      sensor_msgs/JointState, effort = external torques by the momentum
+                                   observer (for joint states that carry efforts; see ros.collision)
+             collision             std_msgs/Bool (transient local), any over its collision_threshold
+             /diagnostics          diagnostic_msgs/DiagnosticArray, message counts and collision, 1 Hz
              (an empty ~/reference trajectory lets the held reference go)
 
 Torques are in N m, named and ordered as the model's joints, stamped with the input stamp.
@@ -33,29 +38,54 @@ from .ros.messages import (
     NotForThisModel,
     finite_torques,
     joint_efforts,
+    read_effort,
     read_joint_state,
     read_reference,
 )
-from .ros.node_parameters import (
-    ACCELERATION_MODES,
-    EFFORT_SOURCES,
-    ID_NODE,
-    MAX_CUTOFF_FREQUENCY,
-    MAX_DURATION,
+from .ros.collision import (
+    COLLISION_PARAMETERS,
+    CollisionMonitor,
+    CollisionSettings,
+    build_collision_settings,
+    collision_threshold_specs,
 )
-from .ros.params import check_choice, check_number, check_qos, declare_model, joint_states_qos
+from .ros.model_source import declare_model_source
+from .ros.params import QOS_PARAMETERS, Spec, check_choice, check_number, check_qos, joint_states_qos
 from .ros.spin import run
+
+ACCELERATION_MODES = ("zero", "differentiate")
+EFFORT_SOURCES = ("feedforward", "gravity")
+MAX_CUTOFF_FREQUENCY = 1e6  # Hz
+MAX_TIMEOUT = 1e6  # s
+
+NODE_PARAMETERS = [
+    Spec("acceleration.mode", "zero",
+         "qdd when no ~/reference gives it: 'zero', or 'differentiate' the measured velocities (low-pass "
+         "filtered; for monitoring: as a command it would feed the measured acceleration back, "
+         "so effort_commands never use it)"),
+    Spec("acceleration.cutoff_frequency", 20.0, "cut-off of the velocity differentiation filter", "Hz",
+         minimum=1e-3, maximum=MAX_CUTOFF_FREQUENCY),
+    Spec("reference_timeout", 0.5, "a ~/reference older than this (node clock) is no longer used; 0 = never",
+         "s", minimum=0.0, maximum=MAX_TIMEOUT),
+    Spec("effort_commands.enabled", False, "also publish torques on effort_commands (Float64MultiArray)",
+         read_only=True),
+    Spec("effort_commands.source", "feedforward", "which torques go to effort_commands: 'feedforward' or 'gravity'"),
+    *COLLISION_PARAMETERS,
+    *QOS_PARAMETERS,
+]
+PER_JOINT_PARAMETERS = collision_threshold_specs
 
 
 @dataclass(frozen=True)
 class Settings:
-    """What the node runs on, validated from all of its parameters at once."""
+    """What the node runs on, built and validated from all of its parameters at once."""
 
     model: RobotModel
     acceleration_mode: str
     cutoff_frequency: float
     reference_timeout: float
     effort_source: str
+    collision: CollisionSettings
 
 
 def check_settings(values: dict) -> Settings:
@@ -69,12 +99,13 @@ def check_settings(values: dict) -> Settings:
         values["acceleration.mode"],
         check_number("acceleration.cutoff_frequency", values["acceleration.cutoff_frequency"], 1e-3,
                      MAX_CUTOFF_FREQUENCY, "Hz"),
-        check_number("reference_timeout", values["reference_timeout"], 0.0, MAX_DURATION, "s"),
+        check_number("reference_timeout", values["reference_timeout"], 0.0, MAX_TIMEOUT, "s"),
         values["effort_commands.source"],
+        build_collision_settings(values, model.joint_names),
     )
 
 
-KERNELS = ("rnea", "gravity_torques")  # what a message uses
+KERNELS = ("rnea", "gravity_torques", "momentum")  # what a message uses (momentum: the collision observer)
 
 
 def finish_settings(settings: Settings, previous: Settings | None) -> Settings:
@@ -95,22 +126,20 @@ class IdNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__("id_node", **kwargs)
+        self.settings: Settings | None = None  # None: waiting for the model (robot_description topic)
+        self._started = False
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
         self._reported = self.counts.copy()  # the counts at the last diagnostics
         self._reference = None  # (time received [ns, node clock], q, qd, qdd or None)
         self._differentiator = None
-        self.settings: Settings | None = None
-        self.parameters = declare_model(self, ID_NODE, check_settings, finish_settings, quick=compiled)
-        self._use(self.parameters.current)
+        self.parameters = declare_model_source(self, NODE_PARAMETERS, check_settings, PER_JOINT_PARAMETERS,
+                                               finish=finish_settings, quick=compiled)
         self.parameters.on_change(self._use)
-
-        names = list(self.settings.model.joint_names)
-        self._order = JointOrder(names)
-        self._zeros = [0.0] * len(names)
-        self._feedforward_msg = JointState(name=names)
-        self._gravity_msg = JointState(name=names)
+        self.collision = CollisionMonitor(self, [], self.get_parameter("qos.depth").value)  # joints: by _use
         self._command_msg = Float64MultiArray()
+        if self.parameters.current is not None:
+            self._use(self.parameters.current)
 
         depth = self.get_parameter("qos.depth").value
         self.create_subscription(JointState, "joint_states", self._on_joint_state, joint_states_qos(self))
@@ -122,45 +151,63 @@ class IdNode(Node):
             self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands", depth)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self.create_timer(1.0, self._publish_diagnostics)
-        self.get_logger().info(
-            f"ready: {len(names)} joints {names}, payload {self.settings.model.payload.mass} kg"
-        )
+        self._started = True
+        if self.settings is not None:
+            self._log_ready()
 
     def _use(self, settings: Settings) -> None:
-        """Switch to new (validated, compiled) settings; a held reference they cannot give
-        finite torques for is let go."""
-        if self.settings is None or settings.cutoff_frequency != self.settings.cutoff_frequency:
+        """Switch to new (validated, compiled) settings; new joints come with a new model. A
+        held reference the new model gives no finite torques for is let go."""
+        first, names = self.settings is None, list(settings.model.joint_names)
+        if first or names != list(self.settings.model.joint_names):
+            self._order = JointOrder(names)
+            self._zeros = [0.0] * len(names)
+            self._feedforward_msg = JointState(name=names)
+            self._gravity_msg = JointState(name=names)
+            self._reference = None
+            self._differentiator = None
+        if self._differentiator is None or settings.cutoff_frequency != self.settings.cutoff_frequency:
             self._differentiator = VelocityDifferentiator(settings.model.n, settings.cutoff_frequency)
+        self.collision.use(settings.model, settings.collision)
         self.settings = settings
         if self._reference is not None:
             _, q, qd, qdd = self._reference
             try:
-                finite_torques(rnea, settings.model, q, qd, [0.0] * settings.model.n if qdd is None else qdd)
+                finite_torques(rnea, settings.model, q, qd, self._zeros if qdd is None else qdd)
             except BadMessage as error:
                 self._reference = None
                 self.tally.drop("reference", error)
+        if first and self._started:  # the model came after startup
+            self._log_ready()
+
+    def _log_ready(self) -> None:
+        names = list(self.settings.model.joint_names)
+        self.get_logger().info(f"ready: {len(names)} joints {names}, payload {self.settings.model.payload.mass} kg")
 
     @guarded("joint_states")
     def _on_joint_state(self, msg: JointState) -> None:
         self.counts["joint_states.received"] += 1
         settings = self.settings
+        if settings is None:
+            self.counts["joint_states.no_model_yet"] += 1
+            return
         try:
             q, qd = read_joint_state(msg, self._order)
-            torques = self._torques(msg, q, qd, settings)
+            tau, g, command = self._torques(msg, q, qd, settings)
         except NotForThisModel:
             self.counts["joint_states.ignored"] += 1
             return
         except BadMessage as error:
             self.tally.drop("joint_states", error)
             return
-        tau, g, command = torques
         stamp = msg.header.stamp
         self._feedforward_pub.publish(joint_efforts(self._feedforward_msg, stamp, tau))
         self._gravity_pub.publish(joint_efforts(self._gravity_msg, stamp, g))
-        if self._command_pub is not None:
+        if command is not None:
             self._command_msg.data = command.tolist()
             self._command_pub.publish(self._command_msg)
         self.counts["torques.published"] += 1
+        self._observe(msg, q, qd, g)
 
     def _torques(self, msg: JointState, q, qd, settings: Settings):
         """(feed-forward, gravity, command torques or None), all finite, or BadMessage."""
@@ -184,25 +231,44 @@ class IdNode(Node):
             raise
         return tau, g, command
 
+    def _observe(self, msg: JointState, q, qd, g) -> None:
+        """Efforts in the message: run the momentum observer (external torques, collision)."""
+        try:
+            effort = read_effort(msg, self._order)
+        except BadMessage as error:
+            self.collision.reset()
+            self.counts[f"collision.{error.kind}"] += 1
+            self.tally.warn("collision", f"observer skipped a joint state ({error})")
+            return
+        if effort is None:
+            return
+        try:
+            self.collision.update(self._time_of(msg), q, qd, effort, g, msg.header.stamp)
+        except ValueError as error:
+            self.counts["collision.observer_reset"] += 1
+            self.tally.warn("collision", f"observer reset ({error})")
+
     def _estimated_acceleration(self, msg: JointState, qd, settings: Settings):
         if settings.acceleration_mode == "zero":
             return self._zeros
-        stamp = msg.header.stamp
-        t = stamp.sec + 1e-9 * stamp.nanosec
-        if t == 0.0:  # an unstamped stream: time of arrival
-            t = self.get_clock().now().nanoseconds * 1e-9
-        qdd = self._differentiator.update(t, qd)
+        qdd = self._differentiator.update(self._time_of(msg), qd)
         if not all(map(math.isfinite, qdd)):  # an absurd velocity jump overflowed the difference
             self._differentiator.reset()
             raise BadMessage("not_finite_acceleration", f"the differentiated velocities give {qdd}")
         return qdd
+
+    def _time_of(self, msg: JointState) -> float:
+        """The message's stamp [s]; for an unstamped stream, the time of arrival."""
+        stamp = msg.header.stamp
+        t = stamp.sec + 1e-9 * stamp.nanosec
+        return t if t != 0.0 else self.get_clock().now().nanoseconds * 1e-9
 
     @guarded("reference")
     def _on_reference(self, msg: JointTrajectory) -> None:
         """Hold the first point of a trajectory if the model gives finite torques there;
         an empty trajectory lets the reference go."""
         self.counts["reference.received"] += 1
-        if not msg.points:
+        if not msg.points or self.settings is None:
             self._reference = None
             return
         try:
@@ -233,6 +299,9 @@ class IdNode(Node):
         parameters = self.parameters.status()
         if self.parameters.failure is not None:
             status.level, status.message = DiagnosticStatus.ERROR, parameters
+        elif self.settings is None:
+            status.level = DiagnosticStatus.WARN
+            status.message = "waiting for the model (robot_description topic)"
         elif dropped:
             status.level = DiagnosticStatus.WARN
             status.message = f"{dropped} messages dropped in the last second"
@@ -245,7 +314,8 @@ class IdNode(Node):
         values = [KeyValue(key=key, value=str(value)) for key, value in sorted(self.counts.items())]
         values.append(KeyValue(key="parameters", value=parameters or "in force"))
         status.values = values
-        msg = DiagnosticArray(status=[status])
+        collision = self.collision.status(self.get_name(), self.get_fully_qualified_name())
+        msg = DiagnosticArray(status=[status, collision])
         msg.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(msg)
 

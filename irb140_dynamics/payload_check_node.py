@@ -4,7 +4,10 @@ Serves       ~/check        std_srvs/Trigger: the configured payload (payload.* 
                             against the joint torque limits, at the current joint state (if
                             joint_states was received) and in each joint's worst static pose
                             over the joint ranges; the reply's message is the report
+             ~/estimate_payload, ~/clear_samples   std_srvs/Trigger: payload estimation from the
+                            efforts at rest (see ros.estimation)
 Subscribes   joint_states   sensor_msgs/JointState (matched by joint name, as in id_node)
+             robot_description  std_msgs/String: the model, as in id_node (see ros.model_source)
 Publishes    /diagnostics   diagnostic_msgs/DiagnosticArray: one status per joint and one for
                             the payload, after each check and every diagnostics.period
 
@@ -27,14 +30,30 @@ from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
 from .core import RigidBody, RobotModel, gravity, rnea
+from .core.payload_estimation import EstimationError
 from .core.payload import TorqueLimits, WorkspaceLoad, check_payload, derive_torque_limits, workspace_load
 from .ros.diagnostics import payload_statuses
+from .ros.estimation import ESTIMATION_PARAMETERS, PayloadEstimator, check_estimation
 from .ros.guard import Tally, guarded
-from .ros.messages import BadMessage, JointOrder, NotForThisModel, finite_torques, read_joint_state
-from .ros.node_parameters import MAX_DIAGNOSTICS_PERIOD, MAX_WARN_USE, MIN_DIAGNOSTICS_PERIOD, PAYLOAD_CHECK_NODE
-from .ros.params import check_number, check_qos, declare_model, joint_states_qos
+from .ros.messages import BadMessage, JointOrder, NotForThisModel, finite_torques, read_effort, read_joint_state
+from .ros.model_source import declare_model_source
+from .ros.params import QOS_PARAMETERS, Spec, check_number, check_qos, joint_states_qos
 from .ros.spin import run
 
+MIN_DIAGNOSTICS_PERIOD, MAX_DIAGNOSTICS_PERIOD = 0.1, 3600.0  # s
+MAX_WARN_USE = 1e6  # %
+NODE_PARAMETERS = [
+    Spec("rated_payload.mass", 6.0, "the rated payload the torque limits are derived from", "kg",
+         minimum=0.0),
+    Spec("rated_payload.com", [0.0, 0.0, 0.0], "its centre of mass, in the flange frame", "m"),
+    Spec("diagnostics.warn_use", 90.0, "a joint using more of its limit than this is a WARN", "%",
+         minimum=0.0, maximum=MAX_WARN_USE),
+    Spec("diagnostics.period", 1.0,
+         f"check and publish /diagnostics this often, {MIN_DIAGNOSTICS_PERIOD:g} to {MAX_DIAGNOSTICS_PERIOD:g}; "
+         "0 = only on ~/check", "s", minimum=0.0, maximum=MAX_DIAGNOSTICS_PERIOD, read_only=True),
+    *ESTIMATION_PARAMETERS,
+    *QOS_PARAMETERS,
+]
 STALE_AFTER = 1.0  # s: a joint state older than this is reported as stale
 STARTUP_WAIT = 2.0  # s: at most this long for the first analysis before the node is ready
 
@@ -46,17 +65,21 @@ class Draft:
     model: RobotModel  # with the payload under test
     rated_payload: RigidBody
     warn_use: float
+    rest_velocity: float  # rad/s, payload estimation
+    rest_time: float  # s
 
 
 @dataclass(frozen=True)
 class Settings:
-    """What a check needs that depends only on the parameters, the workspace analysis included."""
+    """What a check needs that depends only on the parameters, the workspace sweep included."""
 
     model: RobotModel  # with the payload under test
     rated_payload: RigidBody
     warn_use: float
     limits: TorqueLimits
     workspace: WorkspaceLoad  # the payload's worst static loads and largest mass
+    rest_velocity: float  # rad/s, payload estimation
+    rest_time: float  # s
 
 
 def check_settings(values: dict) -> Draft:
@@ -69,7 +92,8 @@ def check_settings(values: dict) -> Draft:
         raise ValueError(f"diagnostics.period: must be 0 (only on ~/check) or between {MIN_DIAGNOSTICS_PERIOD:g} "
                          f"and {MAX_DIAGNOSTICS_PERIOD:g} s, got {period}")
     check_qos(values)
-    return Draft(model, rated, warn_use)
+    check_estimation(values)
+    return Draft(model, rated, warn_use, values["estimation.rest_velocity"], values["estimation.rest_time"])
 
 
 def finish_settings(draft: Draft, previous: Settings | None) -> Settings:
@@ -81,7 +105,7 @@ def finish_settings(draft: Draft, previous: Settings | None) -> Settings:
         workspace = previous.workspace
     else:
         workspace = workspace_load(model, model.payload, limits)
-    return Settings(model, rated, draft.warn_use, limits, workspace)
+    return Settings(model, rated, draft.warn_use, limits, workspace, draft.rest_velocity, draft.rest_time)
 
 
 def _same_arm(draft: Draft, previous: Settings | None) -> bool:
@@ -104,16 +128,17 @@ def _failed_check(request, response, error):
 class PayloadCheckNode(Node):
     def __init__(self, **kwargs):
         super().__init__("payload_check_node", **kwargs)
+        self.settings: Settings | None = None  # None: waiting for the model (robot_description topic)
+        self._started = False
+        self._state = None  # (q, qd, time received [node clock]) of the latest good joint state
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
-        self.settings: Settings | None = None
-        self._state = None  # (q, qd, time received [node clock]) of the latest good joint state
-        self.parameters = declare_model(self, PAYLOAD_CHECK_NODE, check_settings, finish_settings, STARTUP_WAIT,
-                                        quick=analysed)
+        self.parameters = declare_model_source(self, NODE_PARAMETERS, check_settings, finish=finish_settings,
+                                               startup_wait=STARTUP_WAIT, quick=analysed)
+        self.parameters.on_change(self._use)
+        self.estimator = PayloadEstimator(self, self._model)
         if self.parameters.current is not None:
             self._use(self.parameters.current)
-        self.parameters.on_change(self._use)
-        self._order = JointOrder(self.get_parameter("joint_names").value)
 
         self.create_subscription(JointState, "joint_states", self._on_joint_state, joint_states_qos(self))
         self.create_service(Trigger, "~/check", self._on_check)
@@ -121,23 +146,42 @@ class PayloadCheckNode(Node):
         period = self.get_parameter("diagnostics.period").value
         if period > 0.0:
             self.create_timer(period, self._on_timer)
-        mass, com = self.get_parameter("payload.mass").value, list(self.get_parameter("payload.com").value)
-        later = "" if self.settings is not None else " (its workspace analysis still running: ~/check says pending)"
-        self.get_logger().info(f"ready: ~/check for a {mass} kg payload at {com} m{later}")
+        self._started = True
+        if self.settings is not None:
+            self._log_ready()
+        elif self.parameters.pending_since is not None:
+            mass, com = self.get_parameter("payload.mass").value, list(self.get_parameter("payload.com").value)
+            self.get_logger().info(f"ready: ~/check for a {mass} kg payload at {com} m "
+                                   "(its workspace analysis still running: ~/check says pending)")
 
     def _use(self, settings: Settings) -> None:
-        """Switch to new settings (limits and workspace analysis done); a held joint state
-        they give no finite torques for is let go."""
+        """Switch to new settings (built, limits and workspace sweep included, when checked)."""
+        first, names = self.settings is None, settings.model.joint_names
+        if first or names != self.settings.model.joint_names:
+            self._order = JointOrder(names)
+            self._state = None
+            self.estimator.detector.clear()  # rest samples of other joints
         self.settings = settings
         problem = None if self._state is None else self._finite_problem(*self._state[:2])
-        if problem is not None:
+        if problem is not None:  # a held state the new model gives no finite torques for
             self.tally.drop("joint_states", problem)
             self._state = None
+        self.estimator.use(settings.rest_velocity, settings.rest_time)
+        if first and self._started:  # the model came after startup
+            self._log_ready()
+
+    def _log_ready(self) -> None:
+        payload = self.settings.model.payload
+        self.get_logger().info(f"ready: ~/check for a {payload.mass} kg payload at {list(payload.com)} m")
+
+    def _model(self) -> RobotModel:
+        """The model in force, for the payload estimate."""
+        if self.settings is None:
+            raise EstimationError("no model yet: waiting for a URDF on the robot_description topic")
+        return self.settings.model
 
     def _finite_problem(self, q, qd) -> BadMessage | None:
         """Why the model in force gives no finite torques at (q, qd), qdd = 0 (as id_node), or None."""
-        if self.settings is None:
-            return None  # checked when the first settings arrive
         model = self.settings.model
         try:
             finite_torques(rnea, model, q, qd, [0.0] * model.n)
@@ -149,6 +193,9 @@ class PayloadCheckNode(Node):
     @guarded("joint_states")
     def _on_joint_state(self, msg: JointState) -> None:
         self.counts["joint_states.received"] += 1
+        if self.settings is None:
+            self.counts["joint_states.no_model_yet"] += 1
+            return
         try:
             q, qd = read_joint_state(msg, self._order)
         except NotForThisModel:
@@ -161,18 +208,32 @@ class PayloadCheckNode(Node):
         if problem is not None:
             self.tally.drop("joint_states", problem)
             return
-        self._state = (q, qd, self.get_clock().now())
+        now = self.get_clock().now()
+        self._state = (q, qd, now)
+        try:
+            effort = read_effort(msg, self._order)
+        except BadMessage as error:
+            self.counts[f"estimation.{error.kind}"] += 1
+            self.tally.warn("estimation", f"no effort of a joint state for the payload estimate ({error})")
+            effort = None
+        stamp = msg.header.stamp
+        t = stamp.sec + 1e-9 * stamp.nanosec
+        self.estimator.update(t if t != 0.0 else now.nanoseconds * 1e-9, q, qd, effort)
 
     def check(self):
         """Check the payload (at the latest state, if any) and publish /diagnostics:
-        (the PayloadCheck, how old the state is in words if older than STALE_AFTER, else None)."""
+        (the PayloadCheck, how old the state is in words if older than STALE_AFTER, else None);
+        (None, None) while there is no model."""
         settings, state = self.settings, self._state
+        if settings is None:
+            return None, None
         q, qd, received = state if state is not None else (None, None, None)
         result = check_payload(
             settings.model, settings.model.payload, settings.limits, q, qd, workspace=settings.workspace
         )
         stale = None if received is None else self._stale(received)
-        self._publish(payload_statuses(result, self.get_name(), settings.warn_use, stale))
+        statuses = payload_statuses(result, self.get_name(), settings.warn_use, stale)
+        self._publish(statuses + [self.estimator.status(self.get_name())])
         return result, stale
 
     def _not_ready(self) -> str | None:
@@ -183,8 +244,10 @@ class PayloadCheckNode(Node):
         if self.parameters.failure is not None:
             return f"cannot check: {status}"
         since = self.parameters.pending_since
-        running = "" if since is None else f" (for {time.monotonic() - since:.1f} s)"
-        return f"pending: the limits and workspace analysis of the new parameters are running{running}; ask again shortly"
+        if since is None:
+            return "no model yet: waiting for a URDF on the robot_description topic"
+        return (f"pending: the limits and workspace analysis of the new parameters are running "
+                f"(for {time.monotonic() - since:.1f} s); ask again shortly")
 
     def _publish(self, statuses) -> None:
         diagnostics = DiagnosticArray(status=statuses)

@@ -1,6 +1,8 @@
 """Inverse and forward dynamics of a RobotModel: the public functions.
 
-    M(q) qdd + C(q, qd) qd + g(q) = tau        (+ the flange wrench, see ``rnea``)
+    M(q) qdd + C(q, qd) qd + g(q) + tau_f(qd) = tau      (+ the flange wrench, see ``rnea``)
+
+M includes the joints' armature (rotor inertia); tau_f is joint friction (see ``friction``).
 
 Single-state functions take sequences of n numbers and return NumPy arrays; the
 ``*_batch`` forms take arrays shaped (N, n) and give the same numbers for N states at once.
@@ -23,7 +25,8 @@ ArrayLike = Sequence[float] | np.ndarray
 
 
 def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=None) -> np.ndarray:
-    """Joint torques tau(q, qd, qdd) [N m] by recursive Newton-Euler, gravity and payload included.
+    """Joint torques tau(q, qd, qdd) [N m] by recursive Newton-Euler: gravity, payload,
+    armature and friction included.
 
     ``f_ext`` (optional, 6 numbers): the wrench (force [N], moment [N m] about the flange
     origin) that the environment exerts on the flange, in the flange frame. tau balances
@@ -32,8 +35,12 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
     kernels = model.kernels
     args = (_state(q, model.n, "q"), _state(qd, model.n, "qd"), _state(qdd, model.n, "qdd"))
     if f_ext is None:
-        return np.array(kernels.rnea.scalar(*args))
-    return np.array(kernels.rnea_wrench.scalar(*args, _state(f_ext, 6, "f_ext")))
+        tau = np.array(kernels.rnea.scalar(*args))
+    else:
+        tau = np.array(kernels.rnea_wrench.scalar(*args, _state(f_ext, 6, "f_ext")))
+    if model.friction is not None:
+        tau += model.friction.torques(args[1])
+    return tau
 
 
 def gravity(model: RobotModel, q: ArrayLike) -> np.ndarray:
@@ -60,7 +67,7 @@ def mass_matrix(model: RobotModel, q: ArrayLike) -> np.ndarray:
 
 
 def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext=None) -> np.ndarray:
-    """Joint accelerations qdd = M(q)^-1 (tau - C(q, qd) qd - g(q)) [rad/s^2]."""
+    """Joint accelerations qdd = M(q)^-1 (tau - C(q, qd) qd - g(q) - tau_f(qd)) [rad/s^2]."""
     tau = np.array(_state(tau, model.n, "tau"), dtype=float)
     bias = rnea(model, q, qd, np.zeros(model.n), f_ext)
     return np.linalg.solve(mass_matrix(model, q), tau - bias)
@@ -71,7 +78,8 @@ def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayL
 
 def rnea_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
     """rnea for N states: Q, QD, QDD shaped (N, n) -> tau shaped (N, n)."""
-    return _evaluate(model.kernels.rnea.array, *_columns(model.n, Q=Q, QD=QD, QDD=QDD))
+    columns = _columns(model.n, Q=Q, QD=QD, QDD=QDD)
+    return _with_friction(model, _evaluate(model.kernels.rnea.array, *columns), columns[1])
 
 
 def gravity_batch(model: RobotModel, Q) -> np.ndarray:
@@ -92,9 +100,16 @@ def mass_matrix_batch(model: RobotModel, Q) -> np.ndarray:
 def forward_dynamics_batch(model: RobotModel, Q, QD, TAU) -> np.ndarray:
     """forward_dynamics for N states: (N, n) arrays -> QDD shaped (N, n)."""
     q, qd, tau = _columns(model.n, Q=Q, QD=QD, TAU=TAU)
-    bias = _evaluate(model.kernels.rnea.array, q, qd, np.zeros_like(q))
+    bias = _with_friction(model, _evaluate(model.kernels.rnea.array, q, qd, np.zeros_like(q)), qd)
     M = _symmetric(_evaluate(model.kernels.mass_matrix.array, q), model.n)
     return np.linalg.solve(M, (tau.T - bias)[..., None])[..., 0]
+
+
+def _with_friction(model: RobotModel, tau: np.ndarray, qd_columns: np.ndarray) -> np.ndarray:
+    """tau (N, n) plus the friction at velocities given as (n, N) columns."""
+    if model.friction is not None:
+        tau += model.friction.torques(qd_columns.T)
+    return tau
 
 
 # -- conversions ----------------------------------------------------------------------

@@ -11,7 +11,7 @@ it along the flange axis, compiles nothing; the code is as short as a fully fold
 from __future__ import annotations
 
 import types
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from functools import cached_property, lru_cache
 
 from . import algorithms
@@ -48,7 +48,8 @@ class Kernels:
         last = links[-1]
         constants = (last.m, *last.h, *last.I, *model.gravity)
         self.constants = tuple(x for x in constants if x != 0.0)
-        self._arm = _arm(links[:-1] + (replace(last, m=0.0, h=ZERO3, I=ZERO6),), tuple(x != 0.0 for x in constants))
+        arm = links[:-1] + (replace(last, m=0.0, h=ZERO3, I=ZERO6),)
+        self._arm = _arm(arm, model.flange, tuple(x != 0.0 for x in constants))
 
     def compiled(self, *names: str) -> bool:
         """Whether these kernels' code exists already (shared with a model of the same arm):
@@ -85,10 +86,27 @@ class Kernels:
         """(q, qd) -> C(q, qd), row by row"""
         return self._arm.coriolis_matrix.bound(self.constants)
 
+    @cached_property
+    def regressor(self) -> Kernel:
+        """(q, qd, qdd) -> the rigid-body regressor, n x 10n row by row (see regressor)."""
+        return self._arm.regressor.bound(self.constants)
+
+    @cached_property
+    def momentum(self) -> Kernel:
+        """(q, qd) -> [M qd, C^T qd]: the generalized momentum and dT/dq (see observer)."""
+        return self._arm.momentum.bound(self.constants)
+
 
 @lru_cache(maxsize=ARMS_CACHED)
-def _arm(links, nonzero: tuple[bool, ...]) -> "_ArmKernels":
-    return _ArmKernels(links, nonzero)
+def _arm(links, flange, nonzero: tuple[bool, ...]) -> "_ArmKernels":
+    return _ArmKernels(links, flange, nonzero)
+
+
+@dataclass(frozen=True)
+class _Flange:
+    """What algorithms.flange_wrench reads of a model."""
+
+    flange: object
 
 
 class _ArmKernels:
@@ -96,9 +114,10 @@ class _ArmKernels:
     use; the last link's inertia and gravity come from the argument ``k``, its nonzero ones
     of the 13 numbers (``nonzero``), the others are zero."""
 
-    def __init__(self, links, nonzero: tuple[bool, ...]):
+    def __init__(self, links, flange, nonzero: tuple[bool, ...]):
         self.n = len(links)
         self.links = links
+        self.flange = _Flange(flange)
         self.nonzero = nonzero
         self.angles = [link.theta_offset for link in links]
 
@@ -132,7 +151,7 @@ class _ArmKernels:
         return self._kernel(
             "rnea_wrench",
             lambda cs, qd, qdd, wrench, k: algorithms.rnea(
-                self._links(k), cs, qd, qdd, self._gravity(k), wrench[:3], wrench[3:]
+                self._links(k), cs, qd, qdd, self._gravity(k), *algorithms.flange_wrench(self.flange, wrench[:3], wrench[3:])
             ),
             qd=self.n,
             qdd=self.n,
@@ -168,3 +187,25 @@ class _ArmKernels:
             return [x for row in C for x in row]
 
         return self._kernel("coriolis_matrix", flat, qd=self.n)
+
+    @cached_property
+    def regressor(self) -> Kernel:
+        from .regressor import rigid_body_regressor
+
+        def flat(cs, qd, qdd, k):
+            return [x for row in rigid_body_regressor(self._links(k), cs, qd, qdd, self._gravity(k)) for x in row]
+
+        return self._kernel("regressor", flat, qd=self.n, qdd=self.n)
+
+    @cached_property
+    def momentum(self) -> Kernel:
+        from .observer import energy_gradient
+
+        zeros = [0.0] * self.n
+
+        def terms(cs, qd, k):
+            links = self._links(k)
+            p = algorithms.rnea(links, cs, zeros, qd, (0.0, 0.0, 0.0))  # M qd
+            return [*p, *energy_gradient(links, cs, qd)]
+
+        return self._kernel("momentum", terms, qd=self.n)

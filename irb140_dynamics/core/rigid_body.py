@@ -147,3 +147,11 @@ def combine(a: RigidBody, b: RigidBody) -> RigidBody:
     # back from the origin to the combined centre of mass: I_c = I_o - m (|c|^2 1 - c c^T)
     _, _, shift = shift_inertia(m, ZERO3, ZERO6, com)
     return RigidBody(m, com, tuple(x - y for x, y in zip(about_origin, shift)))
+
+
+def placed(body: RigidBody, rotation, translation) -> RigidBody:
+    """``body`` given in a frame F, expressed in the frame where F sits at (rotation, translation)."""
+    R = np.asarray(rotation, dtype=float)
+    com = R @ np.asarray(body.com) + np.asarray(translation, dtype=float)
+    I = R @ inertia_matrix(body.inertia) @ R.T
+    return RigidBody(body.mass, tuple(com.tolist()), (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]))

@@ -43,12 +43,17 @@ class LiveParameters:
     (the configuration before stays).
     """
 
-    def __init__(self, node: Node, specs: list, check: Callable[[dict], Any], finish: Callable[[Any, Any], Any],
-                 declared=(), startup_wait: float | None = None, quick: Callable[[Any, Any], bool] | None = None):
-        """``declared``: names of parameters the caller has declared already; ``quick(draft,
+    def __init__(self, node: Node, specs: list, check: Callable[[dict], Any],
+                 finish: Callable[[Any, Any], Any] | None = None, declared=(), startup_wait: float | None = None,
+                 quick: Callable[[Any, Any], bool] | None = None):
+        """``finish`` None: ``check`` builds the whole configuration (then always quick);
+        ``declared``: names of parameters the caller has declared already; ``quick(draft,
         previous)``: True when finish will be quick (nothing to compile): then it runs at
-        once, and the change is in force when the call returns."""
-        self._node, self._check_values, self._quick = node, check, quick
+        once, and the change is in force when the call returns. A draft None (an input from
+        elsewhere, a URDF, yet to come) finishes as None: nothing to run on yet."""
+        self._node, self._check_values = node, check
+        self._quick = (lambda draft, previous: True) if finish is None else quick
+        finish = finish or (lambda draft, previous: draft)
         self._names = [spec.name for spec in specs] + list(declared)
         for spec in specs:
             declare(node, spec)
@@ -56,18 +61,22 @@ class LiveParameters:
         self.current = None
         self.failure: str | None = None
         self.pending_since: float | None = time.monotonic()
+        self._declaring = self._starting = False
         self._listeners: list[Callable[[Any], None]] = []
-        self._accepted = self._applied = 1  # generations: the newest accepted change, the one in force
+        self._accepted, self._applied = 1, 0  # generations: the newest accepted change, the one in force
         self._checked = None  # (values, draft) accepted by _check, not yet applied
+        finish = _or_none(finish)
         self._builder = Builder(node, finish, self._deliver, f"{node.get_name()} parameters")
         draft = check(self.values())
         if startup_wait is None:
             self._deliver(1, finish(draft, None))
             self._builder.previous = self.current
         else:
-            self._applied = 0
+            self._starting = True  # a failure is raised, not logged
             self._builder.submit(1, draft)
-            if self._builder.wait(startup_wait, node.context.ok) and self.failure is not None:
+            delivered = self._builder.wait(startup_wait, node.context.ok)
+            self._starting = False
+            if delivered and self.failure is not None:
                 raise ValueError(self.failure)
         node.add_pre_set_parameters_callback(self._coerce_integers)
         node.add_on_set_parameters_callback(self._check)
@@ -83,6 +92,23 @@ class LiveParameters:
 
     def on_change(self, listener: Callable[[Any], None]) -> None:
         self._listeners.append(listener)
+
+    def declare(self, specs: list) -> None:
+        """Declare more parameters (a new model's per-joint ones); those declared already stay.
+        Declaring is not a change: the checks are not run for it."""
+        self._declaring = True
+        try:
+            for spec in specs:
+                if not self._node.has_parameter(spec.name):
+                    declare(self._node, spec)
+                    self._names.append(spec.name)
+        finally:
+            self._declaring = False
+
+    def submit(self, draft) -> None:
+        """Apply a draft checked elsewhere (from the current values and an input from outside
+        the parameters, such as a new robot_description), as an accepted change."""
+        self._accept(draft)
 
     def status(self) -> str | None:
         """None when the parameters are in force; else in words why not (yet)."""
@@ -123,6 +149,8 @@ class LiveParameters:
     def _check(self, parameters: list[Parameter]) -> SetParametersResult:
         """Validate the whole new configuration; refuse the change if that fails."""
         self._checked = None
+        if self._declaring:
+            return SetParametersResult(successful=True)
         try:
             self._refuse_undeclared([p for p in parameters if not p.name])  # others: rclpy's check, above
             values = self.values(parameters)
@@ -140,12 +168,14 @@ class LiveParameters:
         checked, self._checked = self._checked, None
         if checked is None or checked[0] != self.values():  # not the change just checked
             return
+        self._accept(checked[1])
+
+    def _accept(self, draft) -> None:
         self._accepted += 1
         if self.pending_since is None:
             self.pending_since = time.monotonic()
-        draft = checked[1]
         try:
-            quick = self._quick is not None and self._quick(draft, self._builder.previous)
+            quick = draft is None or (self._quick is not None and self._quick(draft, self._builder.previous))
         except Exception:  # noqa: BLE001  (then the worker finds out)
             quick = False
         if quick:
@@ -155,15 +185,18 @@ class LiveParameters:
 
     def _deliver(self, generation: int, result) -> None:
         """On the executor thread: swap in a finished configuration, or note its failure."""
-        if generation <= self._applied and self.current is not None:
+        if generation <= self._applied:  # a newer one is in force already
             return
         if generation == self._accepted:
             self.pending_since = None
         if isinstance(result, Failed):
             self.failure = _error_text(result.error)
-            self._node.get_logger().error(f"new parameters not applied, the previous stay in force: {self.failure}")
+            if not self._starting:
+                self._node.get_logger().error(f"new parameters not applied, the previous stay in force: {self.failure}")
             return
         self._applied, self.current, self.failure = generation, result, None
+        if result is None:  # nothing to run on yet (waiting for a URDF)
+            return
         for listener in self._listeners:
             try:
                 listener(result)
@@ -201,3 +234,8 @@ def declare(node: Node, spec) -> Any:
         if given is None or (spec.minimum is None and spec.maximum is None):
             raise ValueError(f"{spec.name}: {error}") from None
         raise ValueError(f"{spec.name}: {_range_text(spec)}, got {given.value}") from None
+
+
+def _or_none(finish: Callable[[Any, Any], Any]) -> Callable[[Any, Any], Any]:
+    """finish, for a draft None (nothing to run on yet) None."""
+    return lambda draft, previous: None if draft is None else finish(draft, previous)

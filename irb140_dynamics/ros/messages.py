@@ -4,21 +4,23 @@ from __future__ import annotations
 
 import math
 from array import array
+from collections import Counter
 
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
 
+from ..core.joint_order import BadMessage, JointOrder, NotForThisModel
 
-class BadMessage(ValueError):
-    """A message that must not yield torques; ``kind`` is a short tag for counting."""
-
-    def __init__(self, kind: str, detail: str):
-        super().__init__(f"{kind}: {detail}")
-        self.kind = kind
+__all__ = ["BadMessage", "JointOrder", "NotForThisModel", "count_and_warn", "finite_torques", "joint_efforts",
+           "read_effort", "read_joint_state", "read_reference"]
 
 
-class NotForThisModel(BadMessage):
-    """A message about none of the model's joints (a gripper's, another arm's): ignored."""
+def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> None:
+    """Count a dropped message by kind, and warn about it (every 2 s at most). (id_node and
+    payload_check_node count per topic with ros.guard.Tally.)"""
+    counts[f"dropped_{error.kind}"] += 1
+    counts["dropped"] += 1
+    logger.warning(f"dropped a {topic} message ({error})", throttle_duration_sec=2.0)
 
 
 def finite_torques(function, model, *state):
@@ -32,42 +34,6 @@ def finite_torques(function, model, *state):
     if not (math.isfinite(sum(tau)) or all(map(math.isfinite, tau))):
         raise BadMessage("non_finite_torques", f"the model gives {[float(x) for x in tau]}")
     return tau
-
-
-class JointOrder:
-    """Where each of the model's joints sits in a message's name list.
-
-    Cached per name list: streams from a few publishers (arm, gripper) each keep theirs.
-    """
-
-    _CACHE_SIZE = 16
-
-    def __init__(self, joint_names):
-        self.joint_names = tuple(joint_names)
-        self._cache: dict[tuple, list[int]] = {}
-
-    def indices(self, names) -> list[int]:
-        names = tuple(names)
-        index = self._cache.get(names)
-        if index is None:
-            index = self._match(names)
-            if len(self._cache) >= self._CACHE_SIZE:
-                self._cache.clear()
-            self._cache[names] = index
-        return index
-
-    def _match(self, names: tuple) -> list[int]:
-        if not names:
-            raise BadMessage("unnamed", "no joint names and the lengths do not match the model")
-        if len(set(names)) != len(names):
-            raise BadMessage("duplicate_names", f"duplicate joint names in {list(names)}")
-        where = {name: i for i, name in enumerate(names)}
-        missing = [name for name in self.joint_names if name not in where]
-        if len(missing) == len(self.joint_names):
-            raise NotForThisModel("other_joints", f"none of the model's joints in {list(names)}")
-        if missing:
-            raise BadMessage("missing_joints", f"no {', '.join(missing)} in {list(names)}")
-        return [where[name] for name in self.joint_names]
 
 
 def _pick(values, index: list[int], field: str, length: int, required: bool) -> list[float]:
@@ -97,6 +63,18 @@ def read_joint_state(msg: JointState, order: JointOrder) -> tuple[list[float], l
     return q, qd
 
 
+def read_effort(msg: JointState, order: JointOrder) -> list[float] | None:
+    """The efforts of the model's joints, None when the message has none (BadMessage
+    ``effort_not_finite`` for a NaN or infinite one). Call after read_joint_state."""
+    if len(msg.effort) == 0:
+        return None
+    index, length = _index(msg.name, len(msg.position), order)
+    try:
+        return _pick(msg.effort, index, "effort", length, required=True)
+    except BadMessage as error:
+        raise BadMessage("effort_not_finite", str(error)) from None
+
+
 def read_reference(msg: JointTrajectory, order: JointOrder):
     """(q, qd, qdd or None) of the model's joints from the first point of a non-empty trajectory.
 
@@ -113,9 +91,7 @@ def read_reference(msg: JointTrajectory, order: JointOrder):
 
 
 def _index(names, n_positions: int, order: JointOrder) -> tuple[list[int], int]:
-    if not names and n_positions == len(order.joint_names):
-        return list(range(n_positions)), n_positions
-    return order.indices(names), len(names)
+    return order.for_values(names, n_positions)
 
 
 def joint_efforts(msg: JointState, stamp, effort) -> JointState:

@@ -3,19 +3,19 @@
 A node lists its parameters as ``Spec``s and gives two functions: ``check`` turns all of
 their values into a draft of the configuration it runs on (a RobotModel, options),
 raising ValueError naming the parameter when something is wrong, quickly; ``finish``
-does the slow rest (compiling kernels, the workspace analysis). ``LiveParameters``
+does the slow rest (compiling kernels, the workspace analysis); a draft may be None while
+an input from elsewhere, a URDF, has yet to come. ``LiveParameters`` (see ``live``)
 declares the parameters, builds the first configuration (a failure stops startup), and
 from then on checks every change whole before it is accepted (a refused change keeps the
-old configuration), then finishes it in a worker thread and swaps it in on the executor
-thread: a change stalls no message. Parameters given that no node of the package knows
-are warned about by name, with the nearest known name.
+old configuration), then finishes it off the executor and swaps it in: a change stalls no
+message. Parameters given that no node of the package knows are warned about by name,
+with the nearest known name.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Callable
 
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
@@ -24,10 +24,11 @@ from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from ..core.model import check_joint_names, read_parameter_file
+from ..package_files import CONFIG_NAME, PACKAGE, default_config_path  # noqa: F401 (PACKAGE, CONFIG_NAME: re-exported)
 from .live import LiveParameters, declare
 
-PACKAGE = "irb140_dynamics"
-CONFIG_NAME = "irb140.yaml"
+_declare = declare  # the name model_source imports
+
 
 
 @dataclass(frozen=True)
@@ -92,16 +93,6 @@ def joint_states_qos(node: Node) -> QoSProfile:
     return QoSProfile(depth=node.get_parameter("qos.depth").value, reliability=reliability)
 
 
-def default_config_path() -> Path:
-    """The installed config/irb140.yaml (where ros2 run finds it), else the source tree's."""
-    try:
-        from ament_index_python.packages import get_package_share_directory
-
-        return Path(get_package_share_directory(PACKAGE)) / "config" / CONFIG_NAME
-    except (ImportError, LookupError, OSError):  # not installed, or no AMENT_PREFIX_PATH
-        return Path(__file__).resolve().parents[2] / "config" / CONFIG_NAME
-
-
 def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
     """The model's parameters for these joints; defaults from the default model's file.
 
@@ -115,6 +106,8 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
 
     specs = [
         Spec("gravity", defaults.get("gravity", [0.0, 0.0, -9.81]), "gravity in the base frame", "m/s^2"),
+        Spec("friction.smoothing_velocity", defaults.get("friction.smoothing_velocity", 0.01),
+             "Coulomb friction is coulomb * tanh(qd / this)", "rad/s", minimum=1e-9),
         *_body_specs("payload", "the payload on the flange", "flange frame", lambda name, kind: defaults.get(name, kind)),
     ]
     for joint in joint_names:
@@ -126,6 +119,16 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
                  "[lower, upper] joint position", "rad"),
             Spec(f"{joint}.torque_limit", default(f"{joint}.torque_limit", 0.0),
                  "joint torque limit, 0 = none given", "N m", minimum=0.0),
+            Spec(f"{joint}.velocity_limit", default(f"{joint}.velocity_limit", 0.0),
+                 "joint speed limit, 0 = none given", "rad/s", minimum=0.0),
+            Spec(f"{joint}.acceleration_limit", default(f"{joint}.acceleration_limit", 0.0),
+                 "joint acceleration limit, 0 = none given", "rad/s^2", minimum=0.0),
+            Spec(f"{joint}.friction.viscous", default(f"{joint}.friction.viscous", 0.0),
+                 "viscous friction coefficient", "N m s/rad", minimum=0.0),
+            Spec(f"{joint}.friction.coulomb", default(f"{joint}.friction.coulomb", 0.0),
+                 "Coulomb friction level (smoothed, see friction.smoothing_velocity)", "N m", minimum=0.0),
+            Spec(f"{joint}.armature", default(f"{joint}.armature", 0.0),
+                 "rotor inertia reflected through the gear, added to M's diagonal", "kg m^2", minimum=0.0),
         ]
     return specs
 
@@ -143,10 +146,14 @@ def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
     ]
 
 
-def declare_model(node: Node, extra: list[Spec], check: Callable[[dict], Any], finish: Callable[[Any, Any], Any],
-                  startup_wait: float | None = None, quick: Callable[[Any, Any], bool] | None = None) -> LiveParameters:
-    """Declare the robot model's parameters and a node's own, with the default model's defaults
-    (see LiveParameters for ``check``, ``finish``, ``startup_wait`` and ``quick``)."""
+def declare_model(
+    node: Node, extra: list[Spec], check: Callable[[dict], Any], per_joint: Callable[[list[str]], list[Spec]] = None,
+    finish: Callable[[Any, Any], Any] | None = None, startup_wait: float | None = None,
+    quick: Callable[[Any, Any], bool] | None = None,
+) -> LiveParameters:
+    """Declare the robot model's parameters and a node's own (``extra``, and ``per_joint``
+    specs made for the model's joint names), with the default model's defaults (see
+    LiveParameters for ``check``, ``finish``, ``startup_wait`` and ``quick``)."""
     path = default_config_path()
     if not path.is_file():
         raise ValueError(f"default model: no {path}; is the package installed? (or give --params-file)")
@@ -157,8 +164,9 @@ def declare_model(node: Node, extra: list[Spec], check: Callable[[dict], Any], f
         Spec("joint_names", defaults["joint_names"], "the model's joints, base to flange", read_only=True),
     )
     names = check_joint_names(names)  # they become parameter prefixes: check them first
-    specs = [*model_specs(names, defaults), *extra]
-    return LiveParameters(node, specs, check, finish, ["joint_names"], startup_wait, quick)
+    own = per_joint(names) if per_joint else []
+    specs = [*model_specs(names, defaults), *extra, *own]
+    return LiveParameters(node, specs, check, finish, declared=["joint_names"], startup_wait=startup_wait, quick=quick)
 
 
 def check_number(name: str, value, minimum: float, maximum: float, unit: str = "") -> float:
