@@ -166,3 +166,13 @@ def test_payload_check_answers_an_internal_error_and_goes_on(payload_node, monke
     assert payload_node.node.counts["check.errors"] == 1
     monkeypatch.undo()
     assert check(payload_node).success
+
+
+def test_nan_in_a_joint_the_model_does_not_have_is_not_its_concern(id_node):
+    """Joints the model lacks are ignored entirely, values and all (README, Joint matching)."""
+    node = id_node
+    msg = joint_state(Q + [math.nan, math.inf], [0.0] * 6 + [math.nan, 0.0], names=NAMES + ["gripper", "tool"])
+    publish_and_count(node, msg, "torques.published")
+    assert node.spin_until(lambda: node.gravity)
+    np.testing.assert_allclose(node.gravity[-1].effort, gravity(irb140(), Q), rtol=1e-12, atol=1e-12)
+    assert node.node.counts["joint_states.dropped"] == 0

@@ -29,6 +29,7 @@ def run(name: str, make_node: Callable[[], Node], args: list[str] | None = None,
         rclpy.try_shutdown()
         return 1
     try:
+        freeze_startup_objects()
         spin(node, executor)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
@@ -39,6 +40,15 @@ def run(name: str, make_node: Callable[[], Node], args: list[str] | None = None,
 
 
 INTERRUPTED = "cannot start: interrupted (Ctrl-C) before the node was ready"
+
+
+def freeze_startup_objects() -> None:
+    """Keep the objects of startup (modules, rclpy, NumPy, the model: some 40,000) out of
+    the garbage collector's full passes: each pass over them takes ~10 ms (more on a busy
+    machine), a stall in which a 1 kHz stream overflows its queue (bench/bench_nodes.py,
+    the run with parameter changes). Objects made later are collected as ever."""
+    gc.collect()
+    gc.freeze()
 
 
 def _start(make_node: Callable[[], Node], args: list[str], logger) -> Node | None:
