@@ -27,15 +27,16 @@ def state(x, n: int, name: str) -> list:
     if kind is np.ndarray and x.dtype is _FLOAT64 and x.shape == (n,):
         x = x.tolist()
     elif not ((kind is list or kind is tuple) and len(x) == n and _NUMBERS.issuperset(map(type, x))):
-        x = _real_numbers(x, n, name)
+        x = real_numbers(x, n, name).tolist()
     # a finite sum is all finite (nan and inf carry through a sum); it only costs ~0.1 us
     if not math.isfinite(sum(x)) and not all(map(math.isfinite, x)):
         raise ValueError(f"{name}: must be finite, got {list(x)}")
     return x
 
 
-def _real_numbers(x, n: int, name: str) -> list:
-    """The other cases of ``state``: any real sequence or array, converted; or ValueError."""
+def real_numbers(x, n: int, name: str) -> np.ndarray:
+    """n real numbers (any real sequence or array, not yet checked finite) as floats, or
+    ValueError naming ``name``: the other cases of ``state``."""
     if x is None or isinstance(x, _NOT_SEQUENCES) or np.ndim(x) != 1:
         raise ValueError(f"{name}: expected {n} real numbers (one per joint), got {_short(x)}")
     if isinstance(x, (list, tuple)) and any(isinstance(v, (bool, np.bool_)) for v in x):
@@ -43,7 +44,7 @@ def _real_numbers(x, n: int, name: str) -> list:
     array = _real_array(x, name)
     if len(array) != n:
         raise ValueError(f"{name}: expected {n} values, got {len(array)}")
-    return array.tolist()
+    return array
 
 
 def states(n: int, **arrays) -> list[np.ndarray]:
