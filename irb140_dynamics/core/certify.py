@@ -66,20 +66,23 @@ class Maxima:
 
 
 def certify_maxima(objectives, lower, upper, incumbent, tol, polish=None, evaluations: int | None = None) -> Maxima:
-    """Upper bounds of the objectives' maxima over theta in [lower, upper] (n,), proven to
+    """Upper bounds of the objectives' maxima over theta in [lower, upper] ((n,), or (K, n):
+    a box per objective), proven to
     within ``tol`` (K,) of the best value known (``incumbent`` (K,), values at real poses)
     unless the budget of ``evaluations`` box bounds runs out first. Objectives over the same
-    joints are searched together; the groups take turns of SLICE box bounds, so that a
-    hard one cannot starve the others.
+    joints are searched together; after a first bound of the whole box each, the groups
+    take turns of at most SLICE box bounds, so that a hard one cannot starve the others.
 
     Where a box's centre beats the best value known by more than tol, the search missed a
     maximum there: ``polish(indices, theta)`` (objectives (P,), angles (P, n)) -> (values,
     theta) climbs from it to the real poses' values, which then serve as the best known.
     """
     evaluations = EVALUATIONS if evaluations is None else evaluations
-    lower, upper = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    K = len(objectives)
+    lower = np.broadcast_to(np.asarray(lower, dtype=float), (K, np.shape(lower)[-1]))
+    upper = np.broadcast_to(np.asarray(upper, dtype=float), lower.shape)
     incumbent, tol = np.asarray(incumbent, dtype=float), np.asarray(tol, dtype=float)
-    K, n = len(objectives), len(lower)
+    n = lower.shape[1]
     members: dict[tuple, list[int]] = {}
     for k, objective in enumerate(objectives):
         members.setdefault((objective.value.dims, objective.norm.dims), []).append(k)
@@ -87,14 +90,15 @@ def certify_maxima(objectives, lower, upper, incumbent, tol, polish=None, evalua
     for ks in members.values():
         ks = np.array(ks)
         climb = None if polish is None else (lambda local, theta, ks=ks: polish(ks[local], theta))
-        groups.append((ks, _Group([objectives[k] for k in ks], lower, upper, incumbent[ks], tol[ks], climb)))
-    spent = 0
+        groups.append((ks, _Group([objectives[k] for k in ks], lower[ks], upper[ks], incumbent[ks], tol[ks], climb)))
+    spent = sum(group.advance(group.boxes) for _, group in groups)  # the whole box, whatever the budget
     while spent < evaluations:
         open_groups = [group for _, group in groups if group.boxes]
         if not open_groups:
             break
+        share = max(1, min(SLICE, (evaluations - spent) // len(open_groups)))
         for group in open_groups:
-            spent += group.advance(min(SLICE, max(evaluations - spent, 0)))
+            spent += group.advance(share)
     bound, value, theta = np.full(K, -np.inf), np.full(K, -np.inf), np.full((K, n), np.nan)
     for ks, group in groups:
         bound[ks], value[ks], theta[ks] = group.result()
@@ -117,11 +121,11 @@ class _Group:
         norm_error = np.array([np.sum(o.norm.error) for o in objectives])
         self.norm_slack = g * (norm_error + rounding(len(self.norm_dims)) * norm_size)
         self.gravity = g * (1 + 8 * U)
-        K, n = len(objectives), len(lower)
+        K, n = lower.shape
         upper = np.minimum(upper, lower + 2 * math.pi)  # the sums repeat every turn
         self.tol = np.maximum(tol, 4 * (self.value_slack + self.norm_slack))  # rounding is not to be closed
         self.polish = polish
-        self.lo, self.hi, self.owner = np.tile(lower, (K, 1)), np.tile(upper, (K, 1)), np.arange(K)
+        self.lo, self.hi, self.owner = lower.copy(), upper.copy(), np.arange(K)
         self.inherited = np.full(K, np.inf)
         self.best, self.closed = incumbent.copy(), np.full(K, -np.inf)
         self.best_value, self.best_theta = np.full(K, -np.inf), np.full((K, n), np.nan)

@@ -62,9 +62,10 @@ class HarmonicSum:
         c = self.coefficients
         return HarmonicSum(self.dims, Interval(c.lo[index], c.hi[index]))
 
-    def reduced(self) -> "Reduced":
+    def reduced(self, merge: bool = False) -> "Reduced":
         """Midpoint coefficients and an error bound, without the joints it hardly depends on
-        (whose terms then count in the error: |phi| <= 1)."""
+        (whose terms then count in the error: |phi| <= 1); with ``merge`` (a single sum),
+        joints it depends on only through theta_a +- theta_b become one (``merge_parallel``)."""
         c, d = self.coefficients, len(self.dims)
         lead = c.lo.shape[:-1]
         mid = c.mid.reshape(lead + (3,) * d)
@@ -78,7 +79,11 @@ class HarmonicSum:
                 error = error + np.abs(dropped).reshape(lead + (-1,)).sum(axis=-1)
                 mid, weight = np.take(mid, 0, axis=len(lead) + axis), np.take(weight, 0, axis=axis)
                 del dims[axis]
-        return Reduced(tuple(dims), mid.reshape(lead + (-1,)), np.asarray(error, dtype=float))
+        merges: list[tuple[int, int, float]] = []
+        if merge and not lead:
+            mid, residual = merge_parallel(mid, dims, merges, NOISE * total)
+            error = error + residual
+        return Reduced(tuple(dims), mid.reshape(lead + (-1,)), np.asarray(error, dtype=float), tuple(merges))
 
     def __call__(self, theta: np.ndarray) -> np.ndarray:
         """The midpoint sum at angles theta (N, n): (N, ...); for tests."""
@@ -92,11 +97,37 @@ class HarmonicSum:
 
 @dataclass(frozen=True, eq=False)
 class Reduced:
-    """A harmonic sum with point coefficients (..., 3^len(dims)) and a bound on its error."""
+    """A harmonic sum with point coefficients (..., 3^len(dims)) and a bound on its error;
+    ``merges`` (a, b, sign) in order: theta_b folded into theta_a as theta_a + sign theta_b."""
 
     dims: tuple[int, ...]
     coefficients: np.ndarray
     error: np.ndarray
+    merges: tuple[tuple[int, int, float], ...] = ()
+
+    def box(self, lower, upper) -> tuple[np.ndarray, np.ndarray]:
+        """The box of angles this sum is over, from the joints' (n,): a merged joint a
+        ranges over theta_a + sign theta_b, theta_b is 0."""
+        lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
+        for a, b, sign in self.merges:
+            lo[a], hi[a] = (lo[a] + lo[b], hi[a] + hi[b]) if sign > 0 else (lo[a] - hi[b], hi[a] - lo[b])
+            lo[b] = hi[b] = 0.0
+        return lo, hi
+
+    def angles(self, theta, lower, upper) -> np.ndarray:
+        """Joint angles (K, n) within [lower, upper] with the same sum as theta (K, n) from
+        ``box``: each merged sum split back, theta_b near the middle of its range."""
+        theta = np.array(theta, dtype=float, ndmin=2)
+        lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
+        before = []
+        for a, b, sign in self.merges:
+            before.append((lo[a], hi[a]))
+            lo[a], hi[a] = (lo[a] + lower[b], hi[a] + upper[b]) if sign > 0 else (lo[a] - upper[b], hi[a] - lower[b])
+        for (a, b, sign), (lo_a, hi_a) in zip(reversed(self.merges), reversed(before)):
+            total, middle = theta[:, a].copy(), 0.5 * (lower[b] + upper[b])
+            theta[:, a] = np.clip(total - sign * middle, lo_a, hi_a)
+            theta[:, b] = np.clip(sign * (total - theta[:, a]), lower[b], upper[b])
+        return theta
 
 
 @dataclass(frozen=True, eq=False)
@@ -164,3 +195,26 @@ def _fit(values: Interval, d: int, first: int = 0) -> HarmonicSum:
         c = Interval(np.stack([A.lo, B.lo, C.lo], axis), np.stack([A.hi, B.hi, C.hi], axis))
     flat = lead + (3**d,)
     return HarmonicSum(tuple(range(first, first + d)), Interval(c.lo.reshape(flat), c.hi.reshape(flat)))
+
+
+def merge_parallel(T, dims: list, merges: list, noise: float):
+    """T (3,)*d without pairs of neighbouring joints it depends on only through theta_a +-
+    theta_b (parallel joints before the one whose torque it is: they only turn gravity),
+    each pair folded into joint a (theta_b = 0; dims and merges updated); and the size of
+    the terms that did not fit that form, for the error bound."""
+    residual, p = 0.0, 0
+    while p + 1 < len(dims):
+        X = np.moveaxis(T, (p, p + 1), (0, 1))
+        for sign in (1.0, -1.0):  # cos(a +- b) = ca cb -+ sa sb, sin(a +- b) = sa cb +- ca sb
+            B, C = 0.5 * (X[1, 1] - sign * X[2, 2]), 0.5 * (X[2, 1] + sign * X[1, 2])
+            fit = np.zeros_like(X)
+            fit[0, 0], fit[1, 1], fit[2, 2], fit[2, 1], fit[1, 2] = X[0, 0], B, -sign * B, C, sign * C
+            off = np.abs(X - fit).sum()
+            if off <= noise:
+                T = np.moveaxis(np.stack([X[0, 0], B, C]), 0, p)
+                residual += off
+                merges.append((dims[p], dims.pop(p + 1), sign))
+                break
+        else:
+            p += 1
+    return T, residual

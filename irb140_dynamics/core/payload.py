@@ -171,10 +171,11 @@ def workspace_load(
     G0, dG = family.static_torques(ranges.samples)
     load = family.extremes(payload.mass, ranges, G0 + payload.mass * dG)
     torque, pose, bound = load.largest()
-    return WorkspaceLoad(payload, torque, pose, _workspace_max_payload(family, ranges, L, G0, dG, load), bound)
+    best = _workspace_max_payload(family, ranges, L, G0, dG, payload.mass, load)
+    return WorkspaceLoad(payload, torque, pose, best, bound)
 
 
-def _workspace_max_payload(family, ranges, L, G0, dG, load: Extremes) -> MaxPayload:
+def _workspace_max_payload(family, ranges, L, G0, dG, own_mass: float, load: Extremes) -> MaxPayload:
     """Dinkelbach from the payload's worst poses, then the proof at the mass found; where
     the proof finds a worse pose, Dinkelbach goes on from it."""
     poses = load.poses
@@ -198,7 +199,7 @@ def _workspace_max_payload(family, ranges, L, G0, dG, load: Extremes) -> MaxPayl
         if not _lighter(candidate, best) or round_ == _PROOF_ROUNDS - 1:
             break  # (in the last round the bounds, over the limits, make the mass proven lower)
         best, poses = candidate, proven.poses
-    return _proven_mass(family, ranges, L, G0, best, proven, limited)
+    return _proven_mass(family, ranges, L, G0, best, proven, limited, (own_mass, load))
 
 
 def _lighter(candidate: MaxPayload, best: MaxPayload) -> bool:
@@ -210,21 +211,23 @@ def _most_loaded(family, ranges, dG):
     return ranges.maximize(lambda Q: family.static_torques(Q)[1], np.vstack([np.eye(n), -np.eye(n)]), dG)
 
 
-def _proven_mass(family, ranges, L, G0, best: MaxPayload, at_best: Extremes, limited) -> MaxPayload:
+def _proven_mass(family, ranges, L, G0, best: MaxPayload, at_best: Extremes, limited, known) -> MaxPayload:
     """``best`` if the bounds at its mass (capped at MAX_MASS) keep every joint within its
-    limit, else the largest mass they prove: a mass s m (s in [0, 1]) mixes the torques at 0
-    and at m, (1 - s) tau(0) + s tau(m), so the bounds mix the same way."""
+    limit, else the largest mass they prove: between two masses m0 < m1 the torques mix,
+    (1 - s) tau(m0) + s tau(m1), and so do their bounds. m0: the payload's own mass if its
+    bounds (``known``: (mass, Extremes)) are within the limits and below m1, else 0."""
     limit = np.tile(L, 2) * (1 + RTOL)
-    b = at_best.bounds
+    m1, b = min(best.mass, MAX_MASS), at_best.bounds
     if np.all(b <= limit):
         return best
-    a = family.extremes(0.0, ranges, G0, rows=limited).bounds
+    m0, a = known[0], known[1].bounds
+    if not (m0 < m1 and np.all(a[limited] <= limit[limited])):
+        m0, a = 0.0, family.extremes(0.0, ranges, G0, rows=limited).bounds
     over_a, over_b = a > limit, b > limit
     with np.errstate(divide="ignore", invalid="ignore"):
         highest = np.min(np.where(over_b, (limit - a) / (b - a), 1.0))
         lowest = np.max(np.where(over_a, (a - limit) / (a - b), 0.0))
-    m = min(best.mass, MAX_MASS)
-    proven = m * highest if not (over_a & over_b).any() and lowest <= highest else math.nan
+    proven = m0 + (m1 - m0) * highest if not (over_a & over_b).any() and lowest <= highest else math.nan
     with np.errstate(invalid="ignore"):
         worst = int(np.argmax(np.where(np.isfinite(limit), b - limit, -np.inf)))
     joint = best.joint if best.joint is not None else worst % len(L)

@@ -124,20 +124,25 @@ class PayloadFamily:
                                            ranges.lower, ranges.upper, values[rows], tol[rows])
             return Extremes(values, poses, bounds)
         forms = self.forms[0].affine(self.forms[1], m)
-        objectives = [Objective((forms.torque[j] * sign).reduced(), forms.omega[j].reduced(), forms.gravity_norm)
+        objectives = [Objective((forms.torque[j] * sign).reduced(merge=True), forms.omega[j].reduced(), forms.gravity_norm)
                       for j, sign in zip(joints, signs)]
+        boxes = [objective.value.box(lower, upper) for objective in objectives]
+
+        def angles(k, theta):  # the joint angles of objective k's box (parallel joints merged)
+            return np.array([objectives[i].value.angles(t, lower, upper)[0] for i, t in zip(k, theta)])
 
         def polish(k, theta):
-            found, pose = ranges.climb(torque, weights[rows[k]], theta - offsets)
+            found, pose = ranges.climb(torque, weights[rows[k]], angles(k, theta) - offsets)
             return found, pose + offsets
 
-        proof = certify_maxima(objectives, lower, upper, values[rows], tol[rows], polish)
+        proof = certify_maxima(objectives, np.array([b[0] for b in boxes]), np.array([b[1] for b in boxes]),
+                               values[rows], tol[rows], polish)
         bounds[rows] = proof.bound
         values, poses = values.copy(), poses.copy()
         better = np.flatnonzero(proof.value > values[rows])
         found = rows[better]
         if found.size:  # the search missed these maxima: take the real poses' torques
-            pose = proof.theta[better] - offsets
+            pose = angles(better, proof.theta[better]) - offsets
             value = np.einsum("kn,kn->k", torque(pose), weights[found])
             higher = value > values[found]
             values[found[higher]], poses[found[higher]] = value[higher], pose[higher]
