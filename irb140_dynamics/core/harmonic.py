@@ -114,6 +114,14 @@ class Reduced:
             lo[b] = hi[b] = 0.0
         return lo, hi
 
+    def fold(self, theta) -> np.ndarray:
+        """Joint angles (K, n) as a point of ``box``: the inverse of ``angles``."""
+        theta = np.array(theta, dtype=float, ndmin=2)
+        for a, b, sign in self.merges:
+            theta[:, a] += sign * theta[:, b]
+            theta[:, b] = 0.0
+        return theta
+
     def angles(self, theta, lower, upper) -> np.ndarray:
         """Joint angles (K, n) within [lower, upper] with the same sum as theta (K, n) from
         ``box``: each merged sum split back, theta_b near the middle of its range."""

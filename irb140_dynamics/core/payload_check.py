@@ -227,10 +227,12 @@ def _max_payload_text(figures: dict[str, str], where: str) -> str:
     label = f"max payload {where}"
     mass, joint, pose = (figures[f"{label}{key}"] for key in (" [kg]", ": limited by", ": pose [deg]"))
     gap = float(figures.get(f"{label}: gap [kg]", "0"))
-    more = f", perhaps up to {gap:.3f} kg more: the proof's budget ran out" if gap >= VISIBLE else ""
+    at = f" at {pose} deg" if where != "here" else ""
     if mass == "unbounded":
         return mass
+    if mass == "none" and gap > 0:
+        return f"none proven ({joint}{at}; the search found {gap:.3f} kg, the proof's budget ran out)"
     if mass == "none":
-        return f"none ({joint} over its limit{more})"
-    at = f" at {pose} deg" if where != "here" else ""
+        return f"none ({joint} over its limit)"
+    more = f"; perhaps {gap:.3f} kg more: the proof's budget ran out" if gap >= VISIBLE else ""
     return f"{mass} kg ({joint}{at}{more})"

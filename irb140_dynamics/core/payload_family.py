@@ -133,7 +133,7 @@ class PayloadFamily:
 
         def polish(k, theta):
             found, pose = ranges.climb(torque, weights[rows[k]], angles(k, theta) - offsets)
-            return found, pose + offsets
+            return found, np.array([objectives[i].value.fold(t)[0] for i, t in zip(k, pose + offsets)])
 
         proof = certify_maxima(objectives, np.array([b[0] for b in boxes]), np.array([b[1] for b in boxes]),
                                values[rows], tol[rows], polish)
