@@ -71,9 +71,16 @@ def mass_matrix(model: RobotModel, q: ArrayLike) -> np.ndarray:
 
 def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext=None) -> np.ndarray:
     """Joint accelerations qdd = M(q)^-1 (tau - C(q, qd) qd - g(q)) [rad/s^2]."""
-    tau_in = state(tau, model.n, "tau")
-    bias = rnea(model, q, qd, np.zeros(model.n), f_ext)
-    qdd = np.linalg.solve(mass_matrix(model, q), np.array(tau_in, dtype=float) - bias)
+    n, kernels = model.n, model.kernels
+    args = (state(q, n, "q"), state(qd, n, "qd"), [0.0] * n)
+    tau_in = state(tau, n, "tau")
+    if f_ext is None:
+        bias = kernels.rnea.scalar(*args)
+    else:
+        bias = kernels.rnea_wrench.scalar(*args, state(f_ext, 6, "f_ext"))
+    M = _symmetric(np.array(kernels.mass_matrix.scalar(args[0])), n)
+    with np.errstate(invalid="ignore", over="ignore"):
+        qdd = np.linalg.solve(M, np.array(tau_in, dtype=float) - np.array(bias))
     finite_result(qdd.tolist(), "forward_dynamics", q=q, qd=qd, tau=tau, **({} if f_ext is None else {"f_ext": f_ext}))
     return qdd
 
@@ -108,7 +115,8 @@ def forward_dynamics_batch(model: RobotModel, Q, QD, TAU) -> np.ndarray:
     q, qd, tau = states(model.n, Q=Q, QD=QD, TAU=TAU)
     bias = _evaluate(model.kernels.rnea.array, q, qd, np.zeros_like(q))
     M = _symmetric(_evaluate(model.kernels.mass_matrix.array, q), model.n)
-    QDD = np.linalg.solve(M, (tau.T - bias)[..., None])[..., 0]
+    with np.errstate(over="ignore", invalid="ignore"):
+        QDD = np.linalg.solve(M, (tau.T - bias)[..., None])[..., 0]
     return finite_results(QDD, "forward_dynamics_batch", "Q", "QD", "TAU")
 
 
@@ -124,7 +132,8 @@ def _evaluate(kernel, *columns: np.ndarray) -> np.ndarray:
     result = None
     for start in range(0, max(N, 1), _CHUNK):
         chunk = slice(start, start + _CHUNK)
-        outputs = kernel(*(c[:, chunk] for c in columns))
+        with np.errstate(over="ignore", invalid="ignore"):  # the callers check what they return
+            outputs = kernel(*(c[:, chunk] for c in columns))
         if result is None:
             result = np.empty((N, len(outputs)))
         for i, values in enumerate(outputs):  # constants folded at generation broadcast
