@@ -12,6 +12,7 @@ setup(
         ("share/ament_index/resource_index/packages", [f"resource/{package_name}"]),
         (f"share/{package_name}", ["package.xml"]),
         (f"share/{package_name}/config", glob("config/*.yaml")),
+        (f"share/{package_name}/urdf", glob("urdf/*.urdf")),
     ],
     install_requires=["setuptools"],
     zip_safe=True,
@@ -25,6 +26,8 @@ setup(
             "id_node = irb140_dynamics.id_node:main",
             "payload_check_node = irb140_dynamics.payload_check_node:main",
             "demo_node = irb140_dynamics.demo_node:main",
+            "sim_node = irb140_dynamics.sim_node:main",
+            "export_urdf = irb140_dynamics.tools.export_urdf:main",
         ],
     },
 )

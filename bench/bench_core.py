@@ -11,6 +11,8 @@ to bench/results/core.json. Sections:
 - batch: states per second of the ``*_batch`` functions on N random states against a
   Python loop of the Pinocchio call over the same states.
 - kernel generation: the one-off cost of tracing and compiling each kernel of a fresh model.
+- UR5 from its URDF: the UR5 read by our URDF loader (shared/urdf/ur5.urdf) against
+  Pinocchio's URDF parser on the same file, per call.
 
 Every pair is checked to give the same numbers before it is timed.
 """
@@ -44,6 +46,7 @@ from irb140_dynamics.core import (
     rnea_batch,
 )
 from irb140_dynamics.core.rigid_body import inertia_matrix
+from irb140_dynamics.core.urdf import load_urdf
 from test.pinocchio_model import build as pinocchio_model, rot_x, rot_z  # noqa: E402
 
 BATCH_STATES = 100_000
@@ -53,6 +56,7 @@ FRESH_MODELS = 3  # kernel generation is timed on this many fresh models
 KERNELS = ("rnea", "rnea_wrench", "gravity_torques", "coriolis", "mass_matrix", "coriolis_matrix")
 TOLERANCE = dict(rtol=1e-9, atol=1e-9)
 SEED = 140
+UR5 = REPO.parent / "shared" / "urdf" / "ur5.urdf"  # the public description beside the repository
 
 
 # -- the baselines ----------------------------------------------------------------------
@@ -190,6 +194,30 @@ def batch(model, pm, data) -> list[Row]:
     return rows
 
 
+def ur5_from_urdf() -> list[Row]:
+    """Per-call cost on the UR5 as our loader and Pinocchio's parser read its URDF."""
+    text = UR5.read_text()
+    model = load_urdf(text, tip_link="tool0").model
+    pm = pin.buildModelFromXML(text)
+    pm.gravity.linear = np.array(model.gravity)
+    data = pm.createData()
+    q, qd, qdd = (x[0] for x in random_states(model, 1, np.random.default_rng(SEED + 2)))
+    check_same("UR5 rnea", rnea(model, q, qd, qdd), pin.rnea(pm, data, q, qd, qdd))
+    check_same("UR5 gravity", gravity(model, q), pin.computeGeneralizedGravity(pm, data, q))
+    check_same("UR5 mass_matrix", mass_matrix(model, q), symmetric_from_upper(pin.crba(pm, data, q)))
+    cases = [
+        ("UR5 rnea vs pin.rnea", lambda: rnea(model, q, qd, qdd), lambda: pin.rnea(pm, data, q, qd, qdd), Target(8)),
+        ("UR5 gravity vs computeGeneralizedGravity", lambda: gravity(model, q),
+         lambda: pin.computeGeneralizedGravity(pm, data, q), None),
+        ("UR5 mass_matrix vs pin.crba", lambda: mass_matrix(model, q), lambda: pin.crba(pm, data, q), None),
+    ]
+    group = "UR5 from its URDF (ours: load_urdf; Pinocchio: buildModelFromXML), per call"
+    return [
+        Row(group, name, Figure.cost(seconds_per_call(ours)), Figure.cost(seconds_per_call(baseline)), target)
+        for name, ours, baseline, target in cases
+    ]
+
+
 def kernel_generation() -> tuple[list[Row], dict]:
     """Trace-and-compile time of each kernel on fresh models, and the first rnea() call."""
     times = {name: [] for name in ("kernels setup", *KERNELS, "first rnea() call")}
@@ -219,7 +247,7 @@ def main() -> None:
     pm = pinocchio_model(model)  # the builder the tests check against our core
     data = pm.createData()
     generation, source_lines = kernel_generation()  # first: on fresh models, before any warm-up
-    rows = single_state(model, pm, data) + batch(model, pm, data) + generation
+    rows = single_state(model, pm, data) + batch(model, pm, data) + generation + ur5_from_urdf()
     print_table(rows, "irb140_dynamics core vs Pinocchio (ratio = ours / baseline)")
     path = write_results(
         "core",

@@ -121,6 +121,16 @@ def node_environment(domain_id: int) -> dict:
     }
 
 
+def isolated_domain(domain_id: int | None) -> tuple[int, dict]:
+    """A DDS domain of the run's own (``domain_id``, else random in 50..99) on localhost, set
+    for this process (call before rclpy.init); returns it and the nodes' environment."""
+    domain_id = random.randint(50, 99) if domain_id is None else domain_id
+    os.environ["ROS_DOMAIN_ID"] = str(domain_id)
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    print(f"ROS_DOMAIN_ID={domain_id}", flush=True)
+    return domain_id, node_environment(domain_id)
+
+
 class NodeProcess:
     """A node in its own process, its output in a temporary file; stop() always ends it."""
 
@@ -634,11 +644,7 @@ def parse_args(argv=None) -> argparse.Namespace:
 def main(argv=None) -> None:
     args = parse_args(argv)
     started = time.perf_counter()
-    domain_id = random.randint(50, 99) if args.domain_id is None else args.domain_id
-    os.environ["ROS_DOMAIN_ID"] = str(domain_id)  # before rclpy.init, for this process too
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    env = node_environment(domain_id)
-    print(f"ROS_DOMAIN_ID={domain_id}", flush=True)
+    domain_id, env = isolated_domain(args.domain_id)
 
     rows, runs, payload = [], [], {}
     if not args.no_stream:

@@ -2,10 +2,15 @@
 
 Subscribes   joint_states          sensor_msgs/JointState (matched by joint name)
              ~/reference           trajectory_msgs/JointTrajectory (first point: exact feed-forward)
+             robot_description     std_msgs/String (transient local): the model, with model.source
+                                   robot_description and no URDF parameter or file (see ros.model_source)
 Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, qdd)
              gravity_torques       sensor_msgs/JointState, effort = g(q)
              effort_commands       std_msgs/Float64MultiArray (when enabled), model joint order
-             /diagnostics          diagnostic_msgs/DiagnosticArray, message counts, 1 Hz
+             external_torques      sensor_msgs/JointState, effort = external torques by the momentum
+                                   observer (for joint states that carry efforts; see ros.collision)
+             collision             std_msgs/Bool (transient local), any over its collision_threshold
+             /diagnostics          diagnostic_msgs/DiagnosticArray, message counts and collision, 1 Hz
              (an empty ~/reference trajectory lets the held reference go)
 
 Torques are in N m, named and ordered as the model's joints, stamped with the input stamp.
@@ -31,10 +36,19 @@ from .ros.messages import (
     NotForThisModel,
     count_and_warn,
     joint_efforts,
+    read_effort,
     read_joint_state,
     read_reference,
 )
-from .ros.params import QOS_PARAMETERS, Spec, check_choice, check_qos, declare_model, joint_states_qos
+from .ros.collision import (
+    COLLISION_PARAMETERS,
+    CollisionMonitor,
+    CollisionSettings,
+    build_collision_settings,
+    collision_threshold_specs,
+)
+from .ros.model_source import declare_model_source
+from .ros.params import QOS_PARAMETERS, Spec, check_choice, check_qos, joint_states_qos
 from .ros.spin import run
 
 ACCELERATION_MODES = ("zero", "differentiate")
@@ -52,6 +66,7 @@ NODE_PARAMETERS = [
     Spec("effort_commands.enabled", False, "also publish torques on effort_commands (Float64MultiArray)",
          read_only=True),
     Spec("effort_commands.source", "feedforward", "which torques go to effort_commands: 'feedforward' or 'gravity'"),
+    *COLLISION_PARAMETERS,
     *QOS_PARAMETERS,
 ]
 
@@ -65,6 +80,7 @@ class Settings:
     cutoff_frequency: float
     reference_timeout: float
     effort_source: str
+    collision: CollisionSettings
 
 
 def build_settings(values: dict) -> Settings:
@@ -80,6 +96,7 @@ def build_settings(values: dict) -> Settings:
         values["acceleration.cutoff_frequency"],
         values["reference_timeout"],
         values["effort_commands.source"],
+        build_collision_settings(values, model.joint_names),
     )
 
 
@@ -88,18 +105,17 @@ class IdNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__("id_node", **kwargs)
-        self.parameters = declare_model(self, NODE_PARAMETERS, build_settings)
+        self.settings: Settings | None = None  # None: waiting for the model (robot_description topic)
+        self._started = False
+        self.parameters = declare_model_source(self, NODE_PARAMETERS, build_settings, collision_threshold_specs)
         self.parameters.on_change(self._use)
         self.counts: Counter[str] = Counter()
         self._reported = Counter()  # the counts at the last diagnostics
         self._reference = None  # (time received [ns, node clock], q, qd, qdd or None)
-        self._use(self.parameters.current)
-
-        names = list(self.settings.model.joint_names)
-        self._order = JointOrder(names)
-        self._feedforward_msg = JointState(name=names)
-        self._gravity_msg = JointState(name=names)
+        self.collision = CollisionMonitor(self, [], self.get_parameter("qos.depth").value)  # joints: by _use
         self._command_msg = Float64MultiArray()
+        if self.parameters.current is not None:
+            self._use(self.parameters.current)
 
         depth = self.get_parameter("qos.depth").value
         self.create_subscription(JointState, "joint_states", self._on_joint_state, joint_states_qos(self))
@@ -111,17 +127,33 @@ class IdNode(Node):
             self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands", depth)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self.create_timer(1.0, self._publish_diagnostics)
-        self.get_logger().info(
-            f"ready: {len(names)} joints {names}, payload {self.settings.model.payload.mass} kg"
-        )
+        self._started = True
+        if self.settings is not None:
+            self._log_ready()
 
     def _use(self, settings: Settings) -> None:
-        """Switch to new (validated, compiled) settings."""
+        """Switch to new (validated, compiled) settings; new joints come with a new model."""
+        first, names = self.settings is None, list(settings.model.joint_names)
+        if first or names != list(self.settings.model.joint_names):
+            self._order = JointOrder(names)
+            self._feedforward_msg = JointState(name=names)
+            self._gravity_msg = JointState(name=names)
+            self._reference = None
         self._differentiator = VelocityDifferentiator(settings.model.n, settings.cutoff_frequency)
+        self.collision.use(settings.model, settings.collision)
         self.settings = settings
+        if first and self._started:  # the model came after startup
+            self._log_ready()
+
+    def _log_ready(self) -> None:
+        names = list(self.settings.model.joint_names)
+        self.get_logger().info(f"ready: {len(names)} joints {names}, payload {self.settings.model.payload.mass} kg")
 
     def _on_joint_state(self, msg: JointState) -> None:
         self.counts["received"] += 1
+        if self.settings is None:
+            self.counts["no_model_yet"] += 1
+            return
         try:
             q, qd = read_joint_state(msg, self._order)
         except NotForThisModel:
@@ -154,19 +186,39 @@ class IdNode(Node):
             self._command_msg.data = command.tolist()
             self._command_pub.publish(self._command_msg)
         self.counts["published"] += 1
+        self._observe(msg, q, qd, g)
+
+    def _observe(self, msg: JointState, q, qd, g) -> None:
+        """Efforts in the message: run the momentum observer (external torques, collision)."""
+        try:
+            effort = read_effort(msg, self._order)
+        except BadMessage as error:
+            self.collision.reset()
+            self.counts[error.kind] += 1
+            self.get_logger().warning(f"observer skipped a joint state ({error})", throttle_duration_sec=2.0)
+            return
+        if effort is None:
+            return
+        try:
+            self.collision.update(self._time_of(msg), q, qd, effort, g, msg.header.stamp)
+        except ValueError as error:
+            self.counts["observer_reset"] += 1
+            self.get_logger().warning(f"observer reset ({error})", throttle_duration_sec=2.0)
 
     def _estimated_acceleration(self, msg: JointState, qd, settings: Settings):
         if settings.acceleration_mode == "zero":
             return [0.0] * settings.model.n
+        return self._differentiator.update(self._time_of(msg), qd)
+
+    def _time_of(self, msg: JointState) -> float:
+        """The message's stamp [s]; for an unstamped stream, the time of arrival."""
         stamp = msg.header.stamp
         t = stamp.sec + 1e-9 * stamp.nanosec
-        if t == 0.0:  # an unstamped stream: time of arrival
-            t = self.get_clock().now().nanoseconds * 1e-9
-        return self._differentiator.update(t, qd)
+        return t if t != 0.0 else self.get_clock().now().nanoseconds * 1e-9
 
     def _on_reference(self, msg: JointTrajectory) -> None:
         """Hold the first point of a trajectory; an empty trajectory lets the reference go."""
-        if not msg.points:
+        if not msg.points or self.settings is None:
             self._reference = None
             return
         try:
@@ -190,7 +242,10 @@ class IdNode(Node):
         recent = self.counts - self._reported
         self._reported = self.counts.copy()
         status = DiagnosticStatus(name=f"{self.get_name()}: messages", hardware_id=self.get_fully_qualified_name())
-        if recent["dropped"]:
+        if self.settings is None:
+            status.level = DiagnosticStatus.WARN
+            status.message = "waiting for the model (robot_description topic)"
+        elif recent["dropped"]:
             status.level = DiagnosticStatus.WARN
             status.message = f"{recent['dropped']} messages dropped in the last second"
         elif self.counts["received"] and not recent["received"]:
@@ -200,7 +255,8 @@ class IdNode(Node):
             status.level = DiagnosticStatus.OK
             status.message = f"{recent['published']} torque messages in the last second"
         status.values = [KeyValue(key=key, value=str(value)) for key, value in sorted(self.counts.items())]
-        msg = DiagnosticArray(status=[status])
+        collision = self.collision.status(self.get_name(), self.get_fully_qualified_name())
+        msg = DiagnosticArray(status=[status, collision])
         msg.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(msg)
 

@@ -1,10 +1,11 @@
-"""A Pinocchio model of a RobotModel, built from its DH rows and inertials alone.
+"""A Pinocchio model of a RobotModel, built from its joints' placements and inertials alone.
 
-Standard DH: A_i = Rot_z(q_i + theta_offset_i) Trans_z(d_i) Trans_x(a_i) Rot_x(alpha_i).
-Joint i is a revolute joint about z placed at (body frame i-1) * Rot_z(theta_offset_i);
-body frame i (DH frame i) sits at SE3(Rot_x(alpha_i), (a_i, 0, d_i)) in joint i's frame.
-The payload is appended to the last joint as a body of its own (Pinocchio adds the
-inertias), so the payload merge of our code is checked as well.
+Joint i moves link i by pre * Rot(axis, q_i + offset_i) * post (DH: pre = identity, axis
+z, post = Trans(a, 0, d) Rot_x(alpha)). Pinocchio's joint i is a revolute joint about the
+axis placed at (link frame i-1) * pre * Rot(axis, offset_i); link frame i sits at post in
+joint i's frame. The payload is appended to the last joint as a body of its own at
+post * flange (Pinocchio adds the inertias), so the payload merge of our code is checked
+as well. Armature goes to Pinocchio's model.armature; Pinocchio has no friction.
 """
 
 import numpy as np
@@ -21,9 +22,13 @@ def rot_z(angle: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-def body_placement(dh) -> pin.SE3:
-    """DH frame i in joint i's frame: Trans_z(d) Trans_x(a) Rot_x(alpha)."""
-    return pin.SE3(rot_x(dh.alpha), np.array([dh.a, 0.0, dh.d]))
+def se3(placement) -> pin.SE3:
+    return pin.SE3(placement.rotation(), np.array(placement.xyz, dtype=float))
+
+
+def body_placement(joint) -> pin.SE3:
+    """Link frame i in joint i's frame (DH: Trans_z(d) Trans_x(a) Rot_x(alpha))."""
+    return se3(joint.post)
 
 
 def spatial_inertia(body) -> pin.Inertia:
@@ -39,12 +44,16 @@ def build(robot) -> pin.Model:
     model.gravity.linear = np.array(robot.gravity, dtype=float)
     parent, previous_body = 0, pin.SE3.Identity()
     for i, joint in enumerate(robot.joints):
-        placement = previous_body * pin.SE3(rot_z(joint.dh.theta_offset), np.zeros(3))
-        joint_id = model.addJoint(parent, pin.JointModelRZ(), placement, joint.name)
-        previous_body = body_placement(joint.dh)
+        axis = np.array(joint.turning_axis, dtype=float)
+        offset = pin.SE3(pin.AngleAxis(joint.offset, axis).matrix(), np.zeros(3))
+        placement = previous_body * se3(joint.pre) * offset
+        kind = pin.JointModelRZ() if tuple(axis) == (0.0, 0.0, 1.0) else pin.JointModelRevoluteUnaligned(axis)
+        joint_id = model.addJoint(parent, kind, placement, joint.name)
+        model.armature[i] = joint.armature
+        previous_body = body_placement(joint)
         model.appendBodyToJoint(joint_id, spatial_inertia(joint.link), previous_body)
         if i == robot.n - 1:
-            model.appendBodyToJoint(joint_id, spatial_inertia(robot.payload), previous_body)
+            model.appendBodyToJoint(joint_id, spatial_inertia(robot.payload), previous_body * se3(robot.flange))
         parent = joint_id
     return model
 
@@ -57,5 +66,5 @@ def flange_fext(pin_model: pin.Model, robot, wrench) -> pin.StdVec_Force:
         fext.append(pin.Force.Zero())
     wrench = np.asarray(wrench, dtype=float)
     on_flange = pin.Force(wrench[:3], wrench[3:])
-    fext[pin_model.njoints - 1] = body_placement(robot.joints[-1].dh).act(on_flange)
+    fext[pin_model.njoints - 1] = (body_placement(robot.joints[-1]) * se3(robot.flange)).act(on_flange)
     return fext

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 
-from irb140_dynamics.core import DH, Joint, RigidBody, RobotModel, irb140
+from irb140_dynamics.core import DH, Friction, Joint, Placement, RigidBody, RobotModel, irb140
 
 RIGHT_ANGLES = (0.0, math.pi / 2, -math.pi / 2, math.pi)
 
@@ -66,6 +66,38 @@ def random_model(rng, n: int) -> RobotModel:
     direction = rng.normal(size=3)
     gravity = tuple(9.81 * direction / np.linalg.norm(direction))
     return RobotModel(joints, gravity, random_body(rng))
+
+
+def random_urdf_model(rng, n: int, friction: bool = False) -> RobotModel:
+    """n revolute joints in URDF form: random origins (about half the rotations right
+    angles), axes along x, y, z or anywhere, a random flange, armature (and friction)."""
+
+    def angle():
+        return float(rng.choice(RIGHT_ANGLES)) if rng.random() < 0.5 else rng.uniform(-math.pi, math.pi)
+
+    def axis():
+        if rng.random() < 0.5:
+            return tuple(float(x) for x in np.eye(3)[rng.integers(3)] * rng.choice([-1.0, 1.0]))
+        u = rng.normal(size=3)
+        return tuple(u / np.linalg.norm(u))
+
+    def placement():
+        return Placement(tuple(rng.uniform(-0.4, 0.4, 3)), (angle(), angle(), angle()))
+
+    joints = tuple(
+        Joint(
+            f"j{i}",
+            link=random_body(rng),
+            origin=placement(),
+            axis=axis(),
+            armature=rng.uniform(0.0, 0.5),
+            friction=Friction(*rng.uniform(0.0, 2.0, 2)) if friction else Friction(),
+        )
+        for i in range(n)
+    )
+    direction = rng.normal(size=3)
+    gravity = tuple(9.81 * direction / np.linalg.norm(direction))
+    return RobotModel(joints, gravity, random_body(rng), flange=placement())
 
 
 def random_states(rng, n: int, count: int):

@@ -27,7 +27,7 @@ def states(robot):
 
 def angles(robot, q):
     """(cos, sin) of q_i + theta_offset_i, computed with math on Python floats."""
-    return [(math.cos(q_i + j.dh.theta_offset), math.sin(q_i + j.dh.theta_offset)) for q_i, j in zip(q, robot.joints)]
+    return [(math.cos(q_i + j.offset), math.sin(q_i + j.offset)) for q_i, j in zip(q, robot.joints)]
 
 
 def test_rnea_kernels_are_the_algorithm_bit_for_bit(robot, states):

@@ -12,6 +12,8 @@ from .node_process import run_to_exit, run_until_ready
 from .paths import CONFIG, ROOT
 
 EXECUTABLES = ["id_node", "payload_check_node"]
+TOOLS = ["export_urdf"]
+URDF = ROOT / "urdf" / "irb140.urdf"
 
 
 @pytest.fixture(scope="module")
@@ -46,7 +48,7 @@ def test_executables_are_where_ros2_run_looks(install):
     prefix = Path(sourced(install, f"{sys.executable} -c "
                           "'from ament_index_python import get_package_prefix as p; print(p(\"irb140_dynamics\"))'"))
     assert prefix == install / "irb140_dynamics"
-    for name in EXECUTABLES:
+    for name in EXECUTABLES + TOOLS:
         executable = prefix / "lib" / "irb140_dynamics" / name
         assert executable.is_file() and os.access(executable, os.X_OK), executable
 
@@ -55,6 +57,7 @@ def test_config_is_in_the_share_directory(install):
     share = Path(sourced(install, f"{sys.executable} -c 'from ament_index_python import "
                          "get_package_share_directory as s; print(s(\"irb140_dynamics\"))'"))
     assert (share / "config" / "irb140.yaml").read_text() == CONFIG.read_text()
+    assert (share / "urdf" / "irb140.urdf").read_text() == URDF.read_text()
     assert (share / "package.xml").is_file()
 
 
@@ -67,3 +70,9 @@ def test_installed_nodes_run_on_the_installed_config(install, name):
     assert code == 0, output
     code, output = run_to_exit([executable, "--ros-args", "-p", "joint_6.link.mass:=-1.0"], env=env)
     assert code == 1 and "joint_6.link.mass" in output, output
+
+
+def test_installed_export_urdf_prints_the_installed_urdf(install):
+    executable = str(install / "irb140_dynamics" / "lib" / "irb140_dynamics" / "export_urdf")
+    code, output = run_to_exit([executable], env=installed_env(install))
+    assert code == 0 and output == URDF.read_text(), output[:500]

@@ -142,7 +142,7 @@ def test_diagnostics_carry_the_figures_of_the_reply(node):
     assert node.spin_until(lambda: len(node.diagnostics) > count)
     rows = parse_report(reply.message)
     statuses = {s.name.split(": ", 1)[1]: s for s in node.diagnostics[-1].status}
-    assert set(statuses) == set(NAMES) | {"payload"}
+    assert set(statuses) == set(NAMES) | {"payload", "payload estimation"}
     for joint in NAMES:
         values = {kv.key: kv.value for kv in statuses[joint].values}
         row = rows[joint]

@@ -1,4 +1,5 @@
-"""The core against Pinocchio, built independently from the same DH rows and inertials."""
+"""The core against Pinocchio, built independently from the same joints and inertials:
+DH rows, and joints in URDF form (any origin, any axis, a flange placement, armature)."""
 
 import numpy as np
 import pinocchio as pin
@@ -15,7 +16,7 @@ from irb140_dynamics.core import (
 )
 
 from . import pinocchio_model
-from .support import assert_close, loaded_irb140, random_model, random_states
+from .support import assert_close, loaded_irb140, random_model, random_states, random_urdf_model
 
 STATES = 200
 RTOL = 1e-9
@@ -25,6 +26,7 @@ MODELS = {
     "irb140": irb140,
     "irb140_offset_payload": loaded_irb140,
     **{f"random_n{n}": (lambda n=n: random_model(np.random.default_rng(100 + n), n)) for n in range(1, 8)},
+    **{f"urdf_form_n{n}": (lambda n=n: random_urdf_model(np.random.default_rng(200 + n), n)) for n in (1, 3, 6, 7)},
 }
 
 

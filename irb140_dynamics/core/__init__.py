@@ -20,7 +20,8 @@ from .dynamics import (
 )
 from .geometry import irb140
 from .kinematics import dh_transform, flange_jacobian, flange_pose, link_frames
-from .model import DH, Joint, RobotModel, load_model, read_parameter_file
+from .joints import DH, Friction, Joint, Placement
+from .model import RobotModel, load_model, read_parameter_file
 from .payload import (
     RATED_PAYLOAD,
     MaxPayload,
@@ -36,10 +37,12 @@ from .rigid_body import ModelError, RigidBody
 
 __all__ = [
     "DH",
+    "Friction",
     "Joint",
     "MaxPayload",
     "ModelError",
     "PayloadCheck",
+    "Placement",
     "RATED_PAYLOAD",
     "RigidBody",
     "RobotModel",

@@ -1,6 +1,8 @@
 """Inverse and forward dynamics of a RobotModel: the public functions.
 
-    M(q) qdd + C(q, qd) qd + g(q) = tau        (+ the flange wrench, see ``rnea``)
+    M(q) qdd + C(q, qd) qd + g(q) + tau_f(qd) = tau      (+ the flange wrench, see ``rnea``)
+
+M includes the joints' armature (rotor inertia); tau_f is joint friction (see ``friction``).
 
 Single-state functions take sequences of n numbers and return NumPy arrays; the
 ``*_batch`` forms take arrays shaped (N, n) and give the same numbers for N states at once.
@@ -28,7 +30,8 @@ ArrayLike = Sequence[float] | np.ndarray
 
 
 def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=None) -> np.ndarray:
-    """Joint torques tau(q, qd, qdd) [N m] by recursive Newton-Euler, gravity and payload included.
+    """Joint torques tau(q, qd, qdd) [N m] by recursive Newton-Euler: gravity, payload,
+    armature and friction included.
 
     ``f_ext`` (optional, 6 numbers): the wrench (force [N], moment [N m] about the flange
     origin) that the environment exerts on the flange, in the flange frame. tau balances
@@ -42,7 +45,10 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
         tau = kernels.rnea_wrench.scalar(*args, state(f_ext, 6, "f_ext"))
     if not math.isfinite(sum(tau)):  # inline: rnea is the hot path
         finite_result(tau, "rnea", q=q, qd=qd, qdd=qdd, **({} if f_ext is None else {"f_ext": f_ext}))
-    return np.array(tau)
+    tau = np.array(tau)
+    if model.friction is not None:
+        tau += model.friction.torques(args[1])
+    return tau
 
 
 def gravity(model: RobotModel, q: ArrayLike) -> np.ndarray:
@@ -70,17 +76,19 @@ def mass_matrix(model: RobotModel, q: ArrayLike) -> np.ndarray:
 
 
 def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext=None) -> np.ndarray:
-    """Joint accelerations qdd = M(q)^-1 (tau - C(q, qd) qd - g(q)) [rad/s^2]."""
+    """Joint accelerations qdd = M(q)^-1 (tau - C(q, qd) qd - g(q) - tau_f(qd)) [rad/s^2]."""
     n, kernels = model.n, model.kernels
     args = (state(q, n, "q"), state(qd, n, "qd"), [0.0] * n)
     tau_in = state(tau, n, "tau")
     if f_ext is None:
-        bias = kernels.rnea.scalar(*args)
+        bias = np.array(kernels.rnea.scalar(*args))
     else:
-        bias = kernels.rnea_wrench.scalar(*args, state(f_ext, 6, "f_ext"))
+        bias = np.array(kernels.rnea_wrench.scalar(*args, state(f_ext, 6, "f_ext")))
+    if model.friction is not None:
+        bias += model.friction.torques(args[1])
     M = _symmetric(np.array(kernels.mass_matrix.scalar(args[0])), n)
     with np.errstate(invalid="ignore", over="ignore"):
-        qdd = np.linalg.solve(M, np.array(tau_in, dtype=float) - np.array(bias))
+        qdd = np.linalg.solve(M, np.array(tau_in, dtype=float) - bias)
     finite_result(qdd.tolist(), "forward_dynamics", q=q, qd=qd, tau=tau, **({} if f_ext is None else {"f_ext": f_ext}))
     return qdd
 
@@ -90,8 +98,9 @@ def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayL
 
 def rnea_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
     """rnea for N states: Q, QD, QDD shaped (N, n) -> tau shaped (N, n)."""
-    return finite_results(_evaluate(model.kernels.rnea.array, *states(model.n, Q=Q, QD=QD, QDD=QDD)),
-                          "rnea_batch", "Q", "QD", "QDD")
+    columns = states(model.n, Q=Q, QD=QD, QDD=QDD)
+    tau = _with_friction(model, _evaluate(model.kernels.rnea.array, *columns), columns[1])
+    return finite_results(tau, "rnea_batch", "Q", "QD", "QDD")
 
 
 def gravity_batch(model: RobotModel, Q) -> np.ndarray:
@@ -113,11 +122,18 @@ def mass_matrix_batch(model: RobotModel, Q) -> np.ndarray:
 def forward_dynamics_batch(model: RobotModel, Q, QD, TAU) -> np.ndarray:
     """forward_dynamics for N states: (N, n) arrays -> QDD shaped (N, n)."""
     q, qd, tau = states(model.n, Q=Q, QD=QD, TAU=TAU)
-    bias = _evaluate(model.kernels.rnea.array, q, qd, np.zeros_like(q))
+    bias = _with_friction(model, _evaluate(model.kernels.rnea.array, q, qd, np.zeros_like(q)), qd)
     M = _symmetric(_evaluate(model.kernels.mass_matrix.array, q), model.n)
     with np.errstate(over="ignore", invalid="ignore"):
         QDD = np.linalg.solve(M, (tau.T - bias)[..., None])[..., 0]
     return finite_results(QDD, "forward_dynamics_batch", "Q", "QD", "TAU")
+
+
+def _with_friction(model: RobotModel, tau: np.ndarray, qd_columns: np.ndarray) -> np.ndarray:
+    """tau (N, n) plus the friction at velocities given as (n, N) columns."""
+    if model.friction is not None:
+        tau += model.friction.torques(qd_columns.T)
+    return tau
 
 
 # -- conversions ----------------------------------------------------------------------

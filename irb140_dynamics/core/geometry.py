@@ -8,6 +8,7 @@ density is solved so that the moving links weigh 78 kg (98 kg arm less a 20 kg b
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Sequence
 
 from .model import DH, Joint, RobotModel
@@ -54,6 +55,33 @@ IRB140_LINK6 = dict(radius=0.108, height=0.065)  # cylinder along z6
 # Joint ranges: the ABB IRB 140 data sheet's axis ranges in this model's convention
 # (q2 = -axis 2, q3 = -axis 3; the zero poses coincide), in degrees.
 IRB140_RANGES_DEG = ((-180, 180), (-110, 90), (-50, 230), (-200, 200), (-115, 115), (-400, 400))
+IRB140_SPEEDS_DEG = (200, 200, 260, 360, 360, 450)  # deg/s, the data sheet's axis speeds
+IRB140_ACCELERATIONS = (14.0, 14.0, 18.0, 25.0, 25.0, 31.0)  # rad/s^2: assumed (not published)
+
+
+@dataclass(frozen=True)
+class Cylinder:
+    """A solid cylinder about its centre, its axis along ``axis`` of its link's frame."""
+
+    radius: float
+    height: float
+    axis: str = "z"
+
+
+@dataclass(frozen=True)
+class Box:
+    """A solid box about its centre, edges ``size`` along its link frame's x, y, z."""
+
+    size: tuple[float, float, float]
+
+
+# The shapes of the links, by the joint that moves them (for drawing: see urdf.export_urdf).
+IRB140_SHAPES = {
+    "joint_1": Cylinder(axis="y", **IRB140_LINK1),
+    "joint_2": Box(IRB140_LINK2),
+    "joint_4": Box(IRB140_LINK4),
+    "joint_6": Cylinder(axis="z", **IRB140_LINK6),
+}
 
 
 def irb140_volumes(
@@ -86,7 +114,12 @@ def irb140(density: float = IRB140_DENSITY, payload: RigidBody = RigidBody()) ->
         DH(0.0, 0.0, 0.065, 0.0),
     ]
     joints = tuple(
-        Joint(f"joint_{i + 1}", row, link, tuple(math.radians(x) for x in limits))
-        for i, (row, link, limits) in enumerate(zip(dh, links, IRB140_RANGES_DEG))
+        Joint(
+            f"joint_{i + 1}", row, link, tuple(math.radians(x) for x in limits),
+            velocity_limit=math.radians(speed), acceleration_limit=acceleration,
+        )
+        for i, (row, link, limits, speed, acceleration) in enumerate(
+            zip(dh, links, IRB140_RANGES_DEG, IRB140_SPEEDS_DEG, IRB140_ACCELERATIONS)
+        )
     )
     return RobotModel(joints, (0.0, 0.0, -9.81), payload)

@@ -20,6 +20,7 @@ class Kernels:
 
     def __init__(self, model):
         self.n = model.n
+        self.model = model
         self.links = algorithms.chain(model)
         self.gravity = model.gravity
         self.angles = [link.theta_offset for link in self.links]
@@ -43,7 +44,7 @@ class Kernels:
         return self._kernel(
             "rnea_wrench",
             lambda cs, qd, qdd, wrench: algorithms.rnea(
-                self.links, cs, qd, qdd, self.gravity, wrench[:3], wrench[3:]
+                self.links, cs, qd, qdd, self.gravity, *algorithms.flange_wrench(self.model, wrench[:3], wrench[3:])
             ),
             qd=self.n,
             qdd=self.n,
@@ -87,3 +88,26 @@ class Kernels:
             return [x for row in C for x in row]
 
         return self._kernel("coriolis_matrix", flat, qd=self.n)
+
+    @cached_property
+    def regressor(self) -> Kernel:
+        """(q, qd, qdd) -> the rigid-body regressor, n x 10n row by row (see regressor)."""
+        from .regressor import rigid_body_regressor
+
+        def flat(cs, qd, qdd):
+            return [x for row in rigid_body_regressor(self.links, cs, qd, qdd, self.gravity) for x in row]
+
+        return self._kernel("regressor", flat, qd=self.n, qdd=self.n)
+
+    @cached_property
+    def momentum(self) -> Kernel:
+        """(q, qd) -> [M qd, C^T qd]: the generalized momentum and dT/dq (see observer)."""
+        from .observer import energy_gradient
+
+        zeros = [0.0] * self.n
+
+        def terms(cs, qd):
+            p = algorithms.rnea(self.links, cs, zeros, qd, (0.0, 0.0, 0.0))  # M qd
+            return [*p, *energy_gradient(self.links, cs, qd)]
+
+        return self._kernel("momentum", terms, qd=self.n)

@@ -1,4 +1,4 @@
-"""Forward kinematics: DH transforms, link frames, the flange pose and Jacobian.
+"""Forward kinematics: joint transforms, link frames, the flange pose and Jacobian.
 
 Poses are 4x4 homogeneous transforms from the frame to the base frame 0, in metres. q is a
 state as in ``states`` (n finite real numbers), else ValueError naming it.
@@ -30,25 +30,26 @@ def dh_transform(dh: DH, q: float) -> np.ndarray:
 
 
 def link_frames(model: RobotModel, q) -> np.ndarray:
-    """The poses of frames 0..n in the base frame, shaped (n + 1, 4, 4); frame n is the flange."""
+    """The poses of the base and the link frames 0..n in the base frame, (n + 1, 4, 4)."""
     frames = [np.eye(4)]
     for joint, q_i in zip(model.joints, state(q, model.n, "q")):
-        frames.append(frames[-1] @ dh_transform(joint.dh, float(q_i)))
+        frames.append(frames[-1] @ joint.transform(float(q_i)))
     return np.array(frames)
 
 
 def flange_pose(model: RobotModel, q) -> np.ndarray:
-    """The flange (frame n) pose in the base frame, 4x4."""
-    return link_frames(model, q)[-1]
+    """The flange pose in the base frame, 4x4 (for DH models frame n)."""
+    return link_frames(model, q)[-1] @ model.flange.matrix()
 
 
 def flange_jacobian(model: RobotModel, q) -> np.ndarray:
     """The 6 x n geometric Jacobian of the flange, rows (v; w), in the base frame."""
     frames = link_frames(model, q)
-    flange = frames[-1][:3, 3]
+    flange = (frames[-1] @ model.flange.matrix())[:3, 3]
     J = np.empty((6, model.n))
-    for i, frame in enumerate(frames[:-1]):  # joint i+1 turns about z of frame i
-        z, origin = frame[:3, 2], frame[:3, 3]
-        J[:3, i] = np.cross(z, flange - origin)
-        J[3:, i] = z
+    for i, (frame, joint) in enumerate(zip(frames[:-1], model.joints)):
+        joint_frame = frame @ joint.pre.matrix()  # joint i+1's axis passes through its origin
+        axis, origin = joint_frame[:3, :3] @ np.array(joint.turning_axis), joint_frame[:3, 3]
+        J[:3, i] = np.cross(axis, flange - origin)
+        J[3:, i] = axis
     return J

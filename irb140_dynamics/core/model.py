@@ -1,10 +1,10 @@
-"""The robot model: a serial chain of revolute joints given by standard DH rows.
+"""The robot model: a serial chain of revolute joints (see ``joints``: DH rows or URDF form).
 
 Units (SI throughout): m, rad, kg, kg m^2, m/s^2, N m.
 
-Standard DH: A_i = Rot_z(q_i + theta_offset_i) Trans_z(d_i) Trans_x(a_i) Rot_x(alpha_i).
-Link i is the body moved by joint i; its frame is DH frame i. The flange is frame n.
-Gravity is given in the base frame 0.
+Link i is the body moved by joint i. The flange, where the payload sits, is the last link's
+frame placed by ``flange`` (identity for DH models: frame n). Gravity is given in the base
+frame 0.
 
 A model is immutable. Its flat parameter form (``to_params`` / ``from_params``) uses the
 same names as the ROS parameters of the nodes, so that a validation error names the
@@ -13,10 +13,18 @@ parameter to fix:
     joint_names                 [name, ...]
     gravity                     [gx, gy, gz]
     payload.mass / .com / .inertia
-    <joint>.dh                  [a, alpha, d, theta_offset]
+    friction.smoothing_velocity rad/s, of the Coulomb friction's tanh
+    flange                      [x, y, z, roll, pitch, yaw] in the last link (identity if absent)
+    <joint>.dh                  [a, alpha, d, theta_offset], or in URDF form:
+    <joint>.origin, .axis       [x, y, z, roll, pitch, yaw] in the parent link; [x, y, z]
     <joint>.link.mass / .com / .inertia
     <joint>.position_limits     [lower, upper]
     <joint>.torque_limit        N m, 0 = none given
+    <joint>.velocity_limit      rad/s, 0 = none given
+    <joint>.acceleration_limit  rad/s^2, 0 = none given
+    <joint>.friction.viscous    N m s/rad
+    <joint>.friction.coulomb    N m
+    <joint>.armature            kg m^2
 
 Besides being finite, masses, lengths, inertias and gravity are within sanity caps (see
 ``rigid_body``) that keep every number the algorithms derive from them finite.
@@ -30,40 +38,12 @@ from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any, Mapping
 
-from .rigid_body import (
-    MAX_GRAVITY,
-    MAX_LENGTH,
-    ZERO3,
-    ModelError,
-    RigidBody,
-    capped,
-    combine,
-    finite_number,
-    finite_numbers,
-)
+from .joints import DH, Friction, Joint, Placement, validated_joint
+from .rigid_body import MAX_GRAVITY, ZERO3, ModelError, RigidBody, capped, combine, finite_number, finite_numbers, placed
 
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
-
-
-@dataclass(frozen=True)
-class DH:
-    """One standard DH row: a [m], alpha [rad], d [m], theta_offset [rad]."""
-
-    a: float = 0.0
-    alpha: float = 0.0
-    d: float = 0.0
-    theta_offset: float = 0.0
-
-
-@dataclass(frozen=True)
-class Joint:
-    """A revolute joint, the link it moves, and its limits."""
-
-    name: str
-    dh: DH
-    link: RigidBody = RigidBody()
-    position_limits: tuple[float, float] = (-math.pi, math.pi)
-    torque_limit: float = 0.0  # N m; 0 means none given
+DEFAULT_SMOOTHING_VELOCITY = 0.01  # rad/s: Coulomb friction reaches 76 % of its level at 0.01 rad/s
+__all__ = ["DH", "Friction", "Joint", "ModelError", "Placement", "RobotModel", "load_model", "read_parameter_file"]
 
 
 @dataclass(frozen=True)
@@ -73,12 +53,19 @@ class RobotModel:
     joints: tuple[Joint, ...]
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     payload: RigidBody = field(default_factory=RigidBody)
+    flange: Placement = Placement()  # the payload's frame in the last link's frame
+    smoothing_velocity: float = DEFAULT_SMOOTHING_VELOCITY  # rad/s, Coulomb friction's tanh
 
     def __post_init__(self):
-        object.__setattr__(self, "joints", tuple(_validated_joint(j) for j in self.joints))
+        object.__setattr__(self, "joints", tuple(validated_joint(j) for j in self.joints))
         object.__setattr__(self, "gravity", finite_numbers("gravity", self.gravity, 3))
         capped("gravity", "|g|", math.hypot(*self.gravity), MAX_GRAVITY, "m/s^2")
         object.__setattr__(self, "payload", _validated_body("payload", self.payload))
+        object.__setattr__(self, "flange", Placement.validated("flange", self.flange))
+        smoothing = finite_number("friction.smoothing_velocity", self.smoothing_velocity)
+        if not smoothing > 0.0:
+            raise ModelError("friction.smoothing_velocity", f"must be > 0, got {smoothing}")
+        object.__setattr__(self, "smoothing_velocity", smoothing)
         check_joint_names(self.joint_names)
 
     @property
@@ -97,8 +84,20 @@ class RobotModel:
     def bodies(self) -> tuple[RigidBody, ...]:
         """The moving bodies, the payload merged into the last link."""
         bodies = [j.link for j in self.joints]
-        bodies[-1] = combine(bodies[-1], self.payload)
+        payload = self.payload
+        if not self.flange.is_identity:
+            payload = placed(payload, self.flange.rotation(), self.flange.xyz)
+        bodies[-1] = combine(bodies[-1], payload)
         return tuple(bodies)
+
+    @cached_property
+    def friction(self):
+        """The joints' friction (see ``friction``), or None when all of it is zero."""
+        from .friction import JointFriction
+
+        if not any(j.friction.viscous or j.friction.coulomb for j in self.joints):
+            return None
+        return JointFriction.of(self)
 
     def with_payload(self, payload: RigidBody) -> "RobotModel":
         return replace(self, payload=payload)
@@ -119,13 +118,25 @@ class RobotModel:
         params: dict[str, Any] = {
             "joint_names": list(self.joint_names),
             "gravity": list(self.gravity),
+            "friction.smoothing_velocity": self.smoothing_velocity,
         }
+        if not self.flange.is_identity:
+            params["flange"] = self.flange.flat()
         params.update(_body_params("payload", self.payload))
         for j in self.joints:
-            params[f"{j.name}.dh"] = [j.dh.a, j.dh.alpha, j.dh.d, j.dh.theta_offset]
+            if j.dh is not None:
+                params[f"{j.name}.dh"] = [j.dh.a, j.dh.alpha, j.dh.d, j.dh.theta_offset]
+            else:
+                params[f"{j.name}.origin"] = j.origin.flat()
+                params[f"{j.name}.axis"] = list(j.axis)
             params.update(_body_params(f"{j.name}.link", j.link))
             params[f"{j.name}.position_limits"] = list(j.position_limits)
             params[f"{j.name}.torque_limit"] = j.torque_limit
+            params[f"{j.name}.velocity_limit"] = j.velocity_limit
+            params[f"{j.name}.acceleration_limit"] = j.acceleration_limit
+            params[f"{j.name}.friction.viscous"] = j.friction.viscous
+            params[f"{j.name}.friction.coulomb"] = j.friction.coulomb
+            params[f"{j.name}.armature"] = j.armature
         return params
 
     @classmethod
@@ -142,19 +153,36 @@ class RobotModel:
         names = check_joint_names(get("joint_names"))
         joints = []
         for name in names:
-            a, alpha, d, offset = finite_numbers(f"{name}.dh", get(f"{name}.dh"), 4)
-            link = _body_from_params(f"{name}.link", get)
+            if params.get(f"{name}.dh") is None and params.get(f"{name}.origin") is not None:
+                kinematics = dict(
+                    origin=Placement.validated(f"{name}.origin", get(f"{name}.origin")),
+                    axis=finite_numbers(f"{name}.axis", get(f"{name}.axis"), 3),
+                )
+            else:
+                kinematics = dict(dh=DH(*finite_numbers(f"{name}.dh", get(f"{name}.dh"), 4)))
             joints.append(
                 Joint(
                     name,
-                    DH(a, alpha, d, offset),
-                    link,
-                    finite_numbers(f"{name}.position_limits", get(f"{name}.position_limits", (-math.pi, math.pi)), 2),
-                    get(f"{name}.torque_limit", 0.0),
+                    link=_body_from_params(f"{name}.link", get),
+                    position_limits=finite_numbers(
+                        f"{name}.position_limits", get(f"{name}.position_limits", (-math.pi, math.pi)), 2
+                    ),
+                    torque_limit=get(f"{name}.torque_limit", 0.0),
+                    velocity_limit=get(f"{name}.velocity_limit", 0.0),
+                    acceleration_limit=get(f"{name}.acceleration_limit", 0.0),
+                    friction=Friction(get(f"{name}.friction.viscous", 0.0), get(f"{name}.friction.coulomb", 0.0)),
+                    armature=get(f"{name}.armature", 0.0),
+                    **kinematics,
                 )
             )
         payload = _body_from_params("payload", get, optional=True)
-        return cls(tuple(joints), finite_numbers("gravity", get("gravity"), 3), payload)
+        return cls(
+            tuple(joints),
+            finite_numbers("gravity", get("gravity"), 3),
+            payload,
+            Placement.validated("flange", get("flange", (0.0,) * 6)),
+            get("friction.smoothing_velocity", DEFAULT_SMOOTHING_VELOCITY),
+        )
 
 
 def check_joint_names(names) -> list[str]:
@@ -177,19 +205,6 @@ def check_joint_names(names) -> list[str]:
 
 def _validated_body(prefix: str, body: RigidBody) -> RigidBody:
     return RigidBody.validated(prefix, body.mass, body.com, body.inertia)
-
-
-def _validated_joint(j: Joint) -> Joint:
-    dh = DH(*finite_numbers(f"{j.name}.dh", (j.dh.a, j.dh.alpha, j.dh.d, j.dh.theta_offset), 4))
-    capped(f"{j.name}.dh", "|a| and |d|", max(abs(dh.a), abs(dh.d)), MAX_LENGTH, "m")
-    lower, upper = finite_numbers(f"{j.name}.position_limits", j.position_limits, 2)
-    if lower > upper:
-        raise ModelError(f"{j.name}.position_limits", f"lower {lower} > upper {upper}")
-    limit = finite_number(f"{j.name}.torque_limit", j.torque_limit)
-    if limit < 0.0:
-        raise ModelError(f"{j.name}.torque_limit", f"must be >= 0 (0 = none), got {limit}")
-    link = _validated_body(f"{j.name}.link", j.link)
-    return Joint(j.name, dh, link, (lower, upper), limit)
 
 
 def _body_params(prefix: str, body: RigidBody) -> dict[str, Any]:

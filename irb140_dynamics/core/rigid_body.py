@@ -173,3 +173,11 @@ def checked_body(field: str, body) -> RigidBody:
 @lru_cache(maxsize=64)
 def _checked_shape(field: str, com, inertia) -> RigidBody:
     return RigidBody.validated(field, 0.0, com, inertia)
+
+
+def placed(body: RigidBody, rotation, translation) -> RigidBody:
+    """``body`` given in a frame F, expressed in the frame where F sits at (rotation, translation)."""
+    R = np.asarray(rotation, dtype=float)
+    com = R @ np.asarray(body.com) + np.asarray(translation, dtype=float)
+    I = R @ inertia_matrix(body.inertia) @ R.T
+    return RigidBody(body.mass, tuple(com.tolist()), (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]))

@@ -92,6 +92,18 @@ def read_joint_state(msg: JointState, order: JointOrder) -> tuple[list[float], l
     return q, qd
 
 
+def read_effort(msg: JointState, order: JointOrder) -> list[float] | None:
+    """The efforts of the model's joints, None when the message has none (BadMessage
+    ``effort_not_finite`` for a NaN or infinite one). Call after read_joint_state."""
+    if len(msg.effort) == 0:
+        return None
+    index, length = _index(msg.name, len(msg.position), order)
+    try:
+        return _pick(msg.effort, index, "effort", length, required=True)
+    except BadMessage as error:
+        raise BadMessage("effort_not_finite", str(error)) from None
+
+
 def read_reference(msg: JointTrajectory, order: JointOrder):
     """(q, qd, qdd or None) of the model's joints from the first point of a non-empty trajectory.
 

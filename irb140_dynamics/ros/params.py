@@ -3,7 +3,9 @@
 A node lists its parameters as ``Spec``s and gives a ``build`` function that turns all of
 their values into the configuration it runs on (a RobotModel, options), raising ValueError
 naming the parameter when something is wrong. Everything that can fail, and everything
-slow (compiling kernels), belongs in ``build``: a configuration that was built is used. ``LiveParameters`` declares them, builds the
+slow (compiling kernels), belongs in ``build``: a configuration that was built is used
+(``build`` may return None while an input from elsewhere, a URDF, has yet to come).
+``LiveParameters`` declares them, builds the
 first configuration (a failure stops startup), and from then on checks every change by
 building the whole new configuration before it is accepted: a refused change keeps the old
 configuration, an accepted one replaces it in a single assignment.
@@ -103,6 +105,8 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
 
     specs = [
         Spec("gravity", defaults.get("gravity", [0.0, 0.0, -9.81]), "gravity in the base frame", "m/s^2"),
+        Spec("friction.smoothing_velocity", defaults.get("friction.smoothing_velocity", 0.01),
+             "Coulomb friction is coulomb * tanh(qd / this)", "rad/s", minimum=1e-9),
         *_body_specs("payload", "the payload on the flange", "flange frame", lambda name, kind: defaults.get(name, kind)),
     ]
     for joint in joint_names:
@@ -114,6 +118,16 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
                  "[lower, upper] joint position", "rad"),
             Spec(f"{joint}.torque_limit", default(f"{joint}.torque_limit", 0.0),
                  "joint torque limit, 0 = none given", "N m", minimum=0.0),
+            Spec(f"{joint}.velocity_limit", default(f"{joint}.velocity_limit", 0.0),
+                 "joint speed limit, 0 = none given", "rad/s", minimum=0.0),
+            Spec(f"{joint}.acceleration_limit", default(f"{joint}.acceleration_limit", 0.0),
+                 "joint acceleration limit, 0 = none given", "rad/s^2", minimum=0.0),
+            Spec(f"{joint}.friction.viscous", default(f"{joint}.friction.viscous", 0.0),
+                 "viscous friction coefficient", "N m s/rad", minimum=0.0),
+            Spec(f"{joint}.friction.coulomb", default(f"{joint}.friction.coulomb", 0.0),
+                 "Coulomb friction level (smoothed, see friction.smoothing_velocity)", "N m", minimum=0.0),
+            Spec(f"{joint}.armature", default(f"{joint}.armature", 0.0),
+                 "rotor inertia reflected through the gear, added to M's diagonal", "kg m^2", minimum=0.0),
         ]
     return specs
 
@@ -131,8 +145,11 @@ def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
     ]
 
 
-def declare_model(node: Node, extra: list[Spec], build: Callable[[dict], Any]) -> "LiveParameters":
-    """Declare the robot model's parameters and a node's own, with the default model's defaults."""
+def declare_model(
+    node: Node, extra: list[Spec], build: Callable[[dict], Any], per_joint: Callable[[list[str]], list[Spec]] = None
+) -> "LiveParameters":
+    """Declare the robot model's parameters and a node's own (``extra``, and ``per_joint``
+    specs made for the model's joint names), with the default model's defaults."""
     path = default_config_path()
     if not path.is_file():
         raise ValueError(f"default model: no {path}; is the package installed? (or give --params-file)")
@@ -143,7 +160,8 @@ def declare_model(node: Node, extra: list[Spec], build: Callable[[dict], Any]) -
         Spec("joint_names", defaults["joint_names"], "the model's joints, base to flange", read_only=True),
     )
     names = check_joint_names(names)  # they become parameter prefixes: check them first
-    return LiveParameters(node, [*model_specs(names, defaults), *extra], build, ["joint_names"])
+    own = per_joint(names) if per_joint else []
+    return LiveParameters(node, [*model_specs(names, defaults), *extra, *own], build, ["joint_names"])
 
 
 class LiveParameters:
@@ -170,6 +188,13 @@ class LiveParameters:
 
     def on_change(self, listener: Callable[[Any], None]) -> None:
         self._listeners.append(listener)
+
+    def declare(self, specs: list[Spec]) -> None:
+        """Declare more parameters (a new model's per-joint ones); those declared already stay."""
+        for spec in specs:
+            if not self._node.has_parameter(spec.name):
+                _declare(self._node, spec)
+                self._names.append(spec.name)
 
     def _coerce_integers(self, parameters: list[Parameter]) -> list[Parameter]:
         """Let `ros2 param set ... payload.mass 3` mean 3.0 for a double parameter."""
@@ -203,9 +228,15 @@ class LiveParameters:
         pending, self._pending = self._pending, None
         if pending is None or pending[0] != self.values():  # not the change just checked
             return
-        self.current = pending[1]
-        for listener in self._listeners:
-            listener(self.current)
+        self.replace(pending[1])
+
+    def replace(self, configuration) -> None:
+        """Swap in a configuration built from the current values (and an input from outside
+        the parameters, such as a new robot_description). None: nothing to run on yet."""
+        self.current = configuration
+        if configuration is not None:
+            for listener in self._listeners:
+                listener(configuration)
 
 
 def _declare(node: Node, spec: Spec):

@@ -1,0 +1,180 @@
+"""The parameter regressor: torques linear in the dynamic parameters, tau = Y(q, qd, qdd) pi.
+
+pi holds 13 numbers per joint, in two blocks:
+
+    pi[10 i : 10 i + 10]       link i's inertial parameters, in Pinocchio's order and frame:
+                               [m, m c_x, m c_y, m c_z, Ixx, Ixy, Iyy, Ixz, Iyz, Izz], the
+                               first moment and the inertia about the origin of joint i's
+                               frame, in that frame (for URDF joints the link frame; for DH
+                               rows frame i-1 turned by theta_i: where Pinocchio puts joint i)
+    pi[10 n + 3 i : + 3]       joint i's [viscous, coulomb, armature]
+
+so Y[:, :10 n] is ``pinocchio.computeJointTorqueRegressor``. The friction columns are qd_i
+and tanh(qd_i / v_s) (the smoothed Coulomb shape, see ``friction``), the armature's qdd_i.
+The rigid-body part is generated code (see ``codegen``), like the other kernels.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .algorithms import (
+    Link,
+    add,
+    cross,
+    dot,
+    forward_motion,
+    inertia_times,
+    rotate,
+    scale,
+    turns,
+)
+from .dynamics import _columns, _evaluate, _state
+from .joints import Friction
+from .model import RobotModel
+from .rigid_body import ModelError, RigidBody, inertia_matrix
+
+LINK_PARAMETERS = ("m", "mcx", "mcy", "mcz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
+JOINT_PARAMETERS = ("viscous", "coulomb", "armature")
+# Pinocchio's inertia order as entries (xx, yy, zz, xy, xz, yz) of our inertia 6-tuples
+_UNIT_INERTIAS = tuple(
+    tuple(1.0 if k == position else 0.0 for k in range(6)) for position in (0, 3, 1, 4, 5, 2)
+)
+_UNIT_VECTORS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+def rigid_body_regressor(links, cs, qd, qdd, gravity):
+    """The n x 10n rigid-body regressor (rows of columns), written on scalars like ``rnea``."""
+    rots = turns(links, cs)
+    motion = forward_motion(links, rots, qd, qdd, gravity)
+    n = len(links)
+    Y = [[0.0] * (10 * n) for _ in range(n)]
+    for k in range(n):
+        w, dw, a = _in_joint_frame(links[k], *motion[k])
+        for column, (f, moment) in enumerate(_unit_wrenches(w, dw, a)):
+            for i in reversed(range(k + 1)):
+                if i < k:
+                    f, moment = _to_parent_joint_frame(links[i + 1], rots[i + 1], links[i], f, moment)
+                Y[i][10 * k + column] = dot(links[i].u, moment)
+    return Y
+
+
+def _in_joint_frame(link: Link, w, dw, a):
+    """Link motion moved from o_i in frame i to the joint origin o'_i in the joint frame."""
+    a = add(a, scale(-1.0, add(cross(dw, link.p), cross(w, cross(w, link.p)))))
+    if link.R1 is None:
+        return w, dw, a
+    return rotate(link.R1, w), rotate(link.R1, dw), rotate(link.R1, a)
+
+
+def _unit_wrenches(w, dw, a):
+    """The wrench (about the joint origin) that each unit inertial parameter needs."""
+    yield a, (0.0, 0.0, 0.0)  # m
+    for e in _UNIT_VECTORS:  # m c
+        yield add(cross(dw, e), cross(w, cross(w, e))), cross(e, a)
+    for E in _UNIT_INERTIAS:
+        yield (0.0, 0.0, 0.0), add(inertia_times(E, dw), cross(w, inertia_times(E, w)))
+
+
+def _to_parent_joint_frame(child: Link, rot, parent: Link, f, n):
+    """A wrench about o'_child in its joint frame, as one about o'_parent in the parent's."""
+    f, n = rotate(rot, f), rotate(rot, n)
+    if child.R0 is not None:
+        f, n = rotate(child.R0, f), rotate(child.R0, n)
+    if child.p0 is not None:
+        n = add(n, cross(child.p0, f))
+    n = add(n, cross(parent.p, f))  # about o'_parent, parent link frame
+    if parent.R1 is not None:
+        f, n = rotate(parent.R1, f), rotate(parent.R1, n)
+    return f, n
+
+
+# -- public functions ---------------------------------------------------------------------
+
+
+def regressor(model: RobotModel, q, qd, qdd) -> np.ndarray:
+    """Y(q, qd, qdd), n x 13n: rnea(model, q, qd, qdd) == Y @ inertial_parameters(model)."""
+    n = model.n
+    q, qd, qdd = _state(q, n, "q"), _state(qd, n, "qd"), _state(qdd, n, "qdd")
+    Y = np.zeros((n, 13 * n))
+    Y[:, : 10 * n] = np.reshape(model.kernels.regressor.scalar(q, qd, qdd), (n, 10 * n))
+    _joint_columns(model, Y, np.array(qd)[None], np.array(qdd)[None])
+    return Y
+
+
+def regressor_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
+    """regressor for N states: (N, n) arrays -> Y shaped (N, n, 13n)."""
+    n = model.n
+    columns = _columns(n, Q=Q, QD=QD, QDD=QDD)
+    N = columns[0].shape[1]
+    Y = np.zeros((N, n, 13 * n))
+    Y[:, :, : 10 * n] = _evaluate(model.kernels.regressor.array, *columns).reshape(N, n, 10 * n)
+    _joint_columns(model, Y, columns[1].T, columns[2].T)
+    return Y
+
+
+def _joint_columns(model: RobotModel, Y: np.ndarray, QD: np.ndarray, QDD: np.ndarray) -> None:
+    """Fill the friction and armature columns of Y (..., n, 13n) for velocities QD (N, n)."""
+    n = model.n
+    rows = np.arange(n)
+    Y[..., rows, 10 * n + 3 * rows] = QD
+    Y[..., rows, 10 * n + 3 * rows + 1] = np.tanh(QD / model.smoothing_velocity)
+    Y[..., rows, 10 * n + 3 * rows + 2] = QDD
+
+
+def parameter_names(model: RobotModel) -> list[str]:
+    """The names of pi's entries, e.g. 'joint_2.mcx', 'joint_2.viscous'."""
+    names = [f"{j.name}.{p}" for j in model.joints for p in LINK_PARAMETERS]
+    return names + [f"{j.name}.{p}" for j in model.joints for p in JOINT_PARAMETERS]
+
+
+def inertial_parameters(model: RobotModel) -> np.ndarray:
+    """pi of the model (13n,), the payload merged into the last link."""
+    links = [body_parameters(body, joint.post) for joint, body in zip(model.joints, model.bodies)]
+    joints = [(j.friction.viscous, j.friction.coulomb, j.armature) for j in model.joints]
+    return np.concatenate([np.ravel(links), np.ravel(joints)])
+
+
+def with_inertial_parameters(model: RobotModel, pi) -> RobotModel:
+    """The model with the links, friction and armature of pi (and no payload: pi's last
+    link carries it). ModelError naming the joint if pi is not physically consistent."""
+    from dataclasses import replace
+
+    n = model.n
+    pi = np.asarray(pi, dtype=float)
+    if pi.shape != (13 * n,):
+        raise ValueError(f"pi: expected {13 * n} parameters, got shape {pi.shape}")
+    joints = []
+    for i, joint in enumerate(model.joints):
+        link = parameters_body(f"{joint.name}.link", pi[10 * i : 10 * i + 10], joint.post)
+        viscous, coulomb, armature = pi[10 * n + 3 * i : 10 * n + 3 * i + 3]
+        joints.append(replace(joint, link=link, friction=Friction(viscous, coulomb), armature=armature))
+    return replace(model, joints=tuple(joints), payload=RigidBody())
+
+
+def body_parameters(body: RigidBody, post) -> np.ndarray:
+    """A body given in the link frame as its 10 parameters in the joint frame (see above)."""
+    R = post.rotation()
+    c = R @ np.array(body.com) + np.array(post.xyz)
+    I = R @ inertia_matrix(body.inertia) @ R.T + body.mass * (c @ c * np.eye(3) - np.outer(c, c))
+    m = body.mass
+    return np.array([m, *(m * c), I[0, 0], I[0, 1], I[1, 1], I[0, 2], I[1, 2], I[2, 2]])
+
+
+def parameters_body(field: str, pi10, post) -> RigidBody:
+    """The body (link frame) of 10 parameters in the joint frame; ModelError if impossible."""
+    m, hx, hy, hz, xx, xy, yy, xz, yz, zz = (float(x) for x in pi10)
+    I = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    h = np.array([hx, hy, hz])
+    if m <= 0.0:
+        if m < 0.0 or np.any(h != 0.0):
+            raise ModelError(f"{field}.mass", f"not physically consistent: m = {m}, m c = {h.tolist()}")
+        c = np.zeros(3)
+    else:
+        c = h / m
+    I_c = I - m * (c @ c * np.eye(3) - np.outer(c, c))
+    R = post.rotation()
+    com = R.T @ (c - np.array(post.xyz))
+    I_link = R.T @ I_c @ R
+    inertia = (I_link[0, 0], I_link[1, 1], I_link[2, 2], I_link[0, 1], I_link[0, 2], I_link[1, 2])
+    return RigidBody.validated(field, m, tuple(com.tolist()), inertia)

@@ -1,0 +1,115 @@
+"""id_node's external-torque estimate and collision flag: the ROS side of core.observer.
+
+Publishes    external_torques   sensor_msgs/JointState, effort = the observer's residual r
+                                [N m], model joint order, stamped like the input
+             collision          std_msgs/Bool, reliable, transient local: true while any
+                                |r_j| exceeds joint j's collision_threshold (0 = off)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Bool
+
+from ..core.observer import MomentumObserver
+from .messages import joint_efforts
+from .params import Spec
+
+MAX_GAIN = 1e4  # 1/s: beyond any sampling rate a joint state stream has
+OBSERVER_GAP = 0.1  # s: a longer gap between stamps restarts the observer
+
+COLLISION_PARAMETERS = [
+    Spec("collision.observer_gain", 100.0,
+         "gain K of the momentum observer: external torques are seen through a lag of time constant 1/K",
+         "1/s", minimum=1e-3, maximum=MAX_GAIN),
+]
+
+
+def collision_threshold_specs(joint_names) -> list[Spec]:
+    return [
+        Spec(f"{name}.collision_threshold", 0.0,
+             "a collision is flagged while |external torque| exceeds this; 0 = off", "N m", minimum=0.0)
+        for name in joint_names
+    ]
+
+
+@dataclass(frozen=True)
+class CollisionSettings:
+    gain: float  # 1/s
+    thresholds: np.ndarray  # N m, 0 = off
+
+
+def build_collision_settings(values: dict, joint_names) -> CollisionSettings:
+    gain = values["collision.observer_gain"]
+    if not 0.0 < gain <= MAX_GAIN:
+        raise ValueError(f"collision.observer_gain: must be in (0, {MAX_GAIN:g}] 1/s, got {gain}")
+    thresholds = np.array([values[f"{name}.collision_threshold"] for name in joint_names], dtype=float)
+    for name, threshold in zip(joint_names, thresholds):
+        if not 0.0 <= threshold < np.inf:
+            raise ValueError(f"{name}.collision_threshold: must be >= 0 and finite, got {threshold}")
+    return CollisionSettings(gain, thresholds)
+
+
+class CollisionMonitor:
+    """Runs the observer on joint states that carry efforts; publishes r and the flag."""
+
+    def __init__(self, node: Node, joint_names, depth: int):
+        self._names = list(joint_names)
+        self._external_msg = JointState(name=self._names)
+        self._external_pub = node.create_publisher(JointState, "external_torques", depth)
+        latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self._collision_pub = node.create_publisher(Bool, "collision", latched)
+        self.colliding: list[str] = []  # names of the joints over their thresholds
+        self._residual = None
+        self._publish_flag(False)
+
+    def use(self, model, settings: CollisionSettings) -> None:
+        """A new model or new gains: the observer starts again (named as the model's joints)."""
+        if list(model.joint_names) != self._names:
+            self._names = list(model.joint_names)
+            self._external_msg = JointState(name=self._names)
+            self._residual = None
+        self._observer = MomentumObserver(model, settings.gain, OBSERVER_GAP)
+        self._thresholds = settings.thresholds
+
+    def reset(self) -> None:
+        self._observer.reset()
+
+    def update(self, t: float, q, qd, effort, g, stamp) -> None:
+        """One joint state with efforts: publish the residual, and the flag when it changes.
+        ValueError (observer reset) if the residual is not finite."""
+        r = self._observer.update(t, q, qd, effort, g)
+        self._residual = r
+        self._external_pub.publish(joint_efforts(self._external_msg, stamp, r))
+        over = (self._thresholds > 0.0) & (np.abs(r) > self._thresholds)
+        colliding = [name for name, hit in zip(self._names, over) if hit]
+        if bool(colliding) != bool(self.colliding):
+            self._publish_flag(bool(colliding))
+        self.colliding = colliding
+
+    def _publish_flag(self, value: bool) -> None:
+        self._collision_pub.publish(Bool(data=value))
+
+    def status(self, node_name: str, hardware_id: str) -> DiagnosticStatus:
+        """ERROR naming the joints and torques while colliding; OK otherwise."""
+        status = DiagnosticStatus(name=f"{node_name}: collision", hardware_id=hardware_id)
+        r = self._residual
+        if r is None:
+            status.level, status.message = DiagnosticStatus.OK, "no efforts received: observer idle"
+            return status
+        torques = {name: r[self._names.index(name)] for name in self.colliding}
+        if torques:
+            status.level = DiagnosticStatus.ERROR
+            status.message = "collision: " + ", ".join(f"{name} {tau:.2f} N m" for name, tau in torques.items())
+        else:
+            status.level, status.message = DiagnosticStatus.OK, "no collision"
+        status.values = [
+            KeyValue(key=f"{name} external torque [N m]", value=f"{value:.3f}") for name, value in zip(self._names, r)
+        ]
+        return status

@@ -1,0 +1,102 @@
+"""payload_check_node's payload estimation: the ROS side of core.payload_estimation.
+
+Serves       ~/estimate_payload   std_srvs/Trigger: mass and CoM from the rest poses seen so far
+             ~/clear_samples      std_srvs/Trigger: forget them
+"""
+
+from __future__ import annotations
+
+from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from std_srvs.srv import Trigger
+
+from ..core.payload_estimation import EstimationError, PayloadEstimate, RestDetector, estimate_payload
+from .params import Spec
+
+ESTIMATION_PARAMETERS = [
+    Spec("estimation.rest_velocity", 0.02, "a joint state is at rest when every joint is slower than this",
+         "rad/s", minimum=1e-6),
+    Spec("estimation.rest_time", 0.5, "a rest this long becomes a sample (one per distinct pose)", "s",
+         minimum=0.0),
+    Spec("estimation.apply", False, "on a successful ~/estimate_payload, set payload.mass and payload.com"),
+]
+
+
+def check_estimation(values: dict) -> None:
+    for name in ("estimation.rest_velocity", "estimation.rest_time"):
+        if not 0.0 <= values[name] < float("inf"):
+            raise ValueError(f"{name}: must be >= 0 and finite, got {values[name]}")
+    if not values["estimation.rest_velocity"] > 0.0:
+        raise ValueError(f"estimation.rest_velocity: must be > 0, got {values['estimation.rest_velocity']}")
+
+
+class PayloadEstimator:
+    """Collects rest samples from joint states and answers ~/estimate_payload."""
+
+    def __init__(self, node: Node, model_of):
+        """``model_of()``: the model in force (the arm the efforts are set against)."""
+        self._node, self._model_of = node, model_of
+        self.detector = RestDetector(
+            node.get_parameter("estimation.rest_velocity").value, node.get_parameter("estimation.rest_time").value
+        )
+        self.last: PayloadEstimate | None = None
+        self._efforts_missing = False
+        node.create_service(Trigger, "~/estimate_payload", self._on_estimate)
+        node.create_service(Trigger, "~/clear_samples", self._on_clear)
+
+    def use(self, rest_velocity: float, rest_time: float) -> None:
+        self.detector.rest_velocity, self.detector.rest_time = rest_velocity, rest_time
+
+    def update(self, t: float, q, qd, effort) -> None:
+        """One joint state (effort None when the message has none)."""
+        self._efforts_missing = effort is None
+        self.detector.update(t, q, qd, effort)
+
+    def _on_estimate(self, request, response):
+        self.detector.flush()
+        try:
+            if self._efforts_missing and not self.detector.samples:
+                raise EstimationError(
+                    "joint_states carry no effort: the estimate needs the driver's measured joint torques"
+                )
+            self.last = estimate_payload(self._model_of(), self.detector.samples)
+        except EstimationError as error:
+            response.success, response.message = False, f"cannot estimate: {error}"
+            return response
+        response.success, response.message = True, self.last.summary()
+        if self._node.get_parameter("estimation.apply").value:
+            response.success, note = self._apply(self.last)
+            response.message += f"\n{note}"
+        return response
+
+    def _apply(self, estimate: PayloadEstimate) -> tuple[bool, str]:
+        """Set payload.mass and payload.com through the validated parameter path."""
+        result = self._node.set_parameters_atomically([
+            Parameter("payload.mass", Parameter.Type.DOUBLE, float(estimate.mass)),
+            Parameter("payload.com", Parameter.Type.DOUBLE_ARRAY, [float(x) for x in estimate.com]),
+        ])
+        if result.successful:
+            return True, "applied: payload.mass and payload.com set"
+        return False, f"not applied: {result.reason}"
+
+    def _on_clear(self, request, response):
+        count = len(self.detector.samples)
+        self.detector.clear()
+        response.success, response.message = True, f"forgot {count} rest samples"
+        return response
+
+    def status(self, node_name: str) -> DiagnosticStatus:
+        samples = len(self.detector.samples)
+        values = [KeyValue(key="rest samples", value=str(samples))]
+        message = f"{samples} rest samples"
+        if self.last is not None:
+            message += f"; last estimate: {self.last.summary()}"
+            values += [
+                KeyValue(key="estimated mass [kg]", value=f"{self.last.mass:.3f}"),
+                KeyValue(key="estimated CoM [m]", value=", ".join(f"{x:.4f}" for x in self.last.com)),
+            ]
+        return DiagnosticStatus(
+            level=DiagnosticStatus.OK, name=f"{node_name}: payload estimation", hardware_id=node_name,
+            message=message, values=values,
+        )

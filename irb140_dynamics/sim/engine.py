@@ -1,0 +1,128 @@
+"""The true arm: a RobotModel simulated by MuJoCo, stepped at a fixed period under held torques.
+
+The physics is MuJoCo's (see ``mjcf``): the model's inertials, armature, viscous friction
+(damping), Coulomb friction (MuJoCo's dry friction, frictionloss) and position limits
+(soft stops). A step holds the applied torques for one period, integrated in ``substeps``
+MuJoCo steps. Torques beyond a joint's torque_limit (when it has one, > 0) are clipped to
+it: the drives saturate, and ``applied`` says what was applied.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import mujoco
+import numpy as np
+
+from ..core.model import RobotModel
+from .mjcf import mujoco_model
+
+
+# 4th order: at 1 kHz a 0.5 s free fall of the IRB-140 through 2.7 rad stays within 1e-8 rad of
+# the exact motion, where implicitfast (first order) is 2e-2 rad off; a step costs ~20 us.
+DEFAULT_INTEGRATOR = "RK4"
+
+
+class SimulationError(RuntimeError):
+    """The simulation blew up (non-finite or absurd state); the arm has been reset."""
+
+
+class SimulatedArm:
+    """One arm in MuJoCo: reset, apply torques, step, read q, qd and the applied torques."""
+
+    def __init__(self, model: RobotModel, period: float = 0.001, substeps: int = 1,
+                 integrator: str = DEFAULT_INTEGRATOR):
+        if not (math.isfinite(period) and period > 0.0):
+            raise ValueError(f"period: must be > 0, got {period}")
+        if int(substeps) != substeps or substeps < 1:
+            raise ValueError(f"substeps: must be an integer >= 1, got {substeps}")
+        if mujoco.get_mju_user_warning() is None:  # else MuJoCo prints and writes MUJOCO_LOG.TXT
+            mujoco.set_mju_user_warning(_log_warning)
+        self.model, self.period, self.substeps = model, period, int(substeps)
+        self.mj_model = mujoco_model(model, timestep=period / self.substeps, integrator=integrator)
+        self.mj_model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET  # we reset, and say so
+        self.data = mujoco.MjData(self.mj_model)
+        limits = np.array(model.torque_limits, dtype=float)
+        self.torque_limits = np.where(limits > 0.0, limits, np.inf)
+        self.applied = np.zeros(model.n)
+        self._reset_state = (np.zeros(model.n), np.zeros(model.n))
+        self.reset(np.zeros(model.n))
+
+    @property
+    def n(self) -> int:
+        return self.model.n
+
+    @property
+    def q(self) -> np.ndarray:
+        """Joint positions [rad] (a copy)."""
+        return self.data.qpos.copy()
+
+    @property
+    def qd(self) -> np.ndarray:
+        """Joint velocities [rad/s] (a copy)."""
+        return self.data.qvel.copy()
+
+    @property
+    def time(self) -> float:
+        """Simulated time since the last reset [s]."""
+        return float(self.data.time)
+
+    def reset(self, q, qd=None) -> None:
+        """Put the arm at q (and qd, default at rest), time 0, no torque applied."""
+        q = self._checked("q", q)
+        qd = np.zeros(self.n) if qd is None else self._checked("qd", qd)
+        mujoco.mj_resetData(self.mj_model, self.data)
+        self._set(q, qd, 0.0)
+        self._reset_state = (q, qd)
+
+    def take_state_of(self, other: "SimulatedArm") -> None:
+        """Continue from another arm's state (a model change while running)."""
+        self._set(other.data.qpos, other.data.qvel, other.data.time)
+        self.applied = other.applied.copy()
+        self._reset_state = other._reset_state
+
+    def step(self, tau) -> None:
+        """Apply tau [N m] (clipped to the torque limits) for one period.
+
+        Raises SimulationError, with the arm reset to where it was last reset, if the state
+        stops being finite (torques far beyond anything the arm can take).
+        """
+        self.applied = np.clip(self._checked("tau", tau), -self.torque_limits, self.torque_limits)
+        data = self.data
+        data.qfrc_applied[:] = self.applied
+        for _ in range(self.substeps):
+            mujoco.mj_step(self.mj_model, data)
+        if not (np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()) or self._diverged():
+            self.reset(*self._reset_state)
+            raise SimulationError("the simulation diverged (non-finite state); the arm was reset")
+
+    def _diverged(self) -> bool:
+        return data_warning(self.data, mujoco.mjtWarning.mjWARN_BADQACC) > 0
+
+    def _set(self, q, qd, time: float) -> None:
+        self.data.qpos[:] = q
+        self.data.qvel[:] = qd
+        self.data.time = time
+        self.data.qfrc_applied[:] = 0.0
+        self.applied = np.zeros(self.n)
+        for warning in self.data.warning:
+            warning.number = 0
+        mujoco.mj_forward(self.mj_model, self.data)
+
+    def _checked(self, name: str, values) -> np.ndarray:
+        x = np.asarray(values, dtype=float)
+        if x.shape != (self.n,):
+            raise ValueError(f"{name}: expected {self.n} values, got shape {x.shape}")
+        if not np.isfinite(x).all():
+            raise ValueError(f"{name}: must be finite, got {x.tolist()}")
+        return x.copy()
+
+
+def _log_warning(message: str) -> None:
+    logging.getLogger(__name__).warning("MuJoCo: %s", message)
+
+
+def data_warning(data: mujoco.MjData, kind) -> int:
+    """How many times MuJoCo raised a warning of ``kind`` since the counters were cleared."""
+    return int(data.warning[int(kind)].number)

@@ -1,0 +1,85 @@
+"""export_urdf: print the current model as URDF (the IRB-140's with the report's shapes).
+
+    ros2 run irb140_dynamics export_urdf [--ros-args --params-file FILE -p NAME:=VALUE ...] > arm.urdf
+
+The model is read as the nodes read it (the default config/irb140.yaml, then the params
+file, then -p; ``model.source:=robot_description`` with ``robot_description`` or
+``model.urdf_file`` works too, the topic does not), in a node named ``export_urdf`` that
+is never spun: parameters under ``/**`` in a params file apply, those under a node's name
+do not. The URDF goes to stdout; a bad parameter is one line on stderr and exit code 1.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import rclpy
+from rclpy.context import Context
+from rclpy.impl.implementation_singleton import rclpy_implementation
+from rclpy.logging import LoggingSeverity
+from rclpy.node import Node
+from rclpy.utilities import remove_ros_args
+
+from ..core import RobotModel, irb140
+from ..core.geometry import IRB140_SHAPES
+from ..core.urdf import export_urdf
+from ..ros.model_source import declare_model_source
+from ..ros.spin import init_error
+
+NAME = "export_urdf"
+
+
+def urdf_of(model: RobotModel) -> str:
+    """The model's URDF; with the IRB-140's joints, named irb140 and drawn with its shapes."""
+    if model.joint_names == irb140().joint_names:
+        return export_urdf(model, "irb140", IRB140_SHAPES)
+    return export_urdf(model, "robot")
+
+
+def current_model(args: list[str]) -> RobotModel:
+    """The model the nodes would run on with these (ROS) arguments, or ValueError."""
+    context = Context()
+    try:
+        rclpy.init(args=args, context=context)
+    except rclpy_implementation.RCLError as error:
+        raise ValueError(init_error(error)) from None
+    node = None
+    try:
+        node = Node(NAME, context=context, start_parameter_services=False, enable_rosout=False)
+        node.get_logger().set_level(LoggingSeverity.WARN)  # stderr for errors only
+        model = declare_model_source(node, [], RobotModel.from_params).current
+        if model is None:
+            raise ValueError("robot_description: export_urdf does not read the topic; give the robot_description "
+                             "parameter or model.urdf_file")
+        return model
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown(context=context)
+
+
+def main(args: list[str] | None = None) -> int:
+    args = sys.argv if args is None else args
+    try:
+        extra = remove_ros_args(args)[1:]
+        if extra:
+            help_asked = extra[0] in ("-h", "--help")
+            print(__doc__ if help_asked else f"{NAME}: unknown arguments {extra}; see --help",
+                  file=sys.stdout if help_asked else sys.stderr)
+            return 0 if help_asked else 2
+        text = urdf_of(current_model(args))
+    except rclpy_implementation.RCLError as error:
+        return _fail(init_error(error))
+    except ValueError as error:
+        return _fail(str(error))
+    sys.stdout.write(text)
+    return 0
+
+
+def _fail(reason: str) -> int:
+    print(f"{NAME}: {reason.replace(chr(10), ' ')}", file=sys.stderr)
+    return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
