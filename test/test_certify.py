@@ -127,7 +127,7 @@ def test_quadratic_max_bounds_the_maximum_and_is_exact_for_a_concave_top_inside(
 
 
 @pytest.mark.parametrize("seed", [11, 12, 13])
-def test_the_bounds_are_above_a_dense_brute_force_on_random_models(seed):
+def test_the_bounds_are_above_a_dense_brute_force_on_random_models(seed, quick_proofs):
     """Random arms, gravity in any direction, random narrowed ranges and payload: every
     bound is at least the largest torque of 200,000 random poses, every value found is a
     real torque at its pose, and found + gap reaches the brute force's maximum."""

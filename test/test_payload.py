@@ -181,14 +181,14 @@ def test_max_payload_puts_a_joint_at_its_limit(model, limits, payload, q, qd):
 
 
 @pytest.mark.parametrize("payload", OFFSET_PAYLOADS)
-def test_workspace_max_payload_holds_everywhere(model, limits, payload, dense_poses):
+def test_workspace_max_payload_holds_everywhere(model, limits, payload, dense_poses, quick_proofs):
     """The mass is proven to hold in every pose; mass + gap puts a joint at its limit in a
     real pose (the gap: what the proof's budget left open; these off-axis payloads leave
-    curves of worst wrist poses, which the budget does not quite close)."""
+    curves of worst wrist poses, which a small budget leaves open a little)."""
     load = workspace_load(model, payload, limits)
     best = load.max_payload
     L = np.array(limits.values)
-    assert 0.0 <= best.gap <= 1e-5 * best.mass
+    assert 0.0 <= best.gap <= 1e-3 * best.mass
     at_limit = gravity(loaded(model, payload, best.mass + best.gap), best.q)
     assert abs(at_limit[best.joint]) == pytest.approx(L[best.joint], rel=1e-9)
     g = gravity_batch(loaded(model, payload, best.mass), dense_poses)
@@ -198,7 +198,7 @@ def test_workspace_max_payload_holds_everywhere(model, limits, payload, dense_po
     np.testing.assert_allclose(np.diag(at_worst), load.torque, rtol=1e-12, atol=1e-9)
     g = np.abs(gravity_batch(model.with_payload(payload), dense_poses))
     assert np.all(g <= load.bound + 1e-12 * load.bound.max())  # (float rounding of the kernels)
-    assert np.all(load.gap >= 0) and np.all(load.gap <= 1e-5 * np.maximum(np.abs(load.torque), 1.0))
+    assert np.all(load.gap >= 0) and np.all(load.gap <= 1e-2 * np.maximum(np.abs(load.torque), 1.0))
 
 
 def test_no_payload_fits_when_the_arm_alone_is_over(model):
@@ -211,7 +211,7 @@ def test_no_payload_fits_when_the_arm_alone_is_over(model):
     assert "none (joint_2 over its limit)" in check.report()
 
 
-def test_unbounded_when_no_limit_is_loaded(model):
+def test_unbounded_when_no_limit_is_loaded(model, quick_proofs):
     only_joint_1 = [50.0] + [math.inf] * 5  # a payload on the flange cannot turn joint 1 statically
     assert max_payload_at(model, RigidBody(3.0, (0.1, 0, 0)), only_joint_1, STRETCHED).mass == math.inf
     assert workspace_load(model, RigidBody(3.0, (0.1, 0, 0)), only_joint_1).max_payload.mass == math.inf
@@ -246,7 +246,7 @@ def test_workspace_part_alone_and_reused(model, limits):
     assert "-" in no_state.report().splitlines()[3].split()[1]
 
 
-def test_report_rows_are_the_figures(model, limits):
+def test_report_rows_are_the_figures(model, limits, quick_proofs):
     """One source: each report row is its joint's figures, the summary the payload's."""
     check = check_payload(model, RigidBody(2.0, (0.0, 0.05, 0.1)), limits, q=STATES[1][0], qd=STATES[1][1])
     lines = check.report().splitlines()
