@@ -166,11 +166,11 @@ class IdNode(Node):
         model = settings.model
         estimate = self._estimated_acceleration(msg, qd, settings)
         q_ff, qd_ff, qdd_ref = self._fresh_reference(settings) or (q, qd, None)
-        tau = rnea(model, q_ff, qd_ff, estimate if qdd_ref is None else qdd_ref)
-        g = gravity(model, q)
-        if not all(map(math.isfinite, tau)) or not all(map(math.isfinite, g)):
-            count_and_warn(self.get_logger(), self.counts, "joint_states",
-                           BadMessage("non_finite_torques", f"the model gives {tau.tolist()}, {g.tolist()}"))
+        try:  # the core refuses a result that would not be finite
+            tau = rnea(model, q_ff, qd_ff, estimate if qdd_ref is None else qdd_ref)
+            g = gravity(model, q)
+        except ValueError as error:
+            count_and_warn(self.get_logger(), self.counts, "joint_states", BadMessage("non_finite_torques", str(error)))
             return
 
         stamp = msg.header.stamp

@@ -26,7 +26,7 @@ from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
-from .core import RigidBody, RobotModel
+from .core import RigidBody, RobotModel, rnea
 from .core.payload_estimation import EstimationError
 from .core.payload import TorqueLimits, WorkspaceLoad, check_payload, derive_torque_limits, workspace_load
 from .ros.diagnostics import payload_statuses
@@ -134,6 +134,11 @@ class PayloadCheckNode(Node):
             return
         except BadMessage as error:
             count_and_warn(self.get_logger(), self.counts, "joint_states", error)
+            return
+        try:  # a state whose torques the core refuses as not finite could not be checked
+            rnea(self.settings.model, q, qd, [0.0] * len(q))
+        except ValueError as error:
+            count_and_warn(self.get_logger(), self.counts, "joint_states", BadMessage("non_finite_torques", str(error)))
             return
         now = self.get_clock().now()
         self._state = (q, qd, now)

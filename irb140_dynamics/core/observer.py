@@ -22,7 +22,8 @@ import numpy as np
 
 from .algorithms import add, cross, dot, inertia_times, scale, to_child, turns
 from .dual import dual_angles, partial
-from .dynamics import _state, gravity
+from .dynamics import gravity
+from .states import state
 from .model import RobotModel
 
 
@@ -68,7 +69,7 @@ class MomentumObserver:
         value is not finite.
         """
         n = self.model.n
-        q, qd, tau = _state(q, n, "q"), _state(qd, n, "qd"), np.asarray(_state(tau, n, "tau"))
+        q, qd, tau = state(q, n, "q"), state(qd, n, "qd"), np.asarray(state(tau, n, "tau"))
         p, beta = self._momentum_terms(q, qd, g)
         drive = tau + beta
         if self._t is None or not 0.0 < t - self._t <= self.max_gap:

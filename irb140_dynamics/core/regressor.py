@@ -29,7 +29,8 @@ from .algorithms import (
     scale,
     turns,
 )
-from .dynamics import _columns, _evaluate, _state
+from .dynamics import _evaluate
+from .states import state, states
 from .joints import Friction
 from .model import RobotModel
 from .rigid_body import ModelError, RigidBody, inertia_matrix
@@ -95,7 +96,7 @@ def _to_parent_joint_frame(child: Link, rot, parent: Link, f, n):
 def regressor(model: RobotModel, q, qd, qdd) -> np.ndarray:
     """Y(q, qd, qdd), n x 13n: rnea(model, q, qd, qdd) == Y @ inertial_parameters(model)."""
     n = model.n
-    q, qd, qdd = _state(q, n, "q"), _state(qd, n, "qd"), _state(qdd, n, "qdd")
+    q, qd, qdd = state(q, n, "q"), state(qd, n, "qd"), state(qdd, n, "qdd")
     Y = np.zeros((n, 13 * n))
     Y[:, : 10 * n] = np.reshape(model.kernels.regressor.scalar(q, qd, qdd), (n, 10 * n))
     _joint_columns(model, Y, np.array(qd)[None], np.array(qdd)[None])
@@ -105,7 +106,7 @@ def regressor(model: RobotModel, q, qd, qdd) -> np.ndarray:
 def regressor_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
     """regressor for N states: (N, n) arrays -> Y shaped (N, n, 13n)."""
     n = model.n
-    columns = _columns(n, Q=Q, QD=QD, QDD=QDD)
+    columns = states(n, Q=Q, QD=QD, QDD=QDD)
     N = columns[0].shape[1]
     Y = np.zeros((N, n, 13 * n))
     Y[:, :, : 10 * n] = _evaluate(model.kernels.regressor.array, *columns).reshape(N, n, 10 * n)
