@@ -303,3 +303,15 @@ def test_payload_family_takes_the_payload_as_validated(model, limits, monkeypatc
         payload_family(model, RigidBody(1.0, (math.nan, 0.0, 0.0)))
     with pytest.raises(ModelError, match="^payload.inertia: "):
         payload_family(model, RigidBody(1.0, (0.0, 0.0, 0.0), (1.0, 1.0, 3.0, 0.0, 0.0, 0.0)))
+
+
+def test_report_columns_stay_apart_at_any_use(model, limits):
+    """Uses of 1,000 % and more keep at least two spaces between the columns, aligned
+    (issue 8: "243.382        1.00024338.2%")."""
+    check = check_payload(model, RigidBody(600.0), limits, q=STRETCHED)
+    rows = check.report().splitlines()[1:8]
+    for j, line in enumerate(rows[1:]):
+        cells = [cell.strip() for cell in line.split("  ") if cell.strip()]
+        assert cells[1:6] == list(check.joint_figures(j).values())[:5] and len(cells) == 7, line
+    assert float(rows[2].split()[3].rstrip("%")) > 1000  # joint_2 now
+    assert len({len(line.split("  (")[0]) for line in rows[1:]}) == 1  # the pose column aligned
