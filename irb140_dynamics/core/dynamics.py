@@ -17,8 +17,8 @@ sanity caps keep them finite.
 
 from __future__ import annotations
 
-import math
 from functools import lru_cache
+from math import isfinite
 from typing import Sequence
 
 import numpy as np
@@ -39,16 +39,12 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
     """
     kernels = model.kernels
     args = (state(q, model.n, "q"), state(qd, model.n, "qd"), state(qdd, model.n, "qdd"))
-    if f_ext is None:
-        tau = kernels.rnea.scalar(*args)
-    else:
-        tau = kernels.rnea_wrench.scalar(*args, state(f_ext, 6, "f_ext"))
-    if not math.isfinite(sum(tau)):  # inline: rnea is the hot path
+    tau = kernels.rnea.scalar(*args) if f_ext is None else kernels.rnea_wrench.scalar(*args, state(f_ext, 6, "f_ext"))
+    if not isfinite(sum(tau)):  # inline: rnea is the hot path
         finite_result(tau, "rnea", q=q, qd=qd, qdd=qdd, **({} if f_ext is None else {"f_ext": f_ext}))
-    tau = np.array(tau)
-    if model.friction is not None:
-        tau += model.friction.torques(args[1])
-    return tau
+    if model.friction is None:
+        return np.array(tau)
+    return np.array(tau) + model.friction.torques(args[1])
 
 
 def gravity(model: RobotModel, q: ArrayLike) -> np.ndarray:

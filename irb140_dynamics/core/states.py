@@ -15,7 +15,7 @@ import reprlib
 
 import numpy as np
 
-_FLOAT64 = np.dtype(float)
+_ARRAY, _FLOAT64 = np.ndarray, np.dtype(float)
 _NUMBERS = frozenset({float, int})
 _REAL_KINDS = "fiu"  # float, signed and unsigned integer dtypes; not bool, complex, object, str
 _NOT_SEQUENCES = (str, bytes, dict, set, frozenset)
@@ -24,7 +24,7 @@ _NOT_SEQUENCES = (str, bytes, dict, set, frozenset)
 def state(x, n: int, name: str) -> list:
     """``x`` as the kernels want it, a list of n finite Python numbers, or ValueError."""
     kind = type(x)
-    if kind is np.ndarray and x.dtype is _FLOAT64 and x.shape == (n,):
+    if kind is _ARRAY and x.dtype is _FLOAT64 and x.shape == (n,):
         x = x.tolist()
     elif not ((kind is list or kind is tuple) and len(x) == n and _NUMBERS.issuperset(map(type, x))):
         x = real_numbers(x, n, name).tolist()
