@@ -18,9 +18,9 @@ def quick_proofs(monkeypatch):
     and reported, not of how far the proof gets. Proofs remembered are forgotten before and
     after, so that no other test sees one of these."""
     from irb140_dynamics.core import certify
-    from irb140_dynamics.core.payload_family import _family
+    from irb140_dynamics.core.payload_family import forget_families
 
     monkeypatch.setattr(certify, "EVALUATIONS", 10_000)
-    _family.cache_clear()
+    forget_families()
     yield
-    _family.cache_clear()
+    forget_families()

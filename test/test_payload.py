@@ -3,6 +3,7 @@ exact largest payloads, checked against the dynamics core and brute-force sampli
 
 import math
 import re
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -315,3 +316,17 @@ def test_report_columns_stay_apart_at_any_use(model, limits):
         assert cells[1:6] == list(check.joint_figures(j).values())[:5] and len(cells) == 7, line
     assert float(rows[2].split()[3].rstrip("%")) > 1000  # joint_2 now
     assert len({len(line.split("  (")[0]) for line in rows[1:]}) == 1  # the pose column aligned
+
+
+def test_the_payload_sits_on_the_model_s_flange(model, limits):
+    """A flange 0.1 m out along z: a payload at its origin loads the arm as one 0.1 m out
+    on the last link (the payload's models keep the flange)."""
+    from irb140_dynamics.core.joints import Placement
+
+    flanged = replace(model, flange=Placement(xyz=(0.0, 0.0, 0.1)))
+    here = max_payload_at(flanged, RigidBody(2.0), limits, STATES[1][0], STATES[1][1])
+    there = max_payload_at(model, RigidBody(2.0, (0.0, 0.0, 0.1)), limits, STATES[1][0], STATES[1][1])
+    assert here.mass == pytest.approx(there.mass, rel=1e-12) and here.joint == there.joint
+    load = workspace_load(flanged, RigidBody(2.0), limits)
+    np.testing.assert_allclose(load.torque, workspace_load(model, RigidBody(2.0, (0.0, 0.0, 0.1)), limits).torque,
+                               rtol=1e-9, atol=1e-9)

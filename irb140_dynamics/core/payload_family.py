@@ -18,8 +18,10 @@ interval bounds within the budget of ``certify.interval_maxima``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from functools import cached_property, lru_cache
+import threading
+from collections import OrderedDict
+from dataclasses import dataclass, fields, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -163,20 +165,39 @@ class PayloadFamily:
 
 
 def payload_family(model: RobotModel, payload: RigidBody) -> PayloadFamily:
-    """``payload``'s shape at any mass on ``model`` (whatever payload ``model`` carries).
+    """``payload``'s shape at any mass on ``model`` (whatever payload ``model`` carries; its
+    flange and everything else kept).
 
-    Built once per arm and shape: the two models validate the CoM and inertia (ModelError
-    naming ``payload.com`` or ``payload.inertia``) and compile their kernels then.
+    Built once per arm and shape (the last FAMILIES remembered): the two models validate
+    the CoM and inertia (ModelError naming ``payload.com`` or ``payload.inertia``) and
+    compile their kernels then.
     """
-    return _family(model.joints, model.gravity, tuple(payload.com), tuple(payload.inertia))
+    arm = tuple(getattr(model, f.name) for f in fields(model) if f.name != "payload")
+    key = (arm, tuple(payload.com), tuple(payload.inertia))
+    with _LOCK:
+        family = _FAMILIES.get(key)
+    if family is None:
+
+        def carrying(mass):
+            return replace(model, payload=RigidBody(mass, payload.com, payload.inertia))
+
+        family = PayloadFamily(carrying(0.0), carrying(1.0))
+        with _LOCK:
+            family = _FAMILIES.setdefault(key, family)
+            while len(_FAMILIES) > FAMILIES:
+                _FAMILIES.popitem(last=False)
+    return family
 
 
-@lru_cache(maxsize=16)
-def _family(joints, gravity, com, inertia) -> PayloadFamily:
-    def carrying(mass):
-        return RobotModel(joints, gravity, RigidBody(mass, com, inertia))
+def forget_families() -> None:
+    """Forget the families built (and so their proofs)."""
+    with _LOCK:
+        _FAMILIES.clear()
 
-    return PayloadFamily(carrying(0.0), carrying(1.0))
+
+FAMILIES = 16
+_FAMILIES: OrderedDict = OrderedDict()
+_LOCK = threading.Lock()
 
 
 def mass_bounds(tau0, dtau, limits) -> tuple[np.ndarray, np.ndarray]:
