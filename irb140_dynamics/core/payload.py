@@ -42,6 +42,7 @@ from .workspace import JointRanges
 
 RATED_PAYLOAD = RigidBody(6.0)  # the IRB-140's rated payload: 6 kg at the flange origin
 _PROOF_ROUNDS = 4  # Dinkelbach restarts from poses the proof finds worse than the search did
+MASS_PROOF_SHARE = 1 / 3  # of the proof's budget for the largest payload (a gap only lowers it a little)
 
 __all__ = ["RATED_PAYLOAD", "RTOL", "MaxPayload", "PayloadCheck", "TorqueLimits", "WorkspaceLoad",
            "check_payload", "derive_torque_limits", "loads", "max_payload_at", "payload_family", "workspace_load"]
@@ -75,7 +76,7 @@ class TorqueLimits:
     rated_payload: RigidBody
     rated_torque: np.ndarray  # (n,) N m, signed
     rated_pose: np.ndarray  # (n, n) rad
-    rated_bound: np.ndarray  # (n,) N m: |rated torque| <= this in every pose
+    rated_bound: np.ndarray  # (n,) N m: |rated torque| <= this in every pose (inf: not needed, a given limit)
 
     def reason(self, j: int) -> str:
         """Why joint j has its limit, in words."""
@@ -112,12 +113,14 @@ class WorkspaceLoad:
 def derive_torque_limits(model: RobotModel, rated_payload: RigidBody = RATED_PAYLOAD) -> TorqueLimits:
     """Each joint's limit: its given torque_limit if > 0, else the worst static torque of
     the rated payload over the joint ranges (the torque found, at a real pose); none (inf)
-    for a joint it cannot load (proven)."""
+    for a joint it cannot load (proven). The rated payload's torques are searched for every
+    joint, proven for those without a given limit."""
     rated_payload = checked_body("rated_payload", rated_payload)
     family = payload_family(model, rated_payload)
-    torque, pose, bound = family.extremes(rated_payload.mass, JointRanges.of(model)).largest()
-    loaded = loads(bound)
     given = np.array(model.torque_limits) > 0
+    rows = np.flatnonzero(~np.tile(given, 2))  # a given limit needs no proof
+    torque, pose, bound = family.extremes(rated_payload.mass, JointRanges.of(model), rows=rows).largest()
+    loaded = loads(np.where(given, 0.0, bound))
     source = np.where(given, "given", np.where(loaded, "derived", "none"))
     limits = np.where(given, model.torque_limits, np.where(loaded, np.abs(torque), np.inf))
     return TorqueLimits(tuple(limits.tolist()), tuple(source.tolist()), rated_payload, torque, pose, bound)
@@ -197,7 +200,7 @@ def _workspace_max_payload(family, ranges, L, G0, dG, own_mass: float, load: Ext
         if math.isnan(best.mass):
             return best  # a real pose the arm cannot hold even empty
         m = min(best.mass, MAX_MASS)  # beyond the sanity cap no mass is valid anyway
-        proven = family.extremes(m, ranges, G0 + m * dG, warm=poses, rows=limited)
+        proven = family.extremes(m, ranges, G0 + m * dG, warm=poses, rows=limited, share=MASS_PROOF_SHARE)
         candidate = _smallest_max_payload(family, proven.poses, L)
         if not _lighter(candidate, best) or round_ == _PROOF_ROUNDS - 1:
             break  # (in the last round the bounds, over the limits, make the mass proven lower)
@@ -225,7 +228,7 @@ def _proven_mass(family, ranges, L, G0, best: MaxPayload, at_best: Extremes, lim
         return best
     m0, a = known[0], known[1].bounds
     if not (m0 < m1 and np.all(a[limited] <= limit[limited])):
-        m0, a = 0.0, family.extremes(0.0, ranges, G0, rows=limited).bounds
+        m0, a = 0.0, family.extremes(0.0, ranges, G0, rows=limited, share=MASS_PROOF_SHARE).bounds
     over_a, over_b = a > limit, b > limit
     with np.errstate(divide="ignore", invalid="ignore"):
         highest = np.min(np.where(over_b, (limit - a) / (b - a), 1.0))

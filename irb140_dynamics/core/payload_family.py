@@ -26,6 +26,7 @@ from functools import cached_property
 import numpy as np
 
 from . import algorithms
+from . import certify
 from .certify import Objective, certify_maxima, interval_maxima
 from .dynamics import gravity_batch, rnea
 from .harmonic import StaticForms
@@ -90,16 +91,18 @@ class PayloadFamily:
         n = self.empty.n
         return ranges.maximize(self.static_torque(m), np.vstack([np.eye(n), -np.eye(n)]), sample_torques, warm)
 
-    def extremes(self, m: float, ranges: JointRanges, sample_torques=None, warm=None, rows=None) -> Extremes:
+    def extremes(self, m: float, ranges: JointRanges, sample_torques=None, warm=None, rows=None,
+                 share: float = 1.0) -> Extremes:
         """The worst static torques at m kg, searched and proven (remembered per m and
-        ranges): all 2n of them, or only ``rows`` proven (the others' bounds inf)."""
+        ranges): all 2n of them, or only ``rows`` proven (the others' bounds inf), within
+        ``share`` of the proof's budget."""
         rows = np.arange(2 * self.empty.n) if rows is None else np.asarray(rows, dtype=int)
         key = (float(m), ranges.lower.tobytes(), ranges.upper.tobytes(), rows.tobytes())
         if key not in self._proven:
             values, poses = self.search(m, ranges, sample_torques, warm)
             if len(self._proven) >= 8:
                 self._proven.pop(next(iter(self._proven)))
-            self._proven[key] = self._prove(m, ranges, values, poses, rows)
+            self._proven[key] = self._prove(m, ranges, values, poses, rows, share)
         return self._proven[key]
 
     @cached_property
@@ -112,7 +115,7 @@ class PayloadFamily:
         empty = StaticForms.of(self.empty)
         return None if empty is None else (empty, StaticForms.of(self.unit))
 
-    def _prove(self, m, ranges, values, poses, rows) -> Extremes:
+    def _prove(self, m, ranges, values, poses, rows, share) -> Extremes:
         n, torque = self.empty.n, self.static_torque(m)
         bounds = np.full(2 * n, np.inf)
         weights = np.vstack([np.eye(n), -np.eye(n)])
@@ -138,7 +141,7 @@ class PayloadFamily:
             return found, np.array([objectives[i].value.fold(t)[0] for i, t in zip(k, pose + offsets)])
 
         proof = certify_maxima(objectives, np.array([b[0] for b in boxes]), np.array([b[1] for b in boxes]),
-                               values[rows], tol[rows], polish)
+                               values[rows], tol[rows], polish, int(share * certify.EVALUATIONS))
         bounds[rows] = proof.bound
         values, poses = values.copy(), poses.copy()
         better = np.flatnonzero(proof.value > values[rows])
