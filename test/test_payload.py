@@ -199,7 +199,7 @@ def test_workspace_max_payload_holds_everywhere(model, limits, payload, dense_po
     np.testing.assert_allclose(np.diag(at_worst), load.torque, rtol=1e-12, atol=1e-9)
     g = np.abs(gravity_batch(model.with_payload(payload), dense_poses))
     assert np.all(g <= load.bound + 1e-12 * load.bound.max())  # (float rounding of the kernels)
-    assert np.all(load.gap >= 0) and np.all(load.gap <= 1e-2 * np.maximum(np.abs(load.torque), 1.0))
+    assert np.all(load.gap >= 0) and np.all(load.gap <= 5e-2 * np.maximum(np.abs(load.torque), 1.0))
 
 
 def test_no_payload_fits_when_the_arm_alone_is_over(model):
