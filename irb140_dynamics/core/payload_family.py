@@ -11,9 +11,10 @@ so at one state each joint allows an interval of masses (|tau_j(m)| <= L_j), exa
 The worst static torques over the joint ranges come in two halves: the search of
 ``workspace`` (sampling and exact coordinate ascent) finds poses and their torques, the
 branch and bound of ``certify`` proves how far above them the true maxima can be (the
-gap; CERTIFY_RTOL of the torque when it closes, always within a budget of EVALUATIONS box
-bounds per joint, see ``certify``). Models beyond harmonic.MAX_JOINTS joints get plain
-interval bounds within the budget of ``certify.interval_maxima``.
+gap; CERTIFY_RTOL of the torque when it closes, always within the budget of
+``certify.EVALUATIONS`` box bounds per proof). Models beyond harmonic.MAX_JOINTS joints
+get plain interval bounds within the budget of ``certify.interval_maxima``. Proofs are
+remembered per payload mass and joint ranges, families per arm and payload shape.
 """
 
 from __future__ import annotations
