@@ -28,6 +28,8 @@ setup(
             "demo_node = irb140_dynamics.demo_node:main",
             "sim_node = irb140_dynamics.sim_node:main",
             "export_urdf = irb140_dynamics.tools.export_urdf:main",
+            "identify = irb140_dynamics.tools.identify:main",
+            "excitation = irb140_dynamics.tools.excitation:main",
         ],
     },
 )

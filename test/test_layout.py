@@ -12,7 +12,8 @@ from .node_process import run_to_exit, run_until_ready
 from .paths import CONFIG, ROOT
 
 EXECUTABLES = ["id_node", "payload_check_node"]
-TOOLS = ["export_urdf"]
+IDENTIFICATION_TOOLS = ["identify", "excitation"]
+TOOLS = ["export_urdf", *IDENTIFICATION_TOOLS]
 URDF = ROOT / "urdf" / "irb140.urdf"
 
 
@@ -70,6 +71,22 @@ def test_installed_nodes_run_on_the_installed_config(install, name):
     assert code == 0, output
     code, output = run_to_exit([executable, "--ros-args", "-p", "joint_6.link.mass:=-1.0"], env=env)
     assert code == 1 and "joint_6.link.mass" in output, output
+
+
+@pytest.mark.parametrize("name", IDENTIFICATION_TOOLS)
+def test_installed_tools_run(install, name):
+    executable = str(install / "irb140_dynamics" / "lib" / "irb140_dynamics" / name)
+    code, output = run_to_exit([executable, "--help"], env=installed_env(install))
+    assert code == 0 and f"usage: {name}" in output and "--out" in output, output
+
+
+def test_installed_excitation_uses_the_installed_model(install, tmp_path):
+    executable = str(install / "irb140_dynamics" / "lib" / "irb140_dynamics" / "excitation")
+    out = tmp_path / "excitation.yaml"
+    command = [executable, "--out", str(out), "--iterations", "0", "--period", "2", "--harmonics", "2", "--rate", "5"]
+    code, output = run_to_exit(command, env=installed_env(install))
+    assert code == 0 and f"model: {install / 'irb140_dynamics' / 'share'}" in output, output
+    assert out.read_text().count("time_from_start") == 11
 
 
 def test_installed_export_urdf_prints_the_installed_urdf(install):

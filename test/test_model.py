@@ -19,6 +19,7 @@ from irb140_dynamics.core import (
     rnea,
 )
 from irb140_dynamics.core.model import read_parameter_file
+from irb140_dynamics.identification.files import nested
 
 from .support import OFFSET_PAYLOAD, random_model, random_rotation
 
@@ -188,18 +189,6 @@ def test_params_round_trip(n):
         params = model.to_params()
         params["use_sim_time"] = False  # other nodes' parameters are ignored
         assert RobotModel.from_params(params) == model
-
-
-def nested(flat: dict) -> dict:
-    """A flat parameter dict as the nested tree of a ROS 2 parameter file."""
-    tree: dict = {}
-    for name, value in flat.items():
-        *groups, leaf = name.split(".")
-        node = tree
-        for group in groups:
-            node = node.setdefault(group, {})
-        node[leaf] = value
-    return tree
 
 
 @pytest.fixture

@@ -199,8 +199,9 @@ def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3):
     return tau
 
 
-def forward_motion(links, rots, qd, qdd, gravity):
-    """(w, dw, a) of each link, in its frame, a at its origin; gravity as a base acceleration."""
+def forward_motion(links, rots, qd, qdd, gravity, at_joints=False):
+    """(w, dw, a) of each link, in its frame, a at its origin (``at_joints``: at its joint
+    origin o'_i); gravity as a base acceleration."""
     w, dw, a = ZERO3, ZERO3, scale(-1.0, gravity)
     motion = []
     for link, rot, qd_i, qdd_i in zip(links, rots, qd, qdd):
@@ -209,8 +210,9 @@ def forward_motion(links, rots, qd, qdd, gravity):
         w_parent = to_child(link, rot, w)
         w = add(w_parent, scale(qd_i, link.b))
         dw = add(to_child(link, rot, dw), scale(qdd_i, link.b), cross(w_parent, scale(qd_i, link.b)))
-        a = add(to_child(link, rot, a), cross(dw, link.p), cross(w, cross(w, link.p)))
-        motion.append((w, dw, a))
+        a_joint = to_child(link, rot, a)
+        a = add(a_joint, cross(dw, link.p), cross(w, cross(w, link.p)))
+        motion.append((w, dw, a_joint if at_joints else a))
     return motion
 
 

@@ -29,7 +29,7 @@ from .algorithms import (
     scale,
     turns,
 )
-from .dynamics import _evaluate
+from .dynamics import _CHUNK
 from .states import state, states
 from .joints import Friction
 from .model import RobotModel
@@ -47,7 +47,7 @@ _UNIT_VECTORS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 def rigid_body_regressor(links, cs, qd, qdd, gravity):
     """The n x 10n rigid-body regressor (rows of columns), written on scalars like ``rnea``."""
     rots = turns(links, cs)
-    motion = forward_motion(links, rots, qd, qdd, gravity)
+    motion = forward_motion(links, rots, qd, qdd, gravity, at_joints=True)
     n = len(links)
     Y = [[0.0] * (10 * n) for _ in range(n)]
     for k in range(n):
@@ -61,8 +61,7 @@ def rigid_body_regressor(links, cs, qd, qdd, gravity):
 
 
 def _in_joint_frame(link: Link, w, dw, a):
-    """Link motion moved from o_i in frame i to the joint origin o'_i in the joint frame."""
-    a = add(a, scale(-1.0, add(cross(dw, link.p), cross(w, cross(w, link.p)))))
+    """Link motion (a at the joint origin o'_i) in frame i, in the joint frame."""
     if link.R1 is None:
         return w, dw, a
     return rotate(link.R1, w), rotate(link.R1, dw), rotate(link.R1, a)
@@ -109,7 +108,15 @@ def regressor_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
     columns = states(n, Q=Q, QD=QD, QDD=QDD)
     N = columns[0].shape[1]
     Y = np.zeros((N, n, 13 * n))
-    Y[:, :, : 10 * n] = _evaluate(model.kernels.regressor.array, *columns).reshape(N, n, 10 * n)
+    flat = Y.reshape(N, 13 * n * n)
+    # kernel output i * 10n + c is Y[:, i, c]: written straight into Y, its zeros skipped
+    # (about half of the entries: link k moves no joint after k)
+    where = [i * 13 * n + c for i in range(n) for c in range(10 * n)]
+    for start in range(0, N, _CHUNK):
+        chunk = slice(start, start + _CHUNK)
+        for index, values in zip(where, model.kernels.regressor.array(*(c[:, chunk] for c in columns))):
+            if isinstance(values, np.ndarray) or values != 0.0:
+                flat[chunk, index] = values
     _joint_columns(model, Y, columns[1].T, columns[2].T)
     return Y
 

@@ -9,17 +9,10 @@ from collections import Counter
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
 
+from ..core.joint_order import BadMessage, JointOrder, NotForThisModel
 
-class BadMessage(ValueError):
-    """A message that must not yield torques; ``kind`` is a short tag for counting."""
-
-    def __init__(self, kind: str, detail: str):
-        super().__init__(f"{kind}: {detail}")
-        self.kind = kind
-
-
-class NotForThisModel(BadMessage):
-    """A message about none of the model's joints (a gripper's, another arm's): ignored."""
+__all__ = ["BadMessage", "JointOrder", "NotForThisModel", "count_and_warn", "joint_efforts", "read_effort", "read_joint_state",
+           "read_reference"]
 
 
 def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> None:
@@ -27,42 +20,6 @@ def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> No
     counts[f"dropped_{error.kind}"] += 1
     counts["dropped"] += 1
     logger.warning(f"dropped a {topic} message ({error})", throttle_duration_sec=2.0)
-
-
-class JointOrder:
-    """Where each of the model's joints sits in a message's name list.
-
-    Cached per name list: streams from a few publishers (arm, gripper) each keep theirs.
-    """
-
-    _CACHE_SIZE = 16
-
-    def __init__(self, joint_names):
-        self.joint_names = tuple(joint_names)
-        self._cache: dict[tuple, list[int]] = {}
-
-    def indices(self, names) -> list[int]:
-        names = tuple(names)
-        index = self._cache.get(names)
-        if index is None:
-            index = self._match(names)
-            if len(self._cache) >= self._CACHE_SIZE:
-                self._cache.clear()
-            self._cache[names] = index
-        return index
-
-    def _match(self, names: tuple) -> list[int]:
-        if not names:
-            raise BadMessage("unnamed", "no joint names and the lengths do not match the model")
-        if len(set(names)) != len(names):
-            raise BadMessage("duplicate_names", f"duplicate joint names in {list(names)}")
-        where = {name: i for i, name in enumerate(names)}
-        missing = [name for name in self.joint_names if name not in where]
-        if len(missing) == len(self.joint_names):
-            raise NotForThisModel("other_joints", f"none of the model's joints in {list(names)}")
-        if missing:
-            raise BadMessage("missing_joints", f"no {', '.join(missing)} in {list(names)}")
-        return [where[name] for name in self.joint_names]
 
 
 def _pick(values, index: list[int], field: str, length: int, required: bool) -> list[float]:
@@ -120,9 +77,7 @@ def read_reference(msg: JointTrajectory, order: JointOrder):
 
 
 def _index(names, n_positions: int, order: JointOrder) -> tuple[list[int], int]:
-    if not names and n_positions == len(order.joint_names):
-        return list(range(n_positions)), n_positions
-    return order.indices(names), len(names)
+    return order.for_values(names, n_positions)
 
 
 def joint_efforts(msg: JointState, stamp, effort) -> JointState:

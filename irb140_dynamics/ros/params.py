@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Callable
 
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
@@ -25,9 +24,8 @@ from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from ..core.model import check_joint_names, read_parameter_file
+from ..package_files import CONFIG_NAME, PACKAGE, default_config_path  # noqa: F401 (PACKAGE, CONFIG_NAME: re-exported)
 
-PACKAGE = "irb140_dynamics"
-CONFIG_NAME = "irb140.yaml"
 
 
 @dataclass(frozen=True)
@@ -80,16 +78,6 @@ def joint_states_qos(node: Node) -> QoSProfile:
     """The joint_states subscription's QoS from the node's qos.* parameters."""
     reliability = RELIABILITIES[node.get_parameter("qos.reliability").value]
     return QoSProfile(depth=node.get_parameter("qos.depth").value, reliability=reliability)
-
-
-def default_config_path() -> Path:
-    """The installed config/irb140.yaml (where ros2 run finds it), else the source tree's."""
-    try:
-        from ament_index_python.packages import get_package_share_directory
-
-        return Path(get_package_share_directory(PACKAGE)) / "config" / CONFIG_NAME
-    except (ImportError, LookupError, OSError):  # not installed, or no AMENT_PREFIX_PATH
-        return Path(__file__).resolve().parents[2] / "config" / CONFIG_NAME
 
 
 def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:

@@ -1,0 +1,56 @@
+"""PNG plots of an identification (matplotlib): measured against predicted torques, residuals."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..core.regressor import inertial_parameters, regressor_batch
+from .pipeline import Result
+
+
+def write_plots(result: Result, directory) -> list[Path]:
+    """torques.png and residuals.png of the held-out fit points in ``directory``; their paths."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    points = result.plot_points
+    if points is None or len(points) == 0:
+        return []
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    order = np.argsort(points.time)
+    time = points.time[order] - points.time[order][0]
+    Y = regressor_batch(result.prior, points.q[order], points.qd[order], points.qdd[order])
+    measured = points.tau[order]
+    predicted = {"prior": Y @ inertial_parameters(result.prior), "identified": Y @ result.fit.pi}
+    names = result.prior.joint_names
+    n = len(names)
+    paths = []
+    for kind in ("torques", "residuals"):
+        figure, axes = plt.subplots(n, 1, figsize=(11, 2.0 * n + 1), sharex=True, squeeze=False)
+        for j, axis in enumerate(axes[:, 0]):
+            if kind == "torques":
+                axis.plot(time, measured[:, j], "k.", markersize=1.5, label="measured")
+                axis.plot(time, predicted["prior"][:, j], color="tab:orange", linewidth=0.8, label="prior model")
+                axis.plot(time, predicted["identified"][:, j], color="tab:blue", linewidth=0.8, label="identified")
+            else:
+                axis.plot(time, measured[:, j] - predicted["prior"][:, j], ".", color="tab:orange", markersize=1.5,
+                          label="measured - prior")
+                axis.plot(time, measured[:, j] - predicted["identified"][:, j], ".", color="tab:blue", markersize=1.5,
+                          label="measured - identified")
+                axis.axhline(0.0, color="k", linewidth=0.5)
+            axis.set_ylabel(f"{names[j]}\n[N m]")
+            axis.grid(True, linewidth=0.3)
+        axes[0, 0].legend(loc="upper right", fontsize="small", ncol=3)
+        axes[0, 0].set_title(f"{kind.capitalize()} on held-out data: {result.held_out_source}")
+        axes[-1, 0].set_xlabel("time [s] (held-out fit points)")
+        figure.tight_layout()
+        path = directory / f"{kind}.png"
+        figure.savefig(path, dpi=110)
+        plt.close(figure)
+        paths.append(path)
+    return paths

@@ -1,0 +1,238 @@
+"""Recorded joint states, read in chunks: ROS 2 bags (through rosbags) and CSV files.
+
+A recording yields ``RawChunk``s of at most ``chunk_size`` samples, so that memory stays
+bounded whatever its length. A sample is one JointState message (one CSV row): its time,
+and the model's joints' positions, velocities and efforts, the joints matched by name like
+id_node does (any order, other joints ignored; an unnamed message positionally when its
+length is the model's). What cannot be used is left out and counted in ``skipped`` by
+reason; velocities or efforts a sample lacks are NaN (the caller leaves it out).
+
+Time: the header stamp, or the bag's receive time when the stamp is zero (s, from the
+first sample). CSV columns, in any order, others ignored (``docs/identification.md``):
+``time`` [s], ``position_<joint>`` [rad], ``velocity_<joint>`` [rad/s] (optional),
+``effort_<joint>`` [N m]; an empty cell is a missing value.
+"""
+
+from __future__ import annotations
+
+import csv
+from collections import Counter
+from dataclasses import dataclass
+from itertools import islice
+from pathlib import Path
+from typing import Iterator
+
+import numpy as np
+
+from ..core.joint_order import BadMessage, JointOrder
+
+JOINT_STATE = "sensor_msgs/msg/JointState"
+DEFAULT_TOPIC = "/joint_states"
+CHUNK_SIZE = 20_000
+BAG_SUFFIXES = (".mcap", ".db3")
+
+
+class RecordingError(ValueError):
+    """A recording that cannot be used: names the file and the problem."""
+
+    def __init__(self, path, problem: str):
+        super().__init__(f"{path}: {problem}")
+        self.path, self.problem = str(path), problem
+
+
+@dataclass(frozen=True, eq=False)
+class RawChunk:
+    first: int  # index of the first sample in the recording
+    time: np.ndarray  # (N,) s
+    position: np.ndarray  # (N, n) rad
+    velocity: np.ndarray  # (N, n) rad/s, NaN where absent
+    effort: np.ndarray  # (N, n) N m, NaN where absent
+
+    def __len__(self) -> int:
+        return len(self.time)
+
+
+class Recording:
+    """A recording of the model's joints: ``total`` samples expected, ``chunks()`` to read."""
+
+    def __init__(self, path, joint_names, topic: str = DEFAULT_TOPIC, chunk_size: int = CHUNK_SIZE):
+        self.path = Path(path)
+        self.order = JointOrder(joint_names)
+        self.n = len(self.order.joint_names)
+        self.topic = topic
+        self.chunk_size = chunk_size
+        self.skipped: Counter = Counter()
+        if not self.path.exists():
+            raise RecordingError(path, "no such file or directory")
+        if self.path.suffix.lower() == ".csv":
+            self._source = _CsvSource(self)
+        elif self.path.is_dir() or self.path.suffix.lower() in BAG_SUFFIXES:
+            self._source = _BagSource(self)
+        else:
+            raise RecordingError(path, "not a ROS 2 bag (.mcap, .db3 or a bag directory) nor a .csv file")
+        self.total = self._source.total
+
+    def chunks(self) -> Iterator[RawChunk]:
+        yield from self._source.chunks()
+
+
+class _Chunker:
+    """Collects samples (already in the model's joint order) into RawChunks."""
+
+    def __init__(self, recording: Recording):
+        self.recording = recording
+        self.first = 0
+        self.times, self.positions, self.velocities, self.efforts = [], [], [], []  # cleared in place
+
+    def _clear(self):
+        for samples in (self.times, self.positions, self.velocities, self.efforts):
+            samples.clear()
+
+    def __len__(self):
+        return len(self.times)
+
+    def take(self) -> RawChunk | None:
+        if not self.times:
+            return None
+        n = self.recording.n
+        arrays = [np.asarray(x, dtype=float).reshape(-1, n) for x in (self.positions, self.velocities, self.efforts)]
+        chunk = RawChunk(self.first, np.asarray(self.times, dtype=float), *arrays)
+        self.first += len(chunk)
+        self._clear()
+        return chunk
+
+
+class _BagSource:
+    def __init__(self, recording: Recording):
+        from rosbags.highlevel import AnyReader
+        from rosbags.typesys import Stores, get_typestore
+
+        self.recording = recording
+        path, topic = recording.path, recording.topic
+        try:
+            self.reader = AnyReader([path], default_typestore=get_typestore(Stores.ROS2_JAZZY))
+            self.reader.open()
+        except Exception as error:  # rosbags raises many kinds for a file that is no bag
+            raise RecordingError(path, f"not a readable ROS 2 bag ({type(error).__name__}: {error})") from None
+        self.connections = [c for c in self.reader.connections if c.topic == topic]
+        if not self.connections:
+            topics = ", ".join(f"{c.topic} ({c.msgtype})" for c in self.reader.connections) or "none"
+            self.reader.close()
+            raise RecordingError(path, f"no topic {topic} (topics: {topics}); choose one with --topic")
+        kinds = {c.msgtype for c in self.connections}
+        if kinds != {JOINT_STATE}:
+            self.reader.close()
+            raise RecordingError(path, f"{topic} carries {', '.join(sorted(kinds))}, not {JOINT_STATE}")
+        self.total = sum(c.msgcount for c in self.connections)
+
+    def chunks(self) -> Iterator[RawChunk]:
+        recording, skipped = self.recording, self.recording.skipped
+        deserialize = self.reader.typestore.deserialize_cdr
+        chunker, chunk_size = _Chunker(recording), recording.chunk_size
+        times = chunker.times
+        add_time, add_position = times.append, chunker.positions.append  # the loop's hot calls, bound once
+        add_velocity, add_effort = chunker.velocities.append, chunker.efforts.append
+        missing = np.full(recording.n, np.nan)
+        names_seen, index, length, bad = None, None, -1, None
+        try:
+            for _, receive_time, raw in self.reader.messages(connections=self.connections):
+                try:
+                    msg = deserialize(raw, JOINT_STATE)
+                except Exception as error:
+                    raise RecordingError(recording.path, f"a {recording.topic} message cannot be read ({error})") from None
+                names, position, velocity, effort = msg.name, msg.position, msg.velocity, msg.effort
+                if names != names_seen or not names:
+                    names_seen, index, length, bad = names, *self._mapping(names, len(position))
+                if bad is not None:
+                    skipped[bad] += 1
+                    continue
+                if len(position) != length or len(velocity) not in (0, length) or len(effort) not in (0, length):
+                    skipped["length_mismatch"] += 1
+                    continue
+                if index is not None:
+                    position = position[index]
+                    velocity = velocity[index] if len(velocity) else velocity
+                    effort = effort[index] if len(effort) else effort
+                stamp = msg.header.stamp
+                add_time(stamp.sec + stamp.nanosec * 1e-9 if stamp.sec or stamp.nanosec else receive_time * 1e-9)
+                add_position(position)
+                add_velocity(velocity if len(velocity) else missing)
+                add_effort(effort if len(effort) else missing)
+                if len(times) >= chunk_size:
+                    yield chunker.take()
+            chunk = chunker.take()
+            if chunk is not None:
+                yield chunk
+        except RecordingError:
+            raise
+        except Exception as error:
+            raise RecordingError(recording.path, f"reading failed ({type(error).__name__}: {error})") from None
+        finally:
+            self.reader.close()
+
+    def _mapping(self, names, count: int):
+        """(index into the message's arrays or None for as-is, their length, why skipped or None)."""
+        try:
+            index, length = self.recording.order.for_values(names, count)
+        except BadMessage as error:
+            return None, -1, error.kind
+        if list(index) == list(range(length)):
+            return None, length, None
+        return np.array(index, dtype=np.intp), length, None
+
+
+class _CsvSource:
+    def __init__(self, recording: Recording):
+        self.recording = recording
+        path = recording.path
+        try:
+            with open(path, newline="") as stream:
+                header = next(csv.reader(stream), None)
+                self.total = sum(1 for line in stream if line.strip())
+        except (OSError, UnicodeDecodeError) as error:
+            raise RecordingError(path, f"cannot be read ({error})") from None
+        if not header:
+            raise RecordingError(path, "empty: expected a header row (time, position_<joint>, ..., effort_<joint>)")
+        where = {name.strip(): i for i, name in enumerate(header)}
+        joints = recording.order.joint_names
+        needed = ["time"] + [f"{field}_{j}" for field in ("position", "effort") for j in joints]
+        missing = [name for name in needed if name not in where]
+        if missing:
+            raise RecordingError(path, f"no column {', '.join(missing)} (columns: {', '.join(header)})")
+        velocity = [f"velocity_{j}" for j in joints]
+        self.has_velocity = all(name in where for name in velocity)
+        self.columns = [where[name] for name in needed + (velocity if self.has_velocity else [])]
+        self.width = len(header)
+
+    def chunks(self) -> Iterator[RawChunk]:
+        recording, n = self.recording, self.recording.n
+        first = 0
+        with open(recording.path, newline="") as stream:
+            next(stream)
+            line_number = 1
+            while True:
+                lines = [line for line in islice(stream, recording.chunk_size) if line.strip()]
+                if not lines:
+                    return
+                values = self._parse(lines, line_number + 1)
+                line_number += len(lines)
+                velocity = values[:, 1 + 2 * n :] if self.has_velocity else np.full((len(lines), n), np.nan)
+                yield RawChunk(first, values[:, 0], values[:, 1 : 1 + n], velocity, values[:, 1 + n : 1 + 2 * n])
+                first += len(lines)
+
+    def _parse(self, lines: list[str], first_line: int) -> np.ndarray:
+        try:
+            table = np.loadtxt(lines, delimiter=",", ndmin=2)
+            if table.shape[1] == self.width:
+                return table[:, self.columns]
+        except ValueError:
+            pass
+        rows = []
+        for k, row in enumerate(csv.reader(lines)):
+            if len(row) != self.width:
+                raise RecordingError(self.recording.path, f"line {first_line + k}: {len(row)} cells, the header has {self.width}")
+            try:
+                rows.append([float(row[i]) if row[i].strip() else np.nan for i in self.columns])
+            except ValueError:
+                raise RecordingError(self.recording.path, f"line {first_line + k}: not a number in {row}") from None
+        return np.array(rows, dtype=float).reshape(-1, len(self.columns))
