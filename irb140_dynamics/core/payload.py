@@ -191,8 +191,10 @@ def _workspace_max_payload(family, ranges, L, G0, dG, own_mass: float, load: Ext
         _, poses = _most_loaded(family, ranges, dG)
         best = _smallest_max_payload(family, poses, L)
     for round_ in range(_PROOF_ROUNDS):
+        found = None
         while math.isfinite(best.mass):  # Dinkelbach
-            _, poses = family.search(best.mass, ranges, G0 + best.mass * dG, warm=poses)
+            found = family.search(best.mass, ranges, G0 + best.mass * dG, warm=poses)
+            poses = found[1]
             candidate = _smallest_max_payload(family, poses, L)
             if not _lighter(candidate, best):
                 break
@@ -200,7 +202,8 @@ def _workspace_max_payload(family, ranges, L, G0, dG, own_mass: float, load: Ext
         if math.isnan(best.mass):
             return best  # a real pose the arm cannot hold even empty
         m = min(best.mass, MAX_MASS)  # beyond the sanity cap no mass is valid anyway
-        proven = family.extremes(m, ranges, G0 + m * dG, warm=poses, rows=limited, share=MASS_PROOF_SHARE)
+        found = found if m == best.mass else None  # the last search was at that mass
+        proven = family.extremes(m, ranges, G0 + m * dG, warm=poses, rows=limited, share=MASS_PROOF_SHARE, found=found)
         candidate = _smallest_max_payload(family, proven.poses, L)
         if not _lighter(candidate, best) or round_ == _PROOF_ROUNDS - 1:
             break  # (in the last round the bounds, over the limits, make the mass proven lower)

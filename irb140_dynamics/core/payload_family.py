@@ -93,14 +93,14 @@ class PayloadFamily:
         return ranges.maximize(self.static_torque(m), np.vstack([np.eye(n), -np.eye(n)]), sample_torques, warm)
 
     def extremes(self, m: float, ranges: JointRanges, sample_torques=None, warm=None, rows=None,
-                 share: float = 1.0) -> Extremes:
+                 share: float = 1.0, found=None) -> Extremes:
         """The worst static torques at m kg, searched and proven (remembered per m and
         ranges): all 2n of them, or only ``rows`` proven (the others' bounds inf), within
-        ``share`` of the proof's budget."""
+        ``share`` of the proof's budget; ``found``: (values, poses) of a search at m done."""
         rows = np.arange(2 * self.empty.n) if rows is None else np.asarray(rows, dtype=int)
         key = (float(m), ranges.lower.tobytes(), ranges.upper.tobytes(), rows.tobytes())
         if key not in self._proven:
-            values, poses = self.search(m, ranges, sample_torques, warm)
+            values, poses = self.search(m, ranges, sample_torques, warm) if found is None else found
             if len(self._proven) >= 8:
                 self._proven.pop(next(iter(self._proven)))
             self._proven[key] = self._prove(m, ranges, values, poses, rows, share)
