@@ -40,7 +40,7 @@ import numpy as np
 from .bounds import U, expand, layout, model, quadratic_max, rounding, sizes, sizes_of_s
 from .harmonic import Reduced
 
-EVALUATIONS = 40_000  # box bounds per call, shared by the groups of objectives, counted in
+EVALUATIONS = 50_000  # box bounds per call, shared by the groups of objectives, counted in
 TERMS = 200  # bounds of sums of this many terms (the IRB-140's): a box over more terms counts more
 BATCH = 1024  # boxes bounded at once (the most promising first)
 SLICE = 2048  # box bounds per turn of a group
