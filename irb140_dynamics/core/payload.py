@@ -19,11 +19,11 @@ The permissible torques follow the report (section 10): the torques of the rated
 6 kg at the flange origin, in the pose that loads each joint most. A given torque limit
 (``Joint.torque_limit`` > 0) always overrides.
 
-Cost (the IRB-140): a first check_payload some 0.3 s (kernels compiled, limits and the
+Cost (the IRB-140): a first check_payload some 0.2 s (kernels compiled, limits and the
 payload's workspace load proven), about 10 ms after (the proofs are remembered per payload
 shape and mass); a payload whose proofs spend their budget (see ``certify``: about 1 s per
 proof whatever the model, the largest payload's with MASS_PROOF_SHARE of it), such as 3 kg
-off the flange axis, 1.4 s: any 6-joint model within a few seconds.
+off the flange axis, 1.0 s; the worst 6-joint model seen (random, gravity tilted) 6 s.
 """
 
 from __future__ import annotations
