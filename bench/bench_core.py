@@ -45,8 +45,9 @@ from irb140_dynamics.core import (
     rnea,
     rnea_batch,
 )
-from irb140_dynamics.core.rigid_body import inertia_matrix
-from irb140_dynamics.core.urdf import load_urdf
+from irb140_dynamics.core import kernels as kernel_cache  # noqa: E402
+from irb140_dynamics.core.rigid_body import RigidBody, inertia_matrix  # noqa: E402
+from irb140_dynamics.core.urdf import load_urdf  # noqa: E402
 from test.pinocchio_model import build as pinocchio_model, rot_x, rot_z  # noqa: E402
 
 BATCH_STATES = 100_000
@@ -219,15 +220,21 @@ def ur5_from_urdf() -> list[Row]:
 
 
 def kernel_generation() -> tuple[list[Row], dict]:
-    """Trace-and-compile time of each kernel on fresh models, and the first rnea() call."""
-    times = {name: [] for name in ("kernels setup", *KERNELS, "first rnea() call")}
-    for _ in range(FRESH_MODELS):
+    """Trace-and-compile time of each kernel on fresh models, and the first rnea() call; then
+    that of a model that differs only in its payload mass (it shares the compiled code)."""
+    payload_changed = "first rnea() call, another payload mass (shared code)"
+    times = {name: [] for name in ("kernels setup", *KERNELS, "first rnea() call", payload_changed)}
+    for k in range(FRESH_MODELS):
+        kernel_cache._arm.cache_clear()  # compiled code is shared between models of the same arm
         kernels = _timed(times["kernels setup"], lambda: irb140().kernels)
         for name in KERNELS:
             _timed(times[name], lambda: getattr(kernels, name))
+        kernel_cache._arm.cache_clear()
         fresh = irb140()
         zeros = np.zeros(fresh.n)
         _timed(times["first rnea() call"], lambda: rnea(fresh, zeros, zeros, zeros))
+        loaded = irb140(payload=RigidBody(1.0 + k))
+        _timed(times[payload_changed], lambda: rnea(loaded, zeros, zeros, zeros))
     group = "kernel generation, fresh model"
     rows = [Row(group, name, Figure.cost(samples, "ms")) for name, samples in times.items()]
     source_lines = {name: getattr(kernels, name).source.count("\n") for name in KERNELS}

@@ -2,6 +2,8 @@
 
     .venv/bin/python bench/bench_nodes.py [--duration 10] [--rates 1000 2000]
         [--executor events [single_threaded]] [--no-event-handlers] [--profile] [--no-payload] [--no-stream]
+        [--change-period 0.1] [--no-changes]
+    .venv/bin/python bench/bench_nodes.py --soak MINUTES
 
 Prints one table and writes the raw figures to bench/results/nodes.json. Sections:
 
@@ -14,6 +16,10 @@ Prints one table and writes the raw figures to bench/results/nodes.json. Section
   sends the message itself): delay = the DDS reception time of the output - the stamp.
   Lost = published in the measured window - received. CPU per message = the node
   process's user + system time over the window / messages published.
+- parameter changes: the relay and id_node again at 1 kHz while payload.mass is set every
+  ``--change-period`` s through the SetParameters service (bench/parameter_changes.py).
+- soak (``--soak MINUTES``, alone): id_node and the relay side by side under the same load,
+  their RSS growth (bench/soak.py, bench/results/soak.json).
 - payload check: check_payload() cold (first call in a fresh process, kernel compilation
   included; the rated payload, and an off-axis one whose proof spends its budget) and warm,
   its two halves (derive_torque_limits, workspace_load) alone, and the round trip of a
@@ -30,15 +36,12 @@ import argparse
 import math
 import os
 import random
-import signal
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -55,6 +58,9 @@ from common import (  # first: puts the checkout on sys.path
     write_results,
 )
 from irb140_dynamics.ros.spin import EXECUTORS  # noqa: E402  (events: what every node's main() uses)
+from node_processes import QOS_DEPTH, NodeProcess, isolated_domain, node_command, wait_for  # noqa: E402
+from parameter_changes import ParameterChanger  # noqa: E402
+from soak import print_soak, soak  # noqa: E402
 
 NAMES = [f"joint_{i}" for i in range(1, 7)]
 CENTRE = np.array([0.0, -0.6, 1.0, 0.0, 0.5, 0.0])  # rad, as the demo node: every joint a sine
@@ -62,9 +68,10 @@ AMPLITUDE = np.array([0.8, 0.5, 0.5, 1.0, 0.6, 1.5])  # rad
 PERIOD = np.array([8.0, 6.0, 5.0, 7.0, 4.0, 9.0])  # s
 
 RATES = (1000, 2000)  # Hz
+CHANGE_RATE = 1000  # Hz, of the run with parameter changes
+CHANGE_PERIOD = 0.1  # s between two parameter changes in that run
 DURATION = 10.0  # s measured, per run
 WARMUP = 1.0  # s streamed before the measured window
-QOS_DEPTH = 10  # id_node's qos.depth default; joint_states best effort as its qos.reliability default
 RECEIVER_DEPTH = 5000  # this process's torque subscription: never the one that overflows
 STARTUP_TIMEOUT = 30.0  # s, for a node process to start and match
 DRAIN_TIMEOUT = 2.0  # s, for the last outputs after the last message published
@@ -92,7 +99,7 @@ class Value(Figure):
         return cls(float(x), float(x), unit)
 
     def __str__(self) -> str:
-        if self.unit == "msgs":
+        if self.unit in ("msgs", "calls"):
             return f"{self.best:.0f} {self.unit}"
         return f"{_number(self.best)} {self.unit}"
 
@@ -105,102 +112,6 @@ class NotMeasured(Figure):
 
     def __str__(self) -> str:
         return f"not measured: {self.reason}"
-
-
-# -- node processes -------------------------------------------------------------------------------
-
-
-def node_environment(domain_id: int) -> dict:
-    """This process's environment for the nodes: the checkout importable, own DDS domain."""
-    path = os.pathsep.join(p for p in (str(REPO), os.environ.get("PYTHONPATH", "")) if p)
-    return {
-        **os.environ,
-        "PYTHONPATH": path,
-        "PYTHONUNBUFFERED": "1",
-        "ROS_DOMAIN_ID": str(domain_id),
-        "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
-    }
-
-
-def isolated_domain(domain_id: int | None) -> tuple[int, dict]:
-    """A DDS domain of the run's own (``domain_id``, else random in 50..99) on localhost, set
-    for this process (call before rclpy.init); returns it and the nodes' environment."""
-    domain_id = random.randint(50, 99) if domain_id is None else domain_id
-    os.environ["ROS_DOMAIN_ID"] = str(domain_id)
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    print(f"ROS_DOMAIN_ID={domain_id}", flush=True)
-    return domain_id, node_environment(domain_id)
-
-
-class NodeProcess:
-    """A node in its own process, its output in a temporary file; stop() always ends it."""
-
-    def __init__(self, command: list[str], env: dict):
-        self.command = command
-        self.log = tempfile.TemporaryFile(mode="w+")
-        self.process = subprocess.Popen(command, env=env, stdout=self.log, stderr=subprocess.STDOUT, text=True,
-                                        preexec_fn=_die_with_parent)
-
-    def alive(self) -> bool:
-        return self.process.poll() is None
-
-    def cpu_seconds(self) -> float:
-        """User + system time of the process so far, all its threads (from /proc/<pid>/stat)."""
-        with open(f"/proc/{self.process.pid}/stat") as stat:
-            fields = stat.read().rsplit(")", 1)[1].split()
-        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")  # utime, stime
-
-    def output(self, last: int = 15) -> str:
-        self.log.flush()
-        self.log.seek(0)
-        return "".join(self.log.readlines()[-last:])
-
-    def stop(self) -> None:
-        if self.alive():
-            self.process.send_signal(signal.SIGINT)
-            try:
-                self.process.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait(timeout=5)
-        self.log.close()
-
-    def fail(self, what: str) -> RuntimeError:
-        state = "running" if self.alive() else f"exited with {self.process.returncode}"
-        return RuntimeError(f"{what} ({' '.join(self.command)}: {state}); its output:\n{self.output()}")
-
-
-def _die_with_parent() -> None:
-    """In the child: be killed if this process dies without stopping it (Linux)."""
-    try:
-        import ctypes
-
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        pass
-
-
-def node_command(kind: str, executor: str, namespace: str, lean: bool = False) -> list[str]:
-    """id_node as `ros2 run` starts it (its main(): the events executor), or through
-    relay_node.py (the relay, or id_node under another executor or without QoS event
-    handlers, ``lean``); both with id_node's default QoS given explicitly."""
-    ros_args = ["--ros-args", "-r", f"__ns:={namespace}",
-                "-p", "qos.reliability:=best_effort", "-p", f"qos.depth:={QOS_DEPTH}"]
-    if kind == "id_node":
-        ros_args += ["-p", "acceleration.mode:=differentiate"]
-        if executor == "events" and not lean:
-            return [sys.executable, "-m", "irb140_dynamics.id_node", *ros_args]
-    lean_flag = ["--no-event-handlers"] if lean else []
-    return [sys.executable, str(REPO / "bench" / "relay_node.py"), kind, "--executor", executor, *lean_flag,
-            *ros_args]
-
-
-def wait_for(condition: Callable[[], bool], timeout: float, process: NodeProcess, what: str) -> None:
-    deadline = time.monotonic() + timeout
-    while not condition():
-        if not process.alive() or time.monotonic() > deadline:
-            raise process.fail(f"{what}: not within {timeout:g} s")
-        time.sleep(0.02)
 
 
 # -- the end-to-end stream ------------------------------------------------------------------------
@@ -264,17 +175,21 @@ def machine_busy() -> tuple[int, int]:
 
 
 def stream_run(node, kind: str, executor: str, rate: float, duration: float, warmup: float,
-               env: dict, index: int, profile: bool = False, lean: bool = False) -> dict:
+               env: dict, index: int, profile: bool = False, lean: bool = False,
+               change_period: float | None = None) -> dict:
     """Start the node, stream joint states at ``rate`` through it, return the raw figures.
 
     ``profile``: py-spy samples the node over the measured window (bench/results/profile_*.txt).
+    ``change_period``: set payload.mass (a new value each time) every that many seconds
+    over the measured window, through the parameter service (see ParameterChanger).
     """
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import JointState
 
     namespace = f"/bench_nodes_{os.getpid()}_{index}"
     process = NodeProcess(node_command(kind, executor, namespace, lean), env)
-    publisher = subscription = receiver = spy = None
+    publisher = subscription = receiver = spy = changer = None
+    changes = None
     profile_path = RESULTS / f"profile_{kind}_{executor}_{rate:g}hz.txt"
     try:
         publisher = node.create_publisher(
@@ -288,6 +203,8 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
                  STARTUP_TIMEOUT, process, f"{kind} matched on joint_states and feedforward_torques")
         receiver = Receiver(subscription, node.context)
         receiver.start()
+        if change_period is not None:
+            changer = ParameterChanger(f"{namespace}/{kind}", change_period)
 
         first = round(warmup * rate)
         total = first + round(duration * rate)
@@ -304,6 +221,8 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
                 cpu0, own0, busy0 = process.cpu_seconds(), time.process_time(), machine_busy()
                 if profile:
                     spy = start_profiler(process, duration, profile_path)
+                if changer is not None:
+                    changer.start()
             remaining = deadline - clock()
             if remaining > 0:  # no busy-wait: its CPU would be taken from the node under test
                 sleep(remaining)
@@ -314,6 +233,8 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
             publisher.publish(msg)
             stamps[i] = stamp
         sent_s = clock() - start - first * period
+        if changer is not None:
+            changes, changer = changer.stop(), None
 
         last = int(stamps[-1])
         drain_end = time.monotonic() + DRAIN_TIMEOUT
@@ -327,6 +248,8 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
         if not process.alive():
             raise process.fail(f"{kind} died during the run")
     finally:
+        if changer is not None:
+            changer.stop() if changer.is_alive() else changer.close()
         if receiver is not None:
             receiver.stop()
         if spy is not None:
@@ -343,6 +266,7 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
     run = summarize(kind, executor, rate, duration, stamps, first, lateness, receiver.records,
                     cpu, own, busy0, busy1, sent_s)
     run["qos_event_handlers"] = not lean
+    run["parameter_changes"] = changes
     if profile:
         run["profile"] = {"file": str(profile_path.relative_to(REPO)), "top": profile_summary(profile_path)}
     return run
@@ -453,24 +377,36 @@ def lost_runs(measured: np.ndarray, arrived: np.ndarray, rate: float, most: int 
     return runs
 
 
-def end_to_end(rates, executors, duration, warmup, env, profile=False, lean=False) -> tuple[list[Row], list[dict]]:
-    """Per executor and rate: the relay, then id_node, each in a fresh process."""
+def end_to_end(rates, executors, duration, warmup, env, profile=False, lean=False,
+               change_period: float | None = None, change_rate: float = CHANGE_RATE) -> tuple[list[Row], list[dict]]:
+    """Per executor and rate: the relay, then id_node, each in a fresh process; then, with
+    ``change_period``, both again at ``change_rate`` with a parameter change every
+    ``change_period`` s."""
     import rclpy
     from rclpy.node import Node
 
     rclpy.init()
     node = Node("bench_nodes_load")
     runs = []
+    plan = [(executor, rate, None) for executor in executors for rate in rates]
+    if change_period is not None:
+        plan.append((executors[0], change_rate, change_period))
     try:
-        for executor in executors:
-            for rate in rates:
-                for kind in ("relay", "id_node"):
-                    print(f"  {kind} at {rate} Hz, {executor}: {warmup + duration:g} s ...", flush=True)
-                    run = stream_run(node, kind, executor, rate, duration, warmup, env, len(runs), profile, lean)
-                    runs.append(run)
-                    d = run["delay_us"]
-                    print(f"    p50 {_opt(d['p50'])} us, p99 {_opt(d['p99'])} us, max {_opt(d['max'])} us, "
-                          f"lost {run['lost']} of {run['sent']}, node CPU {run['node_cpu_us_per_msg']:.1f} us/msg",
+        for executor, rate, changes in plan:
+            for kind in ("relay", "id_node"):
+                every = "" if changes is None else f", payload.mass set every {changes * 1e3:g} ms"
+                print(f"  {kind} at {rate:g} Hz, {executor}{every}: {warmup + duration:g} s ...", flush=True)
+                run = stream_run(node, kind, executor, rate, duration, warmup, env, len(runs), profile, lean,
+                                 changes)
+                runs.append(run)
+                d = run["delay_us"]
+                print(f"    p50 {_opt(d['p50'])} us, p99 {_opt(d['p99'])} us, max {_opt(d['max'])} us, "
+                      f"lost {run['lost']} of {run['sent']}, node CPU {run['node_cpu_us_per_msg']:.1f} us/msg",
+                      flush=True)
+                if run["parameter_changes"] is not None:
+                    c = run["parameter_changes"]
+                    print(f"    changes: {c['accepted']} accepted, {c['refused']} refused, {c['unanswered']} "
+                          f"unanswered; reply p50 {_opt(c['reply_ms']['p50'])} ms, p99 {_opt(c['reply_ms']['p99'])} ms",
                           flush=True)
     finally:
         node.destroy_node()
@@ -484,21 +420,38 @@ def _opt(x) -> str:
 
 def stream_rows(runs: list[dict]) -> list[Row]:
     rows = []
-    pairs = {(r["executor"], r["rate_hz"], r["node"]): r for r in runs}
-    for (executor, rate, kind), ours in pairs.items():
+
+    def key(run, kind):
+        changes = run["parameter_changes"]
+        return run["executor"], run["rate_hz"], None if changes is None else changes["period_s"], kind
+
+    pairs = {key(r, r["node"]): r for r in runs}
+    for (executor, rate, change_period, kind), ours in pairs.items():
         if kind != "id_node":
             continue
-        base = pairs[(executor, rate, "relay")]
+        base = pairs[(executor, rate, change_period, "relay")]
         lean = "" if ours["qos_event_handlers"] else ", no QoS event handlers"
-        group = (f"id_node end to end, {rate:g} Hz for {ours['duration_s']:g} s, executor {executor}{lean} "
-                 "(baseline: relay)")
+        changes = "" if change_period is None else f", payload.mass set every {change_period * 1e3:g} ms"
+        group = (f"id_node end to end, {rate:g} Hz for {ours['duration_s']:g} s{changes}, executor {executor}{lean} "
+                 "(baseline: relay" + (", the same parameter calls)" if changes else ")"))
         for stat, target in (("p50", None), ("p99", P99_TARGET), ("max", None)):
             rows.append(Row(group, f"delay {stat}", _delay(ours, stat), _delay(base, stat), target))
         rows.append(Row(group, f"lost (of {ours['sent']} sent)", Value.of(ours["lost"], "msgs"),
                         Value.of(base["lost"], "msgs"), LOST_TARGET))
         rows.append(Row(group, "node CPU per message", Value.of(ours["node_cpu_us_per_msg"], "us/msg"),
                         Value.of(base["node_cpu_us_per_msg"], "us/msg")))
+        if change_period is not None:
+            ours_c, base_c = ours["parameter_changes"], base["parameter_changes"]
+            rows.append(Row(group, f"changes accepted (of {ours_c['accepted'] + ours_c['refused'] + ours_c['unanswered']})",
+                            Value.of(ours_c["accepted"], "calls"), Value.of(base_c["accepted"], "calls")))
+            for stat in ("p50", "p99"):
+                rows.append(Row(group, f"SetParameters reply {stat}", _reply(ours_c, stat), _reply(base_c, stat)))
     return rows
+
+
+def _reply(changes: dict, stat: str) -> Figure:
+    value = changes["reply_ms"][stat]
+    return NotMeasured(None, None, "ms", "no reply") if value is None else Value.of(value, "ms")
 
 
 def _delay(run: dict, stat: str) -> Figure:
@@ -640,6 +593,13 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help="run both nodes without rclpy's default QoS event handlers "
                              "(a bench-only variant through relay_node.py)")
     parser.add_argument("--no-payload", action="store_true", help="skip the payload check section")
+    parser.add_argument("--change-period", type=float, default=CHANGE_PERIOD,
+                        help=f"s between two payload.mass changes in the run at {CHANGE_RATE} Hz with parameter "
+                             f"changes (default {CHANGE_PERIOD:g})")
+    parser.add_argument("--no-changes", action="store_true", help="skip the run with parameter changes")
+    parser.add_argument("--soak", type=float, metavar="MINUTES", default=None,
+                        help="only the soak: id_node and the relay side by side at 1 kHz for MINUTES "
+                             "(10 in the issue), their RSS growth (bench/results/soak.json)")
     parser.add_argument("--no-stream", action="store_true", help="skip the end-to-end section")
     parser.add_argument("--profile", action="store_true",
                         help="sample each node with py-spy over the measured window "
@@ -652,11 +612,18 @@ def main(argv=None) -> None:
     args = parse_args(argv)
     started = time.perf_counter()
     domain_id, env = isolated_domain(args.domain_id)
+    if args.soak is not None:
+        results = soak(args.soak, CHANGE_RATE, env)
+        print_soak(results)
+        path = write_results("soak", {"benchmark": "soak", "machine": machine_info(("numpy", "rclpy")), **results,
+                                      "runtime_s": time.perf_counter() - started})
+        print(f"raw figures: {path.relative_to(REPO)}")
+        return
 
     rows, runs, payload = [], [], {}
     if not args.no_stream:
         stream, runs = end_to_end(args.rates, args.executor, args.duration, args.warmup, env, args.profile,
-                                  args.no_event_handlers)
+                                  args.no_event_handlers, None if args.no_changes else args.change_period)
         rows += stream
     if not args.no_payload:
         print("  payload check ...", flush=True)

@@ -45,6 +45,7 @@ class RelayNode(Node):
         super().__init__("relay", **kwargs)
         depth = self.declare_parameter("qos.depth", 10).value
         reliability = RELIABILITIES[self.declare_parameter("qos.reliability", "best_effort").value]
+        self.declare_parameter("payload.mass", 0.0)  # set like id_node's in the benchmark; changes nothing here
         self._publisher = self.create_publisher(JointState, "feedforward_torques", depth)
         self.create_subscription(JointState, "joint_states", self._publisher.publish,
                                  QoSProfile(depth=depth, reliability=reliability))

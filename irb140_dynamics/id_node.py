@@ -14,13 +14,14 @@ Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, q
              (an empty ~/reference trajectory lets the held reference go)
 
 Torques are in N m, named and ordered as the model's joints, stamped with the input stamp.
+A message that cannot give finite torques is dropped and counted (per topic), never
+answered; no exception leaves a callback.
 """
 
 from __future__ import annotations
 
 import math
-from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.node import Node
@@ -30,11 +31,12 @@ from trajectory_msgs.msg import JointTrajectory
 
 from .core import RobotModel, gravity, rnea
 from .core.filters import VelocityDifferentiator
+from .ros.guard import Tally, guarded
 from .ros.messages import (
     BadMessage,
     JointOrder,
     NotForThisModel,
-    count_and_warn,
+    finite_torques,
     joint_efforts,
     read_effort,
     read_joint_state,
@@ -48,11 +50,13 @@ from .ros.collision import (
     collision_threshold_specs,
 )
 from .ros.model_source import declare_model_source
-from .ros.params import QOS_PARAMETERS, Spec, check_choice, check_qos, joint_states_qos
+from .ros.params import QOS_PARAMETERS, Spec, check_choice, check_number, check_qos, joint_states_qos
 from .ros.spin import run
 
 ACCELERATION_MODES = ("zero", "differentiate")
 EFFORT_SOURCES = ("feedforward", "gravity")
+MAX_CUTOFF_FREQUENCY = 1e6  # Hz
+MAX_TIMEOUT = 1e6  # s
 
 NODE_PARAMETERS = [
     Spec("acceleration.mode", "zero",
@@ -60,15 +64,16 @@ NODE_PARAMETERS = [
          "filtered; for monitoring: as a command it would feed the measured acceleration back, "
          "so effort_commands never use it)"),
     Spec("acceleration.cutoff_frequency", 20.0, "cut-off of the velocity differentiation filter", "Hz",
-         minimum=1e-3),
+         minimum=1e-3, maximum=MAX_CUTOFF_FREQUENCY),
     Spec("reference_timeout", 0.5, "a ~/reference older than this (node clock) is no longer used; 0 = never",
-         "s", minimum=0.0),
+         "s", minimum=0.0, maximum=MAX_TIMEOUT),
     Spec("effort_commands.enabled", False, "also publish torques on effort_commands (Float64MultiArray)",
          read_only=True),
     Spec("effort_commands.source", "feedforward", "which torques go to effort_commands: 'feedforward' or 'gravity'"),
     *COLLISION_PARAMETERS,
     *QOS_PARAMETERS,
 ]
+PER_JOINT_PARAMETERS = collision_threshold_specs
 
 
 @dataclass(frozen=True)
@@ -83,21 +88,37 @@ class Settings:
     collision: CollisionSettings
 
 
-def build_settings(values: dict) -> Settings:
-    """Validate everything, and compile the model's kernels here, not on a message."""
+def check_settings(values: dict) -> Settings:
+    """Validate every parameter (quick, within the parameter call); kernels not compiled yet."""
     model = RobotModel.from_params(values)
     check_choice("acceleration.mode", values["acceleration.mode"], ACCELERATION_MODES)
     check_choice("effort_commands.source", values["effort_commands.source"], EFFORT_SOURCES)
     check_qos(values)
-    _compiled = (model.kernels.rnea, model.kernels.gravity_torques)
     return Settings(
         model,
         values["acceleration.mode"],
-        values["acceleration.cutoff_frequency"],
-        values["reference_timeout"],
+        check_number("acceleration.cutoff_frequency", values["acceleration.cutoff_frequency"], 1e-3,
+                     MAX_CUTOFF_FREQUENCY, "Hz"),
+        check_number("reference_timeout", values["reference_timeout"], 0.0, MAX_TIMEOUT, "s"),
         values["effort_commands.source"],
         build_collision_settings(values, model.joint_names),
     )
+
+
+KERNELS = ("rnea", "gravity_torques", "momentum")  # what a message uses (momentum: the collision observer)
+
+
+def finish_settings(settings: Settings, previous: Settings | None) -> Settings:
+    """Compile the kernels the messages use, here and not on a message (off the executor
+    unless they exist already: a payload or gravity change shares the arm's code)."""
+    if previous is not None and previous.model == settings.model:
+        return replace(settings, model=previous.model)
+    _compiled = [getattr(settings.model.kernels, name) for name in KERNELS]
+    return settings
+
+
+def compiled(settings: Settings, previous: Settings | None) -> bool:
+    return settings.model.kernels.compiled(*KERNELS)
 
 
 class IdNode(Node):
@@ -107,11 +128,14 @@ class IdNode(Node):
         super().__init__("id_node", **kwargs)
         self.settings: Settings | None = None  # None: waiting for the model (robot_description topic)
         self._started = False
-        self.parameters = declare_model_source(self, NODE_PARAMETERS, build_settings, collision_threshold_specs)
-        self.parameters.on_change(self._use)
-        self.counts: Counter[str] = Counter()
-        self._reported = Counter()  # the counts at the last diagnostics
+        self.tally = Tally(self.get_logger())
+        self.counts = self.tally.counts
+        self._reported = self.counts.copy()  # the counts at the last diagnostics
         self._reference = None  # (time received [ns, node clock], q, qd, qdd or None)
+        self._differentiator = None
+        self.parameters = declare_model_source(self, NODE_PARAMETERS, check_settings, PER_JOINT_PARAMETERS,
+                                               finish=finish_settings, quick=compiled)
+        self.parameters.on_change(self._use)
         self.collision = CollisionMonitor(self, [], self.get_parameter("qos.depth").value)  # joints: by _use
         self._command_msg = Float64MultiArray()
         if self.parameters.current is not None:
@@ -132,16 +156,27 @@ class IdNode(Node):
             self._log_ready()
 
     def _use(self, settings: Settings) -> None:
-        """Switch to new (validated, compiled) settings; new joints come with a new model."""
+        """Switch to new (validated, compiled) settings; new joints come with a new model. A
+        held reference the new model gives no finite torques for is let go."""
         first, names = self.settings is None, list(settings.model.joint_names)
         if first or names != list(self.settings.model.joint_names):
             self._order = JointOrder(names)
+            self._zeros = [0.0] * len(names)
             self._feedforward_msg = JointState(name=names)
             self._gravity_msg = JointState(name=names)
             self._reference = None
-        self._differentiator = VelocityDifferentiator(settings.model.n, settings.cutoff_frequency)
+            self._differentiator = None
+        if self._differentiator is None or settings.cutoff_frequency != self.settings.cutoff_frequency:
+            self._differentiator = VelocityDifferentiator(settings.model.n, settings.cutoff_frequency)
         self.collision.use(settings.model, settings.collision)
         self.settings = settings
+        if self._reference is not None:
+            _, q, qd, qdd = self._reference
+            try:
+                finite_torques(rnea, settings.model, q, qd, self._zeros if qdd is None else qdd)
+            except BadMessage as error:
+                self._reference = None
+                self.tally.drop("reference", error)
         if first and self._started:  # the model came after startup
             self._log_ready()
 
@@ -149,44 +184,52 @@ class IdNode(Node):
         names = list(self.settings.model.joint_names)
         self.get_logger().info(f"ready: {len(names)} joints {names}, payload {self.settings.model.payload.mass} kg")
 
+    @guarded("joint_states")
     def _on_joint_state(self, msg: JointState) -> None:
-        self.counts["received"] += 1
-        if self.settings is None:
-            self.counts["no_model_yet"] += 1
+        self.counts["joint_states.received"] += 1
+        settings = self.settings
+        if settings is None:
+            self.counts["joint_states.no_model_yet"] += 1
             return
         try:
             q, qd = read_joint_state(msg, self._order)
+            tau, g, command = self._torques(msg, q, qd, settings)
         except NotForThisModel:
-            self.counts["ignored"] += 1
+            self.counts["joint_states.ignored"] += 1
             return
         except BadMessage as error:
-            count_and_warn(self.get_logger(), self.counts, "joint_states", error)
+            self.tally.drop("joint_states", error)
             return
-        settings = self.settings
-        model = settings.model
-        estimate = self._estimated_acceleration(msg, qd, settings)
-        q_ff, qd_ff, qdd_ref = self._fresh_reference(settings) or (q, qd, None)
-        try:  # the core refuses a result that would not be finite
-            tau = rnea(model, q_ff, qd_ff, estimate if qdd_ref is None else qdd_ref)
-            g = gravity(model, q)
-        except ValueError as error:
-            count_and_warn(self.get_logger(), self.counts, "joint_states", BadMessage("non_finite_torques", str(error)))
-            return
-
         stamp = msg.header.stamp
         self._feedforward_pub.publish(joint_efforts(self._feedforward_msg, stamp, tau))
         self._gravity_pub.publish(joint_efforts(self._gravity_msg, stamp, g))
-        if self._command_pub is not None:
-            if settings.effort_source == "gravity":
-                command = g
-            elif qdd_ref is None and settings.acceleration_mode == "differentiate":
-                command = rnea(model, q_ff, qd_ff, [0.0] * model.n)  # never a measured qdd
-            else:
-                command = tau
+        if command is not None:
             self._command_msg.data = command.tolist()
             self._command_pub.publish(self._command_msg)
-        self.counts["published"] += 1
+        self.counts["torques.published"] += 1
         self._observe(msg, q, qd, g)
+
+    def _torques(self, msg: JointState, q, qd, settings: Settings):
+        """(feed-forward, gravity, command torques or None), all finite, or BadMessage."""
+        model = settings.model
+        estimate = self._estimated_acceleration(msg, qd, settings)
+        q_ff, qd_ff, qdd_ref = self._fresh_reference(settings) or (q, qd, None)
+        try:
+            tau = finite_torques(rnea, model, q_ff, qd_ff, estimate if qdd_ref is None else qdd_ref)
+            g = finite_torques(gravity, model, q)
+            command = None
+            if self._command_pub is not None:
+                if settings.effort_source == "gravity":
+                    command = g
+                elif qdd_ref is None and settings.acceleration_mode == "differentiate":
+                    command = finite_torques(rnea, model, q_ff, qd_ff, self._zeros)  # never a measured qdd
+                else:
+                    command = tau
+        except BadMessage:
+            if settings.acceleration_mode == "differentiate":
+                self._differentiator.reset()  # the estimate may be what overflowed: start afresh
+            raise
+        return tau, g, command
 
     def _observe(self, msg: JointState, q, qd, g) -> None:
         """Efforts in the message: run the momentum observer (external torques, collision)."""
@@ -194,21 +237,25 @@ class IdNode(Node):
             effort = read_effort(msg, self._order)
         except BadMessage as error:
             self.collision.reset()
-            self.counts[error.kind] += 1
-            self.get_logger().warning(f"observer skipped a joint state ({error})", throttle_duration_sec=2.0)
+            self.counts[f"collision.{error.kind}"] += 1
+            self.tally.warn("collision", f"observer skipped a joint state ({error})")
             return
         if effort is None:
             return
         try:
             self.collision.update(self._time_of(msg), q, qd, effort, g, msg.header.stamp)
         except ValueError as error:
-            self.counts["observer_reset"] += 1
-            self.get_logger().warning(f"observer reset ({error})", throttle_duration_sec=2.0)
+            self.counts["collision.observer_reset"] += 1
+            self.tally.warn("collision", f"observer reset ({error})")
 
     def _estimated_acceleration(self, msg: JointState, qd, settings: Settings):
         if settings.acceleration_mode == "zero":
-            return [0.0] * settings.model.n
-        return self._differentiator.update(self._time_of(msg), qd)
+            return self._zeros
+        qdd = self._differentiator.update(self._time_of(msg), qd)
+        if not all(map(math.isfinite, qdd)):  # an absurd velocity jump overflowed the difference
+            self._differentiator.reset()
+            raise BadMessage("not_finite_acceleration", f"the differentiated velocities give {qdd}")
+        return qdd
 
     def _time_of(self, msg: JointState) -> float:
         """The message's stamp [s]; for an unstamped stream, the time of arrival."""
@@ -216,15 +263,19 @@ class IdNode(Node):
         t = stamp.sec + 1e-9 * stamp.nanosec
         return t if t != 0.0 else self.get_clock().now().nanoseconds * 1e-9
 
+    @guarded("reference")
     def _on_reference(self, msg: JointTrajectory) -> None:
-        """Hold the first point of a trajectory; an empty trajectory lets the reference go."""
+        """Hold the first point of a trajectory if the model gives finite torques there;
+        an empty trajectory lets the reference go."""
+        self.counts["reference.received"] += 1
         if not msg.points or self.settings is None:
             self._reference = None
             return
         try:
             q, qd, qdd = read_reference(msg, self._order)
+            finite_torques(rnea, self.settings.model, q, qd, self._zeros if qdd is None else qdd)
         except BadMessage as error:
-            count_and_warn(self.get_logger(), self.counts, "reference", error)
+            self.tally.drop("reference", error)
             return
         self._reference = (self.get_clock().now().nanoseconds, q, qd, qdd)
 
@@ -237,24 +288,32 @@ class IdNode(Node):
             return None
         return q, qd, qdd
 
+    @guarded("diagnostics")
     def _publish_diagnostics(self) -> None:
-        """Message counts; WARN while messages are dropped or joint_states stop coming."""
+        """Message counts; WARN while messages are dropped or joint_states stop coming,
+        ERROR when accepted parameters could not be applied."""
         recent = self.counts - self._reported
         self._reported = self.counts.copy()
         status = DiagnosticStatus(name=f"{self.get_name()}: messages", hardware_id=self.get_fully_qualified_name())
-        if self.settings is None:
+        dropped = sum(n for key, n in recent.items() if key.endswith((".dropped", ".errors")))
+        parameters = self.parameters.status()
+        if self.parameters.failure is not None:
+            status.level, status.message = DiagnosticStatus.ERROR, parameters
+        elif self.settings is None:
             status.level = DiagnosticStatus.WARN
             status.message = "waiting for the model (robot_description topic)"
-        elif recent["dropped"]:
+        elif dropped:
             status.level = DiagnosticStatus.WARN
-            status.message = f"{recent['dropped']} messages dropped in the last second"
-        elif self.counts["received"] and not recent["received"]:
+            status.message = f"{dropped} messages dropped in the last second"
+        elif self.counts["joint_states.received"] and not recent["joint_states.received"]:
             status.level = DiagnosticStatus.WARN
             status.message = "no joint_states in the last second"
         else:
             status.level = DiagnosticStatus.OK
-            status.message = f"{recent['published']} torque messages in the last second"
-        status.values = [KeyValue(key=key, value=str(value)) for key, value in sorted(self.counts.items())]
+            status.message = f"{recent['torques.published']} torque messages in the last second"
+        values = [KeyValue(key=key, value=str(value)) for key, value in sorted(self.counts.items())]
+        values.append(KeyValue(key="parameters", value=parameters or "in force"))
+        status.values = values
         collision = self.collision.status(self.get_name(), self.get_fully_qualified_name())
         msg = DiagnosticArray(status=[status, collision])
         msg.header.stamp = self.get_clock().now().to_msg()

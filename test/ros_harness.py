@@ -68,13 +68,24 @@ class Harness:
         return client
 
     def set_parameters(self, params: list[Parameter]):
-        """Set parameters one by one through the standard service; the results in order."""
+        """Set parameters one by one through the standard service; the results in order,
+        once the node has applied what it accepted."""
         client = self.parameter_client()
-        return self.call(lambda: client.set_parameters(params)).results
+        results = self.call(lambda: client.set_parameters(params)).results
+        self.settle()
+        return results
 
     def set_parameters_atomically(self, params: list[Parameter]):
         client = self.parameter_client()
-        return self.call(lambda: client.set_parameters_atomically(params)).result
+        result = self.call(lambda: client.set_parameters_atomically(params)).result
+        self.settle()
+        return result
+
+    def settle(self) -> None:
+        """Spin until the node's accepted parameter changes are in force (built off its executor)."""
+        parameters = getattr(self.node, "parameters", None)
+        if parameters is not None:
+            assert self.spin_until(lambda: parameters.pending_since is None), "parameters not applied in time"
 
     def close(self) -> None:
         self.executor.shutdown(timeout_sec=1.0)

@@ -170,7 +170,7 @@ def test_atomic_set_applies_all_or_none(node):
 )
 def test_bad_message_is_dropped_and_counted(node, msg, kind):
     send(node, msg, expect=0)
-    assert node.node.counts[f"dropped_{kind}"] == 1
+    assert node.node.counts[f"joint_states.dropped_{kind}"] == 1
     _, g = send(node, joint_state(STRETCHED))  # still alive and right
     np.testing.assert_allclose(g.effort, [0, 243.382, 79.1556, 0, 2.43004, 0], atol=1e-3)
 
@@ -215,7 +215,7 @@ def test_effort_commands_carry_the_feedforward_in_model_order():
 def test_messages_about_other_joints_only_are_ignored_quietly(node):
     gripper = JointState(name=["gripper_left", "gripper_right"], position=[0.01, 0.01])
     send(node, gripper, expect=0)
-    assert node.node.counts["ignored"] == 1 and node.node.counts["dropped"] == 0
+    assert node.node.counts["joint_states.ignored"] == 1 and node.node.counts["joint_states.dropped"] == 0
     msg = joint_state(STRETCHED)
     msg.effort = [math.nan] * 6  # effort is not used: its values do not matter
     _, g = send(node, msg)
@@ -257,7 +257,7 @@ def test_a_bad_reference_is_dropped_and_the_held_one_kept(node):
     reference.publish(reference_point(q_ref))
     assert node.spin_until(lambda: node.node._reference is not None)
     reference.publish(JointTrajectory(joint_names=NAMES[:5], points=[JointTrajectoryPoint(positions=[0.0] * 5)]))
-    assert node.spin_until(lambda: node.node.counts["dropped_missing_joints"] == 1)
+    assert node.spin_until(lambda: node.node.counts["reference.dropped_missing_joints"] == 1)
     ff, _ = send(node, joint_state(STRETCHED))
     np.testing.assert_allclose(ff.effort, rnea(irb140(), q_ref, np.zeros(6), np.zeros(6)), rtol=1e-12, atol=1e-12)
 
@@ -307,4 +307,4 @@ def test_diagnostics_warn_about_dropped_messages(node):
     assert node.spin_until(warned, timeout=5.0)
     status = [s for d in diagnostics for s in d.status if s.level == DiagnosticStatus.WARN][0]
     assert status.name == "id_node: messages" and "dropped" in status.message
-    assert {kv.key: kv.value for kv in status.values}["dropped_not_finite"] == "1"
+    assert {kv.key: kv.value for kv in status.values}["joint_states.dropped_not_finite"] == "1"

@@ -201,19 +201,22 @@ def test_a_payload_loading_a_joint_without_limit_is_noted_and_warned(node):
     assert statuses["joint_6"].level == DiagnosticStatus.OK
 
 
-def test_a_failure_deriving_the_limits_or_sweeping_refuses_the_change(node, monkeypatch):
-    """The limits and the workspace sweep are part of building the settings: a failure
-    there is a refused change, the old settings stay, and nothing is built twice."""
+def test_a_failure_of_the_analysis_is_reported_and_the_next_change_recovers(node, monkeypatch):
+    """The limits and the workspace analysis run once a change is accepted, off the
+    executor: a failure there (a defect) keeps the previous settings, ~/check says it
+    cannot check, and the next change is analysed once and in force."""
     at_pose(node, STRETCHED)
-    before, settings = check(node).message, node.node.settings
+    settings = node.node.settings
 
     def failing(*args, **kwargs):
         raise ValueError("payload.com: the sweep failed")
 
     monkeypatch.setattr(module, "workspace_load", failing)
-    [result] = node.set_parameters([Parameter("payload.mass", value=2.0)])
-    assert not result.successful and "the sweep failed" in result.reason
-    assert node.node.settings is settings and check(node).message == before
+    assert [r.successful for r in node.set_parameters([Parameter("payload.mass", value=2.0)])] == [True]
+    assert node.node.settings is settings
+    reply = check(node)
+    assert not reply.success
+    assert reply.message == "cannot check: parameters accepted but not applied: payload.com: the sweep failed"
 
     built = []
 
@@ -222,9 +225,11 @@ def test_a_failure_deriving_the_limits_or_sweeping_refuses_the_change(node, monk
         return built[-1]
 
     monkeypatch.setattr(module, "workspace_load", sweep)
-    assert [r.successful for r in node.set_parameters([Parameter("payload.mass", value=2.0)])] == [True]
-    assert len(built) == 1 and node.node.settings.workspace is built[0]  # built once, when checked
-    assert node.node.settings.model.payload.mass == 2.0
+    assert [r.successful for r in node.set_parameters([Parameter("payload.mass", value=3.0)])] == [True]
+    assert len(built) == 1 and node.node.settings.workspace is built[0]  # built once
+    assert node.node.settings.model.payload.mass == 3.0
+    reply = check(node)
+    assert reply.success and reply.message.startswith("payload 3.000 kg"), reply.message
 
 
 def test_fresh_joint_states_carry_no_age_note(node):

@@ -114,7 +114,7 @@ def test_topic_after_start_waits_then_swaps_whole_models_and_refuses_bad_ones():
         inbox = harness.listen(JointState, "gravity_torques")
         harness.joint_states = harness.publisher(JointState, "joint_states")
         harness.joint_states.publish(JointState(name=["shoulder_pan_joint"], position=[0.0]))
-        assert harness.spin_until(lambda: node.counts["no_model_yet"] == 1)
+        assert harness.spin_until(lambda: node.counts["joint_states.no_model_yet"] == 1)
         harness.spin_for(0.2)
         assert not inbox, "published torques without a model"
 

@@ -77,8 +77,9 @@ class MomentumObserver:
             self._t, self._p0, self._integral, self._drive = t, p, np.zeros(n), drive
             return self.r.copy()
         dt = t - self._t
-        integral = self._integral + 0.5 * (drive + self._drive) * dt + self.r * dt
-        r = self.gain * (p - self._p0 - integral)
+        with np.errstate(over="ignore", invalid="ignore"):  # checked just below
+            integral = self._integral + 0.5 * (drive + self._drive) * dt + self.r * dt
+            r = self.gain * (p - self._p0 - integral)
         if not np.all(np.isfinite(r)):
             self.reset()
             raise ValueError(f"observer residual not finite: {r.tolist()}")

@@ -11,15 +11,29 @@ from trajectory_msgs.msg import JointTrajectory
 
 from ..core.joint_order import BadMessage, JointOrder, NotForThisModel
 
-__all__ = ["BadMessage", "JointOrder", "NotForThisModel", "count_and_warn", "joint_efforts", "read_effort", "read_joint_state",
-           "read_reference"]
+__all__ = ["BadMessage", "JointOrder", "NotForThisModel", "count_and_warn", "finite_torques", "joint_efforts",
+           "read_effort", "read_joint_state", "read_reference"]
 
 
 def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> None:
-    """Count a dropped message by kind, and warn about it (every 2 s at most)."""
+    """Count a dropped message by kind, and warn about it (every 2 s at most). (id_node and
+    payload_check_node count per topic with ros.guard.Tally.)"""
     counts[f"dropped_{error.kind}"] += 1
     counts["dropped"] += 1
     logger.warning(f"dropped a {topic} message ({error})", throttle_duration_sec=2.0)
+
+
+def finite_torques(function, model, *state):
+    """``function(model, *state)`` (rnea, gravity) when all its torques are finite, else
+    BadMessage non_finite_torques (an absurd but finite state can overflow the model's
+    sums; the core may return the non-finite torques or refuse them with ValueError)."""
+    try:
+        tau = function(model, *state)
+    except ValueError as error:
+        raise BadMessage("non_finite_torques", str(error)) from None
+    if not (math.isfinite(sum(tau)) or all(map(math.isfinite, tau))):
+        raise BadMessage("non_finite_torques", f"the model gives {[float(x) for x in tau]}")
+    return tau
 
 
 def _pick(values, index: list[int], field: str, length: int, required: bool) -> list[float]:

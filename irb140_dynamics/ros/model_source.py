@@ -27,7 +27,8 @@ from std_msgs.msg import String
 
 from ..core import Joint, RigidBody, RobotModel
 from ..core.urdf import LoadedUrdf, load_urdf
-from .params import LiveParameters, Spec, _declare, check_choice, declare_model, model_specs
+from .live import LiveParameters
+from .params import Spec, _declare, check_choice, declare_model, model_specs
 
 PerJoint = Callable[[list[str]], list[Spec]]  # a node's parameters for each joint of a model
 SOURCES = ("parameters", "robot_description")
@@ -50,24 +51,30 @@ DESCRIPTION_PARAMETERS = [
 
 
 def declare_model_source(
-    node: Node, extra: list[Spec], build: Callable[[dict], Any], per_joint: PerJoint | None = None
+    node: Node, extra: list[Spec], check: Callable[[dict], Any], per_joint: PerJoint | None = None,
+    finish: Callable[[Any, Any], Any] | None = None, startup_wait: float | None = None,
+    quick: Callable[[Any, Any], bool] | None = None,
 ) -> LiveParameters:
     """Declare ``model.source`` and the model's parameters of that source, and a node's own
-    (``extra``, and ``per_joint`` specs made for the model's joint names); ``build`` as for
-    LiveParameters. With the robot_description topic the returned parameters' ``current``
-    is None until a model arrives, and the per-joint specs are declared as models come."""
+    (``extra``, and ``per_joint`` specs made for the model's joint names); ``check``,
+    ``finish``, ``startup_wait`` and ``quick`` as for LiveParameters. With the
+    robot_description topic the returned parameters' ``current`` is None until a model
+    arrives, and the per-joint specs are declared as models come."""
     source = _declare(node, SOURCE)
     check_choice("model.source", source, SOURCES)
     if source == "parameters":
-        return declare_model(node, extra, build, per_joint)
-    return RobotDescription(node, extra, build, per_joint or (lambda names: [])).parameters
+        return declare_model(node, extra, check, per_joint, finish, startup_wait, quick)
+    later = dict(finish=finish, startup_wait=startup_wait, quick=quick)
+    return RobotDescription(node, extra, check, per_joint or (lambda names: []), later).parameters
 
 
 class RobotDescription:
     """The model of a node from a URDF: parameter, file or topic (see the module)."""
 
-    def __init__(self, node: Node, extra: list[Spec], build: Callable[[dict], Any], per_joint: PerJoint):
-        self._node, self._build_node, self._per_joint = node, build, per_joint
+    def __init__(self, node: Node, extra: list[Spec], check: Callable[[dict], Any], per_joint: PerJoint,
+                 later: dict | None = None):
+        """``later``: LiveParameters' finish, startup_wait and quick."""
+        self._node, self._build_node, self._per_joint = node, check, per_joint
         text, path, base, tip = (_declare(node, spec) for spec in DESCRIPTION_PARAMETERS)
         self._chain_ends = (base or None, tip or None)
         self.urdf: LoadedUrdf | None = None  # the URDF's chain of the model in use
@@ -76,7 +83,7 @@ class RobotDescription:
         if text or path:
             self.urdf = self._load(text or _read(path), origin)
         own = per_joint(self.urdf.model.joint_names) if self.urdf is not None else []
-        self.parameters = LiveParameters(node, [*model_specs([], {}), *extra, *own], self._build)
+        self.parameters = LiveParameters(node, [*model_specs([], {}), *extra, *own], self._build, **(later or {}))
         if self.urdf is not None:
             self._announce(origin)
             return
@@ -101,8 +108,9 @@ class RobotDescription:
         )
 
     def _build(self, values: dict) -> Any:
-        """The node's configuration from the URDF's model and the parameter values. Until a
-        URDF has come: None, the parameters checked on a stand-in one-joint arm."""
+        """The node's checked configuration (its draft) from the URDF's model and the
+        parameter values. Until a URDF has come: None, the parameters checked on a stand-in
+        one-joint arm."""
         if self.urdf is None:
             stand_in_defaults = {spec.name: spec.default for spec in self._per_joint(STAND_IN.joint_names)}
             self._build_node({**STAND_IN.to_params(), **stand_in_defaults, **values})
@@ -119,7 +127,7 @@ class RobotDescription:
         try:
             urdf = self._load(msg.data, "robot_description topic")
             self.parameters.declare(self._per_joint(urdf.model.joint_names))
-            configuration = self._build_with(urdf, self.parameters.values())
+            draft = self._build_with(urdf, self.parameters.values())
         except Exception as error:  # noqa: BLE001: nothing of ours may leave a callback
             self.refused += 1
             kind = "" if isinstance(error, ValueError) else f"{type(error).__name__}: "
@@ -127,7 +135,7 @@ class RobotDescription:
             logger.error(f"refused a robot_description ({keeping}): {self.last_refusal}")
             return
         self.urdf = urdf
-        self.parameters.replace(configuration)
+        self.parameters.submit(draft)  # finished (compiled, analysed) off the executor when slow
         self._announce("robot_description topic")
 
 

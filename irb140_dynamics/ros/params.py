@@ -1,14 +1,15 @@
-"""Parameters of the nodes: declared with descriptors, validated whole, swapped atomically.
+"""Parameters of the nodes: declared with descriptors, validated whole, applied off the executor.
 
-A node lists its parameters as ``Spec``s and gives a ``build`` function that turns all of
-their values into the configuration it runs on (a RobotModel, options), raising ValueError
-naming the parameter when something is wrong. Everything that can fail, and everything
-slow (compiling kernels), belongs in ``build``: a configuration that was built is used
-(``build`` may return None while an input from elsewhere, a URDF, has yet to come).
-``LiveParameters`` declares them, builds the
-first configuration (a failure stops startup), and from then on checks every change by
-building the whole new configuration before it is accepted: a refused change keeps the old
-configuration, an accepted one replaces it in a single assignment.
+A node lists its parameters as ``Spec``s and gives two functions: ``check`` turns all of
+their values into a draft of the configuration it runs on (a RobotModel, options),
+raising ValueError naming the parameter when something is wrong, quickly; ``finish``
+does the slow rest (compiling kernels, the workspace analysis); a draft may be None while
+an input from elsewhere, a URDF, has yet to come. ``LiveParameters`` (see ``live``)
+declares the parameters, builds the first configuration (a failure stops startup), and
+from then on checks every change whole before it is accepted (a refused change keeps the
+old configuration), then finishes it off the executor and swaps it in: a change stalls no
+message. Parameters given that no node of the package knows are warned about by name,
+with the nearest known name.
 """
 
 from __future__ import annotations
@@ -17,14 +18,16 @@ import math
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
-from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from ..core.model import check_joint_names, read_parameter_file
 from ..package_files import CONFIG_NAME, PACKAGE, default_config_path  # noqa: F401 (PACKAGE, CONFIG_NAME: re-exported)
+from .live import LiveParameters, declare
+
+_declare = declare  # the name model_source imports
 
 
 
@@ -37,13 +40,20 @@ class Spec:
     description: str
     unit: str = ""
     read_only: bool = False
-    minimum: float | None = None  # for double parameters
+    minimum: float | None = None  # for double and integer parameters
     maximum: float | None = None
 
     def descriptor(self) -> ParameterDescriptor:
         unit = f" [{self.unit}]" if self.unit else ""
         descriptor = ParameterDescriptor(description=self.description + unit, read_only=self.read_only)
-        if self.minimum is not None or self.maximum is not None:
+        if isinstance(self.default, int) and not isinstance(self.default, bool):
+            if self.minimum is not None or self.maximum is not None:
+                descriptor.integer_range = [IntegerRange(
+                    from_value=-2**63 if self.minimum is None else int(self.minimum),
+                    to_value=2**63 - 1 if self.maximum is None else int(self.maximum),
+                    step=1,
+                )]
+        elif self.minimum is not None or self.maximum is not None:
             descriptor.floating_point_range = [
                 FloatingPointRange(
                     from_value=-math.inf if self.minimum is None else self.minimum,
@@ -54,12 +64,14 @@ class Spec:
         return descriptor
 
 
+MAX_QOS_DEPTH = 10_000  # messages: 10 s at 1 kHz; DDS may reserve memory for the whole depth
 RELIABILITIES = {"best_effort": ReliabilityPolicy.BEST_EFFORT, "reliable": ReliabilityPolicy.RELIABLE}
 QOS_PARAMETERS = [
     Spec("qos.reliability", "best_effort",
          "joint_states subscription reliability: 'best_effort' (takes reliable and best-effort publishers) "
          "or 'reliable'", read_only=True),
-    Spec("qos.depth", 10, "queue depth of joint_states, ~/reference and the torque topics", read_only=True),
+    Spec("qos.depth", 10, "queue depth of joint_states, ~/reference and the torque topics", read_only=True,
+         minimum=1, maximum=MAX_QOS_DEPTH),
 ]
 
 
@@ -70,8 +82,9 @@ def check_choice(name: str, value, choices) -> None:
 
 def check_qos(values: dict) -> None:
     check_choice("qos.reliability", values["qos.reliability"], RELIABILITIES)
-    if values["qos.depth"] < 1:
-        raise ValueError(f"qos.depth: must be >= 1, got {values['qos.depth']}")
+    depth = values["qos.depth"]
+    if not (isinstance(depth, int) and 1 <= depth <= MAX_QOS_DEPTH):
+        raise ValueError(f"qos.depth: must be between 1 and {MAX_QOS_DEPTH}, got {depth}")
 
 
 def joint_states_qos(node: Node) -> QoSProfile:
@@ -134,105 +147,31 @@ def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
 
 
 def declare_model(
-    node: Node, extra: list[Spec], build: Callable[[dict], Any], per_joint: Callable[[list[str]], list[Spec]] = None
-) -> "LiveParameters":
+    node: Node, extra: list[Spec], check: Callable[[dict], Any], per_joint: Callable[[list[str]], list[Spec]] = None,
+    finish: Callable[[Any, Any], Any] | None = None, startup_wait: float | None = None,
+    quick: Callable[[Any, Any], bool] | None = None,
+) -> LiveParameters:
     """Declare the robot model's parameters and a node's own (``extra``, and ``per_joint``
-    specs made for the model's joint names), with the default model's defaults."""
+    specs made for the model's joint names), with the default model's defaults (see
+    LiveParameters for ``check``, ``finish``, ``startup_wait`` and ``quick``)."""
     path = default_config_path()
     if not path.is_file():
         raise ValueError(f"default model: no {path}; is the package installed? (or give --params-file)")
     defaults = read_parameter_file(path)
     node.get_logger().info(f"default model: {path}")
-    names = _declare(
+    names = declare(
         node,
         Spec("joint_names", defaults["joint_names"], "the model's joints, base to flange", read_only=True),
     )
     names = check_joint_names(names)  # they become parameter prefixes: check them first
     own = per_joint(names) if per_joint else []
-    return LiveParameters(node, [*model_specs(names, defaults), *extra, *own], build, ["joint_names"])
+    specs = [*model_specs(names, defaults), *extra, *own]
+    return LiveParameters(node, specs, check, finish, declared=["joint_names"], startup_wait=startup_wait, quick=quick)
 
 
-class LiveParameters:
-    """The node's validated configuration, kept in step with its parameters."""
-
-    def __init__(self, node: Node, specs: list[Spec], build: Callable[[dict], Any], declared=()):
-        """``declared``: names of parameters the caller has declared already."""
-        self._node, self._build = node, build
-        self._names = [spec.name for spec in specs] + list(declared)
-        for spec in specs:
-            _declare(node, spec)
-        self.current = build(self.values())
-        self._pending = None  # (values, configuration) checked, not yet applied
-        self._listeners: list[Callable[[Any], None]] = []
-        node.add_pre_set_parameters_callback(self._coerce_integers)
-        node.add_on_set_parameters_callback(self._check)
-        node.add_post_set_parameters_callback(self._apply)
-
-    def values(self, changes=()) -> dict[str, Any]:
-        """All parameter values by name, with ``changes`` (Parameters) applied on top."""
-        values = {name: self._node.get_parameter_or(name).value for name in self._names}
-        values.update({p.name: p.value for p in changes})
-        return values
-
-    def on_change(self, listener: Callable[[Any], None]) -> None:
-        self._listeners.append(listener)
-
-    def declare(self, specs: list[Spec]) -> None:
-        """Declare more parameters (a new model's per-joint ones); those declared already stay."""
-        for spec in specs:
-            if not self._node.has_parameter(spec.name):
-                _declare(self._node, spec)
-                self._names.append(spec.name)
-
-    def _coerce_integers(self, parameters: list[Parameter]) -> list[Parameter]:
-        """Let `ros2 param set ... payload.mass 3` mean 3.0 for a double parameter."""
-        coerced = []
-        for p in parameters:
-            wanted = self._type_of(p.name)
-            if wanted == Parameter.Type.DOUBLE and p.type_ == Parameter.Type.INTEGER:
-                p = Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
-            elif wanted == Parameter.Type.DOUBLE_ARRAY and p.type_ == Parameter.Type.INTEGER_ARRAY:
-                p = Parameter(p.name, Parameter.Type.DOUBLE_ARRAY, [float(x) for x in p.value])
-            coerced.append(p)
-        return coerced
-
-    def _type_of(self, name: str):
-        if not self._node.has_parameter(name):
-            return None
-        return Parameter.Type(self._node.describe_parameter(name).type)
-
-    def _check(self, parameters: list[Parameter]) -> SetParametersResult:
-        """Build the whole new configuration; refuse the change if that fails."""
-        values = self.values(parameters)
-        try:
-            self._pending = (values, self._build(values))
-        except ValueError as error:
-            self._pending = None
-            return SetParametersResult(successful=False, reason=str(error))
-        return SetParametersResult(successful=True)
-
-    def _apply(self, parameters: list[Parameter]) -> None:
-        """Swap in the configuration built by _check for exactly these values."""
-        pending, self._pending = self._pending, None
-        if pending is None or pending[0] != self.values():  # not the change just checked
-            return
-        self.replace(pending[1])
-
-    def replace(self, configuration) -> None:
-        """Swap in a configuration built from the current values (and an input from outside
-        the parameters, such as a new robot_description). None: nothing to run on yet."""
-        self.current = configuration
-        if configuration is not None:
-            for listener in self._listeners:
-                listener(configuration)
-
-
-def _declare(node: Node, spec: Spec):
-    try:
-        return node.declare_parameter(spec.name, spec.default, spec.descriptor()).value
-    except InvalidParameterTypeException:
-        kind = spec.default if isinstance(spec.default, Parameter.Type) else Parameter.Type.from_parameter_value(spec.default)
-        hint = "; write doubles with a decimal point, e.g. 2.0" if "DOUBLE" in kind.name else ""
-        raise ValueError(f"{spec.name}: expected a value of type {kind.name.lower()}{hint}") from None
-    except InvalidParameterValueException as error:
-        raise ValueError(f"{spec.name}: {error}") from None
+def check_number(name: str, value, minimum: float, maximum: float, unit: str = "") -> float:
+    """A finite number within [minimum, maximum], or ValueError naming the parameter."""
+    unit = f" {unit}" if unit else ""
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and minimum <= value <= maximum):
+        raise ValueError(f"{name}: must be between {minimum:g} and {maximum:g}{unit}, got {value}")
+    return float(value)

@@ -2,16 +2,16 @@
 
 from __future__ import annotations
 
+import gc
 import re
 import sys
 from typing import Callable
 
 import rclpy
+import rclpy.logging
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
-
-
 
 EXECUTORS = ("events", "single_threaded")
 
@@ -20,19 +20,12 @@ def run(name: str, make_node: Callable[[], Node], args: list[str] | None = None,
     """Init rclpy, build the node, spin until Ctrl-C or shutdown; 0 on a clean exit.
 
     A model or parameter error at startup prints one line naming the bad field and
-    returns 1 (no traceback). ``executor``: see ``spin``.
+    returns 1 (no traceback); so does Ctrl-C before the node is ready. ``executor``: see
+    ``spin``.
     """
     args = sys.argv if args is None else args
-    logger = rclpy.logging.get_logger(name)
-    try:
-        rclpy.init(args=args)
-    except rclpy_implementation.RCLError as error:
-        logger.fatal(f"cannot start: {init_error(error)}")
-        return 1
-    try:
-        node = make_node()
-    except ValueError as error:
-        logger.fatal(f"cannot start: {_one_line(error)}")
+    node = _start(make_node, args, rclpy.logging.get_logger(name))
+    if node is None:
         rclpy.try_shutdown()
         return 1
     try:
@@ -43,6 +36,34 @@ def run(name: str, make_node: Callable[[], Node], args: list[str] | None = None,
         node.destroy_node()
         rclpy.try_shutdown()
     return 0
+
+
+INTERRUPTED = "cannot start: interrupted (Ctrl-C) before the node was ready"
+
+
+def _start(make_node: Callable[[], Node], args: list[str], logger) -> Node | None:
+    """The node, or None after one FATAL line: rcl refused the arguments, a parameter is
+    bad (ValueError), or Ctrl-C came first (rclpy then shuts the context down, and the
+    next rclpy call of the half-built node fails, or KeyboardInterrupt is raised)."""
+    try:
+        try:
+            rclpy.init(args=args)
+        except rclpy_implementation.RCLError as error:
+            logger.fatal(f"cannot start: {init_error(error)}")
+            return None
+        try:
+            return make_node()
+        except Exception as error:  # noqa: BLE001  (sorted here: ours, or Ctrl-C half-way)
+            if rclpy.ok() and not isinstance(error, ValueError):
+                raise
+            why = f"cannot start: {_one_line(error)}" if rclpy.ok() else INTERRUPTED
+    except KeyboardInterrupt:
+        why = INTERRUPTED
+    # out of the except blocks: the half-built node is gone with the traceback, and with it
+    # its /rosout publisher, which would complain of the shut-down context
+    gc.collect()
+    logger.fatal(why)
+    return None
 
 
 def spin(node: Node, executor: str = "events") -> None:
@@ -86,7 +107,7 @@ def init_error(error: Exception) -> str:
     if not found:
         return text.split(", at /")[0]
     path, reason, line = found["path"], found["reason"].rstrip(". "), found["line"]
-    if line is None:
+    if line is None or int(line) < 1:  # rcl gives line 0 for some errors (a binary file)
         return f"{path}: {reason}"
     source = _line(path, int(line))
     hint = "; write every number of a list as a double, e.g. 0.0 not 0" if "same type" in reason else ""
@@ -94,8 +115,9 @@ def init_error(error: Exception) -> str:
 
 
 def _line(path: str, number: int) -> str:
+    """Line ``number`` of the file, undecodable bytes shown as \\xNN (a binary file)."""
     try:
-        with open(path) as stream:
+        with open(path, encoding="utf-8", errors="backslashreplace") as stream:
             return stream.read().splitlines()[number - 1].strip()
     except (OSError, IndexError):
         return "?"
