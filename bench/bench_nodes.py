@@ -166,6 +166,14 @@ def joint_stream(count: int, rate: float) -> tuple[list, list]:
     return (CENTRE + AMPLITUDE * np.sin(w * t)).tolist(), (AMPLITUDE * w * np.cos(w * t)).tolist()
 
 
+def joint_efforts(positions: list, velocities: list) -> list:
+    """Efforts a driver would publish along the stream: the model's torques at qdd = 0."""
+    from irb140_dynamics.core import irb140, rnea_batch
+
+    Q = np.array(positions)
+    return rnea_batch(irb140(), Q, np.array(velocities), np.zeros_like(Q)).tolist()
+
+
 def machine_busy() -> tuple[int, int]:
     """(busy, total) jiffies of all CPUs so far, from /proc/stat."""
     with open("/proc/stat") as stat:
@@ -176,9 +184,11 @@ def machine_busy() -> tuple[int, int]:
 
 def stream_run(node, kind: str, executor: str, rate: float, duration: float, warmup: float,
                env: dict, index: int, profile: bool = False, lean: bool = False,
-               change_period: float | None = None) -> dict:
+               change_period: float | None = None, effort: bool = False) -> dict:
     """Start the node, stream joint states at ``rate`` through it, return the raw figures.
 
+    ``effort``: every joint state carries efforts (id_node then runs its momentum observer
+    and publishes external_torques too).
     ``profile``: py-spy samples the node over the measured window (bench/results/profile_*.txt).
     ``change_period``: set payload.mass (a new value each time) every that many seconds
     over the measured window, through the parameter service (see ParameterChanger).
@@ -209,6 +219,7 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
         first = round(warmup * rate)
         total = first + round(duration * rate)
         positions, velocities = joint_stream(total, rate)
+        efforts = joint_efforts(positions, velocities) if effort else None
         stamps = np.zeros(total, dtype=np.int64)
         lateness = np.zeros(total)
         msg = JointState(name=NAMES)
@@ -227,6 +238,8 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
             if remaining > 0:  # no busy-wait: its CPU would be taken from the node under test
                 sleep(remaining)
             msg.position, msg.velocity = positions[i], velocities[i]
+            if efforts is not None:
+                msg.effort = efforts[i]
             stamp = now_ns()
             msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp, 1_000_000_000)
             lateness[i] = clock() - deadline
@@ -378,7 +391,8 @@ def lost_runs(measured: np.ndarray, arrived: np.ndarray, rate: float, most: int 
 
 
 def end_to_end(rates, executors, duration, warmup, env, profile=False, lean=False,
-               change_period: float | None = None, change_rate: float = CHANGE_RATE) -> tuple[list[Row], list[dict]]:
+               change_period: float | None = None, change_rate: float = CHANGE_RATE,
+               effort: bool = False) -> tuple[list[Row], list[dict]]:
     """Per executor and rate: the relay, then id_node, each in a fresh process; then, with
     ``change_period``, both again at ``change_rate`` with a parameter change every
     ``change_period`` s."""
@@ -397,7 +411,7 @@ def end_to_end(rates, executors, duration, warmup, env, profile=False, lean=Fals
                 every = "" if changes is None else f", payload.mass set every {changes * 1e3:g} ms"
                 print(f"  {kind} at {rate:g} Hz, {executor}{every}: {warmup + duration:g} s ...", flush=True)
                 run = stream_run(node, kind, executor, rate, duration, warmup, env, len(runs), profile, lean,
-                                 changes)
+                                 changes, effort)
                 runs.append(run)
                 d = run["delay_us"]
                 print(f"    p50 {_opt(d['p50'])} us, p99 {_opt(d['p99'])} us, max {_opt(d['max'])} us, "
@@ -601,6 +615,8 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help="only the soak: id_node and the relay side by side at 1 kHz for MINUTES "
                              "(10 in the issue), their RSS growth (bench/results/soak.json)")
     parser.add_argument("--no-stream", action="store_true", help="skip the end-to-end section")
+    parser.add_argument("--effort", action="store_true",
+                        help="joint states carry efforts: id_node's momentum observer runs on every message")
     parser.add_argument("--profile", action="store_true",
                         help="sample each node with py-spy over the measured window "
                              "(bench/results/profile_*.txt; perturbs the figures a little)")
@@ -623,13 +639,15 @@ def main(argv=None) -> None:
     rows, runs, payload = [], [], {}
     if not args.no_stream:
         stream, runs = end_to_end(args.rates, args.executor, args.duration, args.warmup, env, args.profile,
-                                  args.no_event_handlers, None if args.no_changes else args.change_period)
+                                  args.no_event_handlers, None if args.no_changes else args.change_period,
+                                  effort=args.effort)
         rows += stream
     if not args.no_payload:
         print("  payload check ...", flush=True)
         payload_table, payload = payload_rows(env)
         rows += payload_table
-    print_table(rows, "irb140_dynamics nodes (ratio = ours / baseline; delays: publish -> torques received)")
+    observer = "; joint states with efforts: observer on" if args.effort else ""
+    print_table(rows, f"irb140_dynamics nodes (ratio = ours / baseline; delays: publish -> torques received{observer})")
     busy = [r for r in runs if r["other_processes_cores"] > OTHERS_WARNING]
     if busy:
         worst = max(r["other_processes_cores"] for r in busy)
@@ -640,10 +658,11 @@ def main(argv=None) -> None:
         for r in runs:
             top = ", ".join(f"{name} {share:g}%" for name, share in r.get("profile", {}).get("top", [])[:8])
             print(f"  {r['node']} {r['rate_hz']:g} Hz {r['executor']}: {top}")
+    name = "nodes_effort" if args.effort else "nodes"
     path = write_results(
-        "nodes",
+        name,
         {
-            "benchmark": "nodes",
+            "benchmark": name,
             "machine": machine_info(("numpy", "rclpy")),
             "settings": {
                 "duration_s": args.duration,
@@ -655,6 +674,7 @@ def main(argv=None) -> None:
                 "rmw": os.environ.get("RMW_IMPLEMENTATION", "default (rmw_fastrtps_cpp)"),
                 "ros_domain_id": domain_id,
                 "profiled": args.profile,
+                "efforts": args.effort,
                 "qos_event_handlers": not args.no_event_handlers,
             },
             "rows": [row.as_dict() for row in rows],

@@ -69,7 +69,7 @@ NODE_PARAMETERS = [
          "so effort_commands never use it)"),
     Spec("acceleration.cutoff_frequency", 20.0, "cut-off of the velocity differentiation filter", "Hz",
          minimum=1e-3, maximum=MAX_CUTOFF_FREQUENCY),
-    Spec("reference_timeout", 0.5, "a ~/reference older than this (node clock) is no longer used; 0 = never",
+    Spec("reference_timeout", 0.5, "a ~/reference is let go this long after its last point (node clock); 0 = never",
          "s", minimum=0.0, maximum=MAX_TIMEOUT),
     Spec("effort_commands.enabled", False, "also publish torques on effort_commands (Float64MultiArray)",
          read_only=True),
