@@ -7,7 +7,7 @@ point held after the end. It is in force until reference_timeout after its last 
 
 With ``effort_commands.source: computed_torque`` the commands are
 
-    tau = M(q) (qdd_ref + Kd (qd_ref - qd) + Kp (q_ref - q)) + C(q, qd) qd + g(q) + tau_f(qd)
+    tau = M(q) (qdd_ref + Kd (qd_ref - qd) + Kp (q_ref - q)) + C(q, qd) qd + g(q) + tau_f(qd_ref)
 
 (core.trajectory.computed_torque), with per-joint gains ``<joint>.kp`` [1/s^2] and
 ``<joint>.kd`` [1/s]; without a reference in force the arm holds the position measured
