@@ -85,12 +85,10 @@ class MomentumObserver:
             self._t, self._p0, self._integral, self._drive = t, p, [0.0] * n, drive
             return self.r
         dt, K = t - self._t, self.gain
-        try:
+        with np.errstate(over="ignore", invalid="ignore"):  # NumPy scalars among them: checked below
             integral = [i + 0.5 * (d + d0) * dt + r * dt
                         for i, d, d0, r in zip(self._integral, drive, self._drive, self._r)]
             r = [K * (x - x0 - i) for x, x0, i in zip(p, self._p0, integral)]
-        except OverflowError:
-            r = [math.inf]
         if not math.isfinite(sum(r)) and not all(map(math.isfinite, r)):
             self.reset()
             raise ValueError(f"observer residual not finite: {r}")
