@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 import numpy as np
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
@@ -32,6 +32,7 @@ from trajectory_msgs.msg import JointTrajectory
 
 from .core import gravity, rnea
 from .core.filters import VelocityDifferentiator
+from .ros.diagnostics import message_status
 from .ros.guard import Tally, guarded
 from .ros.messages import (
     BadMessage,
@@ -238,32 +239,12 @@ class IdNode(Node):
 
     @guarded("diagnostics")
     def _publish_diagnostics(self) -> None:
-        """Message counts; WARN while messages are dropped or joint_states stop coming,
-        ERROR when accepted parameters could not be applied."""
+        """Message counts (see message_status) and the collision status."""
         recent = self.counts - self._reported
         self._reported = self.counts.copy()
-        status = DiagnosticStatus(name=f"{self.get_name()}: messages", hardware_id=self.get_fully_qualified_name())
-        dropped = sum(n for key, n in recent.items() if key.endswith((".dropped", ".errors")))
-        parameters = self.parameters.status()
-        if self.parameters.failure is not None:
-            status.level, status.message = DiagnosticStatus.ERROR, parameters
-        elif self.settings is None:
-            status.level = DiagnosticStatus.WARN
-            status.message = "waiting for the model (robot_description topic)"
-        elif dropped:
-            status.level = DiagnosticStatus.WARN
-            status.message = f"{dropped} messages dropped in the last second"
-        elif self.counts["joint_states.received"] and not recent["joint_states.received"]:
-            status.level = DiagnosticStatus.WARN
-            status.message = "no joint_states in the last second"
-        else:
-            status.level = DiagnosticStatus.OK
-            status.message = f"{recent['torques.published']} torque messages in the last second"
-        values = [KeyValue(key=key, value=str(value)) for key, value in sorted(self.counts.items())]
-        values.append(KeyValue(key="parameters", value=parameters or "in force"))
-        status.values = values
-        collision = self.collision.status(self.get_name(), self.get_fully_qualified_name())
-        msg = DiagnosticArray(status=[status, collision])
+        name, hardware_id = self.get_name(), self.get_fully_qualified_name()
+        status = message_status(name, hardware_id, self.counts, recent, self.parameters, self.settings is None)
+        msg = DiagnosticArray(status=[status, self.collision.status(name, hardware_id)])
         msg.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(msg)
 

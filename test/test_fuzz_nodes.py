@@ -21,7 +21,7 @@ from irb140_dynamics.core import RobotModel, check_payload, gravity, rnea
 from irb140_dynamics.id_node import IdNode
 from irb140_dynamics.payload_check_node import PayloadCheckNode
 
-from .fuzz_inputs import NAMES, Fuzzer, parameter_set
+from .fuzz_inputs import Fuzzer, parameter_set
 from .ros_harness import running
 
 BUDGET = 2.5  # s of fuzzing per node and mode, at most

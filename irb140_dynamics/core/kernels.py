@@ -157,7 +157,8 @@ class _ArmKernels:
         return self._kernel(
             "rnea_wrench",
             lambda cs, qd, qdd, wrench, k: algorithms.rnea(
-                self._links(k), cs, qd, qdd, self._gravity(k), *algorithms.flange_wrench(self.flange, wrench[:3], wrench[3:])
+                self._links(k), cs, qd, qdd, self._gravity(k),
+                *algorithms.flange_wrench(self.flange, wrench[:3], wrench[3:]),
             ),
             qd=self.n,
             qdd=self.n,
@@ -167,7 +168,9 @@ class _ArmKernels:
     @cached_property
     def gravity_torques(self) -> Kernel:
         zeros = [0.0] * self.n
-        return self._kernel("gravity", lambda cs, k: algorithms.rnea(self._links(k), cs, zeros, zeros, self._gravity(k)))
+        return self._kernel(
+            "gravity", lambda cs, k: algorithms.rnea(self._links(k), cs, zeros, zeros, self._gravity(k))
+        )
 
     @cached_property
     def coriolis(self) -> Kernel:

@@ -1,7 +1,8 @@
-"""A payload check as diagnostic_msgs statuses, for rqt_robot_monitor and aggregators.
+"""Statuses for /diagnostics (rqt_robot_monitor, aggregators): a payload check, and the
+message counts of id_node.
 
-The key-values are the check's own figures (PayloadCheck.joint_figures, payload_figures):
-the same strings as in the ~/check report.
+The key-values of a payload check are its own figures (PayloadCheck.joint_figures,
+payload_figures): the same strings as in the ~/check report.
 """
 
 from __future__ import annotations
@@ -61,3 +62,25 @@ def _joint_status(check: PayloadCheck, j: int, node_name: str, warn_use: float) 
 
 def _key_values(figures: dict[str, str]) -> list[KeyValue]:
     return [KeyValue(key=key, value=value) for key, value in figures.items()]
+
+
+def message_status(node_name: str, hardware_id: str, counts, recent, parameters, waiting: bool) -> DiagnosticStatus:
+    """The counts per topic and kind (``recent``: those of the last period): ERROR when
+    accepted parameters could not be applied (``parameters``: the node's LiveParameters),
+    WARN while waiting for a model, while messages are dropped or joint_states stop coming."""
+    status = DiagnosticStatus(name=f"{node_name}: messages", hardware_id=hardware_id)
+    dropped = sum(n for key, n in recent.items() if key.endswith((".dropped", ".errors")))
+    in_force = parameters.status()
+    if parameters.failure is not None:
+        status.level, status.message = ERROR, in_force
+    elif waiting:
+        status.level, status.message = WARN, "waiting for the model (robot_description topic)"
+    elif dropped:
+        status.level, status.message = WARN, f"{dropped} messages dropped in the last second"
+    elif counts["joint_states.received"] and not recent["joint_states.received"]:
+        status.level, status.message = WARN, "no joint_states in the last second"
+    else:
+        status.level, status.message = OK, f"{recent['torques.published']} torque messages in the last second"
+    status.values = [KeyValue(key=key, value=str(value)) for key, value in sorted(counts.items())]
+    status.values.append(KeyValue(key="parameters", value=in_force or "in force"))
+    return status

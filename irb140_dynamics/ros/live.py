@@ -226,7 +226,9 @@ def declare(node: Node, spec) -> Any:
     try:
         return node.declare_parameter(spec.name, spec.default, spec.descriptor()).value
     except InvalidParameterTypeException:
-        kind = spec.default if isinstance(spec.default, Parameter.Type) else Parameter.Type.from_parameter_value(spec.default)
+        kind = spec.default
+        if not isinstance(kind, Parameter.Type):
+            kind = Parameter.Type.from_parameter_value(kind)
         hint = "; write doubles with a decimal point, e.g. 2.0" if "DOUBLE" in kind.name else ""
         raise ValueError(f"{spec.name}: expected a value of type {kind.name.lower()}{hint}") from None
     except InvalidParameterValueException as error:
