@@ -21,8 +21,9 @@ Prints one table and writes the raw figures to bench/results/nodes.json. Section
 - soak (``--soak MINUTES``, alone): id_node and the relay side by side under the same load,
   their RSS growth (bench/soak.py, bench/results/soak.json).
 - payload check: check_payload() cold (first call in a fresh process, kernel compilation
-  included) and warm, its two halves (derive_torque_limits, workspace_load) alone, and the
-  round trip of a ``~/check`` service call on a running payload_check_node.
+  included; the rated payload, and an off-axis one whose proof spends its budget) and warm,
+  its two halves (derive_torque_limits, workspace_load) alone, and the round trip of a
+  ``~/check`` service call on a running payload_check_node.
 
 The script sets ROS_DOMAIN_ID (random in 50..99 unless --domain-id) and
 ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST for itself and the nodes it starts, and gives every
@@ -164,6 +165,14 @@ def joint_stream(count: int, rate: float) -> tuple[list, list]:
     return (CENTRE + AMPLITUDE * np.sin(w * t)).tolist(), (AMPLITUDE * w * np.cos(w * t)).tolist()
 
 
+def joint_efforts(positions: list, velocities: list) -> list:
+    """Efforts a driver would publish along the stream: the model's torques at qdd = 0."""
+    from irb140_dynamics.core import irb140, rnea_batch
+
+    Q = np.array(positions)
+    return rnea_batch(irb140(), Q, np.array(velocities), np.zeros_like(Q)).tolist()
+
+
 def machine_busy() -> tuple[int, int]:
     """(busy, total) jiffies of all CPUs so far, from /proc/stat."""
     with open("/proc/stat") as stat:
@@ -174,9 +183,11 @@ def machine_busy() -> tuple[int, int]:
 
 def stream_run(node, kind: str, executor: str, rate: float, duration: float, warmup: float,
                env: dict, index: int, profile: bool = False, lean: bool = False,
-               change_period: float | None = None) -> dict:
+               change_period: float | None = None, effort: bool = False) -> dict:
     """Start the node, stream joint states at ``rate`` through it, return the raw figures.
 
+    ``effort``: every joint state carries efforts (id_node then runs its momentum observer
+    and publishes external_torques too).
     ``profile``: py-spy samples the node over the measured window (bench/results/profile_*.txt).
     ``change_period``: set payload.mass (a new value each time) every that many seconds
     over the measured window, through the parameter service (see ParameterChanger).
@@ -207,6 +218,7 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
         first = round(warmup * rate)
         total = first + round(duration * rate)
         positions, velocities = joint_stream(total, rate)
+        efforts = joint_efforts(positions, velocities) if effort else None
         stamps = np.zeros(total, dtype=np.int64)
         lateness = np.zeros(total)
         msg = JointState(name=NAMES)
@@ -225,6 +237,8 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
             if remaining > 0:  # no busy-wait: its CPU would be taken from the node under test
                 sleep(remaining)
             msg.position, msg.velocity = positions[i], velocities[i]
+            if efforts is not None:
+                msg.effort = efforts[i]
             stamp = now_ns()
             msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp, 1_000_000_000)
             lateness[i] = clock() - deadline
@@ -376,7 +390,8 @@ def lost_runs(measured: np.ndarray, arrived: np.ndarray, rate: float, most: int 
 
 
 def end_to_end(rates, executors, duration, warmup, env, profile=False, lean=False,
-               change_period: float | None = None, change_rate: float = CHANGE_RATE) -> tuple[list[Row], list[dict]]:
+               change_period: float | None = None, change_rate: float = CHANGE_RATE,
+               effort: bool = False) -> tuple[list[Row], list[dict]]:
     """Per executor and rate: the relay, then id_node, each in a fresh process; then, with
     ``change_period``, both again at ``change_rate`` with a parameter change every
     ``change_period`` s."""
@@ -395,7 +410,7 @@ def end_to_end(rates, executors, duration, warmup, env, profile=False, lean=Fals
                 every = "" if changes is None else f", payload.mass set every {changes * 1e3:g} ms"
                 print(f"  {kind} at {rate:g} Hz, {executor}{every}: {warmup + duration:g} s ...", flush=True)
                 run = stream_run(node, kind, executor, rate, duration, warmup, env, len(runs), profile, lean,
-                                 changes)
+                                 changes, effort)
                 runs.append(run)
                 d = run["delay_us"]
                 print(f"    p50 {_opt(d['p50'])} us, p99 {_opt(d['p99'])} us, max {_opt(d['max'])} us, "
@@ -464,29 +479,35 @@ import math, time
 from irb140_dynamics.core import RigidBody, check_payload, irb140
 q = [0.0, -math.pi / 2, math.pi / 2, 0.0, 0.0, 0.0]
 start = time.perf_counter()
-check_payload(irb140(), RigidBody(6.0), q=q)
+check_payload(irb140(), RigidBody({payload}), q=q)
 print(time.perf_counter() - start)
 """
+OFF_AXIS = "3.0, (0.05, 0.0, 0.1)"  # a payload whose worst wrist poses form curves: the proof's budget is spent
 
 
 def payload_rows(env: dict) -> tuple[list[Row], dict]:
     from irb140_dynamics.core import RigidBody, check_payload, derive_torque_limits, irb140, workspace_load
 
     group = "payload check (no baseline)"
-    cold = []
-    for _ in range(COLD_PROCESSES):
-        out = subprocess.run([sys.executable, "-c", COLD_SNIPPET], env=env, capture_output=True, text=True,
-                             timeout=60, check=True)
-        cold.append(float(out.stdout.split()[-1]))
+
+    def cold(payload: str) -> list[float]:
+        seconds = []
+        for _ in range(COLD_PROCESSES):
+            out = subprocess.run([sys.executable, "-c", COLD_SNIPPET.format(payload=payload)], env=env,
+                                 capture_output=True, text=True, timeout=120, check=True)
+            seconds.append(float(out.stdout.split()[-1]))
+        return seconds
+
     model, payload = irb140(), RigidBody(6.0)
     limits = derive_torque_limits(model)
     timed = {
-        "check_payload, cold: first call in a fresh process": cold,
+        "check_payload, cold: first call in a fresh process": cold("6.0"),
+        f"check_payload, cold, RigidBody({OFF_AXIS})": cold(OFF_AXIS),
         "check_payload, warm": seconds_per_call(lambda: check_payload(model, payload, q=STRETCHED),
                                                 blocks=7, block_seconds=0.2),
         "  derive_torque_limits alone": seconds_per_call(lambda: derive_torque_limits(model),
                                                          blocks=7, block_seconds=0.2),
-        "  workspace_load (the sweep) alone": seconds_per_call(lambda: workspace_load(model, payload, limits),
+        "  workspace_load (the sweep and its proof) alone": seconds_per_call(lambda: workspace_load(model, payload, limits),
                                                                blocks=7, block_seconds=0.2),
     }
     rows = [Row(group, name, Figure.cost(samples, "ms")) for name, samples in timed.items()]
@@ -593,6 +614,8 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help="only the soak: id_node and the relay side by side at 1 kHz for MINUTES "
                              "(10 in the issue), their RSS growth (bench/results/soak.json)")
     parser.add_argument("--no-stream", action="store_true", help="skip the end-to-end section")
+    parser.add_argument("--effort", action="store_true",
+                        help="joint states carry efforts: id_node's momentum observer runs on every message")
     parser.add_argument("--profile", action="store_true",
                         help="sample each node with py-spy over the measured window "
                              "(bench/results/profile_*.txt; perturbs the figures a little)")
@@ -615,13 +638,15 @@ def main(argv=None) -> None:
     rows, runs, payload = [], [], {}
     if not args.no_stream:
         stream, runs = end_to_end(args.rates, args.executor, args.duration, args.warmup, env, args.profile,
-                                  args.no_event_handlers, None if args.no_changes else args.change_period)
+                                  args.no_event_handlers, None if args.no_changes else args.change_period,
+                                  effort=args.effort)
         rows += stream
     if not args.no_payload:
         print("  payload check ...", flush=True)
         payload_table, payload = payload_rows(env)
         rows += payload_table
-    print_table(rows, "irb140_dynamics nodes (ratio = ours / baseline; delays: publish -> torques received)")
+    observer = "; joint states with efforts: observer on" if args.effort else ""
+    print_table(rows, f"irb140_dynamics nodes (ratio = ours / baseline; delays: publish -> torques received{observer})")
     busy = [r for r in runs if r["other_processes_cores"] > OTHERS_WARNING]
     if busy:
         worst = max(r["other_processes_cores"] for r in busy)
@@ -632,10 +657,11 @@ def main(argv=None) -> None:
         for r in runs:
             top = ", ".join(f"{name} {share:g}%" for name, share in r.get("profile", {}).get("top", [])[:8])
             print(f"  {r['node']} {r['rate_hz']:g} Hz {r['executor']}: {top}")
+    name = "nodes_effort" if args.effort else "nodes"
     path = write_results(
-        "nodes",
+        name,
         {
-            "benchmark": "nodes",
+            "benchmark": name,
             "machine": machine_info(("numpy", "rclpy")),
             "settings": {
                 "duration_s": args.duration,
@@ -647,6 +673,7 @@ def main(argv=None) -> None:
                 "rmw": os.environ.get("RMW_IMPLEMENTATION", "default (rmw_fastrtps_cpp)"),
                 "ros_domain_id": domain_id,
                 "profiled": args.profile,
+                "efforts": args.effort,
                 "qos_event_handlers": not args.no_event_handlers,
             },
             "rows": [row.as_dict() for row in rows],

@@ -1,12 +1,14 @@
 """id_node: live inverse dynamics and gravity compensation.
 
 Subscribes   joint_states          sensor_msgs/JointState (matched by joint name)
-             ~/reference           trajectory_msgs/JointTrajectory (first point: exact feed-forward)
+             ~/reference           trajectory_msgs/JointTrajectory: followed in time (see ros.tracking)
              robot_description     std_msgs/String (transient local): the model, with model.source
                                    robot_description and no URDF parameter or file (see ros.model_source)
 Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, qdd)
              gravity_torques       sensor_msgs/JointState, effort = g(q)
-             effort_commands       std_msgs/Float64MultiArray (when enabled), model joint order
+             effort_commands       std_msgs/Float64MultiArray (when enabled), model joint order:
+                                   feed-forward, gravity or computed-torque commands
+             ~/tracking_error      sensor_msgs/JointState, position = q_ref - q, velocity = qd_ref - qd
              external_torques      sensor_msgs/JointState, effort = external torques by the momentum
                                    observer (for joint states that carry efforts; see ros.collision)
              collision             std_msgs/Bool (transient local), any over its collision_threshold
@@ -21,15 +23,14 @@ answered; no exception leaves a callback.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
-
+import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
-from .core import RobotModel, gravity, rnea
+from .core import gravity, rnea
 from .core.filters import VelocityDifferentiator
 from .ros.diagnostics import message_status
 from .ros.guard import Tally, guarded
@@ -41,86 +42,21 @@ from .ros.messages import (
     joint_efforts,
     read_effort,
     read_joint_state,
-    read_reference,
+    read_trajectory,
 )
-from .ros.collision import (
-    COLLISION_PARAMETERS,
-    CollisionMonitor,
-    CollisionSettings,
-    build_collision_settings,
-    collision_threshold_specs,
+from .ros.collision import CollisionMonitor
+from .ros.id_node_settings import (  # noqa: F401 (finish_settings, compiled: looked up here, tests patch them)
+    NODE_PARAMETERS,
+    PER_JOINT_PARAMETERS,
+    Settings,
+    check_settings,
+    compiled,
+    finish_settings,
 )
 from .ros.model_source import declare_model_source
-from .ros.params import QOS_PARAMETERS, Spec, check_choice, check_number, check_qos, joint_states_qos
+from .ros.params import joint_states_qos
 from .ros.spin import run
-
-ACCELERATION_MODES = ("zero", "differentiate")
-EFFORT_SOURCES = ("feedforward", "gravity")
-MAX_CUTOFF_FREQUENCY = 1e6  # Hz
-MAX_TIMEOUT = 1e6  # s
-
-NODE_PARAMETERS = [
-    Spec("acceleration.mode", "zero",
-         "qdd when no ~/reference gives it: 'zero', or 'differentiate' the measured velocities (low-pass "
-         "filtered; for monitoring: as a command it would feed the measured acceleration back, "
-         "so effort_commands never use it)"),
-    Spec("acceleration.cutoff_frequency", 20.0, "cut-off of the velocity differentiation filter", "Hz",
-         minimum=1e-3, maximum=MAX_CUTOFF_FREQUENCY),
-    Spec("reference_timeout", 0.5, "a ~/reference older than this (node clock) is no longer used; 0 = never",
-         "s", minimum=0.0, maximum=MAX_TIMEOUT),
-    Spec("effort_commands.enabled", False, "also publish torques on effort_commands (Float64MultiArray)",
-         read_only=True),
-    Spec("effort_commands.source", "feedforward", "which torques go to effort_commands: 'feedforward' or 'gravity'"),
-    *COLLISION_PARAMETERS,
-    *QOS_PARAMETERS,
-]
-PER_JOINT_PARAMETERS = collision_threshold_specs
-
-
-@dataclass(frozen=True)
-class Settings:
-    """What the node runs on, built and validated from all of its parameters at once."""
-
-    model: RobotModel
-    acceleration_mode: str
-    cutoff_frequency: float
-    reference_timeout: float
-    effort_source: str
-    collision: CollisionSettings
-
-
-def check_settings(values: dict) -> Settings:
-    """Validate every parameter (quick, within the parameter call); kernels not compiled yet."""
-    model = RobotModel.from_params(values)
-    check_choice("acceleration.mode", values["acceleration.mode"], ACCELERATION_MODES)
-    check_choice("effort_commands.source", values["effort_commands.source"], EFFORT_SOURCES)
-    check_qos(values)
-    return Settings(
-        model,
-        values["acceleration.mode"],
-        check_number("acceleration.cutoff_frequency", values["acceleration.cutoff_frequency"], 1e-3,
-                     MAX_CUTOFF_FREQUENCY, "Hz"),
-        check_number("reference_timeout", values["reference_timeout"], 0.0, MAX_TIMEOUT, "s"),
-        values["effort_commands.source"],
-        build_collision_settings(values, model.joint_names),
-    )
-
-
-KERNELS = ("rnea", "gravity_torques", "momentum")  # what a message uses (momentum: the collision observer)
-
-
-def finish_settings(settings: Settings, previous: Settings | None) -> Settings:
-    """Compile the kernels the messages use, here and not on a message (off the executor
-    unless they exist already: a payload or gravity change shares the arm's code)."""
-    if previous is not None and previous.model == settings.model:
-        return replace(settings, model=previous.model)
-    _compiled = [getattr(settings.model.kernels, name) for name in KERNELS]
-    return settings
-
-
-def compiled(settings: Settings, previous: Settings | None) -> bool:
-    return settings.model.kernels.compiled(*KERNELS)
-
+from .ros.tracking import ReferenceTracker
 
 class IdNode(Node):
     """Joint states in; feed-forward and gravity torques out."""
@@ -132,7 +68,7 @@ class IdNode(Node):
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
         self._reported = self.counts.copy()  # the counts at the last diagnostics
-        self._reference = None  # (time received [ns, node clock], q, qd, qdd or None)
+        self.tracker = ReferenceTracker()
         self._differentiator = None
         self.parameters = declare_model_source(self, NODE_PARAMETERS, check_settings, PER_JOINT_PARAMETERS,
                                                finish=finish_settings, quick=compiled)
@@ -147,6 +83,7 @@ class IdNode(Node):
         self.create_subscription(JointTrajectory, "~/reference", self._on_reference, depth)
         self._feedforward_pub = self.create_publisher(JointState, "feedforward_torques", depth)
         self._gravity_pub = self.create_publisher(JointState, "gravity_torques", depth)
+        self._tracking_pub = self.create_publisher(JointState, "~/tracking_error", depth)
         self._command_pub = None
         if self.get_parameter("effort_commands.enabled").value:
             self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands", depth)
@@ -165,19 +102,17 @@ class IdNode(Node):
             self._zeros = [0.0] * len(names)
             self._feedforward_msg = JointState(name=names)
             self._gravity_msg = JointState(name=names)
-            self._reference = None
+            self._tracking_msg = JointState(name=names)
+            self.tracker.clear()
             self._differentiator = None
         if self._differentiator is None or settings.cutoff_frequency != self.settings.cutoff_frequency:
             self._differentiator = VelocityDifferentiator(settings.model.n, settings.cutoff_frequency)
         self.collision.use(settings.model, settings.collision)
         self.settings = settings
-        if self._reference is not None:
-            _, q, qd, qdd = self._reference
-            try:
-                finite_torques(rnea, settings.model, q, qd, self._zeros if qdd is None else qdd)
-            except BadMessage as error:
-                self._reference = None
-                self.tally.drop("reference", error)
+        held = self.tracker.trajectory
+        if held is not None and not held.torques_finite(settings.model):
+            self.tracker.clear()
+            self.tally.drop("reference", BadMessage("non_finite_torques", "the new model gives none at the reference"))
         if first and self._started:  # the model came after startup
             self._log_ready()
 
@@ -194,7 +129,7 @@ class IdNode(Node):
             return
         try:
             q, qd = read_joint_state(msg, self._order)
-            tau, g, command = self._torques(msg, q, qd, settings)
+            tau, g, command, reference = self._torques(msg, q, qd, settings)
         except NotForThisModel:
             self.counts["joint_states.ignored"] += 1
             return
@@ -208,13 +143,26 @@ class IdNode(Node):
             self._command_msg.data = command.tolist()
             self._command_pub.publish(self._command_msg)
         self.counts["torques.published"] += 1
+        if reference is not None:
+            self._publish_tracking_error(stamp, q, qd, reference)
         self._observe(msg, q, qd, g)
 
+    def _publish_tracking_error(self, stamp, q, qd, reference) -> None:
+        q_ref, qd_ref, _ = reference
+        msg = self._tracking_msg
+        msg.header.stamp = stamp
+        msg.position = (np.asarray(q_ref) - q).tolist()
+        msg.velocity = (np.asarray(qd_ref) - qd).tolist()
+        self._tracking_pub.publish(msg)
+
     def _torques(self, msg: JointState, q, qd, settings: Settings):
-        """(feed-forward, gravity, command torques or None), all finite, or BadMessage."""
+        """(feed-forward, gravity, command torques or None, the reference in force or None),
+        the torques all finite, or BadMessage."""
         model = settings.model
         estimate = self._estimated_acceleration(msg, qd, settings)
-        q_ff, qd_ff, qdd_ref = self._fresh_reference(settings) or (q, qd, None)
+        now = self.get_clock().now().nanoseconds * 1e-9
+        reference = self.tracker.sample(now, settings.reference_timeout)
+        q_ff, qd_ff, qdd_ref = reference or (q, qd, None)
         try:
             tau = finite_torques(rnea, model, q_ff, qd_ff, estimate if qdd_ref is None else qdd_ref)
             g = finite_torques(gravity, model, q)
@@ -222,6 +170,8 @@ class IdNode(Node):
             if self._command_pub is not None:
                 if settings.effort_source == "gravity":
                     command = g
+                elif settings.effort_source == "computed_torque":
+                    command = finite_torques(self._computed_torque, model, q, qd, reference, settings.gains)
                 elif qdd_ref is None and settings.acceleration_mode == "differentiate":
                     command = finite_torques(rnea, model, q_ff, qd_ff, self._zeros)  # never a measured qdd
                 else:
@@ -230,7 +180,13 @@ class IdNode(Node):
             if settings.acceleration_mode == "differentiate":
                 self._differentiator.reset()  # the estimate may be what overflowed: start afresh
             raise
-        return tau, g, command
+        return tau, g, command, reference
+
+    def _computed_torque(self, model, q, qd, reference, gains):
+        try:
+            return self.tracker.command(model, q, qd, reference, gains)
+        except ValueError as error:  # the core's refusal of a non-finite result
+            raise BadMessage("non_finite_torques", str(error)) from None
 
     def _observe(self, msg: JointState, q, qd, g) -> None:
         """Efforts in the message: run the momentum observer (external torques, collision)."""
@@ -266,28 +222,20 @@ class IdNode(Node):
 
     @guarded("reference")
     def _on_reference(self, msg: JointTrajectory) -> None:
-        """Hold the first point of a trajectory if the model gives finite torques there;
+        """Follow a trajectory from now if the model gives finite torques at every point;
         an empty trajectory lets the reference go."""
         self.counts["reference.received"] += 1
         if not msg.points or self.settings is None:
-            self._reference = None
+            self.tracker.clear()
             return
         try:
-            q, qd, qdd = read_reference(msg, self._order)
-            finite_torques(rnea, self.settings.model, q, qd, self._zeros if qdd is None else qdd)
+            trajectory = read_trajectory(msg, self._order)
+            if not trajectory.torques_finite(self.settings.model):
+                raise BadMessage("non_finite_torques", "the model gives no finite torques at some point")
         except BadMessage as error:
             self.tally.drop("reference", error)
             return
-        self._reference = (self.get_clock().now().nanoseconds, q, qd, qdd)
-
-    def _fresh_reference(self, settings: Settings):
-        if self._reference is None:
-            return None
-        received, q, qd, qdd = self._reference
-        timeout = settings.reference_timeout
-        if timeout > 0.0 and (self.get_clock().now().nanoseconds - received) * 1e-9 > timeout:
-            return None
-        return q, qd, qdd
+        self.tracker.follow(trajectory, self.get_clock().now().nanoseconds * 1e-9)
 
     @guarded("diagnostics")
     def _publish_diagnostics(self) -> None:

@@ -92,7 +92,7 @@ def test_gaps_and_backward_stamps_reset_the_observer():
     for t in (0.049, 0.049, 1.0):  # repeated, backwards, after a gap
         assert np.all(observer.update(t, q, np.zeros(6), g - 5.0) == 0.0)
         observer.update(t + 0.001, q, np.zeros(6), g - 5.0)
-        observer.r[:] = 1.0  # pretend it had run on
+        observer._r = [1.0] * 6  # pretend it had run on
 
 
 def test_bad_values_are_refused():

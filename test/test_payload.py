@@ -2,6 +2,7 @@
 exact largest payloads, checked against the dynamics core and brute-force sampling."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -180,11 +181,15 @@ def test_max_payload_puts_a_joint_at_its_limit(model, limits, payload, q, qd):
 
 
 @pytest.mark.parametrize("payload", OFFSET_PAYLOADS)
-def test_workspace_max_payload_holds_everywhere(model, limits, payload, dense_poses):
+def test_workspace_max_payload_holds_everywhere(model, limits, payload, dense_poses, quick_proofs):
+    """The mass is proven to hold in every pose; mass + gap puts a joint at its limit in a
+    real pose (the gap: what the proof's budget left open; these off-axis payloads leave
+    curves of worst wrist poses, which a small budget leaves open a little)."""
     load = workspace_load(model, payload, limits)
     best = load.max_payload
     L = np.array(limits.values)
-    at_limit = gravity(loaded(model, payload, best.mass), best.q)
+    assert 0.0 <= best.gap <= 1e-2 * best.mass
+    at_limit = gravity(loaded(model, payload, best.mass + best.gap), best.q)
     assert abs(at_limit[best.joint]) == pytest.approx(L[best.joint], rel=1e-9)
     g = gravity_batch(loaded(model, payload, best.mass), dense_poses)
     assert np.all(np.abs(g) <= L * (1 + 1e-9))
@@ -192,7 +197,8 @@ def test_workspace_max_payload_holds_everywhere(model, limits, payload, dense_po
     at_worst = gravity_batch(model.with_payload(payload), load.pose)
     np.testing.assert_allclose(np.diag(at_worst), load.torque, rtol=1e-12, atol=1e-9)
     g = np.abs(gravity_batch(model.with_payload(payload), dense_poses))
-    assert np.all(g <= np.abs(load.torque) * (1 + 1e-9) + 1e-9)
+    assert np.all(g <= load.bound + 1e-12 * load.bound.max())  # (float rounding of the kernels)
+    assert np.all(load.gap >= 0) and np.all(load.gap <= 5e-2 * np.maximum(np.abs(load.torque), 1.0))
 
 
 def test_no_payload_fits_when_the_arm_alone_is_over(model):
@@ -205,73 +211,10 @@ def test_no_payload_fits_when_the_arm_alone_is_over(model):
     assert "none (joint_2 over its limit)" in check.report()
 
 
-def test_unbounded_when_no_limit_is_loaded(model):
+def test_unbounded_when_no_limit_is_loaded(model, quick_proofs):
     only_joint_1 = [50.0] + [math.inf] * 5  # a payload on the flange cannot turn joint 1 statically
     assert max_payload_at(model, RigidBody(3.0, (0.1, 0, 0)), only_joint_1, STRETCHED).mass == math.inf
     assert workspace_load(model, RigidBody(3.0, (0.1, 0, 0)), only_joint_1).max_payload.mass == math.inf
-
-
-# -- the check as the service returns it -----------------------------------------------------------
-
-
-def test_report_text(model, limits):
-    check = check_payload(model, RigidBody(6.0), limits, q=STRETCHED)
-    text = check.report()
-    lines = text.splitlines()
-    assert lines[0] == "payload 6.000 kg at (0.000, 0.000, 0.000) m: OK"
-    assert lines[3].split()[:6] == ["joint_2", "290.765", "290.765", "100.0%", "290.765", "100.0%"]
-    assert lines[3].endswith("  (0, -90, 90, 0, 0, 0)")
-    assert lines[2].split()[:3] == ["joint_1", "0.000", "none"]
-    assert lines[-1] == (
-        "max payload: 6.000 kg (joint_2) here, "
-        "6.000 kg (joint_2 at (0, -90, 90, 0, 0, 0) deg) over the workspace"
-    )
-    print(text)
-
-
-def test_workspace_part_alone_and_reused(model, limits):
-    load = workspace_load(model, RigidBody(6.0), limits)
-    check = check_payload(model, RigidBody(6.0), limits, q=STRETCHED, workspace=load)
-    assert check.workspace is load
-    no_state = check_payload(model, RigidBody(6.0), limits, workspace=load)
-    assert no_state.torque is None and no_state.ok
-    assert "-" in no_state.report().splitlines()[3].split()[1]
-
-
-def test_report_rows_are_the_figures(model, limits):
-    """One source: each report row is its joint's figures, the summary the payload's."""
-    check = check_payload(model, RigidBody(2.0, (0.0, 0.05, 0.1)), limits, q=STATES[1][0], qd=STATES[1][1])
-    lines = check.report().splitlines()
-    for j in range(6):
-        figures = check.joint_figures(j)
-        assert list(figures) == ["torque now [N m]", "limit [N m]", "use now", "worst static torque [N m]",
-                                 "worst use", "worst pose [deg]", "limit source"]
-        row = lines[2 + j]
-        assert row.split()[1:6] == list(figures.values())[:5]
-        assert row.endswith("  " + figures["worst pose [deg]"])
-        assert figures["limit source"] in lines[8]
-    payload = check.payload_figures()
-    assert lines[0].startswith(f"payload {payload['payload mass [kg]']} kg at {payload['payload com [m]']} m: ")
-    here = f"{payload['max payload here [kg]']} kg ({payload['max payload here: limited by']}) here"
-    everywhere = (f"{payload['max payload over the workspace [kg]']} kg "
-                  f"({payload['max payload over the workspace: limited by']} at "
-                  f"{payload['max payload over the workspace: pose [deg]']} deg) over the workspace")
-    assert lines[9] == f"max payload: {here}, {everywhere}"
-
-
-def test_a_payload_loading_a_joint_without_limit_gets_a_note(model, limits):
-    """3 kg 0.1 m off the flange axis turns joint 6, which the rated payload never loads."""
-    check = check_payload(model, RigidBody(3.0, (0.1, 0.0, 0.0)), limits, q=STATES[1][0])
-    assert limits.reason(5) == "none: the rated payload cannot load it"
-    assert abs(check.workspace.torque[5]) == pytest.approx(3.0 * 9.81 * 0.1, rel=1e-9)
-    assert check.loaded_without_limit == [5]  # not joint 1: a payload never turns it statically
-    assert check.ok  # the limits decide, the note only warns
-    assert check.report().splitlines()[-1] == (
-        "note: joint_6 has no limit, yet this payload loads it (2.943 N m in its worst pose): "
-        "set joint_6.torque_limit"
-    )
-    centred = check_payload(model, RigidBody(6.0), limits, q=STRETCHED)
-    assert centred.loaded_without_limit == [] and "note" not in centred.report()
 
 
 def test_payload_family_takes_the_payload_as_validated(model, limits, monkeypatch):
@@ -279,6 +222,7 @@ def test_payload_family_takes_the_payload_as_validated(model, limits, monkeypatc
     once, by the models of its family."""
     family = payload_family(model, RigidBody(2.0, (0.0, 0.0, 0.1)))
     carrying = model.with_payload(RigidBody(1.0))
+    check_payload(model, RigidBody(2.0, (0.0, 0.0, 0.1)), limits, q=STRETCHED)  # its shape checked once
 
     def validated(*args):
         raise AssertionError("validated again")
@@ -292,3 +236,17 @@ def test_payload_family_takes_the_payload_as_validated(model, limits, monkeypatc
         payload_family(model, RigidBody(1.0, (math.nan, 0.0, 0.0)))
     with pytest.raises(ModelError, match="^payload.inertia: "):
         payload_family(model, RigidBody(1.0, (0.0, 0.0, 0.0), (1.0, 1.0, 3.0, 0.0, 0.0, 0.0)))
+
+
+def test_the_payload_sits_on_the_model_s_flange(model, limits):
+    """A flange 0.1 m out along z: a payload at its origin loads the arm as one 0.1 m out
+    on the last link (the payload's models keep the flange)."""
+    from irb140_dynamics.core.joints import Placement
+
+    flanged = replace(model, flange=Placement(xyz=(0.0, 0.0, 0.1)))
+    here = max_payload_at(flanged, RigidBody(2.0), limits, STATES[1][0], STATES[1][1])
+    there = max_payload_at(model, RigidBody(2.0, (0.0, 0.0, 0.1)), limits, STATES[1][0], STATES[1][1])
+    assert here.mass == pytest.approx(there.mass, rel=1e-12) and here.joint == there.joint
+    load = workspace_load(flanged, RigidBody(2.0), limits)
+    np.testing.assert_allclose(load.torque, workspace_load(model, RigidBody(2.0, (0.0, 0.0, 0.1)), limits).torque,
+                               rtol=1e-9, atol=1e-9)

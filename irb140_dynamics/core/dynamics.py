@@ -6,20 +6,25 @@ M includes the joints' armature (rotor inertia); tau_f is joint friction (see ``
 
 Single-state functions take sequences of n numbers and return NumPy arrays; the
 ``*_batch`` forms take arrays shaped (N, n) and give the same numbers for N states at once.
-All run the model's generated kernels (see ``codegen``), compiled on first use. A value
-that is not finite, a wrong length, or batch arguments of different N raise ValueError
-naming the argument (the kernels fold constants: a NaN times a zero constant would vanish).
+All run the model's generated kernels (see ``codegen``), compiled on first use. What a
+state is, and the checks of each argument, are in ``states``: anything else raises
+ValueError naming the argument (the kernels fold constants: a NaN times a zero constant
+would vanish). A result is never silently non-finite: where velocities, accelerations,
+torques or a wrench are so large that it overflows, ValueError says so, naming the inputs.
+g(q) and M(q) need no such check: q enters through cos and sin only, and the model's
+sanity caps keep them finite.
 """
 
 from __future__ import annotations
 
-import math
 from functools import lru_cache
+from math import isfinite
 from typing import Sequence
 
 import numpy as np
 
 from .model import RobotModel
+from .states import finite_result, finite_results, state, states
 
 ArrayLike = Sequence[float] | np.ndarray
 
@@ -33,44 +38,55 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
     it: tau = ID(q, qd, qdd) - J(q)^T f_ext, with J the flange Jacobian in the flange frame.
     """
     kernels = model.kernels
-    args = (_state(q, model.n, "q"), _state(qd, model.n, "qd"), _state(qdd, model.n, "qdd"))
-    if f_ext is None:
-        tau = np.array(kernels.rnea.scalar(*args))
-    else:
-        tau = np.array(kernels.rnea_wrench.scalar(*args, _state(f_ext, 6, "f_ext")))
-    if model.friction is not None:
-        tau += model.friction.torques(args[1])
-    return tau
+    args = (state(q, model.n, "q"), state(qd, model.n, "qd"), state(qdd, model.n, "qdd"))
+    tau = kernels.rnea.scalar(*args) if f_ext is None else kernels.rnea_wrench.scalar(*args, state(f_ext, 6, "f_ext"))
+    if not isfinite(sum(tau)):  # inline: rnea is the hot path
+        finite_result(tau, "rnea", q=q, qd=qd, qdd=qdd, **({} if f_ext is None else {"f_ext": f_ext}))
+    if model.friction is None:
+        return np.array(tau)
+    return np.array(tau) + model.friction.torques(args[1])
 
 
 def gravity(model: RobotModel, q: ArrayLike) -> np.ndarray:
     """Gravity torques g(q) [N m]: what holds the arm (and payload) still at q."""
-    return np.array(model.kernels.gravity_torques.scalar(_state(q, model.n, "q")))
+    return np.array(model.kernels.gravity_torques.scalar(state(q, model.n, "q")))
 
 
 def coriolis(model: RobotModel, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
     """Coriolis and centrifugal torques C(q, qd) qd [N m]."""
-    return np.array(model.kernels.coriolis.scalar(_state(q, model.n, "q"), _state(qd, model.n, "qd")))
+    c = model.kernels.coriolis.scalar(state(q, model.n, "q"), state(qd, model.n, "qd"))
+    return np.array(finite_result(c, "coriolis", q=q, qd=qd))
 
 
 def coriolis_matrix(model: RobotModel, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
     """The Coriolis matrix C(q, qd) of the Christoffel symbols: Mdot - 2C is skew-symmetric."""
     n = model.n
-    flat = model.kernels.coriolis_matrix.scalar(_state(q, n, "q"), _state(qd, n, "qd"))
-    return np.array(flat).reshape(n, n)
+    flat = model.kernels.coriolis_matrix.scalar(state(q, n, "q"), state(qd, n, "qd"))
+    return np.array(finite_result(flat, "coriolis_matrix", q=q, qd=qd)).reshape(n, n)
 
 
 def mass_matrix(model: RobotModel, q: ArrayLike) -> np.ndarray:
     """The joint-space mass matrix M(q) [kg m^2], symmetric positive definite."""
     n = model.n
-    return _symmetric(np.array(model.kernels.mass_matrix.scalar(_state(q, n, "q"))), n)
+    return _symmetric(np.array(model.kernels.mass_matrix.scalar(state(q, n, "q"))), n)
 
 
 def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext=None) -> np.ndarray:
     """Joint accelerations qdd = M(q)^-1 (tau - C(q, qd) qd - g(q) - tau_f(qd)) [rad/s^2]."""
-    tau = np.array(_state(tau, model.n, "tau"), dtype=float)
-    bias = rnea(model, q, qd, np.zeros(model.n), f_ext)
-    return np.linalg.solve(mass_matrix(model, q), tau - bias)
+    n, kernels = model.n, model.kernels
+    args = (state(q, n, "q"), state(qd, n, "qd"), [0.0] * n)
+    tau_in = state(tau, n, "tau")
+    if f_ext is None:
+        bias = np.array(kernels.rnea.scalar(*args))
+    else:
+        bias = np.array(kernels.rnea_wrench.scalar(*args, state(f_ext, 6, "f_ext")))
+    if model.friction is not None:
+        bias += model.friction.torques(args[1])
+    M = _symmetric(np.array(kernels.mass_matrix.scalar(args[0])), n)
+    with np.errstate(invalid="ignore", over="ignore"):
+        qdd = np.linalg.solve(M, np.array(tau_in, dtype=float) - bias)
+    finite_result(qdd.tolist(), "forward_dynamics", q=q, qd=qd, tau=tau, **({} if f_ext is None else {"f_ext": f_ext}))
+    return qdd
 
 
 # -- many states at once --------------------------------------------------------------
@@ -78,31 +94,35 @@ def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayL
 
 def rnea_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
     """rnea for N states: Q, QD, QDD shaped (N, n) -> tau shaped (N, n)."""
-    columns = _columns(model.n, Q=Q, QD=QD, QDD=QDD)
-    return _with_friction(model, _evaluate(model.kernels.rnea.array, *columns), columns[1])
+    columns = states(model.n, Q=Q, QD=QD, QDD=QDD)
+    tau = _with_friction(model, _evaluate(model.kernels.rnea.array, *columns), columns[1])
+    return finite_results(tau, "rnea_batch", "Q", "QD", "QDD")
 
 
 def gravity_batch(model: RobotModel, Q) -> np.ndarray:
     """gravity for N states: Q shaped (N, n) -> g shaped (N, n)."""
-    return _evaluate(model.kernels.gravity_torques.array, *_columns(model.n, Q=Q))
+    return _evaluate(model.kernels.gravity_torques.array, *states(model.n, Q=Q))
 
 
 def coriolis_batch(model: RobotModel, Q, QD) -> np.ndarray:
     """coriolis for N states: (N, n) -> C(q, qd) qd shaped (N, n)."""
-    return _evaluate(model.kernels.coriolis.array, *_columns(model.n, Q=Q, QD=QD))
+    return finite_results(_evaluate(model.kernels.coriolis.array, *states(model.n, Q=Q, QD=QD)),
+                          "coriolis_batch", "Q", "QD")
 
 
 def mass_matrix_batch(model: RobotModel, Q) -> np.ndarray:
     """mass_matrix for N states: Q shaped (N, n) -> M shaped (N, n, n)."""
-    return _symmetric(_evaluate(model.kernels.mass_matrix.array, *_columns(model.n, Q=Q)), model.n)
+    return _symmetric(_evaluate(model.kernels.mass_matrix.array, *states(model.n, Q=Q)), model.n)
 
 
 def forward_dynamics_batch(model: RobotModel, Q, QD, TAU) -> np.ndarray:
     """forward_dynamics for N states: (N, n) arrays -> QDD shaped (N, n)."""
-    q, qd, tau = _columns(model.n, Q=Q, QD=QD, TAU=TAU)
+    q, qd, tau = states(model.n, Q=Q, QD=QD, TAU=TAU)
     bias = _with_friction(model, _evaluate(model.kernels.rnea.array, q, qd, np.zeros_like(q)), qd)
     M = _symmetric(_evaluate(model.kernels.mass_matrix.array, q), model.n)
-    return np.linalg.solve(M, (tau.T - bias)[..., None])[..., 0]
+    with np.errstate(over="ignore", invalid="ignore"):
+        QDD = np.linalg.solve(M, (tau.T - bias)[..., None])[..., 0]
+    return finite_results(QDD, "forward_dynamics_batch", "Q", "QD", "TAU")
 
 
 def _with_friction(model: RobotModel, tau: np.ndarray, qd_columns: np.ndarray) -> np.ndarray:
@@ -115,37 +135,6 @@ def _with_friction(model: RobotModel, tau: np.ndarray, qd_columns: np.ndarray) -
 # -- conversions ----------------------------------------------------------------------
 
 
-def _state(x, n: int, name: str):
-    """A sequence of n finite numbers as the kernels want it: a list of Python floats."""
-    if isinstance(x, np.ndarray):
-        if x.shape != (n,):
-            raise ValueError(f"{name}: expected shape ({n},), got {x.shape}")
-        x = x.tolist()
-    elif len(x) != n:
-        raise ValueError(f"{name}: expected {n} values, got {len(x)}")
-    # a finite sum is all finite (nan and inf carry through a sum); it only costs ~0.1 us
-    if not math.isfinite(sum(x)) and not all(map(math.isfinite, x)):
-        raise ValueError(f"{name}: must be finite, got {list(x)}")
-    return x
-
-
-def _columns(n: int, **arrays) -> list[np.ndarray]:
-    """Arrays of N states (N, n), given by name, as the kernels want them: (n, N) columns,
-    finite, all of the first one's N."""
-    columns = []
-    for name, X in arrays.items():
-        X = np.asarray(X, dtype=float)
-        if X.ndim != 2 or X.shape[1] != n:
-            raise ValueError(f"{name}: expected shape (N, {n}), got {X.shape}")
-        if columns and X.shape[0] != columns[0].shape[1]:
-            first = next(iter(arrays))
-            raise ValueError(f"{name}: expected {columns[0].shape[1]} states like {first}, got {X.shape[0]}")
-        if not np.isfinite(X).all():
-            raise ValueError(f"{name}: must be finite (state {int(np.argmin(np.isfinite(X).all(axis=1)))} is not)")
-        columns.append(np.ascontiguousarray(X.T))
-    return columns
-
-
 _CHUNK = 8192  # states per pass: the kernels' intermediates then stay in the CPU caches
 
 
@@ -155,7 +144,8 @@ def _evaluate(kernel, *columns: np.ndarray) -> np.ndarray:
     result = None
     for start in range(0, max(N, 1), _CHUNK):
         chunk = slice(start, start + _CHUNK)
-        outputs = kernel(*(c[:, chunk] for c in columns))
+        with np.errstate(over="ignore", invalid="ignore"):  # the callers check what they return
+            outputs = kernel(*(c[:, chunk] for c in columns))
         if result is None:
             result = np.empty((N, len(outputs)))
         for i, values in enumerate(outputs):  # constants folded at generation broadcast

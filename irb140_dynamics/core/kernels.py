@@ -44,12 +44,18 @@ class Kernels:
 
     def __init__(self, model):
         self.n = model.n
-        links = algorithms.chain(model)
+        self.links = links = algorithms.chain(model)  # the whole model's, for other number types
+        self.gravity = model.gravity
         last = links[-1]
         constants = (last.m, *last.h, *last.I, *model.gravity)
         self.constants = tuple(x for x in constants if x != 0.0)
         arm = links[:-1] + (replace(last, m=0.0, h=ZERO3, I=ZERO6),)
         self._arm = _arm(arm, model.flange, tuple(x != 0.0 for x in constants))
+
+    @property
+    def angles(self) -> list[float]:
+        """The joints' angle offsets (theta_i = q_i + offset_i)."""
+        return self._arm.angles
 
     def compiled(self, *names: str) -> bool:
         """Whether these kernels' code exists already (shared with a model of the same arm):

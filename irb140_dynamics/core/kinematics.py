@@ -1,6 +1,7 @@
 """Forward kinematics: joint transforms, link frames, the flange pose and Jacobian.
 
-Poses are 4x4 homogeneous transforms from the frame to the base frame 0, in metres.
+Poses are 4x4 homogeneous transforms from the frame to the base frame 0, in metres. q is a
+state as in ``states`` (n finite real numbers), else ValueError naming it.
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ import math
 import numpy as np
 
 from .model import DH, RobotModel
+from .states import state
 
 
 def dh_transform(dh: DH, q: float) -> np.ndarray:
@@ -29,10 +31,8 @@ def dh_transform(dh: DH, q: float) -> np.ndarray:
 
 def link_frames(model: RobotModel, q) -> np.ndarray:
     """The poses of the base and the link frames 0..n in the base frame, (n + 1, 4, 4)."""
-    if len(q) != model.n:
-        raise ValueError(f"q: expected {model.n} values, got {len(q)}")
     frames = [np.eye(4)]
-    for joint, q_i in zip(model.joints, q):
+    for joint, q_i in zip(model.joints, state(q, model.n, "q")):
         frames.append(frames[-1] @ joint.transform(float(q_i)))
     return np.array(frames)
 

@@ -18,11 +18,14 @@ or an older time resets the observer (the next sample starts it again at r = 0).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .algorithms import add, cross, dot, inertia_times, scale, to_child, turns
 from .dual import dual_angles, partial
-from .dynamics import _state, gravity
+from .dynamics import gravity
+from .states import state
 from .model import RobotModel
 
 
@@ -58,37 +61,47 @@ class MomentumObserver:
 
     def reset(self) -> None:
         """Forget the past: the next sample starts the observer again."""
-        self.r = np.zeros(self.model.n)
+        self._r = [0.0] * self.model.n
         self._t = None
+
+    @property
+    def r(self) -> np.ndarray:
+        """The residual after the last sample [N m]."""
+        return np.array(self._r)
 
     def update(self, t: float, q, qd, tau, g=None) -> np.ndarray:
         """The residual after the sample (t [s], q, qd, tau measured): r, or zeros after a reset.
 
         ``g``: gravity(model, q) if the caller has it already. ValueError (and a reset) if a
-        value is not finite.
+        value is not finite. Plain Python arithmetic on n numbers: a few microseconds
+        besides the kernel, where small NumPy arrays would cost tens.
         """
         n = self.model.n
-        q, qd, tau = _state(q, n, "q"), _state(qd, n, "qd"), np.asarray(_state(tau, n, "tau"))
+        q, qd, tau = state(q, n, "q"), state(qd, n, "qd"), state(tau, n, "tau")
         p, beta = self._momentum_terms(q, qd, g)
-        drive = tau + beta
+        drive = [x + y for x, y in zip(tau, beta)]
         if self._t is None or not 0.0 < t - self._t <= self.max_gap:
-            self.r = np.zeros(n)
-            self._t, self._p0, self._integral, self._drive = t, p, np.zeros(n), drive
-            return self.r.copy()
-        dt = t - self._t
-        integral = self._integral + 0.5 * (drive + self._drive) * dt + self.r * dt
-        r = self.gain * (p - self._p0 - integral)
-        if not np.all(np.isfinite(r)):
+            self._r = [0.0] * n
+            self._t, self._p0, self._integral, self._drive = t, p, [0.0] * n, drive
+            return self.r
+        dt, K = t - self._t, self.gain
+        with np.errstate(over="ignore", invalid="ignore"):  # NumPy scalars among them: checked below
+            integral = [i + 0.5 * (d + d0) * dt + r * dt
+                        for i, d, d0, r in zip(self._integral, drive, self._drive, self._r)]
+            r = [K * (x - x0 - i) for x, x0, i in zip(p, self._p0, integral)]
+        if not math.isfinite(sum(r)) and not all(map(math.isfinite, r)):
             self.reset()
-            raise ValueError(f"observer residual not finite: {r.tolist()}")
-        self._t, self._integral, self._drive, self.r = t, integral, drive, r
-        return r.copy()
+            raise ValueError(f"observer residual not finite: {r}")
+        self._t, self._integral, self._drive, self._r = t, integral, drive, r
+        return self.r
 
-    def _momentum_terms(self, q, qd, g=None) -> tuple[np.ndarray, np.ndarray]:
+    def _momentum_terms(self, q, qd, g=None) -> tuple[list, list]:
         """p = M qd and C^T qd - g - tau_f: what the observer integrates besides tau and r."""
         model = self.model
-        p, ct_qd = np.split(np.array(model.kernels.momentum.scalar(q, qd)), 2)
-        beta = ct_qd - (gravity(model, q) if g is None else g)
+        terms = model.kernels.momentum.scalar(q, qd)
+        n = model.n
+        g = gravity(model, q) if g is None else g
+        beta = [c - gi for c, gi in zip(terms[n:], g)]
         if model.friction is not None:
-            beta -= model.friction.torques(qd)
-        return p, beta
+            beta = [b - f for b, f in zip(beta, model.friction.torques(qd).tolist())]
+        return list(terms[:n]), beta

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Sequence
 
 import numpy as np
@@ -68,6 +69,15 @@ def capped(field: str, what: str, size: float, cap: float, unit: str) -> None:
         raise ModelError(field, f"{what} must be <= {cap:g} {unit} (sanity cap), got {size:g}".lstrip())
 
 
+def checked_mass(field: str, mass) -> float:
+    """A mass as a float: finite, >= 0, at most MAX_MASS; else ModelError naming ``field``."""
+    m = finite_number(field, mass)
+    if m < 0.0:
+        raise ModelError(field, f"must be >= 0, got {m}")
+    capped(field, "", m, MAX_MASS, "kg")
+    return m
+
+
 def inertia_matrix(inertia: Sequence[float]) -> np.ndarray:
     xx, yy, zz, xy, xz, yz = inertia
     return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
@@ -99,10 +109,7 @@ class RigidBody:
     @classmethod
     def validated(cls, field: str, mass, com=ZERO3, inertia=ZERO6) -> "RigidBody":
         """Build from raw values; errors name ``field.mass``, ``field.com``, ``field.inertia``."""
-        m = finite_number(f"{field}.mass", mass)
-        if m < 0.0:
-            raise ModelError(f"{field}.mass", f"must be >= 0, got {m}")
-        capped(f"{field}.mass", "", m, MAX_MASS, "kg")
+        m = checked_mass(f"{field}.mass", mass)
         c = finite_numbers(f"{field}.com", com, 3)
         capped(f"{field}.com", "|com|", math.hypot(*c), MAX_LENGTH, "m")
         return cls(m, c, validate_inertia(f"{field}.inertia", inertia))
@@ -147,6 +154,25 @@ def combine(a: RigidBody, b: RigidBody) -> RigidBody:
     # back from the origin to the combined centre of mass: I_c = I_o - m (|c|^2 1 - c c^T)
     _, _, shift = shift_inertia(m, ZERO3, ZERO6, com)
     return RigidBody(m, com, tuple(x - y for x, y in zip(about_origin, shift)))
+
+
+def checked_body(field: str, body) -> RigidBody:
+    """A RigidBody argument checked as ``RigidBody.validated`` checks raw values (ModelError
+    naming field.mass, field.com, field.inertia). The mass is checked on every call, the
+    shape (CoM and inertia) once: it is remembered."""
+    if not isinstance(body, RigidBody):
+        raise ModelError(field, f"expected a RigidBody, got {body!r}")
+    mass = checked_mass(f"{field}.mass", body.mass)
+    try:
+        shape = _checked_shape(field, tuple(body.com), tuple(body.inertia))
+    except TypeError:  # not sequences, or of unhashable things: no memory, the same errors
+        shape = RigidBody.validated(field, mass, body.com, body.inertia)
+    return RigidBody(mass, shape.com, shape.inertia)
+
+
+@lru_cache(maxsize=64)
+def _checked_shape(field: str, com, inertia) -> RigidBody:
+    return RigidBody.validated(field, 0.0, com, inertia)
 
 
 def placed(body: RigidBody, rotation, translation) -> RigidBody:

@@ -102,6 +102,14 @@ class JointRanges:
         poses = X[np.argmin(simplest, axis=0), np.arange(K)]  # of equal maxima the nearest q = 0
         return self._canonical(torque, W, poses, tol)
 
+    def climb(self, torque: StaticTorque, weights: np.ndarray, starts: np.ndarray, rtol: float = 1e-12):
+        """Coordinate ascent of objective weights[k] . torque from starts[k] (K, n): (values
+        (K,), poses (K, n)), the poses made simple as in ``maximize``."""
+        W, X = np.atleast_2d(weights), np.asarray(starts, dtype=float)[None]
+        tol = rtol * max(1.0, float(np.max(np.abs(torque(X[0])))))
+        X, _ = self._ascend(torque, W, X, tol)
+        return self._canonical(torque, W, X[0], tol)
+
     def _values(self, torque: StaticTorque, W: np.ndarray, X: np.ndarray) -> np.ndarray:
         """Objective k at each pose X[..., k, :]."""
         tau = torque(X.reshape(-1, X.shape[-1])).reshape(X.shape)

@@ -6,13 +6,14 @@ import math
 from array import array
 from collections import Counter
 
+import numpy as np
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
 
 from ..core.joint_order import BadMessage, JointOrder, NotForThisModel
 
 __all__ = ["BadMessage", "JointOrder", "NotForThisModel", "count_and_warn", "finite_torques", "joint_efforts",
-           "read_effort", "read_joint_state", "read_reference"]
+           "read_effort", "read_joint_state", "read_reference", "read_trajectory"]
 
 
 def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> None:
@@ -88,6 +89,28 @@ def read_reference(msg: JointTrajectory, order: JointOrder):
     if len(point.accelerations):
         qdd = _pick(point.accelerations, index, "accelerations", length, required=True)
     return q, qd, qdd
+
+
+def read_trajectory(msg: JointTrajectory, order: JointOrder):
+    """The whole trajectory of a non-empty message as a core Trajectory (points by
+    time_from_start). Velocities count as zero when empty; accelerations are given on
+    every point or on none."""
+    from ..core.trajectory import Trajectory
+
+    times, Q, QD, QDD = [], [], [], []
+    for k, point in enumerate(msg.points):
+        index, length = _index(msg.joint_names, len(point.positions), order)
+        Q.append(_pick(point.positions, index, f"points[{k}].positions", length, required=True))
+        QD.append(_pick(point.velocities, index, f"points[{k}].velocities", length, required=False))
+        if len(point.accelerations):
+            QDD.append(_pick(point.accelerations, index, f"points[{k}].accelerations", length, required=True))
+        times.append(point.time_from_start.sec + 1e-9 * point.time_from_start.nanosec)
+    if QDD and len(QDD) != len(Q):
+        raise BadMessage("length_mismatch", "accelerations must be given on every point or on none")
+    try:
+        return Trajectory(np.array(times), np.array(Q), np.array(QD), np.array(QDD) if QDD else None)
+    except ValueError as error:
+        raise BadMessage("bad_trajectory", str(error)) from None
 
 
 def _index(names, n_positions: int, order: JointOrder) -> tuple[list[int], int]:
