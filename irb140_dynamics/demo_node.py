@@ -26,6 +26,7 @@ NAMES = [f"joint_{i}" for i in range(1, 7)]
 CENTRE = [0.0, -0.6, 1.0, 0.0, 0.5, 0.0]  # rad: where the motion starts and ends (sim_node's initial_positions)
 AMPLITUDE = [0.8, 0.5, 0.5, 1.0, 0.6, 1.5]  # rad
 POINTS_PER_SECOND = 50
+PARAMETER_NAMES = ("period", "plot_file", "duration")  # declared below; known to the other nodes' warnings
 
 
 def motion(t: np.ndarray, period: float):

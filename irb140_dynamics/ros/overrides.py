@@ -14,8 +14,8 @@ import importlib
 from rclpy.node import Node
 
 MAX_UNKNOWN_WARNINGS = 10
-SIBLINGS = ("irb140_dynamics.id_node", "irb140_dynamics.payload_check_node", "irb140_dynamics.sim_node")
-OTHER_NAMES = {"rate"}  # demo_node's
+SIBLINGS = ("irb140_dynamics.id_node", "irb140_dynamics.payload_check_node", "irb140_dynamics.sim_node",
+            "irb140_dynamics.demo_node")
 
 
 def warn_unknown_overrides(node: Node) -> None:
@@ -62,13 +62,14 @@ def _known_parent(name: str, declared: set[str]) -> str | None:
 def _sibling_names(joint_names) -> tuple[set[str], tuple[str, ...]]:
     """The parameters of the package's nodes (for these joints), and the suffixes of their
     per-joint parameters (``.collision_threshold``)."""
-    names, suffixes = set(OTHER_NAMES), set()
+    names, suffixes = set(), set()
     for module_name in SIBLINGS:
         try:
             module = importlib.import_module(module_name)
         except Exception:  # noqa: BLE001  (sim_node needs MuJoCo: without it, no sim_node either)
             continue
         names |= {spec.name for spec in getattr(module, "NODE_PARAMETERS", [])}
+        names |= set(getattr(module, "PARAMETER_NAMES", ()))  # a node declaring its own by hand
         per_joint = getattr(module, "PER_JOINT_PARAMETERS", None)
         if per_joint is not None:
             names |= {spec.name for spec in per_joint(joint_names or [])}
