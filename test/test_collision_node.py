@@ -76,6 +76,7 @@ def test_step_on_joint_2_flags_a_collision_within_10_ms(node):
     q = np.array([0.0, -0.6, 0.9, 0.0, 0.4, 0.0])
     g = gravity(model, q)
     step = np.array([0.0, 20.0, 0.0, 0.0, 0.0, 0.0])
+    assert node.spin_until(lambda: node.collision)  # the latched flag's topic matched (discovery done)
     flagged_at, r = None, None
     for k in range(120):
         t = 2 + k * 0.001
