@@ -55,6 +55,27 @@ def test_coriolis_matrix_kernel_is_the_algorithm_bit_for_bit(robot, states):
         assert coriolis_matrix(robot, q, qd).tolist() == algorithms.christoffel_coriolis(links, angles(robot, q), qd)
 
 
+KERNEL_INPUTS = {  # the argument groups after q, by kernel
+    "rnea": ("qd", "qdd"), "rnea_wrench": ("qd", "qdd", "wrench"), "gravity_torques": (), "coriolis": ("qd",),
+    "mass_matrix": (), "coriolis_matrix": ("qd",), "regressor": ("qd", "qdd"), "momentum": ("qd",),
+}
+
+
+@pytest.mark.parametrize("name", list(KERNEL_INPUTS))
+def test_writing_array_form_is_the_array_form_bit_for_bit(robot, name):
+    kernel = getattr(robot.kernels, name)
+    rng = np.random.default_rng(33)
+    Q, QD, QDD = random_states(rng, robot.n, 64)
+    groups = [Q.T, *({"qd": QD.T, "qdd": QDD.T, "wrench": rng.normal(0.0, 20.0, (6, 64))}[g] for g in KERNEL_INPUTS[name])]
+    expected = kernel.array(*groups)
+    out = [np.full(64, np.nan) for _ in expected]
+    kernel.into(out, *groups)
+    for j in kernel.written:
+        assert np.array_equal(out[j], np.broadcast_to(expected[j], 64)), f"output {j}"
+    folded = set(range(len(expected))) - set(kernel.written)
+    assert all(isinstance(expected[j], float) and np.isnan(out[j]).all() for j in folded)  # left to the caller
+
+
 def trivial_operations(source: str) -> list[str]:
     """Multiplications by 0 or +-1 and additions or subtractions of 0 in generated code."""
 

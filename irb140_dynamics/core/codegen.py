@@ -104,18 +104,12 @@ def _is_const(x) -> bool:
     return False
 
 
-def compile_kernel(
-    name: str,
-    algorithm: Callable[..., Sequence],
-    inputs: dict[str, int],
-    angles: Sequence[float] | None = None,
-) -> tuple[str, Callable, Callable]:
-    """Trace ``algorithm`` and compile it.
+def trace(algorithm: Callable[..., Sequence], inputs: dict[str, int], angles: Sequence[float] | None = None):
+    """Run ``algorithm`` on symbols: (the parameters' names, the outputs: Syms and floats).
 
     ``inputs`` names the argument groups and their lengths, e.g. {"qd": 6, "qdd": 6}.
     With ``angles`` (the theta offsets), a first argument ``q`` is added and the algorithm
-    receives the (cos, sin) pairs of q_i + offset_i as its first argument.
-    Returns (source, scalar_fn, array_fn): array_fn evaluates the same code on NumPy arrays.
+    receives the (cos, sin) pairs of q_i + offset_i (symbols c_i, s_i) as its first argument.
     """
     args = {}
     params = []
@@ -127,20 +121,24 @@ def compile_kernel(
     for group, length in inputs.items():
         params.append(group)
         args[group] = [Sym("var", name=f"{group}{i}") for i in range(length)]
-    outputs = list(algorithm(*args.values()))
+    return params, list(algorithm(*args.values()))
 
+
+def compile_kernel(
+    name: str,
+    algorithm: Callable[..., Sequence],
+    inputs: dict[str, int],
+    angles: Sequence[float] | None = None,
+) -> tuple[str, Callable, Callable]:
+    """Trace ``algorithm`` (see ``trace``) and compile it.
+
+    Returns (source, scalar_fn, array_fn): array_fn evaluates the same code on NumPy arrays.
+    """
+    params, outputs = trace(algorithm, inputs, angles)
     lines = [f"def {name}({', '.join(params)}):"]
-    if angles is not None:
-        lines.append(f"    {_unpack('q', len(angles))} = q")
-    for group, length in inputs.items():
-        lines.append(f"    {_unpack(group, length)} = {group}")
+    lines += input_lines(inputs, angles)
     body, results, used = _emit(outputs)
-    if angles is not None:
-        for i, offset in enumerate(angles):
-            theta = f"q{i}" if offset == 0 else f"q{i} + {offset!r}"
-            for var, fn in ((f"c{i}", "cos"), (f"s{i}", "sin")):
-                if var in used:
-                    lines.append(f"    {var} = {fn}({theta})")
+    lines += angle_lines(angles, used)
     lines += body
     lines.append(f"    return ({', '.join(results)},)")
     source = "\n".join(lines) + "\n"
@@ -150,6 +148,23 @@ def compile_kernel(
     exec(code, scalar_ns)
     exec(code, array_ns)
     return source, scalar_ns[name], array_ns[name]
+
+
+def input_lines(inputs: dict[str, int], angles: Sequence[float] | None) -> list[str]:
+    """The lines unpacking the argument groups into variables q0, q1, ..., qd0, ..."""
+    lines = [f"    {_unpack('q', len(angles))} = q"] if angles is not None else []
+    return lines + [f"    {_unpack(group, length)} = {group}" for group, length in inputs.items()]
+
+
+def angle_lines(angles: Sequence[float] | None, used: set[str]) -> list[str]:
+    """The lines computing the cosines and sines among ``used``."""
+    lines = []
+    for i, offset in enumerate(angles or ()):
+        theta = f"q{i}" if offset == 0 else f"q{i} + {offset!r}"
+        for var, fn in ((f"c{i}", "cos"), (f"s{i}", "sin")):
+            if var in used:
+                lines.append(f"    {var} = {fn}({theta})")
+    return lines
 
 
 def _unpack(group: str, length: int) -> str:

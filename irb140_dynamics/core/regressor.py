@@ -29,11 +29,12 @@ from .algorithms import (
     scale,
     turns,
 )
-from .dynamics import _CHUNK
 from .states import state, states
 from .joints import Friction
 from .model import RobotModel
 from .rigid_body import ModelError, RigidBody, inertia_matrix
+
+_CHUNK = 4096  # states per pass of the kernel (its buffers then stay in the CPU caches)
 
 LINK_PARAMETERS = ("m", "mcx", "mcy", "mcz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
 JOINT_PARAMETERS = ("viscous", "coulomb", "armature")
@@ -97,39 +98,44 @@ def regressor(model: RobotModel, q, qd, qdd) -> np.ndarray:
     n = model.n
     q, qd, qdd = state(q, n, "q"), state(qd, n, "qd"), state(qdd, n, "qdd")
     Y = np.zeros((n, 13 * n))
-    Y[:, : 10 * n] = np.reshape(model.kernels.regressor.scalar(q, qd, qdd), (n, 10 * n))
-    _joint_columns(model, Y, np.array(qd)[None], np.array(qdd)[None])
+    Y[:, : 10 * n] = np.reshape(model.kernels.regressor.scalar(q, qd, qdd), (10 * n, n)).T
+    _joint_columns(model, Y, np.array(qd), np.array(qdd))
     return Y
 
 
 def regressor_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
     """regressor for N states: (N, n) arrays -> Y shaped (N, n, 13n)."""
     n = model.n
-    columns = states(n, Q=Q, QD=QD, QDD=QDD)
-    N = columns[0].shape[1]
-    # Y is a view of rows[entry, state]: each kernel output (a row of N states) is written
-    # whole and contiguously (a (N, n, 13n) array filled entry by entry would be written with
-    # a stride of 13 n^2 numbers, four times slower). Output i * 10n + c is Y[:, i, c]; the
-    # constant zeros (about half: link k moves no joint after k) are left as they are.
-    rows = np.zeros((n * 13 * n, N))  # calloc'd: the pages of rows never written stay untouched
-    where = [i * 13 * n + c for i in range(n) for c in range(10 * n)]
+    q, qd, qdd = states(n, Q=Q, QD=QD, QDD=QDD)
+    N = q.shape[1]
+    # Y is a view of rows[entry, state]: the kernel writes each of its outputs (a row of N
+    # states) whole and contiguously (a (N, n, 13n) array filled entry by entry would be
+    # written with a stride of 13 n^2 numbers, four times slower). Output c * n + i is
+    # Y[:, i, c]; the constant zeros (about half: link k moves no joint after k) are left
+    # as they are, their pages never touched.
+    rows = np.zeros((n * 13 * n, N))
+    kernel = model.kernels.regressor
+    where = [(j, (j % n) * 13 * n + j // n) for j in kernel.written]
+    out = [None] * (10 * n * n)
     for start in range(0, N, _CHUNK):
         chunk = slice(start, start + _CHUNK)
-        for index, values in zip(where, model.kernels.regressor.array(*(c[:, chunk] for c in columns))):
-            if isinstance(values, np.ndarray) or values != 0.0:
-                rows[index, chunk] = values
-    Y = rows.T.reshape(N, n, 13 * n)
-    _joint_columns(model, Y, columns[1].T, columns[2].T)
-    return Y
+        for j, row in where:
+            out[j] = rows[row, chunk]
+        kernel.into(out, q[:, chunk], qd[:, chunk], qdd[:, chunk])
+    joints = np.arange(n) * 13 * n + 10 * n + 3 * np.arange(n)
+    rows[joints] = qd
+    rows[joints + 1] = np.tanh(qd / model.smoothing_velocity)
+    rows[joints + 2] = qdd
+    return rows.T.reshape(N, n, 13 * n)
 
 
-def _joint_columns(model: RobotModel, Y: np.ndarray, QD: np.ndarray, QDD: np.ndarray) -> None:
-    """Fill the friction and armature columns of Y (..., n, 13n) for velocities QD (N, n)."""
+def _joint_columns(model: RobotModel, Y: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> None:
+    """Fill the friction and armature columns of one state's Y (n, 13n)."""
     n = model.n
     rows = np.arange(n)
-    Y[..., rows, 10 * n + 3 * rows] = QD
-    Y[..., rows, 10 * n + 3 * rows + 1] = np.tanh(QD / model.smoothing_velocity)
-    Y[..., rows, 10 * n + 3 * rows + 2] = QDD
+    Y[rows, 10 * n + 3 * rows] = qd
+    Y[rows, 10 * n + 3 * rows + 1] = np.tanh(qd / model.smoothing_velocity)
+    Y[rows, 10 * n + 3 * rows + 2] = qdd
 
 
 def parameter_names(model: RobotModel) -> list[str]:
