@@ -152,12 +152,12 @@ def _add(prior, points: FitPoints, split, where, min_speed, tally, keeper) -> No
     half_window = tally.design.half / tally.design.rate
     use = np.abs(points.qd) >= min_speed + np.abs(points.qdd) * half_window
     tally.slow_rows += np.sum(~use, axis=0)
-    training = points.index < split
-    for part, equations in ((training, where[0]), (~training, where[1])):
-        if part.any():
-            equations.add(Y[part], points.tau[part], use[part])
-    if (~training).any():
-        keeper.add(points.take(~training))
+    training = int(np.searchsorted(points.index, split))  # the points are in the recording's order
+    for part, equations in ((slice(0, training), where[0]), (slice(training, None), where[1])):
+        if len(points.index[part]):
+            equations.add(Y[part], points.tau[part], use[part])  # views, not copies
+    if training < len(points):
+        keeper.add(points.take(slice(training, None)))
 
 
 def _rate(recording: Recording, chunk) -> float:

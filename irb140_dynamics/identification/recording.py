@@ -76,30 +76,59 @@ class Recording:
         yield from self._source.chunks()
 
 
-class _Chunker:
-    """Collects samples (already in the model's joint order) into RawChunks."""
+class _BagChunker:
+    """Collects a bag's messages into RawChunks, with as little work per message as can be
+    (a long bag has millions): the bytes of its arrays are appended to buffers, so that the
+    message is freed at once (keeping thousands alive costs more than the copy), its stamp's
+    integers and receive time to lists (nothing the garbage collector has to visit); the
+    times and the joint order are worked out a chunk at a time, in NumPy."""
 
     def __init__(self, recording: Recording):
         self.recording = recording
         self.first = 0
-        self.times, self.positions, self.velocities, self.efforts = [], [], [], []  # cleared in place
+        self.positions, self.velocities, self.efforts = bytearray(), bytearray(), bytearray()
+        self.seconds, self.nanoseconds, self.receive_times = [], [], []
+        self.index, self.length, self.bad = None, -1, None  # the joint mapping of the messages collected
+        self.missing = np.zeros(0)  # the values of an absent velocity or effort: NaN, ``length`` of them
+        self.parts: list[tuple] = []  # converted messages of earlier mappings, in this chunk
+        self.converted = 0  # messages in parts
 
-    def _clear(self):
-        for samples in (self.times, self.positions, self.velocities, self.efforts):
-            samples.clear()
-
-    def __len__(self):
-        return len(self.times)
+    def layout(self, index, length: int, bad: str | None) -> None:
+        """The mapping of the messages that come next (see _BagSource._mapping)."""
+        same_index = (index is None) == (self.index is None) and (index is None or np.array_equal(index, self.index))
+        if not (same_index and length == self.length):
+            self._convert()
+            self.missing = np.full(max(length, 0), np.nan)
+        self.index, self.length, self.bad = index, length, bad
 
     def take(self) -> RawChunk | None:
-        if not self.times:
+        self._convert()
+        if not self.parts:
             return None
-        n = self.recording.n
-        arrays = [np.asarray(x, dtype=float).reshape(-1, n) for x in (self.positions, self.velocities, self.efforts)]
-        chunk = RawChunk(self.first, np.asarray(self.times, dtype=float), *arrays)
+        fields = [np.concatenate(x) if len(self.parts) > 1 else x[0] for x in zip(*self.parts)]
+        chunk = RawChunk(self.first, *fields)
         self.first += len(chunk)
-        self._clear()
+        self.parts, self.converted = [], 0
         return chunk
+
+    def _convert(self) -> None:
+        """The messages collected so far, as arrays in the model's joint order, into parts."""
+        count = len(self.receive_times)
+        if count == 0:
+            return
+        # each array has ``length`` float64 values in the machine's byte order (rosbags swaps
+        # the others), so the buffers hold the values row by row
+        values = [np.frombuffer(x, np.float64).reshape(count, self.length).copy()
+                  for x in (self.positions, self.velocities, self.efforts)]
+        if self.index is not None:
+            values = [v[:, self.index] for v in values]
+        sec, nanosec, received = (np.fromiter(x, np.int64, count).astype(np.float64)  # (faster than
+                                  for x in (self.seconds, self.nanoseconds, self.receive_times))  # to float64)
+        time = np.where((sec != 0.0) | (nanosec != 0.0), sec + nanosec * 1e-9, received * 1e-9)
+        for x in (self.positions, self.velocities, self.efforts, self.seconds, self.nanoseconds, self.receive_times):
+            x.clear()
+        self.parts.append((time, *values))
+        self.converted += count
 
 
 class _BagSource:
@@ -128,12 +157,12 @@ class _BagSource:
     def chunks(self) -> Iterator[RawChunk]:
         recording, skipped = self.recording, self.recording.skipped
         deserialize = self.reader.typestore.deserialize_cdr
-        chunker, chunk_size = _Chunker(recording), recording.chunk_size
-        times = chunker.times
-        add_time, add_position = times.append, chunker.positions.append  # the loop's hot calls, bound once
-        add_velocity, add_effort = chunker.velocities.append, chunker.efforts.append
-        missing = np.full(recording.n, np.nan)
-        names_seen, index, length, bad = None, None, -1, None
+        chunker, chunk_size = _BagChunker(recording), recording.chunk_size
+        received = chunker.receive_times
+        # the loop's hot calls, bound once
+        add_position, add_velocity, add_effort = chunker.positions.__iadd__, chunker.velocities.__iadd__, chunker.efforts.__iadd__
+        add_seconds, add_nanoseconds, add_time = chunker.seconds.append, chunker.nanoseconds.append, received.append
+        names_seen, length, room = None, -1, chunk_size
         try:
             for _, receive_time, raw in self.reader.messages(connections=self.connections):
                 try:
@@ -142,24 +171,28 @@ class _BagSource:
                     raise RecordingError(recording.path, f"a {recording.topic} message cannot be read ({error})") from None
                 names, position, velocity, effort = msg.name, msg.position, msg.velocity, msg.effort
                 if names != names_seen or not names:
-                    names_seen, index, length, bad = names, *self._mapping(names, len(position))
-                if bad is not None:
-                    skipped[bad] += 1
+                    names_seen = names
+                    chunker.layout(*self._mapping(names, len(position)))
+                    length, room = chunker.length, chunk_size - chunker.converted
+                if chunker.bad is not None:
+                    skipped[chunker.bad] += 1
                     continue
-                if len(position) != length or len(velocity) not in (0, length) or len(effort) not in (0, length):
-                    skipped["length_mismatch"] += 1
-                    continue
-                if index is not None:
-                    position = position[index]
-                    velocity = velocity[index] if len(velocity) else velocity
-                    effort = effort[index] if len(effort) else effort
-                stamp = msg.header.stamp
-                add_time(stamp.sec + stamp.nanosec * 1e-9 if stamp.sec or stamp.nanosec else receive_time * 1e-9)
+                if len(position) != length or len(velocity) != length or len(effort) != length:
+                    if len(position) != length or len(velocity) not in (0, length) or len(effort) not in (0, length):
+                        skipped["length_mismatch"] += 1
+                        continue
+                    velocity = velocity if len(velocity) else chunker.missing
+                    effort = effort if len(effort) else chunker.missing
                 add_position(position)
-                add_velocity(velocity if len(velocity) else missing)
-                add_effort(effort if len(effort) else missing)
-                if len(times) >= chunk_size:
-                    yield chunker.take()
+                add_velocity(velocity)
+                add_effort(effort)
+                stamp = msg.header.stamp
+                add_seconds(stamp.sec)
+                add_nanoseconds(stamp.nanosec)
+                add_time(receive_time)
+                if len(received) >= room:
+                    chunk, room = chunker.take(), chunk_size
+                    yield chunk
             chunk = chunker.take()
             if chunk is not None:
                 yield chunk
