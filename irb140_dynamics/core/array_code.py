@@ -22,7 +22,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from .codegen import Sym, angle_lines, input_lines, trace
+from .codegen import Sym, operand, angle_lines, input_lines, operands_first, trace
 
 _UFUNCS = {"*": "mul", "+": "add", "-": "sub"}
 _NAMESPACE = {"cos": np.cos, "sin": np.sin, "mul": np.multiply, "add": np.add, "sub": np.subtract,
@@ -62,7 +62,7 @@ def compile_into(
 def _emit_into(outputs: list, scalar_vars: set[str]):
     """(body lines, the input variables used, an array input's name, buffers needed)."""
     outputs = _merged(outputs)
-    order = _operands_first(outputs)
+    order = operands_first(outputs)
     scalar = set()  # ids of the nodes that depend on scalar inputs only
     last_use = {}
     for k, x in enumerate(order):
@@ -78,13 +78,13 @@ def _emit_into(outputs: list, scalar_vars: set[str]):
 
     names: dict[int, str] = {}
     lines: list[str] = []
+    buffers: set[str] = set()
     free: list[str] = []  # buffers whose values are dead, the most recently freed last
-    registers = 0
     for k, x in enumerate(order):
         if x.op == "var":
             names[id(x)] = x.name
             continue
-        operands = [names[id(a)] if isinstance(a, Sym) else _constant(a) for a in x.args]
+        operands = [names[id(a)] if isinstance(a, Sym) else operand(a, None) for a in x.args]
         if id(x) in scalar:
             expr = f"-{operands[0]}" if x.op == "neg" else f"{operands[0]} {x.op} {operands[1]}"
             names[id(x)] = f"t{k}"
@@ -92,14 +92,15 @@ def _emit_into(outputs: list, scalar_vars: set[str]):
             continue
         for a in {id(a): a for a in x.args if isinstance(a, Sym)}.values():
             name = names[id(a)]
-            if last_use[id(a)] == k and name.startswith("r"):
+            if last_use[id(a)] == k and name in buffers:
                 free.append(name)
         if id(x) in destination:
             target = destination[id(x)]
         elif free:
             target = free.pop()
         else:
-            target, registers = f"r{registers}", registers + 1
+            target = f"r{len(buffers)}"
+            buffers.add(target)
         call = "neg" if x.op == "neg" else _UFUNCS[x.op]
         lines.append(f"    {call}({', '.join(operands)}, {target})")
         names[id(x)] = target
@@ -108,7 +109,7 @@ def _emit_into(outputs: list, scalar_vars: set[str]):
             lines.append(f"    o{j}[...] = {names[id(out)]}")
     used = {x.name for x in order if x.op == "var"}
     first_array = next((x.name for x in order if x.op == "var" and x.name not in scalar_vars), None)
-    return lines, used, first_array, registers
+    return lines, used, first_array, len(buffers)
 
 
 def _merged(outputs: list) -> list:
@@ -117,7 +118,7 @@ def _merged(outputs: list) -> list:
     commute)."""
     done: dict[tuple, Sym] = {}
     new: dict[int, Sym] = {}
-    for x in _operands_first(outputs):
+    for x in operands_first(outputs):
         if x.op == "var":
             new[id(x)] = x
             continue
@@ -128,25 +129,3 @@ def _merged(outputs: list) -> list:
             done[key] = Sym(x.op, args)
         new[id(x)] = done[key]
     return [new[id(out)] if isinstance(out, Sym) else out for out in outputs]
-
-
-def _constant(x) -> str:
-    return f"({float(x)!r})" if x < 0 else repr(float(x))
-
-
-def _operands_first(outputs: list) -> list[Sym]:
-    """The nodes the outputs need, each after its operands (depth first, in the outputs' order)."""
-    order, seen = [], set()
-    for out in outputs:
-        stack = [(out, False)]
-        while stack:
-            x, expanded = stack.pop()
-            if not isinstance(x, Sym):
-                continue
-            if expanded:
-                order.append(x)
-            elif id(x) not in seen:
-                seen.add(id(x))
-                stack.append((x, True))
-                stack.extend((a, False) for a in reversed(x.args))
-    return order

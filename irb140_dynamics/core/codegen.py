@@ -174,28 +174,15 @@ def _unpack(group: str, length: int) -> str:
 
 def _emit(outputs: list) -> tuple[list[str], list[str], set[str]]:
     """Lines computing the live operations, the outputs' expressions, the inputs used."""
-    order: list[Sym] = []
-
-    def visit(node):  # depth-first, so that operands come before their users
-        stack = [(node, False)]
-        while stack:
-            x, expanded = stack.pop()
-            if not isinstance(x, Sym):
-                continue
-            if expanded:
-                x.index = len(order)
-                order.append(x)
-                continue
-            x.uses += 1
-            if x.uses > 1:
-                continue
-            stack.append((x, True))
-            stack.extend((arg, False) for arg in reversed(x.args))
-
+    order = operands_first(outputs)
+    for k, x in enumerate(order):
+        x.index = k
+        for arg in x.args:
+            if isinstance(arg, Sym):
+                arg.uses += 1
     for out in outputs:
-        visit(out)
         if isinstance(out, Sym):
-            out.uses += 1  # an output is always stored in a variable
+            out.uses += 2  # an output is always stored in a variable
 
     depth: dict[int, int] = {}
     exprs: dict[int, str] = {}
@@ -205,7 +192,7 @@ def _emit(outputs: list) -> tuple[list[str], list[str], set[str]]:
             exprs[x.index] = x.name
             depth[x.index] = 0
             continue
-        operands = [_operand(arg, exprs) for arg in x.args]
+        operands = [operand(arg, exprs) for arg in x.args]
         if x.op == "neg":
             expr = f"-{operands[0]}"
         else:
@@ -218,14 +205,32 @@ def _emit(outputs: list) -> tuple[list[str], list[str], set[str]]:
             lines.append(f"    t{x.index} = {expr}")
             exprs[x.index] = f"t{x.index}"
             depth[x.index] = 0
-    results = [_operand(out, exprs) for out in outputs]
+    results = [operand(out, exprs) for out in outputs]
     used = {x.name for x in order if x.op == "var"}
     for x in order:  # leave the traced graph reusable
         x.uses, x.index = 0, -1
     return lines, results, used
 
 
-def _operand(x, exprs) -> str:
+def operands_first(outputs: list) -> list[Sym]:
+    """The nodes the outputs need, each after its operands (depth first, in the outputs' order)."""
+    order, seen = [], set()
+    for out in outputs:
+        stack = [(out, False)]
+        while stack:
+            x, expanded = stack.pop()
+            if not isinstance(x, Sym):
+                continue
+            if expanded:
+                order.append(x)
+            elif id(x) not in seen:
+                seen.add(id(x))
+                stack.append((x, True))
+                stack.extend((arg, False) for arg in reversed(x.args))
+    return order
+
+
+def operand(x, exprs) -> str:
     if isinstance(x, Sym):
         return exprs[x.index]
     return f"({float(x)!r})" if x < 0 else repr(float(x))
