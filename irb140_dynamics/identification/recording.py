@@ -122,8 +122,9 @@ class _BagChunker:
                   for x in (self.positions, self.velocities, self.efforts)]
         if self.index is not None:
             values = [v[:, self.index] for v in values]
-        sec, nanosec, received = (np.fromiter(x, np.int64, count).astype(np.float64)  # (faster than
-                                  for x in (self.seconds, self.nanoseconds, self.receive_times))  # to float64)
+        # the integers through int64 arrays: half the time of the lists to float64 directly
+        sec, nanosec, received = (np.fromiter(x, np.int64, count).astype(np.float64)
+                                  for x in (self.seconds, self.nanoseconds, self.receive_times))
         time = np.where((sec != 0.0) | (nanosec != 0.0), sec + nanosec * 1e-9, received * 1e-9)
         for x in (self.positions, self.velocities, self.efforts, self.seconds, self.nanoseconds, self.receive_times):
             x.clear()
@@ -172,6 +173,8 @@ class _BagSource:
                 names, position, velocity, effort = msg.name, msg.position, msg.velocity, msg.effort
                 if names != names_seen or not names:
                     names_seen = names
+                    if position.dtype != np.float64:  # the buffers take the arrays' bytes
+                        raise RecordingError(recording.path, f"rosbags gave {position.dtype} positions, not float64")
                     chunker.layout(*self._mapping(names, len(position)))
                     length, room = chunker.length, chunk_size - chunker.converted
                 if chunker.bad is not None:
