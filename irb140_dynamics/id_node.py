@@ -160,8 +160,9 @@ class IdNode(Node):
         the torques all finite, or BadMessage."""
         model = settings.model
         estimate = self._estimated_acceleration(msg, qd, settings)
-        now = self.get_clock().now().nanoseconds * 1e-9
-        reference = self.tracker.sample(now, settings.reference_timeout)
+        tracker = self.tracker
+        reference = tracker.sample(self.get_clock().now().nanoseconds * 1e-9, settings.reference_timeout) \
+            if tracker.trajectory is not None else None  # no clock read without one
         q_ff, qd_ff, qdd_ref = reference or (q, qd, None)
         try:
             tau = finite_torques(rnea, model, q_ff, qd_ff, estimate if qdd_ref is None else qdd_ref)
