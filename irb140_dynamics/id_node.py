@@ -39,7 +39,7 @@ from .ros.messages import (
     JointOrder,
     NotForThisModel,
     finite_torques,
-    joint_efforts,
+    publish_efforts,
     read_effort,
     read_joint_state,
     read_trajectory,
@@ -137,13 +137,13 @@ class IdNode(Node):
             self.tally.drop("joint_states", error)
             return
         stamp = msg.header.stamp
-        self._feedforward_pub.publish(joint_efforts(self._feedforward_msg, stamp, tau))
-        self._gravity_pub.publish(joint_efforts(self._gravity_msg, stamp, g))
+        publish_efforts(self._feedforward_pub, self._feedforward_msg, stamp, tau)
+        publish_efforts(self._gravity_pub, self._gravity_msg, stamp, g)
         if command is not None:
             self._command_msg.data = command.tolist()
             self._command_pub.publish(self._command_msg)
         self.counts["torques.published"] += 1
-        if reference is not None:
+        if reference is not None and self._tracking_pub.get_subscription_count():
             self._publish_tracking_error(stamp, q, qd, reference)
         self._observe(msg, q, qd, g)
 

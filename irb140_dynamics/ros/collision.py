@@ -18,7 +18,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Bool
 
 from ..core.observer import MomentumObserver
-from .messages import joint_efforts
+from .messages import publish_efforts
 from .params import Spec
 
 MAX_GAIN = 1e4  # 1/s: beyond any sampling rate a joint state stream has
@@ -86,7 +86,7 @@ class CollisionMonitor:
         ValueError (observer reset) if the residual is not finite."""
         r = self._observer.advance(t, q, qd, effort, g)
         self._residual = r
-        self._external_pub.publish(joint_efforts(self._external_msg, stamp, r))
+        publish_efforts(self._external_pub, self._external_msg, stamp, r)
         colliding = [name for name, x, limit in zip(self._names, r, self._thresholds) if 0.0 < limit < abs(x)]
         if bool(colliding) != bool(self.colliding):
             self._publish_flag(bool(colliding))
