@@ -6,7 +6,9 @@ in namespaces of their own; this process publishes the same JointState stream to
 ``rate`` (the moving arm; 1 % of the messages with a
 NaN position, which id_node drops, and 1 % with an extra joint of a name never seen before,
 which it ignores), takes their outputs, and sets payload.mass on each every
-``change_period`` s. The resident set size (VmRSS) of each is sampled every
+``change_period`` s. The anonymous resident memory (RssAnon: heap and stacks; VmRSS
+also counts the pages of mapped files, which the kernel drops and reads back as it likes,
+at the same instants in every process) of each is sampled every
 ``sample_period`` s; growth is given in kB per minute as the least-squares slope over the
 whole run and over its second half (after start-up allocations have settled), after a
 warm-up that is not counted.
@@ -134,7 +136,7 @@ def soak(minutes: float, rate: float, env: dict, change_period: float = CHANGE_P
                 for kind in KINDS:
                     if not processes[kind].alive():
                         raise processes[kind].fail(f"{kind} died during the soak")
-                    samples[kind].append((now - start - warmup, rss_kb(processes[kind].process.pid)))
+                    samples[kind].append((now - start - warmup, rss_kb(processes[kind].process.pid, "RssAnon")))
                 next_sample += sample_period
             t = sent * period
             q = [0.5 * math.sin(wi * t) for wi in w]
@@ -161,7 +163,7 @@ def soak(minutes: float, rate: float, env: dict, change_period: float = CHANGE_P
             t, rss = (np.array(x, dtype=float) for x in zip(*samples[kind])) if samples[kind] else (np.zeros(0),) * 2
             half = t >= t[-1] / 2 if t.size else t
             results[kind] = {
-                "rss_kb": samples[kind],
+                "rss_anon_kb": samples[kind],
                 "growth_kb": float(rss[-1] - rss[0]) if rss.size else None,
                 "slope_kb_per_min": slope_kb_per_min(t, rss),
                 "slope_second_half_kb_per_min": slope_kb_per_min(t[half], rss[half]),
@@ -200,8 +202,8 @@ def print_soak(results: dict) -> bool:
     """The soak side by side; True if id_node grew no faster than the relay (second half)."""
     s = results["settings"]
     print(f"\nsoak: {s['minutes']:g} min at {s['rate_hz']:g} Hz, {results['sent']} messages to each node, "
-          f"payload.mass set every {s['change_period_s']:g} s; RSS after a {s['warmup_s']:g} s warm-up\n")
-    print(f"{'node':<14}{'RSS start [MB]':>16}{'RSS end [MB]':>14}{'growth [kB]':>13}"
+          f"payload.mass set every {s['change_period_s']:g} s; RssAnon after a {s['warmup_s']:g} s warm-up\n")
+    print(f"{'node':<14}{'RssAnon start [MB]':>20}{'RssAnon end [MB]':>18}{'growth [kB]':>13}"
           f"{'kB/min':>9}{'kB/min, 2nd half':>18}{'outputs':>10}{'logs':>7}")
 
     def fmt(x, spec):
@@ -209,9 +211,9 @@ def print_soak(results: dict) -> bool:
 
     for kind in KINDS:
         r = results[kind]
-        first = r["rss_kb"][0][1] / 1024 if r["rss_kb"] else None
-        last = r["rss_kb"][-1][1] / 1024 if r["rss_kb"] else None
-        print(f"{kind:<14}{fmt(first, '.1f'):>16}{fmt(last, '.1f'):>14}{fmt(r['growth_kb'], '.0f'):>13}"
+        first = r["rss_anon_kb"][0][1] / 1024 if r["rss_anon_kb"] else None
+        last = r["rss_anon_kb"][-1][1] / 1024 if r["rss_anon_kb"] else None
+        print(f"{kind:<14}{fmt(first, '.1f'):>20}{fmt(last, '.1f'):>18}{fmt(r['growth_kb'], '.0f'):>13}"
               f"{fmt(r['slope_kb_per_min'], '.1f'):>9}{fmt(r['slope_second_half_kb_per_min'], '.1f'):>18}"
               f"{r['outputs']:>10}{r.get('log_messages', 0):>7}")
     print("logs: messages each node sent to /rosout; rcl keeps its last 1,000 (~0.5 kB each), so a node that "
