@@ -5,7 +5,8 @@ kernels, sweeping the workspace) there would stall them. ``Builder.submit`` hand
 work to a worker thread, started when there is work and ended when there is none; the
 result comes back to the executor thread through a timer polling every POLL_PERIOD while
 a build is under way (the EventsExecutor takes no guard conditions), whose callback hands
-it to ``deliver``. Only the newest job waiting is kept: jobs submitted while one is being
+it to ``deliver``; the timer runs on the steady clock, so that a node on simulated time
+(use_sim_time) takes its parameter changes while the simulation is paused too. Only the newest job waiting is kept: jobs submitted while one is being
 built collapse into the latest, and every job finished is delivered (in order), so the
 newest always follows within two builds.
 
@@ -22,8 +23,11 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable
 
+from rclpy.clock import Clock, ClockType
+
 SWITCH_INTERVAL = 2e-4  # s: how long the message thread may wait for the interpreter lock
 POLL_PERIOD = 0.002  # s: how soon a finished build is swapped in
+STEADY = Clock(clock_type=ClockType.STEADY_TIME)
 
 
 @dataclass(frozen=True)
@@ -84,7 +88,7 @@ class Builder:
     def submit(self, generation: int, job: Any) -> None:
         """Build ``job`` (called on the executor thread, or before it spins)."""
         if self._poll is None:
-            self._poll = self._node.create_timer(POLL_PERIOD, self.deliver_finished)
+            self._poll = self._node.create_timer(POLL_PERIOD, self.deliver_finished, clock=STEADY)
         work = self._work
         with work.lock:
             work.job = (generation, job)
