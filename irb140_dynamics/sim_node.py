@@ -231,6 +231,8 @@ class SimNode(Node):
 
     def _publish_lockstep(self) -> None:
         """Lockstep: /clock, then the state, both at the current simulated time."""
+        if not self.context.ok():  # shutting down (Ctrl-C): a command still came in
+            return
         with self._lock:
             self.last_stamp = self.lockstep.stamp
             state = self._state()

@@ -13,13 +13,16 @@ A motion starts alike each time: id_node holds the arm at its first point (a one
 ~/reference; its arrival is seen in ~/tracking_error, so the connection is up); for the
 demo's motion sim_node is reset there and held still for reset_hold, and the motion's
 ~/reference is stamped to start when the hold ends (the excitation starts from the hold,
-so that the recording holds nothing but physics). Lockstep makes what follows the same
+so that the recording holds nothing but physics; the recording is stopped with id_node
+paused, so that it ends TAIL after the motion). Lockstep makes what follows the same
 whatever the machine's load: each joint state k+1 is checked to carry (as effort) exactly
 the command computed from state k and the reference at state k's simulated time, so no
 step went without its command, none had two, and id_node's clock read each state's stamp.
 """
 
+import os
 import re
+import signal
 import sys
 import time
 
@@ -196,7 +199,7 @@ def test_identified_from_a_ros_recording_tracks_five_times_better(probe, process
     began = time.monotonic()
     excitation_file, bag, identified = tmp_path / "excitation.yaml", tmp_path / "run", tmp_path / "identified.yaml"
     code, output = run_to_exit(tool("excitation", "--out", str(excitation_file), "--period", str(EXCITATION_PERIOD),
-                                    "--rate", "100", "--iterations", "0", "--seed", "2"))
+                                    "--rate", "50", "--iterations", "0", "--seed", "2"))
     assert code == 0, output
     excitation = trajectory_message(excitation_file)
     start_pose = list(excitation.points[0].positions)  # where the recording starts: no motion to get there
@@ -207,7 +210,11 @@ def test_identified_from_a_ros_recording_tracks_five_times_better(probe, process
     lines = []
     assert wait_for_line(recorder, "recording /joint_states", lines, TIMEOUT), "".join(lines)
     loop.move(excitation, EXCITATION_PERIOD + TAIL, reset=False)  # no reset: every state recorded is physical
-    code, output = interrupt(recorder, lines)
+    os.kill(controller.pid, signal.SIGSTOP)  # the loop stands still (lockstep) while the recording stops:
+    try:  # it ends TAIL after the motion, however long the recorder takes to stop
+        code, output = interrupt(recorder, lines)
+    finally:
+        os.kill(controller.pid, signal.SIGCONT)
     assert code == 0 and f"wrote {bag}" in output, output
     # one BLAS thread: OpenBLAS's threads spin for the cores the nodes need (4 s of CPU become 30)
     identify = processes(tool("identify", str(bag), "--out", str(identified), "--quiet"), ONE_THREAD)
