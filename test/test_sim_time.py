@@ -9,30 +9,15 @@ import pytest
 from builtin_interfaces.msg import Time
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray
-from trajectory_msgs.msg import JointTrajectory
 
 from irb140_dynamics.core import RobotModel, gravity, irb140, rnea
-from irb140_dynamics.id_node import IdNode
 
-from .ros_harness import running
-from .test_tracking_node import A, B, follow, send, trajectory
+from .test_tracking_node import A, B, follow, send, tracking, trajectory
 
 
 @pytest.fixture
 def node():
-    overrides = [Parameter("use_sim_time", value=True),
-                 Parameter("effort_commands.enabled", value=True),
-                 Parameter("effort_commands.source", value="computed_torque"),
-                 Parameter("reference_timeout", value=0.5)]
-    with running(IdNode, parameter_overrides=overrides) as harness:
-        harness.feedforward = harness.listen(JointState, "feedforward_torques")
-        harness.gravity = harness.listen(JointState, "gravity_torques")
-        harness.commands = harness.listen(Float64MultiArray, "effort_commands")
-        harness.tracking = harness.listen(JointState, "/id_node/tracking_error")
-        harness.joint_states = harness.publisher(JointState, "joint_states")
-        harness.reference = harness.publisher(JointTrajectory, "/id_node/reference")
+    with tracking(Parameter("use_sim_time", value=True)) as harness:
         harness.clock = harness.publisher(Clock, "/clock")
         yield harness
 
