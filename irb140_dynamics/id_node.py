@@ -40,7 +40,7 @@ from .ros.messages import (
     JointOrder,
     NotForThisModel,
     finite_torques,
-    joint_efforts,
+    publish_efforts,
     read_effort,
     read_joint_state,
     read_trajectory,
@@ -138,13 +138,13 @@ class IdNode(Node):
             self.tally.drop("joint_states", error)
             return
         stamp = msg.header.stamp
-        self._feedforward_pub.publish(joint_efforts(self._feedforward_msg, stamp, tau))
-        self._gravity_pub.publish(joint_efforts(self._gravity_msg, stamp, g))
+        publish_efforts(self._feedforward_pub, self._feedforward_msg, stamp, tau)
+        publish_efforts(self._gravity_pub, self._gravity_msg, stamp, g)
         if command is not None:
             self._command_msg.data = command.tolist()
             self._command_pub.publish(self._command_msg)
         self.counts["torques.published"] += 1
-        if reference is not None:
+        if reference is not None and self._tracking_pub.get_subscription_count():
             self._publish_tracking_error(stamp, q, qd, reference)
         self._observe(msg, q, qd, g)
 
@@ -161,8 +161,9 @@ class IdNode(Node):
         the torques all finite, or BadMessage."""
         model = settings.model
         estimate = self._estimated_acceleration(msg, qd, settings)
-        now = self.get_clock().now().nanoseconds * 1e-9
-        reference = self.tracker.sample(now, settings.reference_timeout)
+        tracker = self.tracker
+        reference = tracker.sample(self.get_clock().now().nanoseconds * 1e-9, settings.reference_timeout) \
+            if tracker.trajectory is not None else None  # no clock read without one
         q_ff, qd_ff, qdd_ref = reference or (q, qd, None)
         try:
             tau = finite_torques(rnea, model, q_ff, qd_ff, estimate if qdd_ref is None else qdd_ref)
