@@ -9,6 +9,7 @@ import pytest
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import irb140
 from irb140_dynamics.sim.engine import SimulatedArm
@@ -152,3 +153,12 @@ def test_reset_hold_counts_simulated_time(lockstep):
     assert all(msg.position.tolist() == POSE and not np.any(msg.effort) for msg in held)
     applied = step(sim, np.full(6, 50.0))
     assert applied.effort.tolist() == [50.0] * 6 and applied.position.tolist() != POSE
+    client = sim.probe.create_client(Trigger, "/sim_node/reset")  # a reset: the same again, from now
+    assert client.wait_for_service(timeout_sec=10.0)
+    reply = sim.call(lambda: client.call_async(Trigger.Request()))
+    now = stamp(applied)
+    assert reply.success and reply.message.endswith(f"held until {(now + 5 * PERIOD_NS) * 1e-9:.9f} s of simulated time")
+    held = [step(sim, np.full(6, 50.0)) for _ in range(5)]  # from now to now + 0.04 s: held
+    assert all(msg.position.tolist() == POSE and not np.any(msg.effort) for msg in held)
+    assert stamp(held[-1]) == now + 5 * PERIOD_NS  # the first step taken is from the time the reply gave
+    assert step(sim, np.full(6, 50.0)).effort.tolist() == [50.0] * 6
