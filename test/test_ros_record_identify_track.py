@@ -51,7 +51,7 @@ PERIOD = round(1e9 / RATE)  # ns
 EXCITATION_PERIOD = 5.0  # s
 DEMO_PERIOD = 8.0  # s: demo_node's default motion
 TRACKED = 4.0  # s of it compared: out to its far end
-TAIL = 0.5  # s recorded after the excitation
+TAIL = 1.0  # s recorded after the excitation
 ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 HOLD = 0.5  # s of simulated time the arm is held still after a reset: the reference arrives meanwhile
 SIM = ["--params-file", str(ROOT / "config" / "true_arm.yaml"), "-p", "lockstep:=true", "-p", f"rate:={RATE}",
