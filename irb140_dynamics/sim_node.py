@@ -244,7 +244,7 @@ class SimNode(Node):
     @guarded("joint_states")
     def _republish(self) -> None:
         """Lockstep, no command for lockstep_timeout: the last state (and /clock) again."""
-        if self.lockstep.tick() and self.arm is not None:
+        if self.arm is not None and self.lockstep.tick():
             self._publish_lockstep()
 
     def _on_step_error(self, error: Exception) -> None:
