@@ -1,7 +1,8 @@
 """id_node: live inverse dynamics and gravity compensation.
 
 Subscribes   joint_states          sensor_msgs/JointState (matched by joint name)
-             ~/reference           trajectory_msgs/JointTrajectory: followed in time (see ros.tracking)
+             ~/reference           trajectory_msgs/JointTrajectory: followed in time from its
+                                   header.stamp, or on arrival (see ros.tracking)
              robot_description     std_msgs/String (transient local): the model, with model.source
                                    robot_description and no URDF parameter or file (see ros.model_source)
 Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, qdd)
@@ -223,8 +224,8 @@ class IdNode(Node):
 
     @guarded("reference")
     def _on_reference(self, msg: JointTrajectory) -> None:
-        """Follow a trajectory from now if the model gives finite torques at every point;
-        an empty trajectory lets the reference go."""
+        """Follow a trajectory from its header.stamp (zero: now) if the model gives finite
+        torques at every point; an empty trajectory lets the reference go."""
         self.counts["reference.received"] += 1
         if not msg.points or self.settings is None:
             self.tracker.clear()
@@ -236,7 +237,8 @@ class IdNode(Node):
         except BadMessage as error:
             self.tally.drop("reference", error)
             return
-        self.tracker.follow(trajectory, self.get_clock().now().nanoseconds * 1e-9)
+        start = (msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec) * 1e-9
+        self.tracker.follow(trajectory, start or self.get_clock().now().nanoseconds * 1e-9)
 
     @guarded("diagnostics")
     def _publish_diagnostics(self) -> None:

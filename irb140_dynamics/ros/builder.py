@@ -6,10 +6,11 @@ work to a worker thread, started when there is work and ended LINGER s after the
 (one thread per change grew the process's memory); the result comes back to the executor
 thread through a timer polling every POLL_PERIOD while a build is under way (the
 EventsExecutor takes no guard conditions; the timer is made once and cancelled in
-between: rcl leaks ~80 B per timer made), whose callback hands it to ``deliver``. Only
-the newest job waiting is kept: jobs submitted while one is being built collapse into the
-latest, and every job finished is delivered (in order), so the newest always follows
-within two builds.
+between: rcl leaks ~80 B per timer made), whose callback hands it to ``deliver``. The
+timer runs on the steady clock, so that a node on simulated time (use_sim_time) takes its
+parameter changes while the simulation stands still too. Only the newest job waiting is
+kept: jobs submitted while one is being built collapse into the latest, and every job
+finished is delivered (in order), so the newest always follows within two builds.
 
 While a build runs, the executor thread must still get the interpreter lock quickly:
 ``submit`` lowers the interpreter's switch interval to SWITCH_INTERVAL (process-wide; it
@@ -24,9 +25,12 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable
 
+from rclpy.clock import Clock, ClockType
+
 SWITCH_INTERVAL = 2e-4  # s: how long the message thread may wait for the interpreter lock
 POLL_PERIOD = 0.002  # s: how soon a finished build is swapped in
 LINGER = 10.0  # s a worker thread waits for the next job before it ends (a thread per change grew memory)
+STEADY = Clock(clock_type=ClockType.STEADY_TIME)
 
 
 @dataclass(frozen=True)
@@ -99,7 +103,7 @@ class Builder:
     def submit(self, generation: int, job: Any) -> None:
         """Build ``job`` (called on the executor thread, or before it spins)."""
         if self._poll is None:  # made once, then cancelled and reset: each timer made leaks ~80 B in rcl
-            self._poll = self._node.create_timer(POLL_PERIOD, self.deliver_finished)
+            self._poll = self._node.create_timer(POLL_PERIOD, self.deliver_finished, clock=STEADY)
         elif self._poll.is_canceled():
             self._poll.reset()
         if sys.getswitchinterval() > SWITCH_INTERVAL:
