@@ -2,9 +2,9 @@
 
 A node's executor thread serves its messages; building a new configuration (compiling
 kernels, sweeping the workspace) there would stall them. ``Builder.submit`` hands the
-work to a worker thread, started when there is work and ended LINGER s after the last job
-(one thread per change grew the process's memory); the result comes back to the executor
-thread through a timer polling every POLL_PERIOD while a build is under way (the
+work to a worker thread, started when there is work and ended when there is none (a
+thread that lingered for the next job kept the last result, and what it holds, alive past
+its node); the result comes back to the executor thread through a timer polling every POLL_PERIOD while a build is under way (the
 EventsExecutor takes no guard conditions; the timer is made once and cancelled in
 between: rcl leaks ~80 B per timer made), whose callback hands it to ``deliver``. The
 timer runs on the steady clock, so that a node on simulated time (use_sim_time) takes its
@@ -29,7 +29,6 @@ from rclpy.clock import Clock, ClockType
 
 SWITCH_INTERVAL = 2e-4  # s: how long the message thread may wait for the interpreter lock
 POLL_PERIOD = 0.002  # s: how soon a finished build is swapped in
-LINGER = 10.0  # s a worker thread waits for the next job before it ends (a thread per change grew memory)
 STEADY = Clock(clock_type=ClockType.STEADY_TIME)
 
 
@@ -46,19 +45,19 @@ class _Work:
 
     def __init__(self, build: Callable[[Any, Any], Any]):
         self.build = build
-        self.lock = threading.Condition()
+        self.lock = threading.Lock()
         self.job: tuple[int, Any] | None = None  # the newest job not yet started
         self.busy = False  # a job is waiting or being built
-        self.thread = False  # a worker thread is under way (building, or lingering for the next job)
+        self.thread = False  # a worker thread is under way
         self.finished: tuple[int, Any] | None = None  # the newest result not yet delivered
         self.done = threading.Event()  # set whenever a result is waiting to be delivered
         self.previous = None  # the last result built
 
     def run(self) -> None:
-        """The worker thread: build jobs until none has come for LINGER s."""
+        """The worker thread: build jobs until there are none."""
         while True:
             with self.lock:
-                if not self.lock.wait_for(lambda: self.job is not None, timeout=LINGER):
+                if self.job is None:
                     self.thread = False
                     return
                 (generation, job), self.job = self.job, None
@@ -75,9 +74,7 @@ class _Work:
         with self.lock:
             self.job = (generation, job)
             self.busy = True
-            if self.thread:
-                self.lock.notify()
-            else:
+            if not self.thread:
                 self.thread = True
                 threading.Thread(target=self.run, name=name, daemon=True).start()
 
