@@ -30,6 +30,7 @@ setup(
             "export_urdf = irb140_dynamics.tools.export_urdf:main",
             "identify = irb140_dynamics.tools.identify:main",
             "excitation = irb140_dynamics.tools.excitation:main",
+            "record = irb140_dynamics.tools.record:main",
         ],
     },
 )

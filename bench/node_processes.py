@@ -114,10 +114,11 @@ def wait_for(condition: Callable[[], bool], timeout: float, process: NodeProcess
 
 
 
-def rss_kb(pid: int) -> int:
-    """Resident set size of a process [kB] (VmRSS of /proc/<pid>/status)."""
+def rss_kb(pid: int, field: str = "VmRSS") -> int:
+    """Resident set size of a process [kB] (VmRSS of /proc/<pid>/status; ``field`` RssAnon:
+    its anonymous part, the heap and stacks, without the file pages the kernel may drop)."""
     with open(f"/proc/{pid}/status") as status:
         for line in status:
-            if line.startswith("VmRSS:"):
+            if line.startswith(f"{field}:"):
                 return int(line.split()[1])
-    raise RuntimeError(f"no VmRSS for process {pid}")
+    raise RuntimeError(f"no {field} for process {pid}")

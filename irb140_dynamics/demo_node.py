@@ -36,6 +36,19 @@ def motion(t: np.ndarray, period: float):
     return c + a * (1 - np.cos(w * t)) / 2, a * w * np.sin(w * t) / 2, a * w**2 * np.cos(w * t) / 2
 
 
+def reference_message(period: float) -> JointTrajectory:
+    """One period of the motion, POINTS_PER_SECOND points a second, as id_node's ~/reference."""
+    t = np.arange(int(period * POINTS_PER_SECOND) + 1) / POINTS_PER_SECOND
+    Q, QD, QDD = motion(t, period)
+    msg = JointTrajectory(joint_names=NAMES)
+    for ti, q, qd, qdd in zip(t, Q, QD, QDD):
+        sec, nanosec = divmod(int(round(ti * 1e9)), 10**9)
+        msg.points.append(JointTrajectoryPoint(
+            positions=q.tolist(), velocities=qd.tolist(), accelerations=qdd.tolist(),
+            time_from_start=Duration(sec=sec, nanosec=nanosec)))
+    return msg
+
+
 class DemoNode(Node):
     def __init__(self, **kwargs):
         super().__init__("demo_node", **kwargs)
@@ -68,15 +81,7 @@ class DemoNode(Node):
         return (self.get_clock().now() - self._start).nanoseconds * 1e-9
 
     def _send_reference(self) -> None:
-        t = np.arange(int(self.period * POINTS_PER_SECOND) + 1) / POINTS_PER_SECOND
-        Q, QD, QDD = motion(t, self.period)
-        msg = JointTrajectory(joint_names=NAMES)
-        for ti, q, qd, qdd in zip(t, Q, QD, QDD):
-            sec, nanosec = divmod(int(round(ti * 1e9)), 10**9)
-            msg.points.append(JointTrajectoryPoint(
-                positions=q.tolist(), velocities=qd.tolist(), accelerations=qdd.tolist(),
-                time_from_start=Duration(sec=sec, nanosec=nanosec)))
-        self._reference_pub.publish(msg)
+        self._reference_pub.publish(reference_message(self.period))
 
     @staticmethod
     def _ns(msg) -> int:

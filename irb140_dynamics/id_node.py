@@ -1,7 +1,8 @@
 """id_node: live inverse dynamics and gravity compensation.
 
 Subscribes   joint_states          sensor_msgs/JointState (matched by joint name)
-             ~/reference           trajectory_msgs/JointTrajectory: followed in time (see ros.tracking)
+             ~/reference           trajectory_msgs/JointTrajectory: followed in time from its
+                                   header.stamp, or on arrival (see ros.tracking)
              robot_description     std_msgs/String (transient local): the model, with model.source
                                    robot_description and no URDF parameter or file (see ros.model_source)
 Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, qdd)
@@ -39,7 +40,7 @@ from .ros.messages import (
     JointOrder,
     NotForThisModel,
     finite_torques,
-    joint_efforts,
+    publish_efforts,
     read_effort,
     read_joint_state,
     read_trajectory,
@@ -137,13 +138,13 @@ class IdNode(Node):
             self.tally.drop("joint_states", error)
             return
         stamp = msg.header.stamp
-        self._feedforward_pub.publish(joint_efforts(self._feedforward_msg, stamp, tau))
-        self._gravity_pub.publish(joint_efforts(self._gravity_msg, stamp, g))
+        publish_efforts(self._feedforward_pub, self._feedforward_msg, stamp, tau)
+        publish_efforts(self._gravity_pub, self._gravity_msg, stamp, g)
         if command is not None:
             self._command_msg.data = command.tolist()
             self._command_pub.publish(self._command_msg)
         self.counts["torques.published"] += 1
-        if reference is not None:
+        if reference is not None and self._tracking_pub.get_subscription_count():
             self._publish_tracking_error(stamp, q, qd, reference)
         self._observe(msg, q, qd, g)
 
@@ -160,8 +161,9 @@ class IdNode(Node):
         the torques all finite, or BadMessage."""
         model = settings.model
         estimate = self._estimated_acceleration(msg, qd, settings)
-        now = self.get_clock().now().nanoseconds * 1e-9
-        reference = self.tracker.sample(now, settings.reference_timeout)
+        tracker = self.tracker
+        reference = tracker.sample(self.get_clock().now().nanoseconds * 1e-9, settings.reference_timeout) \
+            if tracker.trajectory is not None else None  # no clock read without one
         q_ff, qd_ff, qdd_ref = reference or (q, qd, None)
         try:
             tau = finite_torques(rnea, model, q_ff, qd_ff, estimate if qdd_ref is None else qdd_ref)
@@ -222,8 +224,8 @@ class IdNode(Node):
 
     @guarded("reference")
     def _on_reference(self, msg: JointTrajectory) -> None:
-        """Follow a trajectory from now if the model gives finite torques at every point;
-        an empty trajectory lets the reference go."""
+        """Follow a trajectory from its header.stamp (zero: now) if the model gives finite
+        torques at every point; an empty trajectory lets the reference go."""
         self.counts["reference.received"] += 1
         if not msg.points or self.settings is None:
             self.tracker.clear()
@@ -235,7 +237,8 @@ class IdNode(Node):
         except BadMessage as error:
             self.tally.drop("reference", error)
             return
-        self.tracker.follow(trajectory, self.get_clock().now().nanoseconds * 1e-9)
+        start = (msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec) * 1e-9
+        self.tracker.follow(trajectory, start or self.get_clock().now().nanoseconds * 1e-9)
 
     @guarded("diagnostics")
     def _publish_diagnostics(self) -> None:

@@ -31,24 +31,40 @@ def run_to_exit(command: list[str], env: dict | None = None, timeout: float = 60
     return process.returncode, output
 
 
+def wait_for_line(process: subprocess.Popen, text: str, lines: list[str], timeout: float = 60.0) -> bool:
+    """Read the process's output into ``lines`` until a line with ``text`` (True), or the
+    process ends or ``timeout`` passes (False)."""
+    deadline = time.monotonic() + timeout
+    os.set_blocking(process.stdout.fileno(), False)
+    while time.monotonic() < deadline:
+        line = process.stdout.readline()
+        if line:
+            lines.append(line)
+            if text in line:
+                return True
+        elif process.poll() is not None:
+            return False
+        else:
+            time.sleep(0.05)
+    return False
+
+
+def interrupt(process: subprocess.Popen, lines: list[str] | None = None, timeout: float = 20.0) -> tuple[int, str]:
+    """Stop a process with Ctrl-C: (exit code, its output, after ``lines`` read before)."""
+    try:
+        process.send_signal(signal.SIGINT)
+        rest, _ = process.communicate(timeout=timeout)
+    finally:
+        process.kill()
+    return process.returncode, "".join(lines or []) + (rest or "")
+
+
 def run_until_ready(command: list[str], env: dict | None = None, timeout: float = 60.0) -> tuple[int, str]:
     """Start a node, wait for its 'ready' line, stop it with Ctrl-C: (exit code, output)."""
     process = start(command, env)
     lines = []
-    deadline = time.monotonic() + timeout
     try:
-        os.set_blocking(process.stdout.fileno(), False)
-        while time.monotonic() < deadline and not any("ready" in line for line in lines):
-            line = process.stdout.readline()
-            if line:
-                lines.append(line)
-            elif process.poll() is not None:
-                break
-            else:
-                time.sleep(0.05)
-        process.send_signal(signal.SIGINT)
-        rest, _ = process.communicate(timeout=20)
-        lines.append(rest or "")
+        wait_for_line(process, "ready", lines, timeout)
     finally:
-        process.kill()
-    return process.returncode, "".join(lines)
+        code, output = interrupt(process, lines)
+    return code, output

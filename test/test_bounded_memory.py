@@ -75,7 +75,8 @@ def test_id_node_holds_no_more_memory_after_warming_up(monkeypatch):
         assert len(node._order._cache) <= 16
         assert len(node.counts) <= 30 and all(key.count(".") == 1 for key in node.counts), dict(node.counts)
         assert len(node.tally._next_warning) <= 3
-        assert len(list(node.timers)) == 1  # diagnostics; the builder's poll timer is gone once idle
+        timers = list(node.timers)  # diagnostics, and the builder's poll timer: made once, cancelled once idle
+        assert len(timers) == 2 and sum(timer.is_canceled() for timer in timers) == 1
         assert threading.active_count() == threads
         assert not any(key.endswith(".errors") for key in node.counts)
 
@@ -110,5 +111,6 @@ def test_payload_check_node_holds_no_more_memory_after_warming_up():
         # The certified analysis keeps more that is bounded (the proofs' report strings and
         # shapes of its remembered families): 39 kB after 600 inputs, 45 kB after 1800.
         assert growth < 2 * GROWTH_LIMIT, top
-        assert len(node._order._cache) <= 16 and len(node.counts) <= 20 and len(list(node.timers)) == 0
+        assert len(node._order._cache) <= 16 and len(node.counts) <= 20
+        assert all(timer.is_canceled() for timer in node.timers)  # the builder's poll timer, once idle
         assert not any(key.endswith(".errors") for key in node.counts)

@@ -39,6 +39,9 @@ class Recorder:
     def publish(self, msg):
         self.efforts.append(list(msg.effort))
 
+    def get_subscription_count(self) -> int:
+        return 1  # a subscriber listens: id_node publishes only then
+
 
 def held_point(node):
     """The first point of the trajectory id_node follows, as (q, qd, qdd or None) lists."""

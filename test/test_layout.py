@@ -12,7 +12,7 @@ from .node_process import run_to_exit, run_until_ready
 from .paths import CONFIG, ROOT
 
 EXECUTABLES = ["id_node", "payload_check_node"]
-IDENTIFICATION_TOOLS = ["identify", "excitation"]
+IDENTIFICATION_TOOLS = ["identify", "excitation", "record"]
 TOOLS = ["export_urdf", *IDENTIFICATION_TOOLS]
 URDF = ROOT / "urdf" / "irb140.urdf"
 

@@ -12,6 +12,7 @@ from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import RigidBody, gravity, irb140
+from irb140_dynamics import sim_node
 from irb140_dynamics.sim_node import SimNode
 
 from .ros_harness import running
@@ -102,11 +103,37 @@ def test_bad_commands_are_dropped_counted_and_never_applied(sim):
     wait_for_effort(sim, COMMAND)
     for bad in (COMMAND[:5], COMMAND + [7.0], [np.nan] + COMMAND[1:], COMMAND[:5] + [np.inf]):
         command(sim, bad)
-    assert sim.spin_until(lambda: sim.node.counts["dropped"] == 4)
+    assert sim.spin_until(lambda: sim.node.counts["effort_commands.dropped"] == 4)
     assert all(np.array_equal(msg.effort, COMMAND) for msg in states_after(sim, 100))
-    assert sim.node.counts["dropped_length_mismatch"] == 2 and sim.node.counts["dropped_not_finite"] == 2
+    counts = sim.node.counts
+    assert counts["effort_commands.dropped_length_mismatch"] == 2 and counts["effort_commands.dropped_not_finite"] == 2
     assert sim.spin_until(lambda: any(s.level == DiagnosticStatus.WARN and "dropped" in s.message
                                       for msg in diagnostics for s in msg.status), timeout=3.0)
+
+
+def test_no_exception_leaves_a_callback(sim, monkeypatch):
+    """A defect of ours in a callback (here: made to raise) is counted per topic and warned
+    about; the node goes on, and a service answers that it failed."""
+    diagnostics = sim.listen(DiagnosticArray, "/diagnostics")
+
+    def broken(msg, n):
+        raise RuntimeError("a defect")
+
+    monkeypatch.setattr(sim_node, "read_command", broken)
+    command(sim, COMMAND)
+    assert sim.spin_until(lambda: sim.node.counts["effort_commands.errors"] >= 1)
+    monkeypatch.undo()
+    command(sim, COMMAND)
+    wait_for_effort(sim, COMMAND)  # commands apply again
+    monkeypatch.setattr(sim.node, "reset", lambda: 1 / 0)
+    client = sim.probe.create_client(Trigger, "/sim_node/reset")
+    assert client.wait_for_service(timeout_sec=10.0)
+    reply = sim.call(lambda: client.call_async(Trigger.Request()))
+    assert not reply.success and reply.message == "reset failed: division by zero"
+    assert sim.node.counts["reset.errors"] == 1
+    assert sim.spin_until(lambda: any(s.level == DiagnosticStatus.WARN and "callbacks failed" in s.message
+                                      for msg in diagnostics for s in msg.status), timeout=3.0)
+    states_after(sim, 50)  # still stepping
 
 
 def test_diagnostics_warn_when_real_time_is_lost(sim):

@@ -1,6 +1,8 @@
 """id_node following a whole ~/reference trajectory, computed-torque commands, the hold
 position without a reference, and ~/tracking_error (in-process)."""
 
+from contextlib import contextmanager
+
 import numpy as np
 import pytest
 from builtin_interfaces.msg import Duration
@@ -21,17 +23,25 @@ B = [0.4, -0.2, 0.9, 0.5, -0.3, 0.8]
 KP, KD = np.full(6, 400.0), np.full(6, 40.0)  # the defaults
 
 
-@pytest.fixture
-def node():
-    overrides = [Parameter("effort_commands.enabled", value=True),
-                 Parameter("effort_commands.source", value="computed_torque"),
-                 Parameter("reference_timeout", value=0.5)]
-    with running(IdNode, parameter_overrides=overrides) as harness:
+@contextmanager
+def tracking(*overrides: Parameter):
+    """id_node in computed-torque mode (and ``overrides``), with the probe's topics."""
+    defaults = [Parameter("effort_commands.enabled", value=True),
+                Parameter("effort_commands.source", value="computed_torque"),
+                Parameter("reference_timeout", value=0.5)]
+    with running(IdNode, parameter_overrides=[*defaults, *overrides]) as harness:
         harness.feedforward = harness.listen(JointState, "feedforward_torques")
+        harness.gravity = harness.listen(JointState, "gravity_torques")
         harness.commands = harness.listen(Float64MultiArray, "effort_commands")
         harness.tracking = harness.listen(JointState, "/id_node/tracking_error")
         harness.joint_states = harness.publisher(JointState, "joint_states")
         harness.reference = harness.publisher(JointTrajectory, "/id_node/reference")
+        yield harness
+
+
+@pytest.fixture
+def node():
+    with tracking() as harness:
         yield harness
 
 

@@ -190,7 +190,7 @@ def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3):
     for i in reversed(range(len(links))):
         link, (w, dw, a) = links[i], motion[i]
         if i + 1 < len(links):
-            f, n = _to_parent_wrench(links[i + 1], rots[i + 1], f, n)
+            f, n = to_parent_wrench(links[i + 1], rots[i + 1], f, n)
         force = add(scale(link.m, a), cross(dw, link.h), cross(w, cross(w, link.h)))
         moment = add(inertia_times(link.I, dw), cross(w, inertia_times(link.I, w)), cross(link.h, a))
         f = add(force, f)
@@ -216,7 +216,7 @@ def forward_motion(links, rots, qd, qdd, gravity, at_joints=False):
     return motion
 
 
-def _to_parent_wrench(child: Link, rot, f, n):
+def to_parent_wrench(child: Link, rot, f, n):
     """A wrench about o'_child in the child's frame, as one about o_parent in the parent's."""
     f, n = to_parent(child, rot, f), to_parent(child, rot, n)
     if child.p0 is not None:
@@ -256,7 +256,7 @@ def crba(links, cs):
         n = add(inertia_times(inertia, link.b), cross(h, a), cross(link.p, f))
         M[j][j] = dot(link.b, n) + link.armature
         for i in reversed(range(j)):
-            f, n = _to_parent_wrench(links[i + 1], rots[i + 1], f, n)
+            f, n = to_parent_wrench(links[i + 1], rots[i + 1], f, n)
             n = add(n, cross(links[i].p, f))
             M[i][j] = M[j][i] = dot(links[i].b, n)
     return M

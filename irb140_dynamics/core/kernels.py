@@ -234,13 +234,6 @@ class _ArmKernels:
 
     @cached_property
     def momentum(self) -> Kernel:
-        from .observer import energy_gradient
+        from .observer import momentum_terms
 
-        zeros = [0.0] * self.n
-
-        def terms(cs, qd, k):
-            links = self._links(k)
-            p = algorithms.rnea(links, cs, zeros, qd, (0.0, 0.0, 0.0))  # M qd
-            return [*p, *energy_gradient(links, cs, qd)]
-
-        return self._kernel("momentum", terms, qd=self.n)
+        return self._kernel("momentum", lambda cs, qd, k: momentum_terms(self._links(k), cs, qd), qd=self.n)

@@ -10,7 +10,8 @@ With p = M(q) qd the generalized momentum, the equations of motion give
 
 obeys dr/dt = K (tau_ext - r): a first-order low-pass of the external torques with time
 constant 1/K [s], needing no acceleration. C^T qd is dT/dq, the gradient of the kinetic
-energy T = 1/2 qd^T M qd, generated exactly (dual numbers) like the other kernels.
+energy T = 1/2 qd^T M qd; ``momentum_terms`` gives it and p in two passes like RNEA's
+(``energy_gradient``, T on dual numbers, is the definition it is tested against).
 
 Units: N m, s, 1/s. Samples come with their time; a gap longer than ``max_gap``, a repeated
 or an older time resets the observer (the next sample starts it again at r = 0).
@@ -22,11 +23,12 @@ import math
 
 import numpy as np
 
-from .algorithms import add, cross, dot, inertia_times, scale, to_child, turns
+from .algorithms import add, cross, dot, inertia_times, scale, to_child, to_parent_wrench, turns
 from .dual import dual_angles, partial
 from .dynamics import gravity
 from .states import state
 from .model import RobotModel
+from .rigid_body import ZERO3
 
 
 def kinetic_energy(links, cs, qd):
@@ -48,6 +50,45 @@ def energy_gradient(links, cs, qd):
     """dT/dq = C(q, qd)^T qd, exact: T on dual numbers carrying d/dq_k."""
     T = kinetic_energy(links, dual_angles(cs), qd)
     return [partial(T, k) for k in range(len(links))]
+
+
+def momentum_terms(links, cs, qd):
+    """[p, dT/dq]: the generalized momentum M qd and C^T qd, O(n).
+
+    With h_i the spatial momentum of link i, H_k the sum over the subtree k..n and v_k the
+    spatial velocity of link k: turning joint k at fixed qd turns the subtree about S_k,
+    dv_i/dq_k = S_k x (v_i - v_k) and dI_i/dq_k = S_k x* I_i - I_i S_k x, which leaves
+    (Featherstone's notation, x* the force cross product)
+
+        p_k = S_k . H_k,    dT/dq_k = -S_k . (v_k x* H_k).
+
+    Forward: each link's velocity (w; u at the joint origin o'_i, v at o_i). Backward: H
+    (linear L, angular A about o'_k) gathered like RNEA's wrenches; S_k . (v_k x* H_k) is
+    b . (w x A + u x L).
+    """
+    rots = turns(links, cs)
+    w, v = ZERO3, ZERO3
+    frames = []
+    for link, rot, qd_i in zip(links, rots, qd):  # velocities, as forward_motion's
+        if link.p0 is not None:
+            v = add(v, cross(w, link.p0))
+        w = add(to_child(link, rot, w), scale(qd_i, link.b))
+        u = to_child(link, rot, v)  # the joint origin's velocity, in frame i
+        v = add(u, cross(w, link.p))
+        frames.append((w, u, v))
+    n_links = len(links)
+    p, gradient = [0.0] * n_links, [0.0] * n_links
+    L, A = ZERO3, ZERO3  # the subtree's momentum
+    for i in reversed(range(n_links)):
+        link, (w, u, v) = links[i], frames[i]
+        if i + 1 < n_links:
+            L, A = to_parent_wrench(links[i + 1], rots[i + 1], L, A)
+        L_i = add(scale(link.m, v), cross(w, link.h))
+        L = add(L, L_i)
+        A = add(A, inertia_times(link.I, w), cross(link.h, v), cross(link.p, L))  # about o'_i
+        p[i] = dot(link.b, A) + link.armature * qd[i]
+        gradient[i] = -dot(link.b, add(cross(w, A), cross(u, L)))
+    return p + gradient
 
 
 class MomentumObserver:
@@ -73,9 +114,13 @@ class MomentumObserver:
         """The residual after the sample (t [s], q, qd, tau measured): r, or zeros after a reset.
 
         ``g``: gravity(model, q) if the caller has it already. ValueError (and a reset) if a
-        value is not finite. Plain Python arithmetic on n numbers: a few microseconds
-        besides the kernel, where small NumPy arrays would cost tens.
+        value is not finite.
         """
+        return np.array(self.advance(t, q, qd, tau, g))
+
+    def advance(self, t: float, q, qd, tau, g=None) -> list[float]:
+        """``update``, the residual as a list. Plain Python arithmetic on n floats: a few
+        microseconds besides the kernel, where small NumPy arrays would cost tens."""
         n = self.model.n
         q, qd, tau = state(q, n, "q"), state(qd, n, "qd"), state(tau, n, "tau")
         p, beta = self._momentum_terms(q, qd, g)
@@ -83,17 +128,16 @@ class MomentumObserver:
         if self._t is None or not 0.0 < t - self._t <= self.max_gap:
             self._r = [0.0] * n
             self._t, self._p0, self._integral, self._drive = t, p, [0.0] * n, drive
-            return self.r
+            return self._r
         dt, K = t - self._t, self.gain
-        with np.errstate(over="ignore", invalid="ignore"):  # NumPy scalars among them: checked below
-            integral = [i + 0.5 * (d + d0) * dt + r * dt
-                        for i, d, d0, r in zip(self._integral, drive, self._drive, self._r)]
-            r = [K * (x - x0 - i) for x, x0, i in zip(p, self._p0, integral)]
+        integral = [i + 0.5 * (d + d0) * dt + r * dt  # Python floats: an overflow is inf, checked below
+                    for i, d, d0, r in zip(self._integral, drive, self._drive, self._r)]
+        r = [K * (x - x0 - i) for x, x0, i in zip(p, self._p0, integral)]
         if not math.isfinite(sum(r)) and not all(map(math.isfinite, r)):
             self.reset()
             raise ValueError(f"observer residual not finite: {r}")
         self._t, self._integral, self._drive, self._r = t, integral, drive, r
-        return self.r
+        return r
 
     def _momentum_terms(self, q, qd, g=None) -> tuple[list, list]:
         """p = M qd and C^T qd - g - tau_f: what the observer integrates besides tau and r."""
@@ -101,7 +145,7 @@ class MomentumObserver:
         terms = model.kernels.momentum.scalar(q, qd)
         n = model.n
         g = gravity(model, q) if g is None else g
-        beta = [c - gi for c, gi in zip(terms[n:], g)]
+        beta = [c - gi for c, gi in zip(terms[n:], g.tolist() if type(g) is np.ndarray else g)]
         if model.friction is not None:
             beta = [b - f for b, f in zip(beta, model.friction.torques(qd).tolist())]
         return list(terms[:n]), beta

@@ -149,8 +149,10 @@ def optimise_excitation(
 
     start = np.random.default_rng(seed).normal(size=2 * n * (harmonics - 1))
     start_cost = cost(start)
-    result = minimize(cost, start, method="L-BFGS-B", options={"maxiter": iterations, "eps": 1e-6})
-    best = result.x if result.fun < start_cost else start
+    best = start
+    if iterations > 0:  # (minimize spends a gradient, 2 n (harmonics - 1) evaluations, even on none)
+        result = minimize(cost, start, method="L-BFGS-B", options={"maxiter": iterations, "eps": 1e-6})
+        best = result.x if result.fun < start_cost else start
     trajectory = shaped(best, n, harmonics, period, limits)
     return Excitation(trajectory, condition_number(model, base, trajectory, samples), math.exp(start_cost), evaluations)
 

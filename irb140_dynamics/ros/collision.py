@@ -18,7 +18,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Bool
 
 from ..core.observer import MomentumObserver
-from .messages import joint_efforts
+from .messages import publish_efforts
 from .params import Spec
 
 MAX_GAIN = 1e4  # 1/s: beyond any sampling rate a joint state stream has
@@ -76,7 +76,7 @@ class CollisionMonitor:
             self._external_msg = JointState(name=self._names)
             self._residual = None
         self._observer = MomentumObserver(model, settings.gain, OBSERVER_GAP)
-        self._thresholds = settings.thresholds
+        self._thresholds = settings.thresholds.tolist()
 
     def reset(self) -> None:
         self._observer.reset()
@@ -84,11 +84,10 @@ class CollisionMonitor:
     def update(self, t: float, q, qd, effort, g, stamp) -> None:
         """One joint state with efforts: publish the residual, and the flag when it changes.
         ValueError (observer reset) if the residual is not finite."""
-        r = self._observer.update(t, q, qd, effort, g)
+        r = self._observer.advance(t, q, qd, effort, g)
         self._residual = r
-        self._external_pub.publish(joint_efforts(self._external_msg, stamp, r))
-        over = (self._thresholds > 0.0) & (np.abs(r) > self._thresholds)
-        colliding = [name for name, hit in zip(self._names, over) if hit]
+        publish_efforts(self._external_pub, self._external_msg, stamp, r)
+        colliding = [name for name, x, limit in zip(self._names, r, self._thresholds) if 0.0 < limit < abs(x)]
         if bool(colliding) != bool(self.colliding):
             self._publish_flag(bool(colliding))
         self.colliding = colliding

@@ -1,8 +1,10 @@
 """id_node's reference: a whole trajectory followed in time, and computed-torque control.
 
-A ~/reference (trajectory_msgs/JointTrajectory) is sampled by time_from_start from the
-time it arrived (node clock): q, qd, qdd interpolated linearly between points, the last
-point held after the end. It is in force until reference_timeout after its last point
+A ~/reference (trajectory_msgs/JointTrajectory) is sampled by time_from_start from its
+start: header.stamp when set, else the time it arrived (node clock; as ros2_control's
+joint_trajectory_controller): q, qd, qdd interpolated linearly between points, the last
+point held after the end. Until a stamped start the arm holds its position as without a
+reference. It is in force until reference_timeout after its last point
 (0 = for ever); an empty trajectory lets it go.
 
 With ``effort_commands.source: computed_torque`` the commands are
@@ -66,22 +68,24 @@ class ReferenceTracker:
 
     def clear(self) -> None:
         self._trajectory: Trajectory | None = None
-        self._received = 0.0  # s, node clock
+        self._start = 0.0  # s, node clock
         self._hold = None
 
     @property
     def trajectory(self) -> Trajectory | None:
         return self._trajectory
 
-    def follow(self, trajectory: Trajectory, now: float) -> None:
-        self._trajectory, self._received = trajectory, now
+    def follow(self, trajectory: Trajectory, start: float) -> None:
+        """Follow ``trajectory`` from ``start`` [s, node clock] on."""
+        self._trajectory, self._start = trajectory, start
 
     def sample(self, now: float, timeout: float):
-        """(q, qd, qdd or None) of the reference in force at ``now`` [s], or None."""
+        """(q, qd, qdd or None) of the reference in force at ``now`` [s], or None (none, not
+        started yet, or let go)."""
         if self._trajectory is None:
             return None
-        elapsed = now - self._received
-        if timeout > 0.0 and elapsed > self._trajectory.duration + timeout:
+        elapsed = now - self._start
+        if elapsed < 0.0 or (timeout > 0.0 and elapsed > self._trajectory.duration + timeout):
             return None
         return self._trajectory.sample(elapsed)
 
