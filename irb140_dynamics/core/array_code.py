@@ -4,8 +4,8 @@
 of that source allocates a fresh array for its result, and every named intermediate stays
 alive until the function returns: for a kernel of a thousand operations (the regressor)
 most of the time goes to the allocator and to memory that has left the CPU caches. This
-form runs the same operations, on the same operands in the same order (so its floats are
-identical), as one NumPy ufunc call each with an ``out`` argument:
+form runs the same operations on the same operands (so its floats are identical), as one
+NumPy ufunc call each with an ``out`` argument:
 
 - intermediates go to a few preallocated buffers, one freed as soon as its value's last
   user has run and taken by the next result (often in place), so that the working set of
@@ -13,6 +13,8 @@ identical), as one NumPy ufunc call each with an ``out`` argument:
 - the last operation of each output writes straight into the caller's array ``out[j]``;
 - what depends only on the scalar arguments (the payload and gravity ``k``) is computed
   once on floats;
+- an operation the tracer recorded more than once (on the same operands, or on swapped
+  ones for + and *, which commute exactly) is done once;
 - outputs folded to constants are not written: ``written`` lists the others.
 """
 
@@ -22,7 +24,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from .codegen import Sym, operand, angle_lines, input_lines, operands_first, trace
+from .codegen import Sym, angle_lines, input_lines, operand, operands_first, trace
 
 _UFUNCS = {"*": "mul", "+": "add", "-": "sub"}
 _NAMESPACE = {"cos": np.cos, "sin": np.sin, "mul": np.multiply, "add": np.add, "sub": np.subtract,
