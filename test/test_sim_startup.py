@@ -18,3 +18,11 @@ def test_a_bad_initial_pose_stops_startup_with_one_clear_line():
     assert "Traceback" not in output
     fatal = [line for line in output.splitlines() if "cannot start" in line]
     assert len(fatal) == 1 and "initial_positions: joint_2 at -3.0 rad is outside" in fatal[0], output
+
+
+def test_a_queue_depth_beyond_its_range_stops_startup_with_one_clear_line():
+    code, output = run_to_exit(module_command(SIM_NODE, "-p", "qos.depth:=2000000000"))
+    assert code == 1, output
+    assert "Traceback" not in output
+    fatal = [line for line in output.splitlines() if "cannot start" in line]
+    assert len(fatal) == 1 and "qos.depth" in fatal[0], output

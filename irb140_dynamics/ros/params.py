@@ -82,7 +82,10 @@ def check_choice(name: str, value, choices) -> None:
 
 def check_qos(values: dict) -> None:
     check_choice("qos.reliability", values["qos.reliability"], RELIABILITIES)
-    depth = values["qos.depth"]
+    check_qos_depth(values["qos.depth"])
+
+
+def check_qos_depth(depth) -> None:
     if not (isinstance(depth, int) and 1 <= depth <= MAX_QOS_DEPTH):
         raise ValueError(f"qos.depth: must be between 1 and {MAX_QOS_DEPTH}, got {depth}")
 

@@ -13,7 +13,7 @@ from ..sim.engine import DEFAULT_INTEGRATOR, SimulatedArm
 from ..sim.mjcf import INTEGRATORS
 from .messages import BadMessage
 from .model_source import STAND_IN
-from .params import Spec, check_choice
+from .params import MAX_QOS_DEPTH, Spec, check_choice, check_qos_depth
 
 NODE_PARAMETERS = [
     Spec("rate", 1000.0, "simulation steps (and joint_states messages) per second of simulated time", "Hz",
@@ -36,7 +36,8 @@ NODE_PARAMETERS = [
     Spec("noise.effort", 0.0, "std dev of the noise added to the published efforts", "N m", minimum=0.0),
     Spec("thread_priority", 0, "SCHED_FIFO priority (1..99) of the stepping and executor threads, as "
          "ros2_control's controller manager runs its loop; 0 = ordinary scheduling", read_only=True),
-    Spec("qos.depth", 10, "queue depth of joint_states and effort_commands", read_only=True),
+    Spec("qos.depth", 10, "queue depth of joint_states and effort_commands", read_only=True,
+         minimum=1, maximum=MAX_QOS_DEPTH),
 ]
 
 
@@ -62,8 +63,7 @@ def build_settings(values: dict) -> Settings:
         raise ValueError(f"substeps: must be >= 1, got {values['substeps']}")
     if not 0 <= values["thread_priority"] <= 99:
         raise ValueError(f"thread_priority: must be 0..99, got {values['thread_priority']}")
-    if values["qos.depth"] < 1:
-        raise ValueError(f"qos.depth: must be >= 1, got {values['qos.depth']}")
+    check_qos_depth(values["qos.depth"])
     engine = SimulatedArm(model, 1.0 / values["rate"], values["substeps"], values["integrator"])
     initial = np.zeros(model.n) if waiting else initial_positions(model, values["initial_positions"])
     return Settings(model, engine, initial, values["command_timeout"], values["reset_hold"],
