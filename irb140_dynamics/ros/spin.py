@@ -12,8 +12,14 @@ import rclpy.logging
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
+from rclpy.utilities import remove_ros_args
 
 EXECUTORS = ("events", "single_threaded")
+
+
+def tool_arguments(argv: list[str]) -> list[str]:
+    """A tool's own command-line arguments: argv without the program and the ROS arguments."""
+    return remove_ros_args(argv)[1:]
 
 
 def run(name: str, make_node: Callable[[], Node], args: list[str] | None = None, executor: str = "events") -> int:

@@ -18,13 +18,12 @@ from rclpy.context import Context
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.logging import LoggingSeverity
 from rclpy.node import Node
-from rclpy.utilities import remove_ros_args
 
 from ..core import RobotModel, irb140
 from ..core.geometry import IRB140_SHAPES
 from ..core.urdf import export_urdf
 from ..ros.model_source import declare_model_source
-from ..ros.spin import init_error
+from ..ros.spin import init_error, tool_arguments
 
 NAME = "export_urdf"
 
@@ -61,7 +60,7 @@ def current_model(args: list[str]) -> RobotModel:
 def main(args: list[str] | None = None) -> int:
     args = sys.argv if args is None else args
     try:
-        extra = remove_ros_args(args)[1:]
+        extra = tool_arguments(args)
         if extra:
             help_asked = extra[0] in ("-h", "--help")
             print(__doc__ if help_asked else f"{NAME}: unknown arguments {extra}; see --help",

@@ -16,11 +16,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from rclpy.utilities import remove_ros_args
-
 from ..identification.recording import DEFAULT_TOPIC
 from ..ros.recorder import DEFAULT_DEPTH, Recorder
-from ..ros.spin import run
+from ..ros.spin import run, tool_arguments
 
 
 def parser() -> argparse.ArgumentParser:
@@ -35,7 +33,7 @@ def parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     argv = sys.argv if argv is None else argv
-    args = parser().parse_args(remove_ros_args(argv)[1:])
+    args = parser().parse_args(tool_arguments(argv))
     recorders = []
 
     def make_node() -> Recorder:
