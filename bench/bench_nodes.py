@@ -33,6 +33,8 @@ node its own namespace; nodes are stopped on exit whatever happens.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import gc
 import math
 import os
 import subprocess
@@ -76,6 +78,7 @@ STARTUP_TIMEOUT = 30.0  # s, for a node process to start and match
 DRAIN_TIMEOUT = 2.0  # s, for the last outputs after the last message published
 QUIET = 0.3  # s without an output: the stream is over
 OTHERS_WARNING = 0.25  # cores used by other processes during a run worth a note
+BENCH_SWITCH_INTERVAL = 1e-4  # s: how long the publishing thread may wait for the interpreter lock
 
 P99_TARGET = Target(1.5)  # id_node's p99 delay at most 1.5x the relay's
 LOST_TARGET = Target(0, absolute=True)  # no message lost
@@ -158,6 +161,26 @@ class Receiver(threading.Thread):
         self.join(timeout=5)
 
 
+@contextlib.contextmanager
+def steady_publisher():
+    """This process as a steady source while streaming: no garbage-collector pass (one over
+    the stream's ~100,000 lists and records takes tens of ms, after which the late messages
+    leave in a burst that overflows any depth-10 queue: the loss would be the benchmark's,
+    not the node's), and the publishing thread waits at most BENCH_SWITCH_INTERVAL for the
+    interpreter lock held by the receiving and parameter-changing threads."""
+    interval = sys.getswitchinterval()
+    gc.collect()
+    gc.freeze()
+    gc.disable()
+    sys.setswitchinterval(BENCH_SWITCH_INTERVAL)
+    try:
+        yield
+    finally:
+        sys.setswitchinterval(interval)
+        gc.enable()
+        gc.unfreeze()
+
+
 def joint_stream(count: int, rate: float) -> tuple[list, list]:
     """Positions and velocities (lists) of ``count`` samples of the moving arm."""
     t = np.arange(count)[:, None] / rate
@@ -210,50 +233,51 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
         wait_for(lambda: publisher.get_subscription_count() > 0
                  and node.count_publishers(f"{namespace}/feedforward_torques") > 0,
                  STARTUP_TIMEOUT, process, f"{kind} matched on joint_states and feedforward_torques")
-        receiver = Receiver(subscription, node.context)
-        receiver.start()
-        if change_period is not None:
-            changer = ParameterChanger(f"{namespace}/{kind}", change_period)
+        with steady_publisher():
+            receiver = Receiver(subscription, node.context)
+            receiver.start()
+            if change_period is not None:
+                changer = ParameterChanger(f"{namespace}/{kind}", change_period)
 
-        first = round(warmup * rate)
-        total = first + round(duration * rate)
-        positions, velocities = joint_stream(total, rate)
-        efforts = joint_efforts(positions, velocities) if effort else None
-        stamps = np.zeros(total, dtype=np.int64)
-        lateness = np.zeros(total)
-        msg = JointState(name=NAMES)
-        period = 1.0 / rate
-        clock, sleep, now_ns = time.perf_counter, time.sleep, time.time_ns
-        start = clock() + 0.01
-        for i in range(total):
-            deadline = start + i * period
-            if i == first:  # the measured window starts
-                cpu0, own0, busy0 = process.cpu_seconds(), time.process_time(), machine_busy()
-                if profile:
-                    spy = start_profiler(process, duration, profile_path)
-                if changer is not None:
-                    changer.start()
-            remaining = deadline - clock()
-            if remaining > 0:  # no busy-wait: its CPU would be taken from the node under test
-                sleep(remaining)
-            msg.position, msg.velocity = positions[i], velocities[i]
-            if efforts is not None:
-                msg.effort = efforts[i]
-            stamp = now_ns()
-            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp, 1_000_000_000)
-            lateness[i] = clock() - deadline
-            publisher.publish(msg)
-            stamps[i] = stamp
-        sent_s = clock() - start - first * period
-        if changer is not None:
-            changes, changer = changer.stop(), None
+            first = round(warmup * rate)
+            total = first + round(duration * rate)
+            positions, velocities = joint_stream(total, rate)
+            efforts = joint_efforts(positions, velocities) if effort else None
+            stamps = np.zeros(total, dtype=np.int64)
+            lateness = np.zeros(total)
+            msg = JointState(name=NAMES)
+            period = 1.0 / rate
+            clock, sleep, now_ns = time.perf_counter, time.sleep, time.time_ns
+            start = clock() + 0.01
+            for i in range(total):
+                deadline = start + i * period
+                if i == first:  # the measured window starts
+                    cpu0, own0, busy0 = process.cpu_seconds(), time.process_time(), machine_busy()
+                    if profile:
+                        spy = start_profiler(process, duration, profile_path)
+                    if changer is not None:
+                        changer.start()
+                remaining = deadline - clock()
+                if remaining > 0:  # no busy-wait: its CPU would be taken from the node under test
+                    sleep(remaining)
+                msg.position, msg.velocity = positions[i], velocities[i]
+                if efforts is not None:
+                    msg.effort = efforts[i]
+                stamp = now_ns()
+                msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp, 1_000_000_000)
+                lateness[i] = clock() - deadline
+                publisher.publish(msg)
+                stamps[i] = stamp
+            sent_s = clock() - start - first * period
+            if changer is not None:
+                changes, changer = changer.stop(), None
 
-        last = int(stamps[-1])
-        drain_end = time.monotonic() + DRAIN_TIMEOUT
-        while time.monotonic() < drain_end:  # until the last output is in, or the stream is quiet
-            if (receiver.records and receiver.records[-1][0] == last) or time.monotonic() - receiver.last_arrival > QUIET:
-                break
-            time.sleep(0.005)
+            last = int(stamps[-1])
+            drain_end = time.monotonic() + DRAIN_TIMEOUT
+            while time.monotonic() < drain_end:  # until the last output is in, or the stream is quiet
+                if (receiver.records and receiver.records[-1][0] == last) or time.monotonic() - receiver.last_arrival > QUIET:
+                    break
+                time.sleep(0.005)
         cpu = process.cpu_seconds() - cpu0
         own = time.process_time() - own0
         busy1 = machine_busy()
@@ -354,6 +378,8 @@ def summarize(kind, executor, rate, duration, stamps, first, lateness, records, 
         # received here; the rest the node never published (dropped on the way in, or never taken)
         "lost_after_node_published": None if published is None else published - received_count,
         "lost_runs": lost_runs(measured, np.isin(measured, stamp), rate),
+        # [time into the window (s), delay (ms)] of the outputs delayed most: where the stalls were
+        "slowest": slowest(stamp, received, int(measured[0]) if sent else 0),
         "lost_in_warmup": int(first - np.isin(records[:, 0], warmup_stamps).sum()),
         # publish here -> DDS reception of the torques here: the figure of the table
         "delay_us": percentiles(received - stamp),
@@ -374,6 +400,13 @@ def summarize(kind, executor, rate, duration, stamps, first, lateness, records, 
             "max": float(lateness[first:].max() * 1e6),
         },
     }
+
+
+def slowest(stamp: np.ndarray, received: np.ndarray, window_start: int, most: int = 20) -> list[list]:
+    """[time into the window (s), delay (ms)] of the ``most`` outputs delayed most, in time order."""
+    delay = received - stamp
+    worst = np.sort(np.argsort(delay)[-most:]) if delay.size else []
+    return [[round((int(stamp[k]) - window_start) / 1e9, 4), round(int(delay[k]) / 1e6, 2)] for k in worst]
 
 
 def lost_runs(measured: np.ndarray, arrived: np.ndarray, rate: float, most: int = 20) -> list[list]:
@@ -414,8 +447,8 @@ def end_to_end(rates, executors, duration, warmup, env, profile=False, lean=Fals
                 runs.append(run)
                 d = run["delay_us"]
                 print(f"    p50 {_opt(d['p50'])} us, p99 {_opt(d['p99'])} us, max {_opt(d['max'])} us, "
-                      f"lost {run['lost']} of {run['sent']}, node CPU {run['node_cpu_us_per_msg']:.1f} us/msg",
-                      flush=True)
+                      f"lost {run['lost']} of {run['sent']}, node CPU {run['node_cpu_us_per_msg']:.1f} us/msg, "
+                      f"sent late by up to {run['send_lateness_us']['max'] / 1e3:.1f} ms", flush=True)
                 if run["parameter_changes"] is not None:
                     c = run["parameter_changes"]
                     print(f"    changes: {c['accepted']} accepted, {c['refused']} refused, {c['unanswered']} "
@@ -447,7 +480,8 @@ def stream_rows(runs: list[dict]) -> list[Row]:
         changes = "" if change_period is None else f", payload.mass set every {change_period * 1e3:g} ms"
         group = (f"id_node end to end, {rate:g} Hz for {ours['duration_s']:g} s{changes}, executor {executor}{lean} "
                  "(baseline: relay" + (", the same parameter calls)" if changes else ")"))
-        for stat, target in (("p50", None), ("p99", P99_TARGET), ("max", None)):
+        p99_target = P99_TARGET if change_period is None else None  # with changes the target is 0 lost (issue 8)
+        for stat, target in (("p50", None), ("p99", p99_target), ("max", None)):
             rows.append(Row(group, f"delay {stat}", _delay(ours, stat), _delay(base, stat), target))
         rows.append(Row(group, f"lost (of {ours['sent']} sent)", Value.of(ours["lost"], "msgs"),
                         Value.of(base["lost"], "msgs"), LOST_TARGET))

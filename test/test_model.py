@@ -272,3 +272,51 @@ def test_a_model_at_the_caps_stays_finite():
     assert np.isfinite(rnea(model, q, qd, qdd)).all()
     assert np.isfinite(mass_matrix(model, q)).all()
     assert np.isfinite(forward_dynamics(model, q, qd, np.zeros(6))).all()
+
+
+# -- validated once: a model rebuilt for another payload re-validates no joint ------------------
+
+
+def test_a_payload_change_reuses_the_validated_joints_and_links(monkeypatch):
+    from irb140_dynamics.core import joints as joints_module
+
+    params = irb140_params()
+    first = RobotModel.from_params(params)
+    validations = []
+    validate = joints_module._validate_joint
+    monkeypatch.setattr(joints_module, "_validate_joint", lambda j: validations.append(j.name) or validate(j))
+    params["payload.mass"] = 2.5
+    second = RobotModel.from_params(params)
+    assert validations == []
+    assert all(a is b for a, b in zip(first.joints, second.joints))
+    assert second.payload.mass == 2.5
+    assert second.kernels.links[:-1] == first.kernels.links[:-1]
+    assert second.kernels.links[-1].m != first.kernels.links[-1].m
+    state = [0.1] * 6, [0.2] * 6, [0.3] * 6
+    expected = irb140(payload=RigidBody(2.5, OFFSET_PAYLOAD.com, OFFSET_PAYLOAD.inertia))
+    np.testing.assert_array_equal(rnea(second, *state), rnea(expected, *state))  # the last link follows
+    validations.clear()
+    params["joint_3.link.mass"] = 30.0
+    third = RobotModel.from_params(params)
+    assert validations == ["joint_3"]
+    assert third.joints[2].link.mass == 30.0 and third.joints[1] is second.joints[1]
+
+
+@pytest.mark.parametrize("value", [True, 1, -0.0, np.float64(18.0)])
+def test_a_remembered_joint_is_not_given_for_a_value_that_only_equals_its_values(value):
+    """1.0 remembered does not answer for True (refused), nor 0.0 for -0.0, nor a float for
+    an int: each value is validated as given."""
+    params = irb140_params()
+    field = "joint_1.velocity_limit"
+    params[field] = float(value) if not isinstance(value, bool) else 1.0
+    remembered = RobotModel.from_params(params)
+    params[field] = value
+    if isinstance(value, bool):
+        assert_rejected(params, field, "expected numbers")
+        return
+    model = RobotModel.from_params(params)
+    assert model.joints[0].velocity_limit == float(value)
+    assert type(model.joints[0].velocity_limit) is float
+    if value == 0.0:
+        assert math.copysign(1.0, model.joints[0].velocity_limit) == math.copysign(1.0, value)
+    assert model.joints[0] is not remembered.joints[0] or repr(value) == repr(float(value))

@@ -23,6 +23,7 @@ row the generated code is the same as that of a hand-written DH recursion.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -52,24 +53,24 @@ class Link:
 
 def chain(model) -> tuple[Link, ...]:
     """The per-link constants of a RobotModel (payload merged into the last link)."""
-    links = []
-    for joint, body in zip(model.joints, model.bodies):
-        pre, post = joint.pre, joint.post
-        R1 = post.rotation()
-        m, h, inertia = body.about_origin()
-        links.append(
-            Link(
-                joint.offset,
-                None if pre.rpy == ZERO3 else _rows(pre.rotation()),
-                None if pre.xyz == ZERO3 else pre.xyz,
-                joint.turning_axis,
-                None if post.rpy == ZERO3 else _rows(R1),
-                tuple(R1.T @ np.array(post.xyz)) if post.rpy != ZERO3 else post.xyz,
-                tuple(snap(R1.T @ np.array(joint.turning_axis))),
-                m, h, inertia, joint.armature,
-            )
-        )
-    return tuple(links)
+    return tuple(Link(*_joint_constants(joint), *body.about_origin(), joint.armature)
+                 for joint, body in zip(model.joints, model.bodies))
+
+
+@lru_cache(maxsize=256)  # a model rebuilt with another payload recomputes no joint's
+def _joint_constants(joint) -> tuple:
+    """(theta_offset, R0, p0, u, R1, p, b) of a Link."""
+    pre, post = joint.pre, joint.post
+    R1 = post.rotation()
+    return (
+        joint.offset,
+        None if pre.rpy == ZERO3 else _rows(pre.rotation()),
+        None if pre.xyz == ZERO3 else pre.xyz,
+        joint.turning_axis,
+        None if post.rpy == ZERO3 else _rows(R1),
+        tuple(R1.T @ np.array(post.xyz)) if post.rpy != ZERO3 else post.xyz,
+        tuple(snap(R1.T @ np.array(joint.turning_axis))),
+    )
 
 
 def flange_wrench(model, f_ext, n_ext):

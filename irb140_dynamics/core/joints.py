@@ -27,10 +27,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .rigid_body import MAX_LENGTH, ZERO3, ModelError, RigidBody, Vector3, capped, finite_number, finite_numbers
+from .rigid_body import (
+    MAX_LENGTH,
+    ZERO3,
+    ModelError,
+    RigidBody,
+    Validated,
+    Vector3,
+    capped,
+    finite_number,
+    finite_numbers,
+)
 
 Z_AXIS: Vector3 = (0.0, 0.0, 1.0)
 MAX_FRICTION = 1e6  # sanity cap of viscous [N m s/rad], Coulomb [N m] friction and armature [kg m^2]
+
+
+_validated = Validated()  # the placements and joints validated here
 
 
 @dataclass(frozen=True)
@@ -72,11 +85,13 @@ class Placement:
     @classmethod
     def validated(cls, field: str, value) -> "Placement":
         """From [x, y, z, roll, pitch, yaw] (or a Placement), or ModelError naming ``field``."""
+        if value in _validated:
+            return value
         if isinstance(value, Placement):
             value = value.flat()
         numbers = finite_numbers(field, value, 6)
         capped(field, "|xyz|", math.hypot(*numbers[:3]), MAX_LENGTH, "m")
-        return cls(numbers[:3], numbers[3:])
+        return _validated.add(cls(numbers[:3], numbers[3:]))
 
 
 def rpy_matrix(rpy) -> np.ndarray:
@@ -171,7 +186,14 @@ def axis_rotation(axis, angle: float) -> np.ndarray:
 
 
 def validated_joint(j: Joint) -> Joint:
-    """The joint with every value checked (ModelError naming ``<joint>.<field>``)."""
+    """The joint with every value checked (ModelError naming ``<joint>.<field>``); one this
+    function returned comes back at once."""
+    if j in _validated:
+        return j
+    return _validated.add(_validate_joint(j))
+
+
+def _validate_joint(j: Joint) -> Joint:
     name = j.name
     dh = None
     if j.dh is not None:

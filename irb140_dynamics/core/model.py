@@ -60,7 +60,7 @@ class RobotModel:
         object.__setattr__(self, "joints", tuple(validated_joint(j) for j in self.joints))
         object.__setattr__(self, "gravity", finite_numbers("gravity", self.gravity, 3))
         capped("gravity", "|g|", math.hypot(*self.gravity), MAX_GRAVITY, "m/s^2")
-        object.__setattr__(self, "payload", _validated_body("payload", self.payload))
+        object.__setattr__(self, "payload", RigidBody.checked("payload", self.payload))
         object.__setattr__(self, "flange", Placement.validated("flange", self.flange))
         smoothing = finite_number("friction.smoothing_velocity", self.smoothing_velocity)
         if not smoothing > 0.0:
@@ -151,30 +151,7 @@ class RobotModel:
             raise ModelError(name, "missing")
 
         names = check_joint_names(get("joint_names"))
-        joints = []
-        for name in names:
-            if params.get(f"{name}.dh") is None and params.get(f"{name}.origin") is not None:
-                kinematics = dict(
-                    origin=Placement.validated(f"{name}.origin", get(f"{name}.origin")),
-                    axis=finite_numbers(f"{name}.axis", get(f"{name}.axis"), 3),
-                )
-            else:
-                kinematics = dict(dh=DH(*finite_numbers(f"{name}.dh", get(f"{name}.dh"), 4)))
-            joints.append(
-                Joint(
-                    name,
-                    link=_body_from_params(f"{name}.link", get),
-                    position_limits=finite_numbers(
-                        f"{name}.position_limits", get(f"{name}.position_limits", (-math.pi, math.pi)), 2
-                    ),
-                    torque_limit=get(f"{name}.torque_limit", 0.0),
-                    velocity_limit=get(f"{name}.velocity_limit", 0.0),
-                    acceleration_limit=get(f"{name}.acceleration_limit", 0.0),
-                    friction=Friction(get(f"{name}.friction.viscous", 0.0), get(f"{name}.friction.coulomb", 0.0)),
-                    armature=get(f"{name}.armature", 0.0),
-                    **kinematics,
-                )
-            )
+        joints = tuple(_joint_from_params(name, params, get) for name in names)
         payload = _body_from_params("payload", get, optional=True)
         return cls(
             tuple(joints),
@@ -183,6 +160,49 @@ class RobotModel:
             Placement.validated("flange", get("flange", (0.0,) * 6)),
             get("friction.smoothing_velocity", DEFAULT_SMOOTHING_VELOCITY),
         )
+
+
+JOINT_FIELDS = ("dh", "origin", "axis", "link.mass", "link.com", "link.inertia", "position_limits", "torque_limit",
+                "velocity_limit", "acceleration_limit", "friction.viscous", "friction.coulomb", "armature")
+JOINTS_KEPT = 256  # joints remembered by their parameter values
+_joints_by_values: dict[tuple, Joint] = {}
+
+
+def _joint_from_params(name: str, params: Mapping[str, Any], get) -> Joint:
+    """The validated joint ``name``, validated once for the same values: a change of other
+    parameters (the payload's) re-validates no joint. The values are told apart by their
+    repr, exact for the numbers a valid joint has (and True, 1 and 1.0 differ, as 0.0 and -0.0)."""
+    key = name, repr([params.get(f"{name}.{field}") for field in JOINT_FIELDS])
+    joint = _joints_by_values.get(key)
+    if joint is None:
+        joint = validated_joint(_raw_joint(name, params, get))
+        if len(_joints_by_values) >= JOINTS_KEPT:
+            _joints_by_values.clear()
+        _joints_by_values[key] = joint
+    return joint
+
+
+def _raw_joint(name: str, params: Mapping[str, Any], get) -> Joint:
+    if params.get(f"{name}.dh") is None and params.get(f"{name}.origin") is not None:
+        kinematics = dict(
+            origin=Placement.validated(f"{name}.origin", get(f"{name}.origin")),
+            axis=finite_numbers(f"{name}.axis", get(f"{name}.axis"), 3),
+        )
+    else:
+        kinematics = dict(dh=DH(*finite_numbers(f"{name}.dh", get(f"{name}.dh"), 4)))
+    return Joint(
+        name,
+        link=_body_from_params(f"{name}.link", get),
+        position_limits=finite_numbers(
+            f"{name}.position_limits", get(f"{name}.position_limits", (-math.pi, math.pi)), 2
+        ),
+        torque_limit=get(f"{name}.torque_limit", 0.0),
+        velocity_limit=get(f"{name}.velocity_limit", 0.0),
+        acceleration_limit=get(f"{name}.acceleration_limit", 0.0),
+        friction=Friction(get(f"{name}.friction.viscous", 0.0), get(f"{name}.friction.coulomb", 0.0)),
+        armature=get(f"{name}.armature", 0.0),
+        **kinematics,
+    )
 
 
 def check_joint_names(names) -> list[str]:
@@ -203,8 +223,6 @@ def check_joint_names(names) -> list[str]:
     return names
 
 
-def _validated_body(prefix: str, body: RigidBody) -> RigidBody:
-    return RigidBody.validated(prefix, body.mass, body.com, body.inertia)
 
 
 def _body_params(prefix: str, body: RigidBody) -> dict[str, Any]:

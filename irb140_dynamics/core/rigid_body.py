@@ -14,6 +14,7 @@ speeds. Without them 1e200 kg, or a CoM 1e200 m out, would overflow to inf or na
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Sequence
@@ -39,6 +40,21 @@ class ModelError(ValueError):
         super().__init__(f"{field}: {reason}")
         self.field = field
         self.reason = reason
+
+
+class Validated:
+    """The objects a validating function returned, while they live, by identity: validating
+    one of them again is free (a model rebuilt for a new payload re-validates only that)."""
+
+    def __init__(self):
+        self._by_id: weakref.WeakValueDictionary[int, object] = weakref.WeakValueDictionary()
+
+    def __contains__(self, obj) -> bool:
+        return self._by_id.get(id(obj)) is obj
+
+    def add(self, obj):
+        self._by_id[id(obj)] = obj
+        return obj
 
 
 def finite_numbers(field: str, value, length: int | None = None) -> tuple[float, ...]:
@@ -112,11 +128,21 @@ class RigidBody:
         m = checked_mass(f"{field}.mass", mass)
         c = finite_numbers(f"{field}.com", com, 3)
         capped(f"{field}.com", "|com|", math.hypot(*c), MAX_LENGTH, "m")
-        return cls(m, c, validate_inertia(f"{field}.inertia", inertia))
+        return VALIDATED_BODIES.add(cls(m, c, validate_inertia(f"{field}.inertia", inertia)))
+
+    @classmethod
+    def checked(cls, field: str, body: "RigidBody") -> "RigidBody":
+        """``body`` validated (see ``validated``); at once if it came from there."""
+        if body in VALIDATED_BODIES:
+            return body
+        return cls.validated(field, body.mass, body.com, body.inertia)
 
     def about_origin(self) -> tuple[float, Vector3, Inertia6]:
         """(m, h, I_o): mass, first moment m*com, and inertia about the frame origin."""
         return shift_inertia(self.mass, ZERO3, self.inertia, self.com)
+
+
+VALIDATED_BODIES = Validated()
 
 
 def shift_inertia(m, h, inertia, r):

@@ -54,9 +54,10 @@ class LiveParameters:
         self._node, self._check_values = node, check
         self._quick = (lambda draft, previous: True) if finish is None else quick
         finish = finish or (lambda draft, previous: draft)
-        self._names = [spec.name for spec in specs] + list(declared)
         for spec in specs:
             declare(node, spec)
+        self._values = {name: node.get_parameter_or(name).value
+                        for name in [spec.name for spec in specs] + list(declared)}  # kept in step by _apply
         warn_unknown_overrides(node)
         self.current = None
         self.failure: str | None = None
@@ -64,7 +65,7 @@ class LiveParameters:
         self._declaring = self._starting = False
         self._listeners: list[Callable[[Any], None]] = []
         self._accepted, self._applied = 1, 0  # generations: the newest accepted change, the one in force
-        self._checked = None  # (values, draft) accepted by _check, not yet applied
+        self._checked = None  # (the changes, draft) accepted by _check, not yet applied
         finish = _or_none(finish)
         self._builder = Builder(node, finish, self._deliver, f"{node.get_name()} parameters")
         draft = check(self.values())
@@ -86,7 +87,7 @@ class LiveParameters:
 
     def values(self, changes=()) -> dict[str, Any]:
         """All parameter values by name, with ``changes`` (Parameters) applied on top."""
-        values = {name: self._node.get_parameter_or(name).value for name in self._names}
+        values = dict(self._values)
         values.update({p.name: p.value for p in changes})
         return values
 
@@ -100,8 +101,7 @@ class LiveParameters:
         try:
             for spec in specs:
                 if not self._node.has_parameter(spec.name):
-                    declare(self._node, spec)
-                    self._names.append(spec.name)
+                    self._values[spec.name] = declare(self._node, spec)
         finally:
             self._declaring = False
 
@@ -153,8 +153,7 @@ class LiveParameters:
             return SetParametersResult(successful=True)
         try:
             self._refuse_undeclared([p for p in parameters if not p.name])  # others: rclpy's check, above
-            values = self.values(parameters)
-            self._checked = (values, self._check_values(values))
+            self._checked = (_changes(parameters), self._check_values(self.values(parameters)))
         except (ValueError, ParameterNotDeclaredException) as error:
             return SetParametersResult(successful=False, reason=_one_line(error))
         except Exception as error:  # noqa: BLE001  (a defect of ours must not end the node)
@@ -163,10 +162,13 @@ class LiveParameters:
         return SetParametersResult(successful=True)
 
     def _apply(self, parameters: list[Parameter]) -> None:
-        """Build the configuration checked by _check for exactly these values: at once if
+        """Build the configuration checked by _check for exactly these changes: at once if
         that is quick, else off the executor."""
+        for p in parameters:
+            if p.name in self._values:
+                self._values[p.name] = p.value
         checked, self._checked = self._checked, None
-        if checked is None or checked[0] != self.values():  # not the change just checked
+        if checked is None or checked[0] != _changes(parameters):  # not the change just checked
             return
         self._accept(checked[1])
 
@@ -202,6 +204,10 @@ class LiveParameters:
                 listener(result)
             except Exception as error:  # noqa: BLE001  (a defect of ours must not end the node)
                 self._node.get_logger().error(f"applying new parameters: {type(error).__name__}: {error}")
+
+
+def _changes(parameters: list[Parameter]) -> list[tuple[str, Any]]:
+    return [(p.name, p.value) for p in parameters]
 
 
 def _one_line(error: BaseException) -> str:
