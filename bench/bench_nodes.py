@@ -79,6 +79,7 @@ DRAIN_TIMEOUT = 2.0  # s, for the last outputs after the last message published
 QUIET = 0.3  # s without an output: the stream is over
 OTHERS_WARNING = 0.25  # cores used by other processes during a run worth a note
 BENCH_SWITCH_INTERVAL = 1e-4  # s: how long the publishing thread may wait for the interpreter lock
+PUBLISHER_PRIORITY = int(os.environ.get("BENCH_PRIORITY", 50))  # SCHED_FIFO priority of the publishing thread (as ros2_control's loop)
 
 P99_TARGET = Target(1.5)  # id_node's p99 delay at most 1.5x the relay's
 LOST_TARGET = Target(0, absolute=True)  # no message lost
@@ -163,22 +164,41 @@ class Receiver(threading.Thread):
 
 @contextlib.contextmanager
 def steady_publisher():
-    """This process as a steady source while streaming: no garbage-collector pass (one over
-    the stream's ~100,000 lists and records takes tens of ms, after which the late messages
-    leave in a burst that overflows any depth-10 queue: the loss would be the benchmark's,
-    not the node's), and the publishing thread waits at most BENCH_SWITCH_INTERVAL for the
-    interpreter lock held by the receiving and parameter-changing threads."""
+    """This process as a steady source while streaming, as a driver's real-time thread is:
+    late messages leave in a burst that overflows any depth-10 queue, and the loss would be
+    the benchmark's, not the node's. So no garbage-collector pass (one over the stream's
+    ~100,000 lists and records takes tens of ms); the publishing thread waits at most
+    BENCH_SWITCH_INTERVAL for the interpreter lock held by the receiving and
+    parameter-changing threads; and it runs on SCHED_FIFO at PUBLISHER_PRIORITY when
+    allowed (yields whether it does), so that the scheduler does not hold it back for a
+    time slice (~4 ms) behind the node and this process's other threads."""
     interval = sys.getswitchinterval()
     gc.collect()
     gc.freeze()
     gc.disable()
     sys.setswitchinterval(BENCH_SWITCH_INTERVAL)
+    realtime = bool(PUBLISHER_PRIORITY) and set_priority(PUBLISHER_PRIORITY)
     try:
-        yield
+        yield realtime
     finally:
+        if realtime:
+            set_priority(0)
         sys.setswitchinterval(interval)
         gc.enable()
         gc.unfreeze()
+
+
+def set_priority(priority: int) -> bool:
+    """The calling thread on SCHED_FIFO at ``priority`` (0: back to normal scheduling); False
+    if not allowed. Threads and processes it starts inherit it: they call set_priority(0)."""
+    try:
+        if priority:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+        else:
+            os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
+        return True
+    except (OSError, AttributeError):  # not permitted (no CAP_SYS_NICE), or not Linux
+        return False
 
 
 def joint_stream(count: int, rate: float) -> tuple[list, list]:
@@ -233,12 +253,11 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
         wait_for(lambda: publisher.get_subscription_count() > 0
                  and node.count_publishers(f"{namespace}/feedforward_torques") > 0,
                  STARTUP_TIMEOUT, process, f"{kind} matched on joint_states and feedforward_torques")
-        with steady_publisher():
-            receiver = Receiver(subscription, node.context)
-            receiver.start()
-            if change_period is not None:
-                changer = ParameterChanger(f"{namespace}/{kind}", change_period)
-
+        receiver = Receiver(subscription, node.context)
+        receiver.start()
+        if change_period is not None:
+            changer = ParameterChanger(f"{namespace}/{kind}", change_period)
+        with steady_publisher() as realtime:
             first = round(warmup * rate)
             total = first + round(duration * rate)
             positions, velocities = joint_stream(total, rate)
@@ -303,6 +322,7 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
                     cpu, own, busy0, busy1, sent_s)
     run["qos_event_handlers"] = not lean
     run["parameter_changes"] = changes
+    run["publisher_sched_fifo"] = realtime
     if profile:
         run["profile"] = {"file": str(profile_path.relative_to(REPO)), "top": profile_summary(profile_path)}
     return run
@@ -317,7 +337,7 @@ def start_profiler(process: NodeProcess, duration: float, path) -> subprocess.Po
     return subprocess.Popen(
         [str(spy), "record", "--pid", str(process.process.pid), "--duration", f"{duration:g}",
          "--rate", "250", "--nonblocking", "--format", "raw", "--output", str(path)],
-        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, preexec_fn=lambda: set_priority(0))
 
 
 def profile_summary(path, top: int = 15) -> list[tuple[str, float]]:

@@ -24,6 +24,8 @@ answered; no exception leaves a callback.
 from __future__ import annotations
 
 import math
+from array import array
+
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.node import Node
@@ -32,9 +34,11 @@ from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
 from .core import gravity, rnea
+from .core.observer import monitor_terms
 from .core.filters import VelocityDifferentiator
 from .ros.diagnostics import message_status
 from .ros.guard import Tally, guarded
+from .ros.listened import ListenedPublisher
 from .ros.messages import (
     BadMessage,
     JointOrder,
@@ -82,9 +86,9 @@ class IdNode(Node):
         depth = self.get_parameter("qos.depth").value
         self.create_subscription(JointState, "joint_states", self._on_joint_state, joint_states_qos(self))
         self.create_subscription(JointTrajectory, "~/reference", self._on_reference, depth)
-        self._feedforward_pub = self.create_publisher(JointState, "feedforward_torques", depth)
-        self._gravity_pub = self.create_publisher(JointState, "gravity_torques", depth)
-        self._tracking_pub = self.create_publisher(JointState, "~/tracking_error", depth)
+        self._feedforward_pub = ListenedPublisher(self, JointState, "feedforward_torques", depth)
+        self._gravity_pub = ListenedPublisher(self, JointState, "gravity_torques", depth)
+        self._tracking_pub = ListenedPublisher(self, JointState, "~/tracking_error", depth)
         self._command_pub = None
         if self.get_parameter("effort_commands.enabled").value:
             self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands", depth)
@@ -130,7 +134,7 @@ class IdNode(Node):
             return
         try:
             q, qd = read_joint_state(msg, self._order)
-            tau, g, command, reference = self._torques(msg, q, qd, settings)
+            tau, g, command, reference, terms = self._torques(msg, q, qd, settings)
         except NotForThisModel:
             self.counts["joint_states.ignored"] += 1
             return
@@ -141,12 +145,12 @@ class IdNode(Node):
         publish_efforts(self._feedforward_pub, self._feedforward_msg, stamp, tau)
         publish_efforts(self._gravity_pub, self._gravity_msg, stamp, g)
         if command is not None:
-            self._command_msg.data = command.tolist()
+            self._command_msg.data = array("d", command)
             self._command_pub.publish(self._command_msg)
         self.counts["torques.published"] += 1
-        if reference is not None and self._tracking_pub.get_subscription_count():
+        if reference is not None and self._tracking_pub.subscribers:
             self._publish_tracking_error(stamp, q, qd, reference)
-        self._observe(msg, q, qd, g)
+        self._observe(msg, q, qd, g, terms)
 
     def _publish_tracking_error(self, stamp, q, qd, reference) -> None:
         q_ref, qd_ref, _ = reference
@@ -157,8 +161,9 @@ class IdNode(Node):
         self._tracking_pub.publish(msg)
 
     def _torques(self, msg: JointState, q, qd, settings: Settings):
-        """(feed-forward, gravity, command torques or None, the reference in force or None),
-        the torques all finite, or BadMessage."""
+        """(feed-forward, gravity, command torques or None, the reference in force or None,
+        the observer's terms or None), the torques all finite, or BadMessage. With efforts
+        and no reference, one pass gives the torques and the observer's terms."""
         model = settings.model
         estimate = self._estimated_acceleration(msg, qd, settings)
         tracker = self.tracker
@@ -166,8 +171,12 @@ class IdNode(Node):
             if tracker.trajectory is not None else None  # no clock read without one
         q_ff, qd_ff, qdd_ref = reference or (q, qd, None)
         try:
-            tau = finite_torques(rnea, model, q_ff, qd_ff, estimate if qdd_ref is None else qdd_ref)
-            g = finite_torques(gravity, model, q)
+            terms = None
+            if reference is None and len(msg.effort):
+                tau, g, *terms = finite_torques(monitor_terms, model, q, qd, estimate)
+            else:
+                tau = finite_torques(rnea, model, q_ff, qd_ff, estimate if qdd_ref is None else qdd_ref)
+                g = finite_torques(gravity, model, q)
             command = None
             if self._command_pub is not None:
                 if settings.effort_source == "gravity":
@@ -182,7 +191,7 @@ class IdNode(Node):
             if settings.acceleration_mode == "differentiate":
                 self._differentiator.reset()  # the estimate may be what overflowed: start afresh
             raise
-        return tau, g, command, reference
+        return tau, g, command, reference, terms
 
     def _computed_torque(self, model, q, qd, reference, gains):
         try:
@@ -190,7 +199,7 @@ class IdNode(Node):
         except ValueError as error:  # the core's refusal of a non-finite result
             raise BadMessage("non_finite_torques", str(error)) from None
 
-    def _observe(self, msg: JointState, q, qd, g) -> None:
+    def _observe(self, msg: JointState, q, qd, g, terms) -> None:
         """Efforts in the message: run the momentum observer (external torques, collision)."""
         try:
             effort = read_effort(msg, self._order)
@@ -202,7 +211,7 @@ class IdNode(Node):
         if effort is None:
             return
         try:
-            self.collision.update(self._time_of(msg), q, qd, effort, g, msg.header.stamp)
+            self.collision.update(self._time_of(msg), q, qd, effort, g, msg.header.stamp, terms)
         except ValueError as error:
             self.counts["collision.observer_reset"] += 1
             self.tally.warn("collision", f"observer reset ({error})")

@@ -39,8 +39,7 @@ class Recorder:
     def publish(self, msg):
         self.efforts.append(list(msg.effort))
 
-    def get_subscription_count(self) -> int:
-        return 1  # a subscriber listens: id_node publishes only then
+    subscribers = 1  # a subscriber listens: id_node publishes only then (see ros.listened)
 
 
 def held_point(node):

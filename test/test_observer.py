@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import Friction, RigidBody, coriolis_matrix, gravity, irb140, mass_matrix, rnea
-from irb140_dynamics.core.observer import MomentumObserver
+from irb140_dynamics.core.observer import MomentumObserver, monitor_terms
 
 from .support import random_urdf_model
 
@@ -37,6 +37,22 @@ def test_momentum_terms_are_exact(make):
         p, ct_qd = np.split(np.array(model.kernels.momentum.scalar(list(q), list(qd))), 2)
         np.testing.assert_allclose(p, mass_matrix(model, q) @ qd, rtol=1e-12, atol=1e-12)
         np.testing.assert_allclose(ct_qd, coriolis_matrix(model, q, qd).T @ qd, rtol=1e-11, atol=1e-11)
+
+
+@pytest.mark.parametrize("make", [arm_with_friction, lambda: random_urdf_model(np.random.default_rng(4), 6, friction=True)])
+def test_monitor_terms_are_the_separate_algorithms_to_the_last_bit(make):
+    """One pass (the node's, for joint states with efforts) gives exactly what rnea, gravity
+    and the observer's own terms give: the same operations, shared."""
+    model = make()
+    observer = MomentumObserver(model, GAIN)
+    rng = np.random.default_rng(1)
+    for _ in range(50):
+        q, qd, qdd = (rng.uniform(-3.0, 3.0, model.n).tolist() for _ in range(3))
+        tau, g, p, beta = monitor_terms(model, q, qd, qdd)
+        assert tau == rnea(model, q, qd, qdd).tolist() and g == gravity(model, q).tolist()
+        assert (p, beta) == tuple(observer._momentum_terms(q, qd))
+    with pytest.raises(ValueError, match="rnea: the result is not finite"), np.errstate(all="ignore"):
+        monitor_terms(model, [0.0] * model.n, [1e200] * model.n, [0.0] * model.n)
 
 
 def run(model, duration, external=lambda t: np.zeros(6), observer=None):

@@ -125,6 +125,11 @@ class Kernels:
         """(q, qd) -> [M qd, C^T qd]: the generalized momentum and dT/dq (see observer)."""
         return self._arm.momentum.bound(self.constants)
 
+    @cached_property
+    def monitor(self) -> Kernel:
+        """(q, qd, qdd) -> [tau, g, M qd, C^T qd] (rigid body), one pass sharing the kinematics."""
+        return self._arm.monitor.bound(self.constants)
+
 
 @lru_cache(maxsize=ARMS_CACHED)
 def _arm(links, flange, nonzero: tuple[bool, ...]) -> "_ArmKernels":
@@ -237,3 +242,16 @@ class _ArmKernels:
         from .observer import momentum_terms
 
         return self._kernel("momentum", lambda cs, qd, k: momentum_terms(self._links(k), cs, qd), qd=self.n)
+
+    @cached_property
+    def monitor(self) -> Kernel:
+        from .observer import momentum_terms
+
+        zeros = [0.0] * self.n
+
+        def terms(cs, qd, qdd, k):
+            links, gravity = self._links(k), self._gravity(k)
+            return [*algorithms.rnea(links, cs, qd, qdd, gravity), *algorithms.rnea(links, cs, zeros, zeros, gravity),
+                    *momentum_terms(links, cs, qd)]
+
+        return self._kernel("monitor", terms, qd=self.n, qdd=self.n)

@@ -26,7 +26,7 @@ import numpy as np
 from .algorithms import add, cross, dot, inertia_times, scale, to_child, to_parent_wrench, turns
 from .dual import dual_angles, partial
 from .dynamics import gravity
-from .states import state
+from .states import finite_result, state
 from .model import RobotModel
 from .rigid_body import ZERO3
 
@@ -91,6 +91,25 @@ def momentum_terms(links, cs, qd):
     return p + gradient
 
 
+def monitor_terms(model: RobotModel, q, qd, qdd) -> tuple[list, list, list, list]:
+    """(tau, g, p, beta) of one sample, in one pass over the arm (lists of floats): tau =
+    rnea(q, qd, qdd) and g = gravity(q), checked finite (else ValueError, as rnea's), and
+    the observer's p = M qd and beta = C^T qd - g - tau_f (see MomentumObserver.advance).
+    What a node that monitors the arm needs per sample, at about the cost of one rnea."""
+    n = model.n
+    q, qd, qdd = state(q, n, "q"), state(qd, n, "qd"), state(qdd, n, "qdd")
+    terms = model.kernels.monitor.scalar(q, qd, qdd)
+    tau, g, p, c = list(terms[:n]), list(terms[n:2 * n]), list(terms[2 * n:3 * n]), terms[3 * n:]
+    if not math.isfinite(sum(tau) + sum(g)):
+        finite_result(tau, "rnea", q=q, qd=qd, qdd=qdd)
+        finite_result(g, "gravity", q=q)
+    if model.friction is None:
+        return tau, g, p, [ci - gi for ci, gi in zip(c, g)]
+    friction = model.friction.torques(qd).tolist()
+    tau = [t + f for t, f in zip(tau, friction)]
+    return tau, g, p, [ci - gi - f for ci, gi, f in zip(c, g, friction)]
+
+
 class MomentumObserver:
     """The residual r ~ tau_ext [N m], updated sample by sample."""
 
@@ -118,12 +137,16 @@ class MomentumObserver:
         """
         return np.array(self.advance(t, q, qd, tau, g))
 
-    def advance(self, t: float, q, qd, tau, g=None) -> list[float]:
+    def advance(self, t: float, q, qd, tau, g=None, terms=None) -> list[float]:
         """``update``, the residual as a list. Plain Python arithmetic on n floats: a few
-        microseconds besides the kernel, where small NumPy arrays would cost tens."""
+        microseconds besides the kernel, where small NumPy arrays would cost tens.
+        ``terms``: (p, beta) of monitor_terms at (q, qd), if the caller has them already."""
         n = self.model.n
-        q, qd, tau = state(q, n, "q"), state(qd, n, "qd"), state(tau, n, "tau")
-        p, beta = self._momentum_terms(q, qd, g)
+        tau = state(tau, n, "tau")
+        if terms is None:
+            p, beta = self._momentum_terms(state(q, n, "q"), state(qd, n, "qd"), g)
+        else:
+            p, beta = terms
         drive = [x + y for x, y in zip(tau, beta)]
         if self._t is None or not 0.0 < t - self._t <= self.max_gap:
             self._r = [0.0] * n

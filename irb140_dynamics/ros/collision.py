@@ -18,6 +18,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Bool
 
 from ..core.observer import MomentumObserver
+from .listened import ListenedPublisher
 from .messages import publish_efforts
 from .params import Spec
 
@@ -62,7 +63,7 @@ class CollisionMonitor:
     def __init__(self, node: Node, joint_names, depth: int):
         self._names = list(joint_names)
         self._external_msg = JointState(name=self._names)
-        self._external_pub = node.create_publisher(JointState, "external_torques", depth)
+        self._external_pub = ListenedPublisher(node, JointState, "external_torques", depth)
         latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self._collision_pub = node.create_publisher(Bool, "collision", latched)
         self.colliding: list[str] = []  # names of the joints over their thresholds
@@ -81,10 +82,11 @@ class CollisionMonitor:
     def reset(self) -> None:
         self._observer.reset()
 
-    def update(self, t: float, q, qd, effort, g, stamp) -> None:
-        """One joint state with efforts: publish the residual, and the flag when it changes.
-        ValueError (observer reset) if the residual is not finite."""
-        r = self._observer.advance(t, q, qd, effort, g)
+    def update(self, t: float, q, qd, effort, g, stamp, terms=None) -> None:
+        """One joint state with efforts: publish the residual, and the flag when it changes
+        (``terms``: see MomentumObserver.advance). ValueError (observer reset) if the
+        residual is not finite."""
+        r = self._observer.advance(t, q, qd, effort, g, terms)
         self._residual = r
         publish_efforts(self._external_pub, self._external_msg, stamp, r)
         colliding = [name for name, x, limit in zip(self._names, r, self._thresholds) if 0.0 < limit < abs(x)]

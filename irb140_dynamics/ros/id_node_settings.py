@@ -65,7 +65,7 @@ def check_settings(values: dict) -> Settings:
     )
 
 
-KERNELS = ("rnea", "gravity_torques", "momentum")  # what a message uses (momentum: the collision observer)
+KERNELS = ("rnea", "gravity_torques", "momentum", "monitor")  # what a message uses (the last two: the observer)
 
 
 def finish_settings(settings: Settings, previous: Settings | None) -> Settings:

@@ -25,16 +25,19 @@ def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> No
 
 
 def finite_torques(function, model, *state):
-    """``function(model, *state)`` (rnea, gravity) when all its torques are finite, else
-    BadMessage non_finite_torques (an absurd but finite state can overflow the model's
-    sums; the core may return the non-finite torques or refuse them with ValueError)."""
+    """``function(model, *state)`` (rnea, gravity; monitor_terms, whose first two results
+    are torques) when all its torques are finite, else BadMessage non_finite_torques (an
+    absurd but finite state can overflow the model's sums; the core may return the
+    non-finite torques or refuse them with ValueError)."""
     try:
-        tau = function(model, *state)
+        result = function(model, *state)
     except ValueError as error:
         raise BadMessage("non_finite_torques", str(error)) from None
-    if not (math.isfinite(sum(tau)) or all(map(math.isfinite, tau))):
-        raise BadMessage("non_finite_torques", f"the model gives {[float(x) for x in tau]}")
-    return tau
+    torques = result[:2] if type(result) is tuple else (result,)
+    for tau in torques:
+        if not (math.isfinite(sum(tau)) or all(map(math.isfinite, tau))):
+            raise BadMessage("non_finite_torques", f"the model gives {[float(x) for x in tau]}")
+    return result
 
 
 def _pick(values, index: list[int], field: str, length: int, required: bool) -> list[float]:
@@ -118,10 +121,9 @@ def _index(names, n_positions: int, order: JointOrder) -> tuple[list[int], int]:
 
 
 def publish_efforts(publisher, msg: JointState, stamp, effort) -> None:
-    """Fill a reused JointState and publish it, if anything subscribes: a message nobody
-    has subscribed to would cost ~8 us for nothing (a new subscriber is counted once DDS
-    has matched it, from when it would receive anyway)."""
-    if publisher.get_subscription_count():
+    """Fill a reused JointState and publish it on a ListenedPublisher, if anything
+    subscribes: a message nobody has subscribed to would cost ~8 us for nothing."""
+    if publisher.subscribers:
         publisher.publish(joint_efforts(msg, stamp, effort))
 
 
