@@ -43,6 +43,7 @@ from .ros.messages import (
     BadMessage,
     JointOrder,
     NotForThisModel,
+    core_result,
     finite_torques,
     publish_efforts,
     read_effort,
@@ -173,7 +174,7 @@ class IdNode(Node):
         try:
             terms = None
             if reference is None and len(msg.effort):
-                tau, g, *terms = finite_torques(monitor_terms, model, q, qd, estimate)
+                tau, g, *terms = core_result(monitor_terms, model, q, qd, estimate)  # refuses non-finite tau, g
             else:
                 tau = finite_torques(rnea, model, q_ff, qd_ff, estimate if qdd_ref is None else qdd_ref)
                 g = finite_torques(gravity, model, q)
@@ -182,7 +183,7 @@ class IdNode(Node):
                 if settings.effort_source == "gravity":
                     command = g
                 elif settings.effort_source == "computed_torque":
-                    command = finite_torques(self._computed_torque, model, q, qd, reference, settings.gains)
+                    command = finite_torques(self.tracker.command, model, q, qd, reference, settings.gains)
                 elif qdd_ref is None and settings.acceleration_mode == "differentiate":
                     command = finite_torques(rnea, model, q_ff, qd_ff, self._zeros)  # never a measured qdd
                 else:
@@ -192,12 +193,6 @@ class IdNode(Node):
                 self._differentiator.reset()  # the estimate may be what overflowed: start afresh
             raise
         return tau, g, command, reference, terms
-
-    def _computed_torque(self, model, q, qd, reference, gains):
-        try:
-            return self.tracker.command(model, q, qd, reference, gains)
-        except ValueError as error:  # the core's refusal of a non-finite result
-            raise BadMessage("non_finite_torques", str(error)) from None
 
     def _observe(self, msg: JointState, q, qd, g, terms) -> None:
         """Efforts in the message: run the momentum observer (external torques, collision)."""

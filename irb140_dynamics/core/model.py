@@ -154,7 +154,7 @@ class RobotModel:
         joints = tuple(_joint_from_params(name, params, get) for name in names)
         payload = _body_from_params("payload", get, optional=True)
         return cls(
-            tuple(joints),
+            joints,
             finite_numbers("gravity", get("gravity"), 3),
             payload,
             Placement.validated("flange", get("flange", (0.0,) * 6)),
@@ -221,8 +221,6 @@ def check_joint_names(names) -> list[str]:
     if len(set(names)) != len(names):
         raise ModelError("joint_names", f"names must be unique, got {names}")
     return names
-
-
 
 
 def _body_params(prefix: str, body: RigidBody) -> dict[str, Any]:

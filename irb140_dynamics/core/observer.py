@@ -103,11 +103,16 @@ def monitor_terms(model: RobotModel, q, qd, qdd) -> tuple[list, list, list, list
     if not math.isfinite(sum(tau) + sum(g)):
         finite_result(tau, "rnea", q=q, qd=qd, qdd=qdd)
         finite_result(g, "gravity", q=q)
-    if model.friction is None:
-        return tau, g, p, [ci - gi for ci, gi in zip(c, g)]
-    friction = model.friction.torques(qd).tolist()
-    tau = [t + f for t, f in zip(tau, friction)]
-    return tau, g, p, [ci - gi - f for ci, gi, f in zip(c, g, friction)]
+    friction = None if model.friction is None else model.friction.torques(qd).tolist()
+    if friction is not None:
+        tau = [t + f for t, f in zip(tau, friction)]
+    return tau, g, p, _beta(c, g, friction)
+
+
+def _beta(c, g, friction) -> list:
+    """C^T qd - g - tau_f (friction None: none), what the observer integrates besides tau and r."""
+    beta = [ci - gi for ci, gi in zip(c, g)]
+    return beta if friction is None else [b - f for b, f in zip(beta, friction)]
 
 
 class MomentumObserver:
@@ -168,7 +173,5 @@ class MomentumObserver:
         terms = model.kernels.momentum.scalar(q, qd)
         n = model.n
         g = gravity(model, q) if g is None else g
-        beta = [c - gi for c, gi in zip(terms[n:], g.tolist() if type(g) is np.ndarray else g)]
-        if model.friction is not None:
-            beta = [b - f for b, f in zip(beta, model.friction.torques(qd).tolist())]
-        return list(terms[:n]), beta
+        friction = None if model.friction is None else model.friction.torques(qd).tolist()
+        return list(terms[:n]), _beta(terms[n:], g.tolist() if type(g) is np.ndarray else g, friction)

@@ -12,8 +12,8 @@ from trajectory_msgs.msg import JointTrajectory
 
 from ..core.joint_order import BadMessage, JointOrder, NotForThisModel
 
-__all__ = ["BadMessage", "JointOrder", "NotForThisModel", "count_and_warn", "finite_torques", "joint_efforts",
-           "read_effort", "read_joint_state", "read_reference", "read_trajectory"]
+__all__ = ["BadMessage", "JointOrder", "NotForThisModel", "core_result", "count_and_warn", "finite_torques",
+           "joint_efforts", "publish_efforts", "read_effort", "read_joint_state", "read_reference", "read_trajectory"]
 
 
 def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> None:
@@ -24,20 +24,23 @@ def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> No
     logger.warning(f"dropped a {topic} message ({error})", throttle_duration_sec=2.0)
 
 
-def finite_torques(function, model, *state):
-    """``function(model, *state)`` (rnea, gravity; monitor_terms, whose first two results
-    are torques) when all its torques are finite, else BadMessage non_finite_torques (an
-    absurd but finite state can overflow the model's sums; the core may return the
-    non-finite torques or refuse them with ValueError)."""
+def core_result(function, model, *state):
+    """``function(model, *state)``; the core's refusal (ValueError: a state too large for
+    the model, the torques not finite) as BadMessage non_finite_torques."""
     try:
-        result = function(model, *state)
+        return function(model, *state)
     except ValueError as error:
         raise BadMessage("non_finite_torques", str(error)) from None
-    torques = result[:2] if type(result) is tuple else (result,)
-    for tau in torques:
-        if not (math.isfinite(sum(tau)) or all(map(math.isfinite, tau))):
-            raise BadMessage("non_finite_torques", f"the model gives {[float(x) for x in tau]}")
-    return result
+
+
+def finite_torques(function, model, *state):
+    """``function(model, *state)`` (rnea, gravity) when all its torques are finite, else
+    BadMessage non_finite_torques (an absurd but finite state can overflow the model's
+    sums; the core may return the non-finite torques or refuse them with ValueError)."""
+    tau = core_result(function, model, *state)
+    if not (math.isfinite(sum(tau)) or all(map(math.isfinite, tau))):
+        raise BadMessage("non_finite_torques", f"the model gives {[float(x) for x in tau]}")
+    return tau
 
 
 def _pick(values, index: list[int], field: str, length: int, required: bool) -> list[float]:
