@@ -56,6 +56,7 @@ from common import (  # first: puts the checkout on sys.path
     machine_info,
     print_table,
     seconds_per_call,
+    set_priority,
     write_results,
 )
 from irb140_dynamics.ros.spin import EXECUTORS  # noqa: E402  (events: what every node's main() uses)
@@ -79,7 +80,8 @@ DRAIN_TIMEOUT = 2.0  # s, for the last outputs after the last message published
 QUIET = 0.3  # s without an output: the stream is over
 OTHERS_WARNING = 0.25  # cores used by other processes during a run worth a note
 BENCH_SWITCH_INTERVAL = 1e-4  # s: how long the publishing thread may wait for the interpreter lock
-PUBLISHER_PRIORITY = int(os.environ.get("BENCH_PRIORITY", 50))  # SCHED_FIFO priority of the publishing thread (as ros2_control's loop)
+# SCHED_FIFO priority of the publishing thread (as ros2_control's loop); BENCH_PRIORITY=0: normal
+PUBLISHER_PRIORITY = int(os.environ.get("BENCH_PRIORITY", 50))
 
 P99_TARGET = Target(1.5)  # id_node's p99 delay at most 1.5x the relay's
 LOST_TARGET = Target(0, absolute=True)  # no message lost
@@ -186,19 +188,6 @@ def steady_publisher():
         sys.setswitchinterval(interval)
         gc.enable()
         gc.unfreeze()
-
-
-def set_priority(priority: int) -> bool:
-    """The calling thread on SCHED_FIFO at ``priority`` (0: back to normal scheduling); False
-    if not allowed. Threads and processes it starts inherit it: they call set_priority(0)."""
-    try:
-        if priority:
-            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
-        else:
-            os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
-        return True
-    except (OSError, AttributeError):  # not permitted (no CAP_SYS_NICE), or not Linux
-        return False
 
 
 def joint_stream(count: int, rate: float) -> tuple[list, list]:

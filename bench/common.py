@@ -251,3 +251,16 @@ def _git_commit() -> str | None:
     except (OSError, subprocess.CalledProcessError):
         return None
     return commit + ("-dirty" if dirty else "")
+
+
+def set_priority(priority: int) -> bool:
+    """The calling thread on SCHED_FIFO at ``priority`` (0: back to normal scheduling); False
+    if not allowed. Threads and processes it starts inherit it: they call set_priority(0)."""
+    try:
+        if priority:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+        else:
+            os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
+        return True
+    except (OSError, AttributeError):  # not permitted (no CAP_SYS_NICE), or not Linux
+        return False

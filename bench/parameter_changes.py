@@ -7,21 +7,15 @@ standard SetParameters service, as `ros2 param set` would, and times each reply.
 
 from __future__ import annotations
 
-import os
 import threading
 import time
 
 import numpy as np
 
+from common import set_priority
+
 REPLY_TIMEOUT = 5.0  # s
 SERVICES_TIMEOUT = 30.0  # s, for the node's parameter services to appear
-
-
-def _normal_priority() -> None:
-    try:
-        os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
-    except (OSError, AttributeError):
-        pass
 
 
 class ParameterChanger(threading.Thread):
@@ -54,7 +48,7 @@ class ParameterChanger(threading.Thread):
     def run(self) -> None:
         from rclpy.parameter import Parameter
 
-        _normal_priority()  # started by the benchmark's real-time publishing thread: not real-time itself
+        set_priority(0)  # started by the benchmark's real-time publishing thread: not real-time itself
         start = time.monotonic()
         k = 0
         while not self.stopping.is_set():
