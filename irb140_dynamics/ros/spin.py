@@ -18,8 +18,12 @@ EXECUTORS = ("events", "single_threaded")
 
 
 def tool_arguments(argv: list[str]) -> list[str]:
-    """A tool's own command-line arguments: argv without the program and the ROS arguments."""
-    return remove_ros_args(argv)[1:]
+    """A tool's own command-line arguments: argv without the program and the ROS arguments
+    (ValueError in one line if rcl refuses those)."""
+    try:
+        return remove_ros_args(argv)[1:]
+    except rclpy_implementation.RCLError as error:
+        raise ValueError(init_error(error)) from None
 
 
 def run(name: str, make_node: Callable[[], Node], args: list[str] | None = None, executor: str = "events") -> int:

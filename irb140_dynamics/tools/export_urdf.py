@@ -13,17 +13,11 @@ from __future__ import annotations
 
 import sys
 
-import rclpy
-from rclpy.context import Context
-from rclpy.impl.implementation_singleton import rclpy_implementation
-from rclpy.logging import LoggingSeverity
-from rclpy.node import Node
-
 from ..core import RobotModel, irb140
 from ..core.geometry import IRB140_SHAPES
 from ..core.urdf import export_urdf
-from ..ros.model_source import declare_model_source
-from ..ros.spin import init_error, tool_arguments
+from ..ros.model_source import model_from_arguments
+from ..ros.spin import tool_arguments
 
 NAME = "export_urdf"
 
@@ -35,28 +29,6 @@ def urdf_of(model: RobotModel) -> str:
     return export_urdf(model, "robot")
 
 
-def current_model(args: list[str]) -> RobotModel:
-    """The model the nodes would run on with these (ROS) arguments, or ValueError."""
-    context = Context()
-    try:
-        rclpy.init(args=args, context=context)
-    except rclpy_implementation.RCLError as error:
-        raise ValueError(init_error(error)) from None
-    node = None
-    try:
-        node = Node(NAME, context=context, start_parameter_services=False, enable_rosout=False)
-        node.get_logger().set_level(LoggingSeverity.WARN)  # stderr for errors only
-        model = declare_model_source(node, [], RobotModel.from_params).current
-        if model is None:
-            raise ValueError("robot_description: export_urdf does not read the topic; give the robot_description "
-                             "parameter or model.urdf_file")
-        return model
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown(context=context)
-
-
 def main(args: list[str] | None = None) -> int:
     args = sys.argv if args is None else args
     try:
@@ -66,9 +38,7 @@ def main(args: list[str] | None = None) -> int:
             print(__doc__ if help_asked else f"{NAME}: unknown arguments {extra}; see --help",
                   file=sys.stdout if help_asked else sys.stderr)
             return 0 if help_asked else 2
-        text = urdf_of(current_model(args))
-    except rclpy_implementation.RCLError as error:
-        return _fail(init_error(error))
+        text = urdf_of(model_from_arguments(args, NAME))
     except ValueError as error:
         return _fail(str(error))
     sys.stdout.write(text)
