@@ -68,3 +68,12 @@ def run_until_ready(command: list[str], env: dict | None = None, timeout: float 
     finally:
         code, output = interrupt(process, lines)
     return code, output
+
+
+def one_fatal_line(code: int, output: str) -> str:
+    """The one [FATAL] line of a node that refused to start (exit 1, no traceback)."""
+    assert code == 1, output
+    assert "Traceback" not in output, output
+    fatal = [line for line in output.splitlines() if "[FATAL]" in line]
+    assert len(fatal) == 1, output
+    return fatal[0]

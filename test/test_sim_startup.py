@@ -1,6 +1,6 @@
 """Starting sim_node as `ros2 run` does: ready and a clean stop on Ctrl-C, or one clear line."""
 
-from .node_process import module_command, run_to_exit, run_until_ready
+from .node_process import module_command, one_fatal_line, run_to_exit, run_until_ready
 
 SIM_NODE = "irb140_dynamics.sim_node"
 
@@ -13,16 +13,11 @@ def test_starts_with_the_default_model_and_stops_cleanly_on_ctrl_c():
 
 
 def test_a_bad_initial_pose_stops_startup_with_one_clear_line():
-    code, output = run_to_exit(module_command(SIM_NODE, "-p", "initial_positions:=[0.0, -3.0, 0.0, 0.0, 0.0, 0.0]"))
-    assert code == 1, output
-    assert "Traceback" not in output
-    fatal = [line for line in output.splitlines() if "cannot start" in line]
-    assert len(fatal) == 1 and "initial_positions: joint_2 at -3.0 rad is outside" in fatal[0], output
+    pose = "initial_positions:=[0.0, -3.0, 0.0, 0.0, 0.0, 0.0]"
+    fatal = one_fatal_line(*run_to_exit(module_command(SIM_NODE, "-p", pose)))
+    assert "cannot start" in fatal and "initial_positions: joint_2 at -3.0 rad is outside" in fatal, fatal
 
 
 def test_a_queue_depth_beyond_its_range_stops_startup_with_one_clear_line():
-    code, output = run_to_exit(module_command(SIM_NODE, "-p", "qos.depth:=2000000000"))
-    assert code == 1, output
-    assert "Traceback" not in output
-    fatal = [line for line in output.splitlines() if "cannot start" in line]
-    assert len(fatal) == 1 and "qos.depth" in fatal[0], output
+    fatal = one_fatal_line(*run_to_exit(module_command(SIM_NODE, "-p", "qos.depth:=2000000000")))
+    assert "cannot start" in fatal and "qos.depth" in fatal, fatal

@@ -10,20 +10,12 @@ import numpy as np
 import pytest
 import yaml
 
-from .node_process import module_command, run_to_exit, run_until_ready, start
+from .node_process import module_command, one_fatal_line, run_to_exit, run_until_ready, start
 from .paths import CONFIG, ROOT
 from .support import random_model
 
 ID_NODE = "irb140_dynamics.id_node"
 PAYLOAD_CHECK_NODE = "irb140_dynamics.payload_check_node"
-
-
-def one_fatal_line(code: int, output: str) -> str:
-    assert code == 1, output
-    assert "Traceback" not in output, output
-    fatal = [line for line in output.splitlines() if "[FATAL]" in line]
-    assert len(fatal) == 1, output
-    return fatal[0]
 
 
 def params_file(tmp_path, parameters: dict, name="params.yaml") -> str:
