@@ -17,6 +17,16 @@ def test_starts_with_the_default_model_and_stops_cleanly_on_ctrl_c():
     assert code == 0, output
 
 
+def test_ctrl_c_inside_a_callback_stops_cleanly():
+    """Ctrl-C while a callback runs and messages wait: exit 0, no FATAL, no traceback (it
+    used to cut the callback, logged FATAL, or failed in rclpy's C++ building the next
+    message: "RuntimeError: Unable to convert call argument '0'")."""
+    code, output = run_to_exit(module_command("test.interrupting_node"), timeout=30.0)
+    assert code == 0, output
+    assert "FATAL" not in output and "Traceback" not in output, output
+    assert "exit after" in output, output
+
+
 def bad_file(tmp_path, text):
     path = tmp_path / "bad.yaml"
     path.write_text(textwrap.dedent(text))

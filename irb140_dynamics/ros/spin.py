@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import gc
 import re
+import signal
 import sys
-from typing import Callable
+from contextlib import contextmanager
+from typing import Callable, Iterator
 
 import rclpy
 import rclpy.logging
@@ -87,11 +89,12 @@ def _start(make_node: Callable[[], Node], args: list[str], logger) -> Node | Non
 
 
 def spin(node: Node, executor: str = "events") -> None:
-    """Run the node's callbacks until its context shuts down.
+    """Run the node's callbacks until its context shuts down or Ctrl-C.
 
     ``events``: rclpy's EventsExecutor, when this rclpy has it: under half the CPU per
     message of the default executor (bench/bench_nodes.py). Driven by spin_once: its
-    spin() in the 7.1 wheels busy-loops without running callbacks. ``single_threaded``:
+    spin() in the 7.1 wheels busy-loops without running callbacks; Ctrl-C is read between
+    spin_once calls (``ctrl_c_as_a_flag``). ``single_threaded``:
     rclpy.spin, the default SingleThreadedExecutor.
     """
     try:
@@ -103,11 +106,37 @@ def spin(node: Node, executor: str = "events") -> None:
         return
     events = EventsExecutor(context=node.context)
     events.add_node(node)
+    with ctrl_c_as_a_flag() as interrupted:
+        try:
+            while node.context.ok() and not interrupted:
+                events.spin_once(timeout_sec=WAKE_PERIOD)
+        finally:
+            events.shutdown()
+
+
+WAKE_PERIOD = 0.1  # s: the longest spin_once waits, so the longest a Ctrl-C waits to be seen
+
+
+@contextmanager
+def ctrl_c_as_a_flag() -> Iterator[list]:
+    """Ctrl-C (SIGINT) appends to the list yielded instead of raising KeyboardInterrupt.
+
+    Python raises KeyboardInterrupt at the next line of Python that runs, which under the
+    EventsExecutor may be inside rclpy's C++: building a message (its __init__ is Python)
+    then fails as "RuntimeError: Unable to convert call argument '0' to Python object", or
+    a callback is cut half-way and logged FATAL. The flag is read between spin_once calls
+    instead. Outside the main thread (no signals there) the list stays empty.
+    """
+    interrupted: list = []
     try:
-        while node.context.ok():
-            events.spin_once(timeout_sec=0.5)
+        previous = signal.signal(signal.SIGINT, lambda *_: interrupted.append(True))
+    except ValueError:  # not the main thread
+        yield interrupted
+        return
+    try:
+        yield interrupted
     finally:
-        events.shutdown()
+        signal.signal(signal.SIGINT, previous)
 
 
 def _one_line(error: Exception) -> str:
