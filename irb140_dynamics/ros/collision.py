@@ -19,6 +19,7 @@ from std_msgs.msg import Bool
 
 from ..core.observer import MomentumObserver
 from .listened import ListenedPublisher
+from .joint_state_cdr import EffortMessage
 from .messages import publish_efforts
 from .params import Spec
 
@@ -62,7 +63,7 @@ class CollisionMonitor:
 
     def __init__(self, node: Node, joint_names, depth: int):
         self._names = list(joint_names)
-        self._external_msg = JointState(name=self._names)
+        self._external_msg = EffortMessage(self._names)
         self._external_pub = ListenedPublisher(node, JointState, "external_torques", depth)
         latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self._collision_pub = node.create_publisher(Bool, "collision", latched)
@@ -74,7 +75,7 @@ class CollisionMonitor:
         """A new model or new gains: the observer starts again (named as the model's joints)."""
         if list(model.joint_names) != self._names:
             self._names = list(model.joint_names)
-            self._external_msg = JointState(name=self._names)
+            self._external_msg = EffortMessage(self._names)
             self._residual = None
         self._observer = MomentumObserver(model, settings.gain, OBSERVER_GAP)
         self._thresholds = settings.thresholds.tolist()

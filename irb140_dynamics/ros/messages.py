@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from array import array
 from collections import Counter
 
 import numpy as np
@@ -13,7 +12,7 @@ from trajectory_msgs.msg import JointTrajectory
 from ..core.joint_order import BadMessage, JointOrder, NotForThisModel
 
 __all__ = ["BadMessage", "JointOrder", "NotForThisModel", "core_result", "count_and_warn", "finite_torques",
-           "joint_efforts", "publish_efforts", "read_effort", "read_joint_state", "read_reference", "read_trajectory"]
+           "publish_efforts", "read_effort", "read_joint_state", "read_reference", "read_trajectory"]
 
 
 def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> None:
@@ -123,15 +122,9 @@ def _index(names, n_positions: int, order: JointOrder) -> tuple[list[int], int]:
     return order.for_values(names, n_positions)
 
 
-def publish_efforts(publisher, msg: JointState, stamp, effort) -> None:
-    """Fill a reused JointState and publish it on a ListenedPublisher, if anything
-    subscribes: a message nobody has subscribed to would cost ~8 us for nothing."""
+def publish_efforts(publisher, message, stamp, effort) -> None:
+    """Publish ``message`` (a ros.joint_state_cdr.EffortMessage: fixed names) with ``stamp``
+    and ``effort`` on a ListenedPublisher, if anything subscribes: a message nobody has
+    subscribed to would cost its serialization for nothing."""
     if publisher.subscribers:
-        publisher.publish(joint_efforts(msg, stamp, effort))
-
-
-def joint_efforts(msg: JointState, stamp, effort) -> JointState:
-    """Fill a reused JointState (names already set) with a stamp and efforts."""
-    msg.header.stamp = stamp
-    msg.effort = array("d", effort)
-    return msg
+        publisher.publish(message.serialize(stamp, effort))
