@@ -3,8 +3,8 @@
 rclpy turns every message taken into a Python object field by field (18 us for a 6-joint
 JointState) and every message published back into C (11 us). id_node reads its joint
 states from the serialized bytes with ``struct`` instead (4 us), and publishes its torque
-messages as bytes: rclpy's own serialization of the message once, then only the stamp and
-the efforts written into a copy (2 us). bench/bench_nodes.py measures what that saves.
+messages as bytes: the message written once, then only the stamp and the efforts written
+into a copy (1 us). bench/bench_nodes.py measures what that saves.
 
 The layout is XCDR1 (what rmw_fastrtps and rmw_cyclonedds send for ROS 2 types): a
 4-byte encapsulation header, then the fields in order, each primitive aligned to its size
@@ -18,7 +18,7 @@ from __future__ import annotations
 import struct
 from typing import NamedTuple
 
-from rclpy.serialization import deserialize_message, serialize_message
+from rclpy.serialization import deserialize_message
 from sensor_msgs.msg import JointState
 
 from ..core.joint_order import BadMessage
@@ -59,7 +59,7 @@ def read_joint_state_cdr(raw: bytes) -> JointStateView | JointState:
         except Exception as error:  # noqa: BLE001  (rclpy raises its own kinds for bad bytes)
             raise BadMessage("malformed", f"undecodable joint state: {error}") from None
     try:
-        return _read_plain_le(raw)[0]
+        return _read_plain_le(raw)
     except (struct.error, UnicodeDecodeError, ValueError) as error:
         raise BadMessage("malformed", f"undecodable joint state: {error}") from None
 
@@ -85,7 +85,7 @@ def _read_plain_le(raw: bytes) -> tuple[JointStateView, int]:
     position, at = _doubles(raw, at, end)
     velocity, at = _doubles(raw, at, end)
     effort, at = _doubles(raw, at, end)
-    return JointStateView(Header(Time(sec, nanosec), frame_id), names, position, velocity, effort), at
+    return JointStateView(Header(Time(sec, nanosec), frame_id), names, position, velocity, effort)
 
 
 def _aligned(at: int, size: int) -> int:
@@ -127,18 +127,14 @@ def _doubles(raw: bytes, at: int, end: int) -> tuple[tuple, int]:
 
 
 class EffortMessage:
-    """JointState bytes with fixed names, empty positions and velocities, and efforts: rclpy
-    serializes it once; ``serialize`` writes a stamp and the efforts into a copy."""
+    """JointState bytes with fixed names, empty positions and velocities, and efforts: written
+    once; ``serialize`` writes a stamp and the efforts into a copy."""
 
     def __init__(self, names):
         self.names = list(names)
-        serialized = serialize_message(JointState(name=self.names, effort=[0.0] * len(self.names)))
-        if serialized[:2] != PLAIN_CDR_LE:
-            raise RuntimeError(f"rclpy serializes with encapsulation {serialized[:2].hex()}, not plain CDR LE")
-        end = _read_plain_le(serialized)[1]  # the bytes after it are not the message's
-        self._template = serialized[:end]
         self._efforts = struct.Struct(f"<{len(self.names)}d")
-        self._at = end - self._efforts.size  # effort is the last field
+        self._template = _plain_le(self.names, len(self.names))
+        self._at = len(self._template) - self._efforts.size  # effort is the last field
 
     def serialize(self, stamp, effort) -> bytes:
         """The message with ``stamp`` (anything with sec, nanosec) and ``effort`` (one per name)."""
@@ -146,3 +142,33 @@ class EffortMessage:
         _STAMP.pack_into(buffer, HEADER, stamp.sec, stamp.nanosec)
         self._efforts.pack_into(buffer, self._at, *effort)
         return bytes(buffer)
+
+
+def _plain_le(names, efforts: int) -> bytes:
+    """A JointState with ``names``, ``efforts`` zero efforts and nothing else (stamp 0)."""
+    out = bytearray(PLAIN_CDR_LE + b"\0\0")
+
+    def align(size: int) -> None:
+        out.extend(bytes(-(len(out) - HEADER) % size))
+
+    def count(value: int) -> None:
+        align(4)
+        out.extend(_UINT32.pack(value))
+
+    def string(text: str) -> None:
+        encoded = text.encode() + b"\0"
+        count(len(encoded))
+        out.extend(encoded)
+
+    out.extend(bytes(_STAMP.size))
+    string("")  # frame_id
+    count(len(names))
+    for name in names:
+        string(name)
+    count(0)  # position
+    count(0)  # velocity
+    count(efforts)
+    if efforts:
+        align(8)
+        out.extend(bytes(8 * efforts))
+    return bytes(out)
