@@ -79,6 +79,7 @@ STARTUP_TIMEOUT = 30.0  # s, for a node process to start and match
 DRAIN_TIMEOUT = 2.0  # s, for the last outputs after the last message published
 QUIET = 0.3  # s without an output: the stream is over
 OTHERS_WARNING = 0.25  # cores used by other processes during a run worth a note
+STOLEN_WARNING = 1.0  # % of the CPUs' time taken by the hypervisor during a run worth a note
 BENCH_SWITCH_INTERVAL = 1e-4  # s: how long the publishing thread may wait for the interpreter lock
 # SCHED_FIFO priority of the publishing thread (as ros2_control's loop); BENCH_PRIORITY=0: normal
 PUBLISHER_PRIORITY = int(os.environ.get("BENCH_PRIORITY", 50))
@@ -167,8 +168,9 @@ class Receiver(threading.Thread):
 @contextlib.contextmanager
 def steady_publisher():
     """This process as a steady source while streaming, as a driver's real-time thread is:
-    late messages leave in a burst that overflows any depth-10 queue, and the loss would be
-    the benchmark's, not the node's. So no garbage-collector pass (one over the stream's
+    after a stall, late messages would leave in a burst that overflows any depth-10 queue,
+    and the loss would be the benchmark's, not the node's (stream_run sends no tick whose
+    successor is due already: a driver's loop that overran sends its current state). So no garbage-collector pass (one over the stream's
     ~100,000 lists and records takes tens of ms); the publishing thread waits at most
     BENCH_SWITCH_INTERVAL for the interpreter lock held by the receiving and
     parameter-changing threads; and it runs on SCHED_FIFO at PUBLISHER_PRIORITY when
@@ -205,12 +207,14 @@ def joint_efforts(positions: list, velocities: list) -> list:
     return rnea_batch(irb140(), Q, np.array(velocities), np.zeros_like(Q)).tolist()
 
 
-def machine_busy() -> tuple[int, int]:
-    """(busy, total) jiffies of all CPUs so far, from /proc/stat."""
+def machine_busy() -> tuple[int, int, int]:
+    """(busy, total, stolen) jiffies of all CPUs so far, from /proc/stat; stolen: the time
+    a virtual machine's CPUs were runnable but the hypervisor ran something else."""
     with open("/proc/stat") as stat:
         values = [int(x) for x in stat.readline().split()[1:]]
     idle = values[3] + values[4]  # idle, iowait
-    return sum(values) - idle, sum(values)
+    steal = values[7] if len(values) > 7 else 0
+    return sum(values) - idle, sum(values), steal
 
 
 def stream_run(node, kind: str, executor: str, rate: float, duration: float, warmup: float,
@@ -253,6 +257,7 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
             efforts = joint_efforts(positions, velocities) if effort else None
             stamps = np.zeros(total, dtype=np.int64)
             lateness = np.zeros(total)
+            skipped = np.zeros(total, dtype=bool)
             msg = JointState(name=NAMES)
             period = 1.0 / rate
             clock, sleep, now_ns = time.perf_counter, time.sleep, time.time_ns
@@ -268,6 +273,9 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
                 remaining = deadline - clock()
                 if remaining > 0:  # no busy-wait: its CPU would be taken from the node under test
                     sleep(remaining)
+                elif -remaining > period:  # the next tick is due too: this state is stale, not sent
+                    skipped[i], lateness[i] = True, -remaining
+                    continue
                 msg.position, msg.velocity = positions[i], velocities[i]
                 if efforts is not None:
                     msg.effort = efforts[i]
@@ -307,8 +315,12 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
         if publisher is not None:
             node.destroy_publisher(publisher)
         process.stop()
-    run = summarize(kind, executor, rate, duration, stamps, first, lateness, receiver.records,
-                    cpu, own, busy0, busy1, sent_s)
+    run = summarize(kind, executor, rate, duration, stamps[~skipped], first - int(skipped[:first].sum()),
+                    lateness[~skipped], receiver.records, cpu, own, busy0, busy1, sent_s)
+    # ticks of the window the source was too late for (a stall of this process): not sent,
+    # as a driver's fixed-rate loop that overran sends its current state, not the missed ones
+    run["stale_ticks_not_sent"] = int(skipped[first:].sum())
+    run["source_late_max_ms"] = float(lateness[first:].max() * 1e3)
     run["qos_event_handlers"] = not lean
     run["parameter_changes"] = changes
     run["publisher_sched_fifo"] = realtime
@@ -400,6 +412,8 @@ def summarize(kind, executor, rate, duration, stamps, first, lateness, records, 
         "node_cpu_percent": cpu / duration * 100,
         "bench_cpu_percent": own / duration * 100,
         "machine_busy_percent": 100 * busy_cores / (os.cpu_count() or 1),
+        # share of the CPUs' time the hypervisor gave to others (steal): stalls nobody here caused
+        "stolen_percent": 100 * (busy1[2] - busy0[2]) / max(1, busy1[1] - busy0[1]),
         # CPU of everything else on the machine, in cores: not ours, not the node's
         "other_processes_cores": busy_cores - (cpu + own) / window_s,
         "achieved_rate_hz": sent / sent_s if sent_s > 0 else None,
@@ -457,7 +471,8 @@ def end_to_end(rates, executors, duration, warmup, env, profile=False, lean=Fals
                 d = run["delay_us"]
                 print(f"    p50 {_opt(d['p50'])} us, p99 {_opt(d['p99'])} us, max {_opt(d['max'])} us, "
                       f"lost {run['lost']} of {run['sent']}, node CPU {run['node_cpu_us_per_msg']:.1f} us/msg, "
-                      f"sent late by up to {run['send_lateness_us']['max'] / 1e3:.1f} ms", flush=True)
+                      f"source late by up to {run['source_late_max_ms']:.1f} ms "
+                      f"({run['stale_ticks_not_sent']} stale ticks not sent)", flush=True)
                 if run["parameter_changes"] is not None:
                     c = run["parameter_changes"]
                     print(f"    changes: {c['accepted']} accepted, {c['refused']} refused, {c['unanswered']} "
@@ -695,6 +710,10 @@ def main(argv=None) -> None:
         worst = max(r["other_processes_cores"] for r in busy)
         print(f"note: other processes used up to {worst:.2f} of {os.cpu_count()} cores during "
               f"{len(busy)} of {len(runs)} runs: the delays and losses are not those of an idle machine")
+    stolen = [r for r in runs if r["stolen_percent"] > STOLEN_WARNING]
+    if stolen:
+        print(f"note: the hypervisor took up to {max(r['stolen_percent'] for r in stolen):.1f} % of the CPUs' time "
+              f"(steal) during {len(stolen)} of {len(runs)} runs: stalls of a shared host, not of these processes")
     if args.profile:
         print("profiled (py-spy): figures perturbed; share of the node's samples, inclusive:")
         for r in runs:
