@@ -214,7 +214,7 @@ def machine_busy() -> tuple[int, int, int]:
         values = [int(x) for x in stat.readline().split()[1:]]
     idle = values[3] + values[4]  # idle, iowait
     steal = values[7] if len(values) > 7 else 0
-    return sum(values) - idle, sum(values), steal
+    return sum(values) - idle - steal, sum(values), steal
 
 
 def stream_run(node, kind: str, executor: str, rate: float, duration: float, warmup: float,
