@@ -132,6 +132,30 @@ class Row:
         return row
 
 
+@dataclass(frozen=True)
+class Value(Figure):
+    """One measured number (best = median = it), printed alone."""
+
+    @classmethod
+    def of(cls, x: float, unit: str) -> "Value":
+        return cls(float(x), float(x), unit)
+
+    def __str__(self) -> str:
+        if self.unit in ("msgs", "calls"):
+            return f"{self.best:.0f} {self.unit}"
+        return f"{_number(self.best)} {self.unit}"
+
+
+@dataclass(frozen=True)
+class NotMeasured(Figure):
+    """A figure that could not be taken, and why."""
+
+    reason: str = ""
+
+    def __str__(self) -> str:
+        return f"not measured: {self.reason}"
+
+
 def _divide(a: float | None, b: float | None) -> float | None:
     return None if a is None or b is None or b == 0 else a / b
 
