@@ -175,6 +175,19 @@ def test_bad_message_is_dropped_and_counted(node, msg, kind):
     np.testing.assert_allclose(g.effort, [0, 243.382, 79.1556, 0, 2.43004, 0], atol=1e-3)
 
 
+def test_undecodable_bytes_on_joint_states_are_dropped_as_malformed(node):
+    """A publisher may send any bytes under the JointState type (rclpy's publish(bytes)):
+    id_node reads them itself (ros.joint_state_cdr), drops them, and goes on."""
+    garbage = [b"", b"\x00\x01\x00\x00", b"\x00\x01\x00\x00" + b"\xff" * 40,  # a count of 4e9 names
+               b"\x00\x00\x00\x00" + b"\x07" * 30, b"\x13\x37" * 50]  # big-endian (rclpy's reader), unknown
+    for raw in garbage:
+        send(node, raw, expect=0)
+    assert node.node.counts["joint_states.dropped_malformed"] == len(garbage)
+    assert not any(key.endswith(".errors") for key in node.node.counts), dict(node.node.counts)
+    _, g = send(node, joint_state(STRETCHED))  # still alive and right
+    np.testing.assert_allclose(g.effort, [0, 243.382, 79.1556, 0, 2.43004, 0], atol=1e-3)
+
+
 @pytest.mark.parametrize("reliability", [ReliabilityPolicy.RELIABLE, ReliabilityPolicy.BEST_EFFORT])
 def test_reliable_and_best_effort_publishers_are_both_heard(node, reliability):
     pub = node.publisher(JointState, "joint_states", QoSProfile(depth=10, reliability=reliability))
