@@ -72,6 +72,36 @@ def test_cut_or_damaged_bytes_are_refused_as_malformed():
     assert refused > 200
 
 
+def little_endian(frame_id: bytes, names: list[bytes]) -> bytes:
+    """A JointState's bytes with the strings given raw (length, then the bytes as they are)."""
+    out = bytearray(b"\x00\x01\x00\x00" + struct.pack("<iI", 3, 4))
+
+    def count(value):
+        out.extend(bytes(-(len(out) - 4) % 4) + struct.pack("<I", value))
+
+    def string(data):
+        count(len(data))
+        out.extend(data)
+
+    string(frame_id)
+    count(len(names))
+    for name in names:
+        string(name)
+    for _ in range(3):  # position, velocity, effort: empty
+        count(0)
+    return bytes(out)
+
+
+@pytest.mark.parametrize("frame_id, names", [
+    (b"b\x00se\x00", [b"joint_1\x00"]),  # an embedded NUL: the string ends there
+    (b"base\x00", [b"\xff\xfe\x00", b"j\xc3\x00"]),  # not UTF-8: replaced, as rclpy does
+    (b"", [b"", b"joint_1\x00"]),  # length 0: an empty string
+    (b"base", [b"joint_1"]),  # no terminating NUL
+])
+def test_odd_strings_read_as_rclpy_reads_them(frame_id, names):
+    assert_read_as_rclpy(little_endian(frame_id, names))
+
+
 def test_big_endian_goes_to_rclpy():
     """A big-endian message (encapsulation 0x0000), written here by hand: read by rclpy's reader."""
     body = struct.pack(">iI", 7, 9) + struct.pack(">I", 1) + b"\0" + b"\0" * 3  # stamp, frame_id "", pad

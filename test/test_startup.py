@@ -1,5 +1,6 @@
 """Starting id_node: the default model, and one clear line for a bad model."""
 
+import sys
 import textwrap
 
 import pytest
@@ -25,6 +26,47 @@ def test_ctrl_c_inside_a_callback_stops_cleanly():
     assert code == 0, output
     assert "FATAL" not in output and "Traceback" not in output, output
     assert "exit after" in output, output
+
+
+CTRL_C_AS_A_FLAG = """
+import os, signal, time
+import rclpy
+from irb140_dynamics.ros.spin import ctrl_c_as_a_flag
+rclpy.init()
+with ctrl_c_as_a_flag() as interrupted:
+    os.kill(os.getpid(), signal.SIGINT)
+    time.sleep(0.1)
+    print("flag", bool(interrupted), "ok", rclpy.ok())
+    try:
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(1.0)
+        print("second Ctrl-C ignored")
+    except KeyboardInterrupt:
+        print("second Ctrl-C raises")
+    os.kill(os.getpid(), signal.SIGTERM)
+    time.sleep(0.2)
+    print("SIGTERM ok", rclpy.ok())
+context = rclpy.Context()
+rclpy.init(context=context)
+try:
+    os.kill(os.getpid(), signal.SIGINT)
+    time.sleep(1.0)
+except KeyboardInterrupt:
+    pass
+time.sleep(0.2)
+print("after ok", context.ok())
+"""
+
+
+def test_ctrl_c_as_a_flag_sets_rclpy_handlers_aside_and_back():
+    """Inside: Ctrl-C only sets the flag, a second raises, SIGTERM still shuts rclpy down;
+    after: rclpy's Ctrl-C handling is back (the context shuts down)."""
+    code, output = run_to_exit([sys.executable, "-c", CTRL_C_AS_A_FLAG], timeout=30.0)
+    assert code == 0, output
+    assert "flag True ok True" in output, output
+    assert "second Ctrl-C raises" in output, output
+    assert "SIGTERM ok False" in output, output
+    assert "after ok False" in output, output
 
 
 def bad_file(tmp_path, text):

@@ -6,6 +6,7 @@ import gc
 import re
 import signal
 import sys
+import threading
 from contextlib import contextmanager
 from typing import Callable, Iterator
 
@@ -14,6 +15,12 @@ import rclpy.logging
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
+from rclpy.signals import (
+    SignalHandlerOptions,
+    get_current_signal_handlers_options,
+    install_signal_handlers,
+    uninstall_signal_handlers,
+)
 from rclpy.utilities import remove_ros_args
 
 EXECUTORS = ("events", "single_threaded")
@@ -119,24 +126,37 @@ WAKE_PERIOD = 0.1  # s: the longest spin_once waits, so the longest a Ctrl-C wai
 
 @contextmanager
 def ctrl_c_as_a_flag() -> Iterator[list]:
-    """Ctrl-C (SIGINT) appends to the list yielded instead of raising KeyboardInterrupt.
+    """Ctrl-C (SIGINT) appends to the list yielded instead of raising KeyboardInterrupt; a
+    second Ctrl-C raises it (a callback that hangs can still be cut).
 
     Python raises KeyboardInterrupt at the next line of Python that runs, which under the
     EventsExecutor may be inside rclpy's C++: building a message (its __init__ is Python)
     then fails as "RuntimeError: Unable to convert call argument '0' to Python object", or
     a callback is cut half-way and logged FATAL. The flag is read between spin_once calls
-    instead. Outside the main thread (no signals there) the list stays empty.
+    instead. rclpy's own handlers are set aside meanwhile (SIGTERM keeps rclpy's: it shuts
+    the context down) and put back after. Outside the main thread the list stays empty.
     """
     interrupted: list = []
-    try:
-        previous = signal.signal(signal.SIGINT, lambda *_: interrupted.append(True))
-    except ValueError:  # not the main thread
+    if threading.current_thread() is not threading.main_thread():
         yield interrupted
         return
+
+    def on_sigint(*_) -> None:
+        if interrupted:
+            raise KeyboardInterrupt
+        interrupted.append(True)
+
+    options = get_current_signal_handlers_options()
+    uninstall_signal_handlers()  # rclpy chains to the handler before it: unchain it first
+    previous = signal.signal(signal.SIGINT, on_sigint)
+    if options in (SignalHandlerOptions.SIGTERM, SignalHandlerOptions.ALL):
+        install_signal_handlers(SignalHandlerOptions.SIGTERM)
     try:
         yield interrupted
     finally:
+        uninstall_signal_handlers()
         signal.signal(signal.SIGINT, previous)
+        install_signal_handlers(options)
 
 
 def _one_line(error: Exception) -> str:
