@@ -41,7 +41,6 @@ import subprocess
 import sys
 import threading
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -52,7 +51,6 @@ from common import (  # first: puts the checkout on sys.path
     Figure,
     NotMeasured,
     Row,
-    Value,
     machine_info,
     print_table,
     seconds_per_call,

@@ -30,9 +30,9 @@ import time
 
 import numpy as np
 
-from bench_nodes import (OTHERS_WARNING, NodeProcess, Receiver, Value, isolated_domain, machine_busy,
-                         percentiles, wait_for)
-from common import REPO, Row, Target, machine_info, print_table, write_results
+from bench_nodes import (OTHERS_WARNING, NodeProcess, Receiver, isolated_domain, machine_busy, percentiles,
+                         wait_for)
+from common import REPO, Row, Target, Value, machine_info, print_table, write_results
 
 POSE = "[0.0, -0.5, 0.5, 0.0, 0.5, 0.0]"  # rad, initial_positions
 RATE = 1000.0  # Hz

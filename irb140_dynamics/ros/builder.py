@@ -4,9 +4,10 @@ A node's executor thread serves its messages; building a new configuration (comp
 kernels, sweeping the workspace) there would stall them. ``Builder.submit`` hands the
 work to a worker thread, started when there is work and ended when there is none (a
 thread that lingered for the next job kept the last result, and what it holds, alive past
-its node); the result comes back to the executor thread through a timer polling every POLL_PERIOD while a build is under way (the
-EventsExecutor takes no guard conditions; the timer is made once and cancelled in
-between: rcl leaks ~80 B per timer made), whose callback hands it to ``deliver``. The
+its node); the result comes back to the executor thread through a timer polling every
+POLL_PERIOD while a build is under way (the EventsExecutor takes no guard conditions; the
+timer is made once and cancelled in between: rcl leaks ~80 B per timer made), whose
+callback hands it to ``deliver``. The
 timer runs on the steady clock, so that a node on simulated time (use_sim_time) takes its
 parameter changes while the simulation stands still too. Only the newest job waiting is
 kept: jobs submitted while one is being built collapse into the latest, and every job

@@ -18,8 +18,8 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Bool
 
 from ..core.observer import MomentumObserver
-from .listened import ListenedPublisher
 from .joint_state_cdr import EffortMessage
+from .listened import ListenedPublisher
 from .messages import publish_efforts
 from .params import Spec
 
