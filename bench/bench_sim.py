@@ -30,15 +30,16 @@ import time
 
 import numpy as np
 
-from bench_nodes import (OTHERS_WARNING, NodeProcess, Receiver, isolated_domain, machine_busy, percentiles,
-                         wait_for)
-from common import REPO, Row, Target, Value, machine_info, print_table, write_results
+from common import REPO, Row, Target, Value, machine_info, print_table, write_results  # first: the checkout on sys.path
+from machine_load import OTHERS_WARNING, load_between, snapshot
+from node_processes import STARTUP_TIMEOUT, NodeProcess, isolated_domain, wait_for
+from receiver import Receiver
+from stream_stats import percentiles
 
 POSE = "[0.0, -0.5, 0.5, 0.0, 0.5, 0.0]"  # rad, initial_positions
 RATE = 1000.0  # Hz
 DURATION = 10.0  # s measured
 WARMUP = 2.0  # s after the loop is closed
-STARTUP_TIMEOUT = 30.0  # s
 LATE_TARGET = Target(0.1, absolute=True)  # % of steps
 SKIPPED_TARGET = Target(0, absolute=True)
 QOS_DEPTH = 1000  # this process's joint_states subscription
@@ -53,13 +54,11 @@ def counts_of(msg, hardware_id: str) -> dict | None:
 
 def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, index: int, priority: int = 0) -> dict:
     """Start sim_node (and id_node when ``loop``), measure a window, return the raw figures."""
-    import rclpy
     from diagnostic_msgs.msg import DiagnosticArray
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.node import Node
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import JointState
-    from std_msgs.msg import Float64MultiArray
 
     namespace = f"/bench_sim_{os.getpid()}_{index}"
     ros_args = ["--ros-args", "-r", f"__ns:={namespace}"]
@@ -98,14 +97,14 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
                  5.0, sim, "sim_node's /diagnostics")
         start_at, start_msg = next((t, m) for t, m in diagnostics[first:] if counts_of(m, hardware_id))
         cpu0 = sim.cpu_seconds(), controller.cpu_seconds() if controller else 0.0
-        own0, busy0 = time.process_time(), machine_busy()
+        load0 = snapshot()
         spin(duration - 0.5)
         later = len(diagnostics)
         wait_for(lambda: spin(0.05) or any(counts_of(m, hardware_id) for _, m in diagnostics[later:]),
                  5.0, sim, "sim_node's /diagnostics")
         end_at, end_msg = next((t, m) for t, m in diagnostics[later:] if counts_of(m, hardware_id))
         cpu1 = sim.cpu_seconds(), controller.cpu_seconds() if controller else 0.0
-        own, busy1 = time.process_time() - own0, machine_busy()
+        load1 = snapshot()
         for process in (sim, controller):
             if process is not None and not process.alive():
                 raise process.fail("died during the run")
@@ -124,9 +123,8 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
     records = np.array(receiver.records, dtype=np.int64).reshape(-1, 5)
     inside = records[(records[:, 0] >= window[0]) & (records[:, 0] < window[1])]
     seconds = end_at - start_at
-    ticks = os.sysconf("SC_CLK_TCK")
-    busy_cores = (busy1[0] - busy0[0]) / ticks / seconds
-    ours = (cpu1[0] - cpu0[0] + cpu1[1] - cpu0[1] + own) / seconds
+    ours = {os.getpid(), *(p.process.pid for p in (sim, controller) if p is not None)}
+    load = load_between(load0, load1, ours)
     return {
         "loop": "beside id_node" if loop else "alone",
         "rate_hz": rate,
@@ -142,8 +140,9 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
         "sim_cpu_us_per_step": (cpu1[0] - cpu0[0]) / max(steps, 1) * 1e6,
         "sim_cpu_percent": (cpu1[0] - cpu0[0]) / seconds * 100,
         "id_node_cpu_percent": (cpu1[1] - cpu0[1]) / seconds * 100 if loop else None,
-        # CPU of everything else on the machine, in cores: not the nodes', not this process's
-        "other_processes_cores": busy_cores - ours,
+        # CPU of everything else on the machine, in cores (not the nodes', not this process's), and steal
+        "other_processes_cores": load["other_processes_cores"],
+        "stolen_percent": load["stolen_percent"],
     }
 
 

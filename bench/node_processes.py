@@ -17,6 +17,7 @@ from typing import Callable
 
 from common import REPO
 
+STARTUP_TIMEOUT = 30.0  # s, for a node process to start and match
 QOS_DEPTH = 10  # id_node's qos.depth default; joint_states best effort as its qos.reliability default
 
 
@@ -111,7 +112,6 @@ def wait_for(condition: Callable[[], bool], timeout: float, process: NodeProcess
         if not process.alive() or time.monotonic() > deadline:
             raise process.fail(f"{what}: not within {timeout:g} s")
         time.sleep(0.02)
-
 
 
 def rss_kb(pid: int, field: str = "VmRSS") -> int:

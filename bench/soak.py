@@ -28,7 +28,7 @@ import time
 
 import numpy as np
 
-from node_processes import QOS_DEPTH, NodeProcess, node_command, rss_kb, wait_for
+from node_processes import QOS_DEPTH, STARTUP_TIMEOUT, NodeProcess, node_command, rss_kb, wait_for
 from parameter_changes import ParameterChanger
 
 NAMES = [f"joint_{i}" for i in range(1, 7)]
@@ -36,7 +36,6 @@ KINDS = ("id_node", "id_node_quiet", "relay")  # id_node_quiet: id_node with --d
 WARMUP = 30.0  # s streamed before the first RSS sample that counts
 SAMPLE_PERIOD = 10.0  # s
 CHANGE_PERIOD = 5.0  # s, as in the soak
-STARTUP_TIMEOUT = 30.0  # s
 TOLERANCE = 5.0  # kB/min: slopes closer than this are the same (page-granular noise)
 
 
