@@ -140,7 +140,8 @@ class IdNode(Node):
             if isinstance(msg, bytes):
                 msg = read_joint_state_cdr(msg)
             q, qd = read_joint_state(msg, self._order)
-            tau, g, command, reference, terms = self._torques(msg, q, qd, settings)
+            t = self._time_of(msg)
+            tau, g, command, reference, terms = self._torques(msg, t, q, qd, settings)
         except NotForThisModel:
             self.counts["joint_states.ignored"] += 1
             return
@@ -156,7 +157,7 @@ class IdNode(Node):
         self.counts["torques.published"] += 1
         if reference is not None and self._tracking_pub.subscribers:
             self._publish_tracking_error(stamp, q, qd, reference)
-        self._observe(msg, q, qd, g, terms)
+        self._observe(msg, t, q, qd, g, terms)
 
     def _publish_tracking_error(self, stamp, q, qd, reference) -> None:
         q_ref, qd_ref, _ = reference
@@ -166,12 +167,12 @@ class IdNode(Node):
         msg.velocity = (np.asarray(qd_ref) - qd).tolist()
         self._tracking_pub.publish(msg)
 
-    def _torques(self, msg, q, qd, settings: Settings):
+    def _torques(self, msg, t: float, q, qd, settings: Settings):
         """(feed-forward, gravity, command torques or None, the reference in force or None,
         the observer's terms or None), the torques all finite, or BadMessage. With efforts
         and no reference, one pass gives the torques and the observer's terms."""
         model = settings.model
-        estimate = self._estimated_acceleration(msg, qd, settings)
+        estimate = self._estimated_acceleration(t, qd, settings)
         tracker = self.tracker
         reference = tracker.sample(self.get_clock().now().nanoseconds * 1e-9, settings.reference_timeout) \
             if tracker.trajectory is not None else None  # no clock read without one
@@ -199,7 +200,7 @@ class IdNode(Node):
             raise
         return tau, g, command, reference, terms
 
-    def _observe(self, msg, q, qd, g, terms) -> None:
+    def _observe(self, msg, t: float, q, qd, g, terms) -> None:
         """Efforts in the message: run the momentum observer (external torques, collision)."""
         try:
             effort = read_effort(msg, self._order)
@@ -211,15 +212,15 @@ class IdNode(Node):
         if effort is None:
             return
         try:
-            self.collision.update(self._time_of(msg), q, qd, effort, g, msg.header.stamp, terms)
+            self.collision.update(t, q, qd, effort, g, msg.header.stamp, terms)
         except ValueError as error:
             self.counts["collision.observer_reset"] += 1
             self.tally.warn("collision", f"observer reset ({error})")
 
-    def _estimated_acceleration(self, msg, qd, settings: Settings):
+    def _estimated_acceleration(self, t: float, qd, settings: Settings):
         if settings.acceleration_mode == "zero":
             return self._zeros
-        qdd = self._differentiator.update(self._time_of(msg), qd)
+        qdd = self._differentiator.update(t, qd)
         if not all(map(math.isfinite, qdd)):  # an absurd velocity jump overflowed the difference
             self._differentiator.reset()
             raise BadMessage("not_finite_acceleration", f"the differentiated velocities give {qdd}")
