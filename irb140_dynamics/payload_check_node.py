@@ -208,11 +208,6 @@ class PayloadCheckNode(Node):
         if problem is not None:
             self.tally.drop("joint_states", problem)
             return
-        try:  # a state whose torques the core refuses as not finite could not be checked
-            rnea(self.settings.model, q, qd, [0.0] * len(q))
-        except ValueError as error:
-            count_and_warn(self.get_logger(), self.counts, "joint_states", BadMessage("non_finite_torques", str(error)))
-            return
         now = self.get_clock().now()
         self._state = (q, qd, now)
         try:

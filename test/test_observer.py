@@ -87,6 +87,19 @@ def test_step_external_torque_is_a_first_order_lag():
     assert step_at < crossed <= step_at + 0.010 + 1e-9
 
 
+@pytest.mark.parametrize("gain", [1500.0, 2500.0, 1e4])  # K dt 1.5 to 10 at 1 kHz: the explicit step rang or diverged
+def test_a_gain_beyond_the_sampling_rate_neither_rings_nor_diverges(gain):
+    model = arm_with_friction()
+    ext = np.array([0.0, 20.0, 0.0, 0.0, 0.0, 0.0])
+    observer = MomentumObserver(model, gain)
+    times, r = run(model, 0.2, lambda t: ext if t >= 0.1 else np.zeros(6), observer)
+    before, after = r[times < 0.1], r[times >= 0.1]
+    assert np.abs(before).max() < 0.2
+    assert after[:, 1].max() <= 20.0 * 1.01  # no overshoot
+    assert np.all(np.diff(after[:, 1]) > -0.05)  # a rise, no ringing
+    assert abs(after[-1, 1] - 20.0) < 0.2
+
+
 def test_unmodelled_payload_shows_as_its_gravity_torque():
     model = irb140()
     true = model.with_payload(RigidBody(2.0, (0.0, 0.0, 0.05)))

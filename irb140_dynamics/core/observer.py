@@ -158,9 +158,14 @@ class MomentumObserver:
             self._t, self._p0, self._integral, self._drive = t, p, [0.0] * n, drive
             return self._r
         dt, K = t - self._t, self.gain
-        integral = [i + 0.5 * (d + d0) * dt + r * dt  # Python floats: an overflow is inf, checked below
-                    for i, d, d0, r in zip(self._integral, drive, self._drive, self._r)]
-        r = [K * (x - x0 - i) for x, x0, i in zip(p, self._p0, integral)]
+        # the drive by the trapezoid rule, r implicitly (backward Euler: r_k in the step to
+        # t_k): r_k = K (p_k - p_0 - I_k), I_k = I_{k-1} + dt (drive) + dt r_k, so r_k is
+        # K (p_k - p_0 - I_{k-1} - dt drive) / (1 + K dt), stable for any K dt (the
+        # explicit step, with r_{k-1}, diverges beyond K dt = 2: K 2000 1/s at 1 kHz)
+        partial_sum = [i + 0.5 * (d + d0) * dt  # Python floats: an overflow is inf, checked below
+                       for i, d, d0 in zip(self._integral, drive, self._drive)]
+        r = [K * (x - x0 - i) / (1.0 + K * dt) for x, x0, i in zip(p, self._p0, partial_sum)]
+        integral = [i + ri * dt for i, ri in zip(partial_sum, r)]
         if not math.isfinite(sum(r)) and not all(map(math.isfinite, r)):
             self.reset()
             raise ValueError(f"observer residual not finite: {r}")

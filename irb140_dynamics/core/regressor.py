@@ -26,7 +26,6 @@ from .algorithms import (
     forward_motion,
     inertia_times,
     rotate,
-    scale,
     turns,
 )
 from .states import state, states

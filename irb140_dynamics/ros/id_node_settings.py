@@ -73,7 +73,8 @@ def finish_settings(settings: Settings, previous: Settings | None) -> Settings:
     unless they exist already: a payload or gravity change shares the arm's code)."""
     if previous is not None and previous.model == settings.model:
         return replace(settings, model=previous.model)
-    _compiled = [getattr(settings.model.kernels, name) for name in KERNELS]
+    for name in KERNELS:
+        getattr(settings.model.kernels, name)  # compiles it
     return settings
 
 

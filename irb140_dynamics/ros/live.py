@@ -7,7 +7,7 @@ given value into one line naming the parameter.
 from __future__ import annotations
 
 import time
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.exceptions import (
@@ -21,6 +21,9 @@ from rclpy.parameter import Parameter
 from .builder import Builder, Failed
 from .overrides import warn_unknown_overrides
 from .parameter_services import guard_parameter_services
+
+if TYPE_CHECKING:
+    from .params import Spec
 
 
 class LiveParameters:
