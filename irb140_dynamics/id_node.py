@@ -52,7 +52,7 @@ from .ros.messages import (
     read_joint_state,
     read_trajectory,
 )
-from .ros.collision import CollisionMonitor
+from .ros.collision import RESTARTS, CollisionMonitor
 from .ros.id_node_settings import (  # noqa: F401 (finish_settings, compiled: looked up here, tests patch them)
     NODE_PARAMETERS,
     PER_JOINT_PARAMETERS,
@@ -201,7 +201,8 @@ class IdNode(Node):
         return tau, g, command, reference, terms
 
     def _observe(self, msg, t: float, q, qd, g, terms) -> None:
-        """Efforts in the message: run the momentum observer (external torques, collision)."""
+        """Efforts in the message: run the momentum observer (external torques, collision),
+        counting its restarts (collision.restart_gap, _repeated_stamp, _older_stamp)."""
         try:
             effort = read_effort(msg, self._order)
         except BadMessage as error:
@@ -212,10 +213,14 @@ class IdNode(Node):
         if effort is None:
             return
         try:
-            self.collision.update(t, q, qd, effort, g, msg.header.stamp, terms)
+            restarted = self.collision.update(t, q, qd, effort, g, msg.header.stamp, terms)
         except ValueError as error:
             self.counts["collision.observer_reset"] += 1
             self.tally.warn("collision", f"observer reset ({error})")
+            return
+        if restarted is not None:
+            self.counts[f"collision.restart_{restarted}"] += 1
+            self.tally.warn("collision", f"observer restarted at r = 0 ({RESTARTS[restarted]})")
 
     def _estimated_acceleration(self, t: float, qd, settings: Settings):
         if settings.acceleration_mode == "zero":

@@ -117,11 +117,16 @@ def test_gaps_and_backward_stamps_reset_the_observer():
     g = gravity(model, q)
     for k in range(50):
         observer.update(k / RATE, q, np.zeros(6), g - 5.0)
-    assert np.all(np.abs(observer.r) > 1.0)
-    for t in (0.049, 0.049, 1.0):  # repeated, backwards, after a gap
+    assert np.all(np.abs(observer.r) > 1.0) and observer.restarted is None
+    for t, kind in ((0.049, "repeated_stamp"), (0.049, "older_stamp"), (1.0, "gap")):
         assert np.all(observer.update(t, q, np.zeros(6), g - 5.0) == 0.0)
+        assert observer.restarted == kind
         observer.update(t + 0.001, q, np.zeros(6), g - 5.0)
+        assert observer.restarted is None
         observer._r = [1.0] * 6  # pretend it had run on
+    observer.reset()
+    observer.update(2.0, q, np.zeros(6), g)
+    assert observer.restarted is None  # the first sample after a reset: a start, no restart
 
 
 def test_bad_values_are_refused():

@@ -14,7 +14,7 @@ energy T = 1/2 qd^T M qd; ``momentum_terms`` gives it and p in two passes like R
 (``energy_gradient``, T on dual numbers, is the definition it is tested against).
 
 Units: N m, s, 1/s. Samples come with their time; a gap longer than ``max_gap``, a repeated
-or an older time resets the observer (the next sample starts it again at r = 0).
+or an older time restarts the observer at that sample (r = 0; ``restarted`` says why).
 """
 
 from __future__ import annotations
@@ -115,6 +115,11 @@ def _beta(c, g, friction) -> list:
     return beta if friction is None else [b - f for b, f in zip(beta, friction)]
 
 
+def _restart_kind(dt: float) -> str:
+    """Why a time step dt [s] restarts the observer."""
+    return "repeated_stamp" if dt == 0.0 else "older_stamp" if dt < 0.0 else "gap"
+
+
 class MomentumObserver:
     """The residual r ~ tau_ext [N m], updated sample by sample."""
 
@@ -128,6 +133,7 @@ class MomentumObserver:
         """Forget the past: the next sample starts the observer again."""
         self._r = [0.0] * self.model.n
         self._t = None
+        self.restarted: str | None = None  # why the last sample restarted the observer (see advance)
 
     @property
     def r(self) -> np.ndarray:
@@ -145,7 +151,9 @@ class MomentumObserver:
     def advance(self, t: float, q, qd, tau, g=None, terms=None) -> list[float]:
         """``update``, the residual as a list. Plain Python arithmetic on n floats: a few
         microseconds besides the kernel, where small NumPy arrays would cost tens.
-        ``terms``: (p, beta) of monitor_terms at (q, qd), if the caller has them already."""
+        ``terms``: (p, beta) of monitor_terms at (q, qd), if the caller has them already.
+        ``restarted`` is then "gap", "repeated_stamp" or "older_stamp" if the sample's time
+        restarted the observer (r = 0), None if not or if it is the first since a reset."""
         n = self.model.n
         tau = state(tau, n, "tau")
         if terms is None:
@@ -154,6 +162,7 @@ class MomentumObserver:
             p, beta = terms
         drive = [x + y for x, y in zip(tau, beta)]
         if self._t is None or not 0.0 < t - self._t <= self.max_gap:
+            self.restarted = None if self._t is None else _restart_kind(t - self._t)
             self._r = [0.0] * n
             self._t, self._p0, self._integral, self._drive = t, p, [0.0] * n, drive
             return self._r
@@ -170,6 +179,7 @@ class MomentumObserver:
             self.reset()
             raise ValueError(f"observer residual not finite: {r}")
         self._t, self._integral, self._drive, self._r = t, integral, drive, r
+        self.restarted = None
         return r
 
     def _momentum_terms(self, q, qd, g=None) -> tuple[list, list]:

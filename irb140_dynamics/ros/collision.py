@@ -2,8 +2,11 @@
 
 Publishes    external_torques   sensor_msgs/JointState, effort = the observer's residual r
                                 [N m], model joint order, stamped like the input
-             collision          std_msgs/Bool, reliable, transient local: true while any
-                                |r_j| exceeds joint j's collision_threshold (0 = off)
+             collision          std_msgs/Bool, reliable, transient local, depth 1: true while
+                                any |r_j| exceeds joint j's collision_threshold (0 = off)
+
+The diagnostics status reports any collision since the last report (the peak |r_j| of each
+joint over its threshold), so that one shorter than the 1 s period still shows as ERROR.
 """
 
 from __future__ import annotations
@@ -25,6 +28,11 @@ from .params import Spec
 
 MAX_GAIN = 1e4  # 1/s: beyond any sampling rate a joint state stream has
 OBSERVER_GAP = 0.1  # s: a longer gap between stamps restarts the observer
+RESTARTS = {  # MomentumObserver.restarted: what restarted it
+    "gap": f"a gap of more than {OBSERVER_GAP:g} s between joint_states stamps",
+    "repeated_stamp": "a repeated joint_states stamp",
+    "older_stamp": "a joint_states stamp older than the one before",
+}
 
 COLLISION_PARAMETERS = [
     Spec("collision.observer_gain", 100.0,
@@ -67,7 +75,8 @@ class CollisionMonitor:
         self._external_pub = ListenedPublisher(node, JointState, "external_torques", depth)
         latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self._collision_pub = node.create_publisher(Bool, "collision", latched)
-        self.colliding: list[str] = []  # names of the joints over their thresholds
+        self.colliding: list[int] = []  # indices of the joints over their thresholds
+        self._peaks = [0.0] * len(self._names)  # N m: the largest |r_j| over threshold since the last report
         self._residual = None
         self._publish_flag(False)
 
@@ -77,41 +86,61 @@ class CollisionMonitor:
             self._names = list(model.joint_names)
             self._external_msg = EffortMessage(self._names)
             self._residual = None
+            self._peaks = [0.0] * len(self._names)  # (the flag: at the next sample, as after any restart)
         self._observer = MomentumObserver(model, settings.gain, OBSERVER_GAP)
         self._thresholds = settings.thresholds.tolist()
+        self._joints = range(len(self._names))
 
     def reset(self) -> None:
         self._observer.reset()
 
-    def update(self, t: float, q, qd, effort, g, stamp, terms=None) -> None:
+    def update(self, t: float, q, qd, effort, g, stamp, terms=None) -> str | None:
         """One joint state with efforts: publish the residual, and the flag when it changes
-        (``terms``: see MomentumObserver.advance). ValueError (observer reset) if the
-        residual is not finite."""
-        r = self._observer.advance(t, q, qd, effort, g, terms)
+        (``terms``: see MomentumObserver.advance). What restarted the observer at this
+        sample (a key of RESTARTS), or None. ValueError (observer reset) if the residual
+        is not finite."""
+        observer = self._observer
+        r = observer.advance(t, q, qd, effort, g, terms)
         self._residual = r
         publish_efforts(self._external_pub, self._external_msg, stamp, r)
-        colliding = [name for name, x, limit in zip(self._names, r, self._thresholds) if 0.0 < limit < abs(x)]
+        colliding = [j for j, x, limit in zip(self._joints, r, self._thresholds) if 0.0 < limit < abs(x)]
+        if colliding:
+            peaks = self._peaks
+            for j in colliding:
+                if abs(r[j]) > peaks[j]:
+                    peaks[j] = abs(r[j])
         if bool(colliding) != bool(self.colliding):
             self._publish_flag(bool(colliding))
         self.colliding = colliding
+        return observer.restarted
 
     def _publish_flag(self, value: bool) -> None:
         self._collision_pub.publish(Bool(data=value))
 
     def status(self, node_name: str, hardware_id: str) -> DiagnosticStatus:
-        """ERROR naming the joints and torques while colliding; OK otherwise."""
+        """ERROR while colliding or after a collision since the last report (naming the
+        joints and torques: now, or the peak |r_j| since); OK otherwise. Starts a new period."""
         status = DiagnosticStatus(name=f"{node_name}: collision", hardware_id=hardware_id)
-        r = self._residual
+        names, r, peaks = self._names, self._residual, self._peaks
+        self._peaks = [0.0] * len(names)
         if r is None:
             status.level, status.message = DiagnosticStatus.OK, "no efforts received: observer idle"
             return status
-        torques = {name: r[self._names.index(name)] for name in self.colliding}
-        if torques:
+        earlier = [j for j, peak in enumerate(peaks) if peak > 0.0 and j not in self.colliding]
+        since = ", ".join(f"{names[j]} {peaks[j]:.2f} N m" for j in earlier)
+        if self.colliding:
             status.level = DiagnosticStatus.ERROR
-            status.message = "collision: " + ", ".join(f"{name} {tau:.2f} N m" for name, tau in torques.items())
+            status.message = "collision: " + ", ".join(f"{names[j]} {r[j]:.2f} N m" for j in self.colliding)
+            if earlier:
+                status.message += f"; since last report: {since}"
+        elif earlier:
+            status.level, status.message = DiagnosticStatus.ERROR, f"collision since last report: {since}"
         else:
             status.level, status.message = DiagnosticStatus.OK, "no collision"
         status.values = [
-            KeyValue(key=f"{name} external torque [N m]", value=f"{value:.3f}") for name, value in zip(self._names, r)
+            KeyValue(key=f"{name} external torque [N m]", value=f"{value:.3f}") for name, value in zip(names, r)
+        ] + [
+            KeyValue(key=f"{names[j]} peak |external torque| since last report [N m]", value=f"{peak:.3f}")
+            for j, peak in enumerate(peaks) if peak > 0.0
         ]
         return status
