@@ -18,8 +18,9 @@ The payload's inertia does not show at rest: it is not estimated.
 
 Refusals (EstimationError, saying what to do): fewer than MIN_POSES poses; poses too
 similar to determine phi (condition number above MAX_CONDITION: the message says which
-part is undetermined and which wrist motion would help); a sample without efforts; an
-implausible result (mass < 0, or the CoM more than MAX_COM_DISTANCE from the flange).
+line of the CoM is undetermined and which wrist motion would help); an implausible result
+(mass <= 0, or the CoM more than MAX_COM_DISTANCE from the flange). A rest without efforts
+is no sample: RestDetector counts its pose in ``without_effort``.
 """
 
 from __future__ import annotations
