@@ -166,7 +166,7 @@ class PayloadCheckNode(Node):
         if problem is not None:  # a held state the new model gives no finite torques for
             self.tally.drop("joint_states", problem)
             self._state = None
-        self.estimator.use(settings.rest_velocity, settings.rest_time)
+        self.estimator.use(settings.rest_velocity, settings.rest_time, settings.model.friction)
         if first and self._started:  # the model came after startup
             self._log_ready()
 

@@ -6,18 +6,21 @@ part is linear in phi = [m, m c_x, m c_y, m c_z] (c in the flange frame):
     effort - g_arm(q) = Y(q) phi,   Y = [-J_v^T g,  -J_w^T (R e_k x g) for k = x, y, z]
 
 with J_v, J_w the flange Jacobian's rows, R the flange orientation and g the gravity
-vector, all in the base frame (g_arm: the model's own gravity torques, payload removed;
-friction is zero at rest). Weighted least squares over the rest poses (each torque weighted
-by the inverse standard error of its average, when the rest had several joint states)
-gives phi, its standard deviations from the residual, and the condition number of the
-(column-scaled) weighted Y.
+vector, all in the base frame (g_arm: the model's own gravity torques, payload removed).
+"At rest" is slower than a rest velocity, where the model's tanh-smoothed Coulomb friction
+is far from zero: RestDetector takes the model's friction at each joint state's measured
+velocity off its efforts (nothing at qd = 0). Weighted least squares over the rest poses
+(each torque weighted by the inverse of its average's standard error, when the rest had
+several joint states) gives phi, its standard deviations from the residual, and the
+condition number of the (column-scaled) weighted Y.
 
 The payload's inertia does not show at rest: it is not estimated.
 
 Refusals (EstimationError, saying what to do): fewer than MIN_POSES poses; poses too
 similar to determine phi (condition number above MAX_CONDITION: the message says which
-part is undetermined and which wrist motion would help); a sample without efforts; an
-implausible result (mass < 0, or the CoM more than MAX_COM_DISTANCE from the flange).
+line of the CoM is undetermined and which wrist motion would help); an implausible result
+(mass <= 0, or the CoM more than MAX_COM_DISTANCE from the flange). A rest without efforts
+is no sample: RestDetector counts its pose in ``without_effort``.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .dynamics import gravity
+from .friction import JointFriction
 from .kinematics import flange_jacobian, flange_pose
 from .model import RobotModel
 from .rigid_body import RigidBody
@@ -35,7 +39,6 @@ from .rigid_body import RigidBody
 MIN_POSES = 3  # 4 unknowns; each pose sees the payload through 2-3 independent torques
 MAX_CONDITION = 1e3  # of Y with columns scaled to unit norm
 MAX_COM_DISTANCE = 0.5  # m from the flange origin: beyond it the estimate is refused
-UNKNOWNS = ("mass", "CoM x", "CoM y", "CoM z")
 
 
 class EstimationError(ValueError):
@@ -44,7 +47,8 @@ class EstimationError(ValueError):
 
 @dataclass(frozen=True)
 class RestSample:
-    """One pose at rest: joint positions [rad] and the averaged efforts [N m]."""
+    """One pose at rest: joint positions [rad] and the averaged efforts [N m] (the model's
+    friction at each joint state's velocity taken off)."""
 
     q: np.ndarray
     effort: np.ndarray
@@ -101,7 +105,8 @@ def estimate_payload(model: RobotModel, samples: list[RestSample]) -> PayloadEst
     U, sigma, Vt = np.linalg.svd(Y / scale, full_matrices=False)
     condition = sigma[0] / sigma[-1] if sigma[-1] > 0 else math.inf
     if condition > MAX_CONDITION:
-        raise EstimationError(f"the poses are too similar (condition number {condition:.3g}): {_advice(Vt[-1])}")
+        advice = _advice(Vt[-1], scale)
+        raise EstimationError(f"the poses are too similar (condition number {condition:.3g}): {advice}")
     phi = (Vt.T @ ((U.T @ b) / sigma)) / scale
     residual = b - Y @ phi
     dof = max(len(b) - 4, 1)
@@ -113,7 +118,10 @@ def estimate_payload(model: RobotModel, samples: list[RestSample]) -> PayloadEst
     com = phi[1:] / mass
     if np.linalg.norm(com) > MAX_COM_DISTANCE:
         raise EstimationError(
-            f"implausible: CoM {np.round(com, 3).tolist()} m is more than {MAX_COM_DISTANCE} m from the flange"
+            f"implausible: CoM {np.round(com, 3).tolist()} m is more than {MAX_COM_DISTANCE} m from the "
+            "flange (the plausibility limit, docs/payload_check_node.md): check that the samples are of the "
+            "payload at rest (not held or pushed), that the model's own link inertials and friction are right "
+            "(identify them), and that the payload really reaches that far out"
         )
     # first-order propagation to c = (m c) / m
     gradient = np.hstack([-com[:, None] / mass, np.eye(3) / mass])
@@ -131,69 +139,95 @@ def _weights(sample: RestSample) -> np.ndarray:
     return 1.0 / np.maximum(sample.effort_error, 1e-4)
 
 
-def _advice(weak: np.ndarray) -> str:
-    """What the weakest direction of [m, m c] says to do."""
-    part = UNKNOWNS[int(np.argmax(np.abs(weak)))]
-    if part == "mass":
+def _advice(weak: np.ndarray, scale: np.ndarray) -> str:
+    """What the weakest direction of the column-scaled [m, m c] says to do."""
+    if np.argmax(np.abs(weak)) == 0:
         return "the mass is not determined: stop the arm in poses with the flange at different reaches"
-    if part == "CoM z":
-        return ("the CoM along the flange z axis is not determined: tilt the wrist (joint 5) so that "
-                "the flange z axis points in different directions across the poses")
-    return (f"the {part} is not determined: turn the flange about its axis (joint 6) and tilt the wrist "
-            "(joint 5) between poses; poses that differ only in joint 1 show the payload the same way")
+    line = weak[1:] / scale[1:]  # in m c, the flange frame: where gravity pointed in every pose
+    line = np.round(line / np.linalg.norm(line) * np.sign(line[np.argmax(np.abs(line))]), 2) + 0.0  # no -0.00
+    what = (f"the CoM along ({line[0]:.2f}, {line[1]:.2f}, {line[2]:.2f}) in the flange frame is not "
+            "determined (gravity pulled the same way in the flange frame in every pose: poses that differ "
+            "only in joint 1 do): ")
+    if abs(line[2]) > 0.9:
+        return what + "tilt the wrist (joint 5) so that the flange z axis points in different directions"
+    return what + "turn the flange about its axis (joint 6) and tilt the wrist (joint 5) between poses"
 
 
 class RestDetector:
     """Averages joint states while every joint is slower than ``rest_velocity`` [rad/s]; a rest
     of at least ``rest_time`` [s] becomes a sample, one per distinct pose (a pose within
-    ``same_pose`` [rad] of an earlier one replaces it)."""
+    ``same_pose`` [rad] of an earlier one replaces it).
 
-    def __init__(self, rest_velocity: float, rest_time: float, same_pose: float = 1e-3, max_samples: int = 100):
+    ``friction`` (the model's JointFriction, or None): its torque at each joint state's
+    measured velocity is taken off that state's efforts before averaging. Inside the rest band
+    the tanh-smoothed Coulomb friction is not small (with the default smoothing velocity, 76 %
+    of its level at 0.01 rad/s, 96 % at 0.02); at qd = 0 it is exactly 0. A rest whose joint states carry no effort
+    is no sample; its pose is counted in ``without_effort`` (until a sample of it comes)."""
+
+    def __init__(self, rest_velocity: float, rest_time: float, same_pose: float = 1e-3, max_samples: int = 100,
+                 friction: JointFriction | None = None):
         self.rest_velocity, self.rest_time = rest_velocity, rest_time
         self.same_pose, self.max_samples = same_pose, max_samples
+        self.friction = friction
         self.samples: list[RestSample] = []
+        self.without_effort: list[np.ndarray] = []  # poses of rests without effort
         self._restart()
 
     def clear(self) -> None:
-        self.samples = []
+        self.samples, self.without_effort = [], []
         self._restart()
 
     def _restart(self) -> None:
-        self._start = None  # time the current rest began
+        self._start = self._last = None  # times of the current rest's first and last joint states
         self._sum_q = self._sum_effort = self._sum_squares = None
         self._count = 0
+        self._has_effort = True  # of the current rest's joint states (a change ends the rest)
 
     def update(self, t: float, q, qd, effort) -> bool:
         """Take one joint state (effort may be None); True when a rest sample was added."""
         q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
-        if effort is None or np.max(np.abs(qd)) >= self.rest_velocity:
+        moving = np.max(np.abs(qd)) >= self.rest_velocity
+        added = False
+        if moving or (self._start is not None and self._has_effort != (effort is not None)):
             added = self._close()
             self._restart()
+        if moving:
             return added
-        effort = np.asarray(effort, dtype=float)
         if self._start is None:
-            self._start = t
+            self._start, self._has_effort = t, effort is not None
             self._sum_q, self._sum_effort, self._sum_squares = (np.zeros_like(q) for _ in range(3))
         self._sum_q += q
-        self._sum_effort += effort
-        self._sum_squares += effort**2
+        if effort is not None:
+            effort = np.asarray(effort, dtype=float)
+            if self.friction is not None:
+                effort = effort - self.friction.torques(qd)
+            self._sum_effort += effort
+            self._sum_squares += effort**2
         self._count += 1
         self._last = t
-        return False
+        return added
 
     def _close(self) -> bool:
         if self._start is None or self._last - self._start < self.rest_time:
             return False
         n = self._count
+        q = self._sum_q / n
+        if not self._has_effort:
+            self.without_effort = self._others(self.without_effort, q, lambda p: p) + [q]
+            return False
         mean = self._sum_effort / n
         error = None
         if n > 1:
             variance = np.maximum(self._sum_squares / n - mean**2, 0.0) * n / (n - 1)
             error = np.sqrt(variance / n)
-        sample = RestSample(self._sum_q / n, mean, n, error)
-        self.samples = [s for s in self.samples if np.max(np.abs(s.q - sample.q)) > self.same_pose]
-        self.samples = (self.samples + [sample])[-self.max_samples :]
+        self.samples = self._others(self.samples, q, lambda s: s.q) + [RestSample(q, mean, n, error)]
+        self.without_effort = self._others(self.without_effort, q, lambda p: p)
         return True
+
+    def _others(self, kept: list, q: np.ndarray, pose_of) -> list:
+        """``kept`` without the entries of pose q, leaving room for one more (at most max_samples)."""
+        others = [x for x in kept if np.max(np.abs(pose_of(x) - q)) > self.same_pose]
+        return others[len(others) - self.max_samples + 1:] if len(others) >= self.max_samples else others
 
     def flush(self) -> bool:
         """Close a rest still going on (e.g. before an estimate): True if it became a sample."""
