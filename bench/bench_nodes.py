@@ -71,6 +71,9 @@ def parse_args(argv=None) -> argparse.Namespace:
                         help="only the soak: id_node and the relay side by side at 1 kHz for MINUTES "
                              "(10 in the issue), their RSS growth (bench/results/soak.json)")
     parser.add_argument("--no-stream", action="store_true", help="skip the end-to-end section")
+    parser.add_argument("--depth", type=int, default=QOS_DEPTH,
+                        help=f"qos.depth of both nodes (default {QOS_DEPTH}, id_node's): their joint_states queue "
+                             "holds depth / rate seconds of a stall")
     parser.add_argument("--effort", action="store_true",
                         help="joint states carry efforts: id_node's momentum observer runs on every message")
     parser.add_argument("--profile", action="store_true",
@@ -96,7 +99,7 @@ def main(argv=None) -> None:
     if not args.no_stream:
         stream, runs = end_to_end(args.rates, args.executor, args.duration, args.warmup, env, args.profile,
                                   args.no_event_handlers, None if args.no_changes else args.change_period,
-                                  effort=args.effort, repeat=args.repeat)
+                                  effort=args.effort, repeat=args.repeat, depth=args.depth)
         rows += stream
     if not args.no_payload:
         print("  payload check ...", flush=True)
@@ -118,7 +121,7 @@ def main(argv=None) -> None:
         for r in runs:
             top = ", ".join(f"{name} {share:g}%" for name, share in r.get("profile", {}).get("top", [])[:8])
             print(f"  {r['node']} {r['rate_hz']:g} Hz {r['executor']}: {top}")
-    name = "nodes_effort" if args.effort else "nodes"
+    name = ("nodes_effort" if args.effort else "nodes") + ("" if args.depth == QOS_DEPTH else f"_depth{args.depth}")
     path = write_results(
         name,
         {
@@ -129,8 +132,8 @@ def main(argv=None) -> None:
                 "warmup_s": args.warmup,
                 "rates_hz": args.rates,
                 "executors": args.executor,
-                "qos": {"joint_states": f"best_effort, depth {QOS_DEPTH}",
-                        "feedforward_torques": f"reliable, depth {QOS_DEPTH} (node) / {RECEIVER_DEPTH} (here)"},
+                "qos": {"joint_states": f"best_effort, depth {args.depth}",
+                        "feedforward_torques": f"reliable, depth {args.depth} (node) / {RECEIVER_DEPTH} (here)"},
                 "rmw": os.environ.get("RMW_IMPLEMENTATION", "default (rmw_fastrtps_cpp)"),
                 "ros_domain_id": domain_id,
                 "profiled": args.profile,

@@ -91,12 +91,12 @@ def _die_with_parent() -> None:
         pass
 
 
-def node_command(kind: str, executor: str, namespace: str, lean: bool = False) -> list[str]:
+def node_command(kind: str, executor: str, namespace: str, lean: bool = False, depth: int = QOS_DEPTH) -> list[str]:
     """id_node as `ros2 run` starts it (its main(): the events executor), or through
     relay_node.py (the relay, or id_node under another executor or without QoS event
     handlers, ``lean``); both with id_node's default QoS given explicitly."""
     ros_args = ["--ros-args", "-r", f"__ns:={namespace}",
-                "-p", "qos.reliability:=best_effort", "-p", f"qos.depth:={QOS_DEPTH}"]
+                "-p", "qos.reliability:=best_effort", "-p", f"qos.depth:={depth}"]
     if kind == "id_node":
         ros_args += ["-p", "acceleration.mode:=differentiate"]
         if executor == "events" and not lean:

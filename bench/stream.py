@@ -88,7 +88,7 @@ def joint_efforts(positions: list, velocities: list) -> list:
 
 def stream_run(node, kind: str, executor: str, rate: float, duration: float, warmup: float,
                env: dict, index: int, profile: bool = False, lean: bool = False,
-               change_period: float | None = None, effort: bool = False) -> dict:
+               change_period: float | None = None, effort: bool = False, depth: int = QOS_DEPTH) -> dict:
     """Start the node, stream joint states at ``rate`` through it, return the raw figures.
 
     ``effort``: every joint state carries efforts (id_node then runs its momentum observer
@@ -101,7 +101,7 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
     from sensor_msgs.msg import JointState
 
     namespace = f"/bench_nodes_{os.getpid()}_{index}"
-    process = NodeProcess(node_command(kind, executor, namespace, lean), env)
+    process = NodeProcess(node_command(kind, executor, namespace, lean, depth), env)
     publisher = subscription = receiver = spy = changer = None
     changes = None
     profile_path = RESULTS / f"profile_{kind}_{executor}_{rate:g}hz.txt"
@@ -191,6 +191,7 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
     run["stale_ticks_not_sent"] = int(skipped[first:].sum())
     run["source_late_max_ms"] = float(lateness[first:].max() * 1e3)
     run["qos_event_handlers"] = not lean
+    run["qos_depth"] = depth
     run["parameter_changes"] = changes
     run["publisher_sched_fifo"] = realtime
     if profile:
@@ -200,7 +201,7 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
 
 def end_to_end(rates, executors, duration, warmup, env, profile=False, lean=False,
                change_period: float | None = None, change_rate: float = CHANGE_RATE,
-               effort: bool = False, repeat: int = 1) -> tuple[list[Row], list[dict]]:
+               effort: bool = False, repeat: int = 1, depth: int = QOS_DEPTH) -> tuple[list[Row], list[dict]]:
     """Per executor and rate: the relay, then id_node, each in a fresh process, ``repeat``
     times in turn; then, with ``change_period``, both again at ``change_rate`` with a
     parameter change every ``change_period`` s."""
@@ -219,7 +220,7 @@ def end_to_end(rates, executors, duration, warmup, env, profile=False, lean=Fals
                 every = "" if changes is None else f", payload.mass set every {changes * 1e3:g} ms"
                 print(f"  {kind} at {rate:g} Hz, {executor}{every}: {warmup + duration:g} s ...", flush=True)
                 run = stream_run(node, kind, executor, rate, duration, warmup, env, len(runs), profile, lean,
-                                 changes, effort)
+                                 changes, effort, depth)
                 runs.append(run)
                 d = run["delay_us"]
                 print(f"    p50 {_opt(d['p50'])} us, p99 {_opt(d['p99'])} us, max {_opt(d['max'])} us, "

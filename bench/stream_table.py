@@ -12,6 +12,7 @@ from __future__ import annotations
 from statistics import median
 
 from common import Figure, NotMeasured, Row, Target, Value
+from node_processes import QOS_DEPTH
 
 P99_TARGET = Target(1.5)  # id_node's p99 delay at most 1.5x the relay's
 LOST_TARGET = Target(0, absolute=True)  # no message lost
@@ -29,6 +30,8 @@ def stream_rows(runs: list[dict]) -> list[Row]:
         lean = "" if ours[0]["qos_event_handlers"] else ", no QoS event handlers"
         changes = "" if change_period is None else f", payload.mass set every {change_period * 1e3:g} ms"
         repeats = f", {len(ours)} runs each, medians" if len(ours) > 1 else ""
+        depth = ours[0].get("qos_depth", QOS_DEPTH)
+        lean += "" if depth == QOS_DEPTH else f", qos.depth {depth}"
         group = (f"id_node end to end, {rate:g} Hz for {ours[0]['duration_s']:g} s{changes}{repeats}, "
                  f"executor {executor}{lean} (baseline: relay" + (", the same parameter calls)" if changes else ")"))
         p99_target = P99_TARGET if change_period is None else None  # with changes the target is 0 lost (issue 8)
