@@ -218,7 +218,11 @@ class PayloadCheckNode(Node):
             effort = None
         stamp = msg.header.stamp
         t = stamp.sec + 1e-9 * stamp.nanosec
-        self.estimator.update(t if t != 0.0 else now.nanoseconds * 1e-9, q, qd, effort)
+        try:
+            self.estimator.update(t if t != 0.0 else now.nanoseconds * 1e-9, q, qd, effort)
+        except ValueError as error:  # an absurd effort: not averaged
+            self.counts["estimation.effort_too_large"] += 1
+            self.tally.warn("estimation", f"a joint state left out of the payload estimate ({error})")
 
     def check(self):
         """Check the payload (at the latest state, if any) and publish /diagnostics:

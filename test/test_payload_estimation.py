@@ -146,6 +146,19 @@ def test_rest_detector_needs_rest_time_and_merges_the_same_pose():
     assert detector.samples == []
 
 
+def test_rest_detector_refuses_an_effort_too_large_to_average_and_keeps_its_rest():
+    detector = RestDetector(rest_velocity=0.01, rest_time=0.5)
+    q, effort = np.zeros(6), np.ones(6)
+    for k in range(600):
+        detector.update(k * 0.001, q, np.zeros(6), effort)
+    with np.errstate(all="raise"):  # no overflow warning on the way
+        with pytest.raises(ValueError, match="too large to average"):
+            detector.update(0.6, q, np.zeros(6), np.full(6, 1e200))
+    detector.update(0.7, q, np.ones(6), effort)  # moving: the rest so far becomes a sample
+    assert len(detector.samples) == 1 and detector.samples[0].count == 600
+    np.testing.assert_array_equal(detector.samples[0].effort, effort)
+
+
 def test_rest_detector_takes_the_models_friction_off_each_joint_state():
     friction = arm().friction
     qd = np.array([0.01, -0.01, 0.005, -0.002, 0.0, 0.019])  # inside the rest band, 0.02 rad/s

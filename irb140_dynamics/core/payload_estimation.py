@@ -184,8 +184,14 @@ class RestDetector:
         self._has_effort = True  # of the current rest's joint states (a change ends the rest)
 
     def update(self, t: float, q, qd, effort) -> bool:
-        """Take one joint state (effort may be None); True when a rest sample was added."""
+        """Take one joint state (effort may be None); True when a rest sample was added.
+        ValueError, nothing taken, for an effort too large to average (its square overflows)."""
         q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
+        if effort is not None:
+            effort = np.asarray(effort, dtype=float)
+            with np.errstate(over="ignore", invalid="ignore"):
+                if not np.isfinite(effort * effort).all():
+                    raise ValueError(f"effort {effort.tolist()} N m: too large to average")
         moving = np.max(np.abs(qd)) >= self.rest_velocity
         added = False
         if moving or (self._start is not None and self._has_effort != (effort is not None)):
@@ -198,7 +204,6 @@ class RestDetector:
             self._sum_q, self._sum_effort, self._sum_squares = (np.zeros_like(q) for _ in range(3))
         self._sum_q += q
         if effort is not None:
-            effort = np.asarray(effort, dtype=float)
             if self.friction is not None:
                 effort = effort - self.friction.torques(qd)
             self._sum_effort += effort
