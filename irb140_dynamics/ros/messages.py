@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from collections import Counter
 
 import numpy as np
 from sensor_msgs.msg import JointState
@@ -11,16 +10,8 @@ from trajectory_msgs.msg import JointTrajectory
 
 from ..core.joint_order import BadMessage, JointOrder, NotForThisModel
 
-__all__ = ["BadMessage", "JointOrder", "NotForThisModel", "core_result", "count_and_warn", "finite_torques",
+__all__ = ["BadMessage", "JointOrder", "NotForThisModel", "core_result", "finite_torques",
            "publish_efforts", "read_effort", "read_joint_state", "read_reference", "read_trajectory"]
-
-
-def count_and_warn(logger, counts: Counter, topic: str, error: BadMessage) -> None:
-    """Count a dropped message by kind, and warn about it (every 2 s at most). (id_node and
-    payload_check_node count per topic with ros.guard.Tally.)"""
-    counts[f"dropped_{error.kind}"] += 1
-    counts["dropped"] += 1
-    logger.warning(f"dropped a {topic} message ({error})", throttle_duration_sec=2.0)
 
 
 def core_result(function, model, *state):
