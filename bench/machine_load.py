@@ -48,17 +48,21 @@ def load_between(before: Snapshot, after: Snapshot, ours: set[int]) -> dict:
 
 def processes_cpu() -> dict:
     """CPU seconds so far of every process alive, by pid."""
-    ticks = os.sysconf("SC_CLK_TCK")
     cpu = {}
     for entry in os.listdir("/proc"):
         if entry.isdigit():
             try:
-                with open(f"/proc/{entry}/stat") as stat:
-                    fields = stat.read().rsplit(")", 1)[1].split()
+                cpu[int(entry)] = process_cpu_seconds(int(entry))
             except OSError:  # ended meanwhile
                 continue
-            cpu[int(entry)] = (int(fields[11]) + int(fields[12])) / ticks
     return cpu
+
+
+def process_cpu_seconds(pid: int) -> float:
+    """User + system time of a process so far, all its threads (from /proc/<pid>/stat)."""
+    with open(f"/proc/{pid}/stat") as stat:
+        fields = stat.read().rsplit(")", 1)[1].split()  # after the command name, which may hold spaces
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")  # utime, stime
 
 
 def _jiffies() -> tuple[int, int]:

@@ -16,6 +16,7 @@ import time
 from typing import Callable
 
 from common import REPO
+from machine_load import process_cpu_seconds
 
 STARTUP_TIMEOUT = 30.0  # s, for a node process to start and match
 QOS_DEPTH = 10  # id_node's qos.depth default; joint_states best effort as its qos.reliability default
@@ -56,10 +57,8 @@ class NodeProcess:
         return self.process.poll() is None
 
     def cpu_seconds(self) -> float:
-        """User + system time of the process so far, all its threads (from /proc/<pid>/stat)."""
-        with open(f"/proc/{self.process.pid}/stat") as stat:
-            fields = stat.read().rsplit(")", 1)[1].split()
-        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")  # utime, stime
+        """User + system time of the process so far, all its threads."""
+        return process_cpu_seconds(self.process.pid)
 
     def output(self, last: int = 15) -> str:
         self.log.flush()
