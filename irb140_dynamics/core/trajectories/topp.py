@@ -1,0 +1,94 @@
+"""Time-optimal path parameterization by reachability analysis (TOPP-RA, Pham and Pham 2018)
+on a grid s_0 < ... < s_N over the path parameter.
+
+The state at grid point i is x_i = sd_i^2, the control u_i = sdd, constant over
+[s_i, s_i+1], so x_i+1 = x_i + 2 Delta_i u_i. At each grid point the limits are rows
+
+    alpha_r u + beta_r x <= gamma_r,      0 <= x <= X_i
+
+(see ``retime`` for how torque, velocity and acceleration limits become rows). Split by
+the sign of alpha, they bound u from above (U_i(x) = min_r (gamma_r - beta_r x) / alpha_r)
+and from below (L_i(x), the max). Backward, the controllable sets K_i = [0, k_i] (x from
+which the end, at rest, can still be reached): k_N = 0, and k_i the largest x <= X_i with
+L_i(x) <= U_i(x) and x + 2 Delta_i L_i(x) <= k_i+1, each a linear inequality per row, so
+closed form. Forward, from rest, the largest u keeping x_i+1 in K_i+1. The result is the
+time-optimal profile on the grid (the greedy forward pass through controllable sets is
+optimal, Pham and Pham 2018, theorem 2).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+BIG = 1e300
+
+
+def max_velocity_curve(alpha, beta, gamma, X) -> np.ndarray:
+    """The largest x <= X_i at each grid point with some u satisfying every row: rows
+    (N+1, R) -> (N+1,). An upper row p and a lower row q (on u) agree iff
+    A_p - B_p x >= A_q - B_q x, linear in x; rows with alpha 0 bound x alone."""
+    A, B, up, low = _split(alpha, beta, gamma)
+    half = max(int(up.sum(axis=1).max()), int(low.sum(axis=1).max()), 1)
+    pu = np.argsort(~up, axis=1, kind="stable")[:, :half]  # each point's upper rows first
+    pl = np.argsort(~low, axis=1, kind="stable")[:, :half]
+    take = np.take_along_axis
+    Au, Bu, mu = take(A, pu, 1), take(B, pu, 1), take(up, pu, 1)
+    Al, Bl, ml = take(A, pl, 1), take(B, pl, 1), take(low, pl, 1)
+    dB = np.where(mu[:, :, None] & ml[:, None, :], Bu[:, :, None] - Bl[:, None, :], 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        pair = np.where(dB > 0, (Au[:, :, None] - Al[:, None, :]) / dB, np.inf).min(axis=(1, 2))
+        flat = (alpha == 0) & (beta > 0)
+        alone = np.where(flat, gamma / np.where(flat, beta, 1.0), np.inf).min(axis=1)
+    return np.maximum(np.minimum(np.minimum(X, pair), alone), 0.0)
+
+
+def topp(alpha, beta, gamma, X, delta, stops) -> tuple[np.ndarray, np.ndarray]:
+    """x (N+1,) and u (N,) of the time-optimal profile from rest to rest; ``stops`` (N+1,)
+    forces x = 0 where True; delta (N,) the grid steps."""
+    A, B, up, low = _split(alpha, beta, gamma)
+    X = max_velocity_curve(alpha, beta, gamma, X)
+    N = len(delta)
+    # rows that can never be met at the next point's x >= 0 (too little deceleration) cap x
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        slope = B[:-1] - 1.0 / (2.0 * delta[:, None])
+        reach = np.where(up[:-1] & (slope > 0), A[:-1] / slope, np.inf).min(axis=1)
+    X = np.maximum(np.minimum(X, np.r_[reach, np.inf]), 0.0)
+    X[stops] = 0.0
+    # backward: x (1 - 2 delta B_q) <= k - 2 delta A_q for every lower row q with 1 - 2 delta B_q > 0
+    P = 1.0 - 2.0 * delta[:, None] * B[:-1]
+    use = low[:-1] & (P > 0)
+    Q = np.where(use, 2.0 * delta[:, None] * A[:-1], -BIG)  # unused rows: (k + BIG) * 1
+    invP = 1.0 / np.where(use, P, 1.0)
+    Q, invP = (_first(v, use).tolist() for v in (Q, invP))
+    Xl = X.tolist()
+    k = [0.0] * (N + 1)
+    for i in range(N - 1, -1, -1):
+        nxt = k[i + 1]
+        k[i] = max(min(Xl[i], min([(nxt - q) * p for q, p in zip(Q[i], invP[i])])), 0.0)
+    # forward: the largest u, x_i+1 within K_i+1
+    Au, Bu = (_first(v, up).tolist() for v in (np.where(up, A, BIG), np.where(up, B, 0.0)))  # unused: BIG
+    dl = delta.tolist()
+    x, u = [0.0] * (N + 1), [0.0] * N
+    for i in range(N):
+        xi, two = x[i], 2.0 * dl[i]
+        umax = min([a - b * xi for a, b in zip(Au[i], Bu[i])])
+        nxt = min(max(xi + two * min(umax, (k[i + 1] - xi) / two), 0.0), k[i + 1])
+        x[i + 1], u[i] = nxt, (nxt - xi) / two
+    return np.array(x), np.array(u)
+
+
+def _first(values, used):
+    """Each row's used entries first, the rest cut as far as no row needs them."""
+    width = max(int(used.sum(axis=1).max()), 1)
+    order = np.argsort(~used, axis=1, kind="stable")[:, :width]
+    return np.take_along_axis(values, order, 1)
+
+
+def _split(alpha, beta, gamma):
+    """A = gamma / alpha, B = beta / alpha (u <= A - B x on rows with alpha > 0, u >= on rows
+    with alpha < 0) and the two masks."""
+    up, low = alpha > 0, alpha < 0
+    safe = np.where(alpha != 0, alpha, 1.0)
+    A = np.where(up | low, gamma / safe, 0.0)
+    B = np.where(up | low, beta / safe, 0.0)
+    return A, B, up, low
