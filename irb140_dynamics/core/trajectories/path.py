@@ -20,6 +20,7 @@ from .interpolation import spline
 from .message import Trajectory, TrajectoryError
 
 MIN_STEPS = 4  # grid steps per input segment at least
+REST_STEPS = 64  # and next to a point at rest on a curve
 
 
 @dataclass(frozen=True, eq=False)
@@ -43,11 +44,13 @@ class PathGrid:
 
 
 def steps_per_segment(tr: Trajectory, grid: int) -> np.ndarray:
-    """About ``grid`` steps in all, shared out by each segment's largest joint motion,
-    at least MIN_STEPS each."""
+    """About ``grid`` steps in all, shared out by each segment's largest joint motion, at
+    least MIN_STEPS each, REST_STEPS next to a point at rest (the path turns sharply there)."""
     motion = np.abs(np.diff(tr.q, axis=0)).max(axis=1)
     share = motion / motion.sum() if motion.sum() > 0 else np.full(len(motion), 1.0 / len(motion))
-    return np.maximum(MIN_STEPS, np.ceil(grid * share).astype(int))
+    rest = tr.has_qd & (np.abs(tr.qd).max(axis=1) == 0)  # a curve through a rest point (lines need none)
+    least = np.where(rest[:-1] | rest[1:], REST_STEPS, MIN_STEPS)
+    return np.maximum(least, np.ceil(grid * share).astype(int))
 
 
 def path_grid(tr: Trajectory, steps: np.ndarray) -> PathGrid:
@@ -60,6 +63,7 @@ def path_grid(tr: Trajectory, steps: np.ndarray) -> PathGrid:
     left_seg = np.where(knot & (np.arange(len(sigma)) > 0), np.maximum(seg - 1, 0), seg)
     left_seg[-1] = len(steps) - 1
     q = sp.evaluate(sigma, seg, order=0)[0]
+    q[knot] = tr.q  # the input's points exactly, not as the polynomials round them
     q1r, q2r, rest_r = _unit_derivatives(sp, sigma, seg)
     q1l, q2l, rest_l = _unit_derivatives(sp, sigma, left_seg)
     rest = rest_r | rest_l

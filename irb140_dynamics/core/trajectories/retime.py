@@ -8,7 +8,8 @@ Along the path q(s) (see ``path``), with x = sd^2 and u = sdd:
 
 (a, b, c from ``rnea``: armature and payload included). Friction tau_f,j = sign(q'_j)
 (viscous_j |q'_j| sd + coulomb_j tanh(|q'_j| sd / v_s)) for sd >= 0. It is bounded soundly by
-terms linear in x: Coulomb between 0 and coulomb_j; the viscous sqrt(x) from above by its
+terms linear in x: Coulomb between 0 and coulomb_j (between -coulomb_j and coulomb_j where q'_j
+changes sign at a neighbouring grid point); the viscous sqrt(x) from above by its
 tangent at x0 (the previous round's x) and from below by its chord over [0, X] (X: the
 velocity cap, which x then may not pass). So every limit is a row linear in (u, x), and
 ``topp`` finds the time-optimal profile on the grid.
@@ -103,7 +104,7 @@ def retime(
     x0 = None
     worst, used = np.inf, 0
     for used in range(1, rounds + 1):
-        x, u = _profile(model, pg, dyn, limits, factor, x0)
+        x, u = _profile(model, pg, dyn, limits, factor, x0, floor)
         out, _ = _output(pg, x, u, tr, accelerations)
         ratio = _ratios(model, out, limits, verify)
         worst = float(ratio.max())
@@ -114,7 +115,7 @@ def retime(
         for i in np.flatnonzero(ratio > 1.0):  # the interval's points and WINDOW either side
             lo, hi = max(i - WINDOW, 0), min(i + 1 + WINDOW, len(shrink) - 1)
             shrink[lo : hi + 1] = np.minimum(shrink[lo : hi + 1], SHRINK / ratio[i])
-        factor = np.maximum(factor * shrink, floor)
+        factor = factor * shrink
     return Retimed(out, pg, x, u, worst, used)
 
 
@@ -139,9 +140,9 @@ def _refuse_static(model, pg, dyn, limits, tr) -> None:
     over = need - limits.torque
     i, j = np.unravel_index(np.argmax(over), over.shape)
     if over[i, j] > 0:
-        where = f"point {pg.point[i]}" if pg.knot[i] else f"between points {pg.point[i]} and {pg.point[i] + 1}"
+        where = f"at point {pg.point[i]}" if pg.knot[i] else f"between points {pg.point[i]} and {pg.point[i] + 1}"
         raise TrajectoryError(
-            f"infeasible path: {model.joint_names[j]} needs {need[i, j]:.4g} N m to hold the pose at {where} "
+            f"infeasible path: {model.joint_names[j]} needs {need[i, j]:.4g} N m to hold the pose {where} "
             f"(input t = {tr.t[0] + pg.sigma[i]:.4g} s), over its torque limit {limits.torque[j]:.4g} N m "
             f"({limits.torque_source[j]}) by {over[i, j]:.4g} N m"
         )
@@ -154,9 +155,9 @@ def _static_share(model, pg, dyn, limits) -> np.ndarray:
     return np.minimum(1.0, share * 1.001)
 
 
-def _rows(model, pg, dyn, limits, factor, x0, X):
+def _rows(model, pg, dyn, limits, factor, x0, X, floor):
     """alpha, beta, gamma (G+1, R) of every limit at every grid point, both sides."""
-    L = limits.torque[None, :] * factor[:, None]
+    L = limits.torque[None, :] * np.maximum(factor, floor)[:, None]  # torque: never below holding the pose
     A = limits.acceleration[None, :] * factor[:, None]
     rows = []
     viscous = np.array([j.friction.viscous for j in model.joints])
@@ -168,9 +169,10 @@ def _rows(model, pg, dyn, limits, factor, x0, X):
         t_slope, t_icpt = d / (2 * root0), d * root0 / 2
         ch_slope = d / np.sqrt(np.maximum(X, 1e-300))[:, None]
         hi_slope = np.where(sign > 0, t_slope, -ch_slope * (sign < 0))
-        hi_icpt = np.where(sign > 0, t_icpt + coulomb, 0.0)
+        near = np.stack([sign, np.r_[sign[:1], sign[:-1]], np.r_[sign[1:], sign[-1:]]])  # Coulomb flips
+        hi_icpt = np.where(sign > 0, t_icpt, 0.0) + coulomb * (near.max(axis=0) > 0)  # where q'_j does
         lo_slope = np.where(sign < 0, -t_slope, ch_slope * (sign > 0))
-        lo_icpt = np.where(sign < 0, -t_icpt - coulomb, 0.0)
+        lo_icpt = np.where(sign < 0, -t_icpt, 0.0) - coulomb * (near.min(axis=0) < 0)
         finite = np.isfinite(L)
         rows += [
             (a * finite, (b + hi_slope) * finite, np.where(finite, L - c - hi_icpt, 0.0)),
@@ -185,18 +187,18 @@ def _rows(model, pg, dyn, limits, factor, x0, X):
     return alpha, beta, gamma
 
 
-def _profile(model, pg, dyn, limits, factor, x0):
+def _profile(model, pg, dyn, limits, factor, x0, floor):
     """x, u on the grid with the limits times ``factor``; the viscous friction's tangent at x0."""
     V = limits.velocity[None, :] * factor[:, None]
     speed = np.abs(pg.q1[1])
     with np.errstate(divide="ignore"):
         X = np.where(speed > 0, (V / np.where(speed > 0, speed, 1.0)) ** 2, np.inf).min(axis=1)
     if model.friction is not None and not np.isfinite(X).all():  # the chord needs an end: the curve without it
-        free = _rows(model, pg, dyn, limits, factor, np.ones(len(X)), np.full(len(X), np.inf))
+        free = _rows(model, pg, dyn, limits, factor, np.ones(len(X)), np.full(len(X), np.inf), floor)
         X = np.where(np.isfinite(X), X, 4.0 * max_velocity_curve(*free, np.minimum(X, 1e12)))
     X = np.minimum(X, 1e12)
     x0 = X if x0 is None else x0
-    return topp(*_rows(model, pg, dyn, limits, factor, np.minimum(x0, X), X), X, pg.delta, pg.stops)
+    return topp(*_rows(model, pg, dyn, limits, factor, np.minimum(x0, X), X, floor), X, pg.delta, pg.stops)
 
 
 def _output(pg: PathGrid, x, u, tr: Trajectory, accelerations: bool = False) -> tuple[Trajectory, np.ndarray]:
