@@ -137,8 +137,10 @@ def write_all(files: dict[str, bytes]) -> None:
 
 def report_text(title: str, report) -> str:
     lines = [
-        f"{title}: {report.duration:.4f} s, {'within every limit' if report.ok else 'OVER A LIMIT'} "
-        f"(worst: {report.worst.line()})"
+        (
+            f"{title}: {report.duration:.4f} s, {'within every limit' if report.ok else 'OVER A LIMIT'} "
+            f"(worst: {report.worst.line()})"
+        )
     ]
     lines += [f"  {line}" for line in report.lines()]
     return "\n".join(lines)
