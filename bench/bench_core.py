@@ -46,8 +46,8 @@ from irb140_dynamics.core import (
     rnea_batch,
 )
 from irb140_dynamics.core import kernels as kernel_cache  # noqa: E402
-from irb140_dynamics.core.rigid_body import RigidBody, inertia_matrix  # noqa: E402
-from irb140_dynamics.core.urdf import load_urdf  # noqa: E402
+from irb140_dynamics.core.model.rigid_body import RigidBody, inertia_matrix  # noqa: E402
+from irb140_dynamics.core.io.urdf import load_urdf  # noqa: E402
 from test.pinocchio_model import build as pinocchio_model, rot_x, rot_z  # noqa: E402
 
 BATCH_STATES = 100_000

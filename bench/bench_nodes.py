@@ -8,7 +8,7 @@
 Prints one table and writes the raw figures to bench/results/nodes.json. Sections:
 
 - end to end, per rate and executor (bench/stream.py): the node under test runs in its
-  own process (id_node as ``python -m irb140_dynamics.id_node``, or the baseline
+  own process (id_node as ``python -m irb140_dynamics.nodes.id_node.node``, or the baseline
   bench/relay_node.py, which republishes joint_states unchanged on feedforward_torques
   with the same QoS). This process publishes JointState at a fixed rate for a warm-up and
   then ``--duration`` seconds, and takes the torque messages as they arrive: their delay,
@@ -34,7 +34,7 @@ import os
 import time
 
 from common import REPO, machine_info, print_table, write_results  # first: puts the checkout on sys.path
-from irb140_dynamics.ros.spin import EXECUTORS  # noqa: E402  (events: what every node's main() uses)
+from irb140_dynamics.ros.runtime.spin import EXECUTORS  # noqa: E402  (events: what every node's main() uses)
 from machine_load import OTHERS_WARNING, STOLEN_WARNING
 from node_processes import QOS_DEPTH, isolated_domain
 from payload_section import payload_rows

@@ -62,11 +62,11 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
 
     namespace = f"/bench_sim_{os.getpid()}_{index}"
     ros_args = ["--ros-args", "-r", f"__ns:={namespace}"]
-    sim = NodeProcess([sys.executable, "-m", "irb140_dynamics.sim_node", *ros_args, "-p", f"rate:={rate}",
+    sim = NodeProcess([sys.executable, "-m", "irb140_dynamics.nodes.sim_node.node", *ros_args, "-p", f"rate:={rate}",
                        "-p", f"initial_positions:={POSE}", "-p", f"thread_priority:={priority}"], env)
     controller = None
     if loop:
-        controller = NodeProcess([sys.executable, "-m", "irb140_dynamics.id_node", *ros_args,
+        controller = NodeProcess([sys.executable, "-m", "irb140_dynamics.nodes.id_node.node", *ros_args,
                                   "-p", "effort_commands.enabled:=true", "-p", "effort_commands.source:=gravity"], env)
     listener, taker = Node("bench_sim_listener"), Node("bench_sim_taker")
     executor = SingleThreadedExecutor()

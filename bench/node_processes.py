@@ -99,7 +99,7 @@ def node_command(kind: str, executor: str, namespace: str, lean: bool = False, d
     if kind == "id_node":
         ros_args += ["-p", "acceleration.mode:=differentiate"]
         if executor == "events" and not lean:
-            return [sys.executable, "-m", "irb140_dynamics.id_node", *ros_args]
+            return [sys.executable, "-m", "irb140_dynamics.nodes.id_node.node", *ros_args]
     lean_flag = ["--no-event-handlers"] if lean else []
     return [sys.executable, str(REPO / "bench" / "relay_node.py"), kind, "--executor", executor, *lean_flag,
             *ros_args]

@@ -93,7 +93,7 @@ def _time_service_calls(env: dict) -> tuple[float, list[float], float]:
     from std_srvs.srv import Trigger
 
     namespace = f"/bench_nodes_{os.getpid()}_payload"
-    process = NodeProcess([sys.executable, "-m", "irb140_dynamics.payload_check_node",
+    process = NodeProcess([sys.executable, "-m", "irb140_dynamics.nodes.payload_check_node.node",
                            "--ros-args", "-r", f"__ns:={namespace}"], env)
 
     def calls(settle: float, count: int) -> list[float]:

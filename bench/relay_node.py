@@ -12,7 +12,7 @@ rclpy without computing anything.
 ``id_node``: irb140_dynamics' IdNode itself, for running it under an executor other than
 the one its main() uses (bench_nodes.py --executor single_threaded).
 
-``--executor``: as irb140_dynamics.ros.spin.run takes it; ``events`` (the default) is what
+``--executor``: as irb140_dynamics.ros.runtime.spin.run takes it; ``events`` (the default) is what
 every node's main() uses, ``single_threaded`` is rclpy.spin, for comparison.
 ``--no-event-handlers``: the node's publishers and subscriptions are created without
 rclpy's default QoS event handlers (the incompatible-QoS and incompatible-type warnings),
@@ -33,7 +33,7 @@ from rclpy.node import Node  # noqa: E402
 from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 
-from irb140_dynamics.ros.spin import EXECUTORS, run  # noqa: E402
+from irb140_dynamics.ros.runtime.spin import EXECUTORS, run  # noqa: E402
 
 RELIABILITIES = {"best_effort": ReliabilityPolicy.BEST_EFFORT, "reliable": ReliabilityPolicy.RELIABLE}
 
@@ -55,7 +55,7 @@ class RelayNode(Node):
 def make_node(kind: str):
     if kind == "relay":
         return RelayNode
-    from irb140_dynamics.id_node import IdNode
+    from irb140_dynamics.nodes.id_node.node import IdNode
 
     return IdNode
 

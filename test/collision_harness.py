@@ -8,7 +8,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Bool
 
-from irb140_dynamics.id_node import IdNode
+from irb140_dynamics.nodes.id_node.node import IdNode
 
 from .ros_harness import running
 

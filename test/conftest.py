@@ -17,8 +17,8 @@ def quick_proofs(monkeypatch):
     """A smaller budget for the proof of worst static torques: for tests of what is proven
     and reported, not of how far the proof gets. Proofs remembered are forgotten before and
     after, so that no other test sees one of these."""
-    from irb140_dynamics.core import certify
-    from irb140_dynamics.core.payload_family import forget_families
+    from irb140_dynamics.core.payload.proof import certify
+    from irb140_dynamics.core.payload.family import forget_families
 
     monkeypatch.setattr(certify, "EVALUATIONS", 10_000)
     forget_families()

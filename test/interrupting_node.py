@@ -8,7 +8,7 @@ import sys
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 
-from irb140_dynamics.ros.spin import run
+from irb140_dynamics.ros.runtime.spin import run
 
 BURST = 20  # messages published per timer tick, to its own subscription
 PRESS_AT = 30  # the message whose callback sends SIGINT

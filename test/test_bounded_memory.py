@@ -10,10 +10,10 @@ import tracemalloc
 
 from rclpy.parameter import Parameter
 
-from irb140_dynamics import id_node as id_module
-from irb140_dynamics.core import payload_family
-from irb140_dynamics.id_node import IdNode
-from irb140_dynamics.payload_check_node import PayloadCheckNode
+from irb140_dynamics.nodes.id_node import node as id_module
+from irb140_dynamics.core.payload import family as payload_family
+from irb140_dynamics.nodes.id_node.node import IdNode
+from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
 
 from .fuzz_inputs import Fuzzer
 from .ros_harness import running

@@ -5,7 +5,7 @@ import threading
 
 from rclpy.node import Node
 
-from irb140_dynamics.ros.builder import Builder, Failed
+from irb140_dynamics.ros.runtime.builder import Builder, Failed
 
 from .ros_harness import running
 

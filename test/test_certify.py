@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import RigidBody, RobotModel, check_payload, derive_torque_limits, gravity, irb140
-from irb140_dynamics.core import certify
-from irb140_dynamics.core.bounds import quadratic_max
-from irb140_dynamics.core.harmonic import MAX_JOINTS, StaticForms
-from irb140_dynamics.core.interval import Interval
-from irb140_dynamics.core.payload import workspace_load
-from irb140_dynamics.core.payload_family import CERTIFY_RTOL, payload_family
-from irb140_dynamics.core.workspace import JointRanges
+from irb140_dynamics.core.payload.proof import certify
+from irb140_dynamics.core.payload.proof.bounds import quadratic_max
+from irb140_dynamics.core.payload.proof.harmonic import MAX_JOINTS, StaticForms
+from irb140_dynamics.core.scalars.interval import Interval
+from irb140_dynamics.core.payload.limits import workspace_load
+from irb140_dynamics.core.payload.family import CERTIFY_RTOL, payload_family
+from irb140_dynamics.core.payload.workspace import JointRanges
 
 from .support import random_model
 

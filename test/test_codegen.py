@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import coriolis, coriolis_matrix, gravity, irb140, mass_matrix, rnea
-from irb140_dynamics.core import algorithms
+from irb140_dynamics.core.algorithms import recursions as algorithms
 
 from .support import model_makers, loaded_irb140, random_model, random_states
 

@@ -7,7 +7,7 @@ import pytest
 from sensor_msgs.msg import JointState
 
 from irb140_dynamics.core import gravity, irb140, rnea
-from irb140_dynamics.core.observer import MomentumObserver
+from irb140_dynamics.core.monitoring.observer import MomentumObserver
 
 from . import collision_harness
 from .collision_harness import GAIN, NAMES, THRESHOLD, feed, send, stamped

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import irb140, load_model
-from irb140_dynamics.core.trajectory import computed_torque
-from irb140_dynamics.demo_node import CENTRE, motion
+from irb140_dynamics.core.trajectories.reference import computed_torque
+from irb140_dynamics.nodes.demo_node.node import CENTRE, motion
 from irb140_dynamics.sim.engine import SimulatedArm
 
 from .paths import ROOT

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from irb140_dynamics.core.filters import VelocityDifferentiator
+from irb140_dynamics.core.monitoring.filters import VelocityDifferentiator
 
 
 def test_converges_to_the_slope_of_a_velocity_ramp():

@@ -22,7 +22,7 @@ from irb140_dynamics.core import (
     rnea,
     rnea_batch,
 )
-from irb140_dynamics.core.friction import JointFriction
+from irb140_dynamics.core.model.friction import JointFriction
 
 from .support import assert_close, random_states, random_urdf_model
 

@@ -19,8 +19,8 @@ from rclpy.serialization import deserialize_message, serialize_message
 from sensor_msgs.msg import JointState
 
 from irb140_dynamics.core import RobotModel, check_payload, gravity, rnea
-from irb140_dynamics.id_node import IdNode
-from irb140_dynamics.payload_check_node import PayloadCheckNode
+from irb140_dynamics.nodes.id_node.node import IdNode
+from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
 
 from .fuzz_inputs import Fuzzer, parameter_set
 from .ros_harness import running

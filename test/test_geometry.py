@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import irb140
-from irb140_dynamics.core.geometry import (
+from irb140_dynamics.core.model.irb140 import (
     box_inertia,
     cylinder_inertia,
     irb140_volumes,

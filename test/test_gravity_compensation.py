@@ -44,9 +44,9 @@ def stamp(msg) -> int:
 
 
 def test_gravity_compensation_holds_the_arm(probe, process):  # noqa: F811
-    process("irb140_dynamics.sim_node", *MODEL_ARGS, "-p", f"initial_positions:={POSE}",
+    process("irb140_dynamics.nodes.sim_node.node", *MODEL_ARGS, "-p", f"initial_positions:={POSE}",
             "-p", f"reset_hold:={HOLD}")
-    process("irb140_dynamics.id_node", *MODEL_ARGS, "-p", "effort_commands.enabled:=true",
+    process("irb140_dynamics.nodes.id_node.node", *MODEL_ARGS, "-p", "effort_commands.enabled:=true",
             "-p", "effort_commands.source:=gravity")
     states = []
     probe.create_subscription(JointState, "joint_states", states.append, 1000)

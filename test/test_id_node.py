@@ -12,7 +12,7 @@ from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from irb140_dynamics.core import RobotModel, gravity, irb140, rnea
-from irb140_dynamics.id_node import IdNode
+from irb140_dynamics.nodes.id_node.node import IdNode
 
 from .ros_harness import running
 

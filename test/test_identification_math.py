@@ -8,7 +8,7 @@ import yaml
 from scipy.signal import freqz, savgol_filter
 
 from irb140_dynamics.core import RigidBody, RobotModel, irb140, rnea_batch
-from irb140_dynamics.core.model import read_parameter_file
+from irb140_dynamics.core.model.robot_model import read_parameter_file
 from irb140_dynamics.core.regressor import inertial_parameters, parameters_body, regressor_batch
 from irb140_dynamics.identification.base import find_base_parameters, random_states
 from irb140_dynamics.identification.consistent import (
@@ -20,8 +20,8 @@ from irb140_dynamics.identification.consistent import (
     parameters_of,
     pseudo_inertia,
 )
-from irb140_dynamics.identification.estimation import NormalEquations, weighted_least_squares
-from irb140_dynamics.identification.files import joint_trajectory_text, parameter_file_text, yaml_float
+from irb140_dynamics.identification.least_squares import NormalEquations, weighted_least_squares
+from irb140_dynamics.core.io.params_file import joint_trajectory_text, parameter_file_text, yaml_float
 from irb140_dynamics.identification.recording import RawChunk
 from irb140_dynamics.identification.signals import POLYORDER, Differentiator, FilterDesign
 

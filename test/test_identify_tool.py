@@ -17,7 +17,7 @@ import yaml
 from rosbags.typesys import Stores, get_typestore
 
 from irb140_dynamics.core import RobotModel, irb140, rnea, rnea_batch
-from irb140_dynamics.core.model import read_parameter_file
+from irb140_dynamics.core.model.robot_model import read_parameter_file
 from irb140_dynamics.core.regressor import inertial_parameters
 from irb140_dynamics.identification.base import find_base_parameters
 from irb140_dynamics.identification.consistent import is_consistent
@@ -149,7 +149,7 @@ def test_plots_are_written(workflow):
 def test_id_node_publishes_the_identified_torques(workflow, identified):
     from sensor_msgs.msg import JointState
 
-    from irb140_dynamics.id_node import IdNode
+    from irb140_dynamics.nodes.id_node.node import IdNode
 
     from .ros_harness import running
 
@@ -169,7 +169,7 @@ def test_id_node_publishes_the_identified_torques(workflow, identified):
 
 
 def test_payload_check_node_starts_on_the_identified_file(workflow, identified):
-    from irb140_dynamics.payload_check_node import PayloadCheckNode
+    from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
 
     from .ros_harness import running
 

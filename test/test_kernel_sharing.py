@@ -4,7 +4,7 @@ and gravity are an argument, only their zeros folded), with the same numbers as 
 import numpy as np
 
 from irb140_dynamics.core import RigidBody, RobotModel, gravity, irb140, mass_matrix, rnea
-from irb140_dynamics.core import kernels as kernel_module
+from irb140_dynamics.core.codegen import kernels as kernel_module
 
 from .support import OFFSET_PAYLOAD, random_model, random_states
 

@@ -12,11 +12,11 @@ from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
-from irb140_dynamics import id_node as id_module
-from irb140_dynamics import payload_check_node as payload_module
+from irb140_dynamics.nodes.id_node import node as id_module
+from irb140_dynamics.nodes.payload_check_node import node as payload_module
 from irb140_dynamics.core import RigidBody, gravity, irb140
-from irb140_dynamics.id_node import IdNode
-from irb140_dynamics.payload_check_node import PayloadCheckNode
+from irb140_dynamics.nodes.id_node.node import IdNode
+from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
 
 from .ros_harness import TIMEOUT, running
 

@@ -18,8 +18,8 @@ from irb140_dynamics.core import (
     mass_matrix,
     rnea,
 )
-from irb140_dynamics.core.model import read_parameter_file
-from irb140_dynamics.identification.files import nested
+from irb140_dynamics.core.model.robot_model import read_parameter_file
+from irb140_dynamics.core.io.params_file import nested
 
 from .support import OFFSET_PAYLOAD, random_model, random_rotation
 
@@ -278,7 +278,7 @@ def test_a_model_at_the_caps_stays_finite():
 
 
 def test_a_payload_change_reuses_the_validated_joints_and_links(monkeypatch):
-    from irb140_dynamics.core import joints as joints_module
+    from irb140_dynamics.core.model import joints as joints_module
 
     params = irb140_params()
     first = RobotModel.from_params(params)

@@ -14,7 +14,7 @@ import pytest
 from irb140_dynamics.core import Friction, forward_dynamics, gravity, irb140, mass_matrix, rnea
 from irb140_dynamics.sim.mjcf import MINIMAL_INERTIA, mjcf, mujoco_model
 
-from irb140_dynamics.core.urdf import load_urdf
+from irb140_dynamics.core.io.urdf import load_urdf
 
 from .support import OFFSET_PAYLOAD, assert_close, loaded_irb140, random_model, random_states, random_urdf_model
 from .urdf_support import ARMS, arm_text

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import Friction, RigidBody, coriolis_matrix, gravity, irb140, mass_matrix, rnea
-from irb140_dynamics.core.observer import MomentumObserver, monitor_terms
+from irb140_dynamics.core.monitoring.observer import MomentumObserver, monitor_terms
 
 from .support import random_urdf_model
 

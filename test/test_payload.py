@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import ModelError, RigidBody, RobotModel, gravity, gravity_batch, irb140, rnea
-from irb140_dynamics.core.payload import (
+from irb140_dynamics.core.payload.limits import (
     RTOL,
     check_payload,
     derive_torque_limits,
@@ -16,7 +16,7 @@ from irb140_dynamics.core.payload import (
     payload_family,
     workspace_load,
 )
-from irb140_dynamics.core.workspace import harmonic_argmax, quasi_random
+from irb140_dynamics.core.payload.workspace import harmonic_argmax, quasi_random
 
 STRETCHED = [0.0, -math.pi / 2, math.pi / 2, 0.0, 0.0, 0.0]
 SIX_KG = [0.0, 290.765, 105.348, 0.0, 6.25594, 0.0]  # report eq. 57
@@ -241,7 +241,7 @@ def test_payload_family_takes_the_payload_as_validated(model, limits, monkeypatc
 def test_the_payload_sits_on_the_model_s_flange(model, limits):
     """A flange 0.1 m out along z: a payload at its origin loads the arm as one 0.1 m out
     on the last link (the payload's models keep the flange)."""
-    from irb140_dynamics.core.joints import Placement
+    from irb140_dynamics.core.model.joints import Placement
 
     flanged = replace(model, flange=Placement(xyz=(0.0, 0.0, 0.1)))
     here = max_payload_at(flanged, RigidBody(2.0), limits, STATES[1][0], STATES[1][1])

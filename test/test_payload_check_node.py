@@ -13,8 +13,8 @@ from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import RigidBody, irb140, rnea, workspace_load
-from irb140_dynamics import payload_check_node as module
-from irb140_dynamics.payload_check_node import PayloadCheckNode
+from irb140_dynamics.nodes.payload_check_node import node as module
+from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
 
 from .ros_harness import running
 

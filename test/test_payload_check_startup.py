@@ -5,7 +5,7 @@ import pytest
 from .node_process import module_command, run_to_exit, run_until_ready
 from .paths import CONFIG
 
-PAYLOAD_CHECK_NODE = "irb140_dynamics.payload_check_node"
+PAYLOAD_CHECK_NODE = "irb140_dynamics.nodes.payload_check_node.node"
 
 
 def test_starts_with_the_defaults_and_stops_cleanly_on_ctrl_c():

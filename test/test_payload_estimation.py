@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import Friction, RigidBody, gravity, irb140, rnea
-from irb140_dynamics.core.payload_estimation import (
+from irb140_dynamics.core.payload.mass_com_estimation import (
     EstimationError,
     RestDetector,
     RestSample,

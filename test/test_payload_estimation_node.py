@@ -9,8 +9,8 @@ from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import rnea
-from irb140_dynamics.payload_check_node import PayloadCheckNode
-from irb140_dynamics.ros import estimation
+from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
+from irb140_dynamics.nodes.payload_check_node import payload_estimator as estimation
 
 from .ros_harness import running
 from .test_payload_estimation import PAYLOAD, WRIST_POSES, arm, peak_torque, rest_velocities

@@ -6,7 +6,7 @@ import re
 import pytest
 
 from irb140_dynamics.core import RigidBody
-from irb140_dynamics.core.payload import check_payload, workspace_load
+from irb140_dynamics.core.payload.limits import check_payload, workspace_load
 
 from .test_payload import STATES, STRETCHED, limits, model  # noqa: F401  (fixtures)
 

@@ -63,7 +63,7 @@ def process():
 
 
 def test_id_node_process_computes_and_takes_a_parameter_change(probe, process):
-    process("irb140_dynamics.id_node")
+    process("irb140_dynamics.nodes.id_node.node")
     received = []
     probe.create_subscription(JointState, "gravity_torques", received.append, 10)
     joint_states = probe.create_publisher(JointState, "joint_states", 10)
@@ -83,7 +83,7 @@ def test_id_node_process_computes_and_takes_a_parameter_change(probe, process):
 
 
 def test_payload_check_node_process_answers_check(probe, process):
-    process("irb140_dynamics.payload_check_node", "-p", "payload.mass:=7.0")
+    process("irb140_dynamics.nodes.payload_check_node.node", "-p", "payload.mass:=7.0")
     client = probe.create_client(Trigger, "/payload_check_node/check")
     assert client.wait_for_service(timeout_sec=TIMEOUT)
     future = client.call_async(Trigger.Request())

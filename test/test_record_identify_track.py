@@ -11,7 +11,7 @@ from irb140_dynamics.core import irb140
 from irb140_dynamics.identification.excitation import optimise_excitation
 from irb140_dynamics.identification.pipeline import identify
 
-from irb140_dynamics.core.trajectory import computed_torque
+from irb140_dynamics.core.trajectories.reference import computed_torque
 from irb140_dynamics.sim.engine import SimulatedArm
 
 from .synthetic_arm import Samples, joint_state_messages, write_bag

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import RigidBody, gravity, irb140, load_model, rnea
-from irb140_dynamics.core.model import read_parameter_file
+from irb140_dynamics.core.model.robot_model import read_parameter_file
 
 from .paths import CONFIG
 

@@ -37,10 +37,10 @@ from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from irb140_dynamics.core import irb140, load_model
-from irb140_dynamics.core.trajectory import computed_torque
-from irb140_dynamics.demo_node import reference_message
-from irb140_dynamics.ros.messages import JointOrder, read_trajectory
-from irb140_dynamics.ros.tracking import DEFAULT_KD, DEFAULT_KP
+from irb140_dynamics.core.trajectories.reference import computed_torque
+from irb140_dynamics.nodes.demo_node.node import reference_message
+from irb140_dynamics.ros.messages.joint_messages import JointOrder, read_trajectory
+from irb140_dynamics.nodes.id_node.tracking import DEFAULT_KD, DEFAULT_KP
 
 from .node_process import interrupt, module_command, run_to_exit, start, wait_for_line
 from .paths import ROOT
@@ -203,8 +203,8 @@ def test_identified_from_a_ros_recording_tracks_five_times_better(probe, process
     assert code == 0, output
     excitation = trajectory_message(excitation_file)
     start_pose = list(excitation.points[0].positions)  # where the recording starts: no motion to get there
-    sim = processes(module_command("irb140_dynamics.sim_node", *SIM, "-p", f"initial_positions:={start_pose}"))
-    controller = processes(module_command("irb140_dynamics.id_node", *CONTROLLER))
+    sim = processes(module_command("irb140_dynamics.nodes.sim_node.node", *SIM, "-p", f"initial_positions:={start_pose}"))
+    controller = processes(module_command("irb140_dynamics.nodes.id_node.node", *CONTROLLER))
     recorder = processes(tool("record", "--out", str(bag), "--ros-args", "-p", "use_sim_time:=true"))
     loop = Loop(probe)
     lines = []
@@ -224,7 +224,7 @@ def test_identified_from_a_ros_recording_tracks_five_times_better(probe, process
     output, _ = identify.communicate(timeout=4 * TIMEOUT)
     assert identify.returncode == 0, output
     interrupt(controller)
-    processes(module_command("irb140_dynamics.id_node", *CONTROLLER, "--params-file", str(identified)))
+    processes(module_command("irb140_dynamics.nodes.id_node.node", *CONTROLLER, "--params-file", str(identified)))
     after, checked_after = loop.check_lockstep(load_model(identified), demo, loop.move(demo, TRACKED))
     assert sim.poll() is None
 

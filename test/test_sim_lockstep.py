@@ -14,7 +14,7 @@ from std_srvs.srv import Trigger
 from irb140_dynamics.core import irb140
 from irb140_dynamics.sim.engine import SimulatedArm
 from irb140_dynamics.sim.lockstep import TICKS, LockstepClock
-from irb140_dynamics.sim_node import SimNode
+from irb140_dynamics.nodes.sim_node.node import SimNode
 
 from .ros_harness import running
 from .test_sim_node import POSE, make, stamp

@@ -12,8 +12,8 @@ from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import RigidBody, gravity, irb140
-from irb140_dynamics import sim_node
-from irb140_dynamics.sim_node import SimNode
+from irb140_dynamics.nodes.sim_node import node as sim_node
+from irb140_dynamics.nodes.sim_node.node import SimNode
 
 from .ros_harness import running
 

@@ -2,7 +2,7 @@
 
 from .node_process import module_command, one_fatal_line, run_to_exit, run_until_ready
 
-SIM_NODE = "irb140_dynamics.sim_node"
+SIM_NODE = "irb140_dynamics.nodes.sim_node.node"
 
 
 def test_starts_with_the_default_model_and_stops_cleanly_on_ctrl_c():

@@ -5,8 +5,8 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, String
 
 from irb140_dynamics.core import gravity
-from irb140_dynamics.core.urdf import load_urdf
-from irb140_dynamics.sim_node import SimNode
+from irb140_dynamics.core.io.urdf import load_urdf
+from irb140_dynamics.nodes.sim_node.node import SimNode
 
 from .paths import URDF_DATA
 from .ros_harness import running

@@ -8,7 +8,7 @@ import pytest
 from .node_process import module_command, run_to_exit, run_until_ready
 from .paths import CONFIG
 
-ID_NODE = "irb140_dynamics.id_node"
+ID_NODE = "irb140_dynamics.nodes.id_node.node"
 
 
 def test_starts_with_the_default_model_and_stops_cleanly_on_ctrl_c():
@@ -31,7 +31,7 @@ def test_ctrl_c_inside_a_callback_stops_cleanly():
 CTRL_C_AS_A_FLAG = """
 import os, signal, time
 import rclpy
-from irb140_dynamics.ros.spin import ctrl_c_as_a_flag
+from irb140_dynamics.ros.runtime.spin import ctrl_c_as_a_flag
 rclpy.init()
 with ctrl_c_as_a_flag() as interrupted:
     os.kill(os.getpid(), signal.SIGINT)

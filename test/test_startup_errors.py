@@ -14,8 +14,8 @@ from .node_process import module_command, one_fatal_line, run_to_exit, run_until
 from .paths import CONFIG, ROOT
 from .support import random_model
 
-ID_NODE = "irb140_dynamics.id_node"
-PAYLOAD_CHECK_NODE = "irb140_dynamics.payload_check_node"
+ID_NODE = "irb140_dynamics.nodes.id_node.node"
+PAYLOAD_CHECK_NODE = "irb140_dynamics.nodes.payload_check_node.node"
 
 
 def params_file(tmp_path, parameters: dict, name="params.yaml") -> str:

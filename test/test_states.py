@@ -29,8 +29,8 @@ from irb140_dynamics.core import (
     rnea_batch,
     workspace_load,
 )
-from irb140_dynamics.core.rigid_body import MAX_MASS
-from irb140_dynamics.core.states import state
+from irb140_dynamics.core.model.rigid_body import MAX_MASS
+from irb140_dynamics.core.model.states import state
 
 MODEL = irb140()
 GOOD = [0.1, -0.2, 0.3, 0.4, -0.5, 0.6]

@@ -12,8 +12,8 @@ from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from irb140_dynamics.core import irb140, rnea
-from irb140_dynamics.core.trajectory import computed_torque
-from irb140_dynamics.id_node import IdNode
+from irb140_dynamics.core.trajectories.reference import computed_torque
+from irb140_dynamics.nodes.id_node.node import IdNode
 
 from .ros_harness import running
 

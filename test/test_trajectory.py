@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import forward_dynamics, irb140
-from irb140_dynamics.core.trajectory import Trajectory, computed_torque
+from irb140_dynamics.core.trajectories.reference import Trajectory, computed_torque
 
 
 def test_sampling_interpolates_and_holds():

@@ -9,10 +9,10 @@ import pinocchio as pin
 import pytest
 
 from irb140_dynamics.core import gravity, irb140, load_model, mass_matrix, rnea
-from irb140_dynamics.core.geometry import IRB140_SHAPES, Cylinder, box_inertia
-from irb140_dynamics.core.joints import rpy_matrix
-from irb140_dynamics.core.urdf import export_urdf, load_urdf
-from irb140_dynamics.core.urdf.writer import inertia_box
+from irb140_dynamics.core.model.irb140 import IRB140_SHAPES, Cylinder, box_inertia
+from irb140_dynamics.core.model.joints import rpy_matrix
+from irb140_dynamics.core.io.urdf import export_urdf, load_urdf
+from irb140_dynamics.core.io.urdf.writer import inertia_box
 from irb140_dynamics.tools.export_urdf import urdf_of
 
 from .node_process import run_to_exit

@@ -9,7 +9,7 @@ import pinocchio as pin
 import pytest
 
 from irb140_dynamics.core import flange_pose, gravity, mass_matrix, rnea
-from irb140_dynamics.core.urdf import CONTINUOUS_LIMITS, load_urdf
+from irb140_dynamics.core.io.urdf import CONTINUOUS_LIMITS, load_urdf
 
 from .support import OFFSET_PAYLOAD, assert_close, random_states
 from .urdf_support import ARMS, arm_text, full_mass_matrix, pinocchio_of, pinocchio_rnea, random_urdf

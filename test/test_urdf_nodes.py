@@ -15,9 +15,9 @@ from std_msgs.msg import String
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import RigidBody, gravity
-from irb140_dynamics.id_node import IdNode
-from irb140_dynamics.payload_check_node import PayloadCheckNode
-from irb140_dynamics.ros.model_source import DESCRIPTION_QOS
+from irb140_dynamics.nodes.id_node.node import IdNode
+from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
+from irb140_dynamics.ros.parameters.model_source import DESCRIPTION_QOS
 
 from .paths import URDF_DATA
 from .ros_harness import Harness, running

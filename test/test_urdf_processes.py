@@ -25,7 +25,7 @@ def test_robot_description_from_a_params_file(tmp_path, probe, process):  # noqa
     text, tip = arm_text("panda"), ARMS["panda"][1]
     params = tmp_path / "panda.yaml"
     params.write_text(PARAMS.format(tip=tip, urdf=textwrap.indent(text, " " * 6)))
-    process("irb140_dynamics.id_node", "--params-file", str(params))
+    process("irb140_dynamics.nodes.id_node.node", "--params-file", str(params))
     received = []
     probe.create_subscription(JointState, "gravity_torques", received.append, 10)
     joint_states = probe.create_publisher(JointState, "joint_states", 10)
@@ -39,7 +39,7 @@ def test_bad_urdf_file_stops_startup_with_one_line(tmp_path):
     bad = tmp_path / "bad.urdf"
     bad.write_text(arm_text("ur5").replace('type="revolute"', 'type="prismatic"', 1))
     args = ["-p", "model.source:=robot_description", "-p", f"model.urdf_file:={bad}", "-p", "model.tip_link:=tool0"]
-    code, output = run_to_exit(module_command("irb140_dynamics.id_node", *args))
+    code, output = run_to_exit(module_command("irb140_dynamics.nodes.id_node.node", *args))
     assert code == 1 and "Traceback" not in output, output
     [fatal] = [line for line in output.splitlines() if "cannot start" in line]
     assert f'model.urdf_file {bad}: URDF joint "shoulder_pan_joint": a prismatic joint' in fatal, output

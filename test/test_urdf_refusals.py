@@ -3,7 +3,7 @@
 import pytest
 
 from irb140_dynamics.core import ModelError
-from irb140_dynamics.core.urdf import UrdfError, load_urdf
+from irb140_dynamics.core.io.urdf import UrdfError, load_urdf
 
 LIMIT = '<limit lower="-1" upper="1" effort="10" velocity="1"/>'
 ARM = f"""<robot name="arm">

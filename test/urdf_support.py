@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from irb140_dynamics.core.urdf import load_urdf
+from irb140_dynamics.core.io.urdf import load_urdf
 
 from .paths import URDF_DATA
 from .pinocchio_model import spatial_inertia

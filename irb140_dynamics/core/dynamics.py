@@ -23,8 +23,8 @@ from typing import Sequence
 
 import numpy as np
 
-from .model import RobotModel
-from .states import finite_result, finite_results, state, states
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.model.states import finite_result, finite_results, state, states
 
 ArrayLike = Sequence[float] | np.ndarray
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .algorithms import (
+from irb140_dynamics.core.algorithms.recursions import (
     Link,
     add,
     cross,
@@ -28,10 +28,10 @@ from .algorithms import (
     rotate,
     turns,
 )
-from .states import state, states
-from .joints import Friction
-from .model import RobotModel
-from .rigid_body import ModelError, RigidBody, inertia_matrix
+from irb140_dynamics.core.model.states import state, states
+from irb140_dynamics.core.model.joints import Friction
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, inertia_matrix
 
 _CHUNK = 4096  # states per pass of the kernel (its buffers then stay in the CPU caches)
 

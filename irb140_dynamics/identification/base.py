@@ -24,8 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import qr
 
-from ..core.model import RobotModel
-from ..core.regressor import parameter_names, regressor_batch
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.regressor import parameter_names, regressor_batch
 
 RANK_TOLERANCE = 1e-8  # |R_ii| of unit-norm columns below this: dependent
 DEFAULT_STATES = 400

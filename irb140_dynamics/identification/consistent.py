@@ -33,10 +33,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..core.model import RobotModel
-from ..core.regressor import inertial_parameters, with_inertial_parameters
-from .base import BaseParameters
-from .estimation import Estimate
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.regressor import inertial_parameters, with_inertial_parameters
+from irb140_dynamics.identification.base import BaseParameters
+from irb140_dynamics.identification.least_squares import Estimate
 
 PRIOR_SPREAD = 0.5
 FRICTION_SPREAD = (10.0, 10.0, 1.0)  # viscous N m s/rad, Coulomb N m, armature kg m^2

@@ -26,9 +26,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize
 
-from ..core.model import RobotModel
-from ..core.regressor import regressor_batch
-from .base import BaseParameters, find_base_parameters
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.regressor import regressor_batch
+from irb140_dynamics.identification.base import BaseParameters, find_base_parameters
 
 DEFAULT_PERIOD = 10.0  # s
 DEFAULT_HARMONICS = 5

@@ -18,13 +18,13 @@ from typing import Callable
 
 import numpy as np
 
-from ..core.model import RobotModel
-from ..core.regressor import inertial_parameters, regressor_batch
-from .base import BaseParameters, find_base_parameters
-from .consistent import ConsistentFit, consistent_parameters
-from .estimation import Estimate, NormalEquations, weighted_least_squares
-from .recording import CHUNK_SIZE, DEFAULT_TOPIC, Recording, RecordingError
-from .signals import DEFAULT_CUTOFF, Differentiator, FilterDesign, FitPoints, _joined
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.regressor import inertial_parameters, regressor_batch
+from irb140_dynamics.identification.base import BaseParameters, find_base_parameters
+from irb140_dynamics.identification.consistent import ConsistentFit, consistent_parameters
+from irb140_dynamics.identification.least_squares import Estimate, NormalEquations, weighted_least_squares
+from irb140_dynamics.identification.recording import CHUNK_SIZE, DEFAULT_TOPIC, Recording, RecordingError
+from irb140_dynamics.identification.signals import DEFAULT_CUTOFF, Differentiator, FilterDesign, FitPoints, _joined
 
 SLOW_SPEEDS = 3.0  # min_speed in smoothing velocities
 FIT_BATCH = 8192  # fit points gathered before the regressor and the sums run: few, large array operations

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.regressor import inertial_parameters, regressor_batch
-from .pipeline import Result
+from irb140_dynamics.core.regressor import inertial_parameters, regressor_batch
+from irb140_dynamics.identification.pipeline import Result
 
 
 def write_plots(result: Result, directory) -> list[Path]:

@@ -24,7 +24,7 @@ from typing import Iterator
 
 import numpy as np
 
-from ..core.joint_order import BadMessage, JointOrder
+from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
 DEFAULT_TOPIC = "/joint_states"

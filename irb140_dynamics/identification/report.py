@@ -6,8 +6,8 @@ from datetime import datetime, timezone
 
 import numpy as np
 
-from .files import parameter_file_text
-from .pipeline import Result, Tally
+from irb140_dynamics.core.io.params_file import parameter_file_text
+from irb140_dynamics.identification.pipeline import Result, Tally
 
 LARGE_DEVIATION = 3.0  # standard deviations
 

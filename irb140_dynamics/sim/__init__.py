@@ -1,6 +1,6 @@
 """The simulated arm: a RobotModel as a MuJoCo model, stepped under applied torques. No ROS here."""
 
-from .engine import SimulatedArm
-from .mjcf import mjcf, mujoco_model
+from irb140_dynamics.sim.engine import SimulatedArm
+from irb140_dynamics.sim.mjcf import mjcf, mujoco_model
 
 __all__ = ["SimulatedArm", "mjcf", "mujoco_model"]

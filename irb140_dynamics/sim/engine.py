@@ -15,8 +15,8 @@ import math
 import mujoco
 import numpy as np
 
-from ..core.model import RobotModel
-from .mjcf import mujoco_model
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.sim.mjcf import mujoco_model
 
 
 # 4th order: at 1 kHz a 0.5 s free fall of the IRB-140 through 2.7 rad stays within 1e-8 rad of

@@ -6,8 +6,8 @@ import sys
 import time
 from pathlib import Path
 
-from ..core.model import RobotModel, load_model
-from ..package_files import default_config_path
+from irb140_dynamics.core.model.robot_model import RobotModel, load_model
+from irb140_dynamics.package_files import default_config_path
 
 
 class ToolError(Exception):

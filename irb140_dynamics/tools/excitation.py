@@ -16,16 +16,16 @@ import sys
 
 import numpy as np
 
-from ..identification.base import find_base_parameters
-from ..identification.excitation import (
+from irb140_dynamics.identification.base import find_base_parameters
+from irb140_dynamics.identification.excitation import (
     DEFAULT_HARMONICS,
     DEFAULT_MARGIN,
     DEFAULT_PERIOD,
     check_limits,
     optimise_excitation,
 )
-from ..identification.files import joint_trajectory_text, write_text
-from .common import ToolError, prior_model, run
+from irb140_dynamics.core.io.params_file import joint_trajectory_text, write_text
+from irb140_dynamics.tools.common import ToolError, prior_model, run
 
 SHELL_ARGUMENT_LIMIT = 128 * 1024  # bytes: Linux's MAX_ARG_STRLEN
 

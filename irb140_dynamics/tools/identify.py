@@ -15,12 +15,12 @@ import argparse
 import shlex
 import sys
 
-from ..identification.files import write_text
-from ..identification.pipeline import Settings, identify
-from ..identification.recording import DEFAULT_TOPIC
-from ..identification.report import identified_file, summary
-from ..identification.signals import DEFAULT_CUTOFF
-from .common import ProgressBar, prior_model, run
+from irb140_dynamics.core.io.params_file import write_text
+from irb140_dynamics.identification.pipeline import Settings, identify
+from irb140_dynamics.identification.recording import DEFAULT_TOPIC
+from irb140_dynamics.identification.report import identified_file, summary
+from irb140_dynamics.identification.signals import DEFAULT_CUTOFF
+from irb140_dynamics.tools.common import ProgressBar, prior_model, run
 
 
 def parser() -> argparse.ArgumentParser:
@@ -59,7 +59,7 @@ def main(argv=None) -> int:
         write_text(args.out, identified_file(result, command))
         print(f"wrote {args.out}")
         if args.plots:
-            from ..identification.plots import write_plots
+            from irb140_dynamics.identification.plots import write_plots
 
             for path in write_plots(result, args.plots):
                 print(f"wrote {path}")

@@ -16,9 +16,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..identification.recording import DEFAULT_TOPIC
-from ..ros.recorder import DEFAULT_DEPTH, Recorder
-from ..ros.spin import run, tool_arguments
+from irb140_dynamics.identification.recording import DEFAULT_TOPIC
+from irb140_dynamics.ros.recorder import DEFAULT_DEPTH, Recorder
+from irb140_dynamics.ros.runtime.spin import run, tool_arguments
 
 
 def parser() -> argparse.ArgumentParser:
