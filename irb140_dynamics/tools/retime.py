@@ -22,13 +22,14 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import sys
 from pathlib import Path
 
 import yaml
 
 from ..core import RigidBody, RobotModel, read_parameter_file
+from ..core.io.atomic import write_files
+from ..core.io.trajectory_file import joint_trajectory_yaml, read_joint_trajectory
 from ..core.trajectories import Trajectory, TrajectoryError, check_trajectory, retime, trajectory_limits
 from .common import ToolError, run
 
@@ -101,38 +102,17 @@ def _with_urdf(params: dict, urdf: str) -> dict:
 
 def read_trajectory(path: str, model: RobotModel) -> Trajectory:
     try:
-        with open(path) as stream:
-            document = next((d for d in yaml.safe_load_all(stream) if d is not None), None)
-    except OSError as error:
-        raise ToolError(f"{path}: cannot read: {error.strerror}") from None
-    except yaml.YAMLError as error:
-        raise ToolError(f"{path}: not YAML: {str(error).splitlines()[0]}") from None
-    try:
-        return Trajectory.from_message(document, model.joint_names)
+        return Trajectory.from_message(read_joint_trajectory(path), model.joint_names)
     except TrajectoryError as error:
         raise ToolError(f"{path}: {error}") from None
 
 
 def write_all(files: dict[str, bytes]) -> None:
-    """Write every file whole or none: each to a temporary file in its folder, fsync'ed,
-    then all renamed."""
-    temporary = {}
+    """Every file whole or none (see ``write_files``)."""
     try:
-        for path, data in files.items():
-            target = Path(path)
-            tmp = target.with_name(f".{target.name}.tmp{os.getpid()}")
-            with open(tmp, "wb") as stream:
-                temporary[path] = tmp
-                stream.write(data)
-                stream.flush()
-                os.fsync(stream.fileno())
-        for path, tmp in temporary.items():
-            os.replace(tmp, path)
+        write_files(files)
     except OSError as error:
         raise ToolError(f"{error.filename}: cannot write: {error.strerror}") from None
-    finally:
-        for tmp in temporary.values():
-            Path(tmp).unlink(missing_ok=True)
 
 
 def report_text(title: str, report) -> str:
@@ -167,11 +147,7 @@ def main(argv=None) -> int:
         except TrajectoryError as error:
             raise ToolError(f"{args.input}: {error}") from None
         after = check_trajectory(model, result.trajectory, limits)
-        files = {
-            args.output: yaml.safe_dump(
-                result.trajectory.to_message(), sort_keys=False, default_flow_style=None, width=10**6
-            ).encode()
-        }
+        files = {args.output: joint_trajectory_yaml(result.trajectory.to_message()).encode()}
         if args.plot:
             files[args.plot] = _plot(model, limits, tr, result.trajectory)
         write_all(files)

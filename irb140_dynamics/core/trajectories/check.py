@@ -20,8 +20,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..dynamics import rnea_batch
-from ..model import RobotModel
+from irb140_dynamics.core.dynamics import rnea_batch
+from irb140_dynamics.core.model.robot_model import RobotModel
+
 from .interpolation import Spline, sample_times, spline
 from .limits import Limits, trajectory_limits
 from .message import Trajectory

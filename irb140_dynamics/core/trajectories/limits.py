@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import RobotModel
-from ..payload import derive_torque_limits
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.payload import derive_torque_limits
 
 
 @dataclass(frozen=True, eq=False)

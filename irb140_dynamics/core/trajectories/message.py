@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-NANO = 1_000_000_000
+from irb140_dynamics.core.io.stamps import NANOSECONDS_PER_SECOND, sec_nanosec, seconds
 
 
 class TrajectoryError(ValueError):
@@ -96,13 +96,13 @@ class Trajectory:
         """The ``ros2 topic echo`` mapping: positions, velocities and accelerations where given."""
         points = []
         for k in range(len(self.t)):
-            ns = round(self.t[k] * NANO)
+            sec, nanosec = sec_nanosec(self.t[k])
             point = {
                 "positions": self.q[k].tolist(),
                 "velocities": self.qd[k].tolist() if self.has_qd[k] else [],
                 "accelerations": self.qdd[k].tolist() if self.has_qdd[k] else [],
                 "effort": [],
-                "time_from_start": {"sec": ns // NANO, "nanosec": ns % NANO},
+                "time_from_start": {"sec": sec, "nanosec": nanosec},
             }
             points.append(point)
         return {
@@ -131,9 +131,12 @@ def _time(value, k: int) -> float:
     if not isinstance(value, dict) or not {"sec", "nanosec"} <= value.keys():
         raise TrajectoryError(f"point {k}: time_from_start must be {{sec, nanosec}}")
     sec, nanosec = value["sec"], value["nanosec"]
-    if not all(isinstance(x, int) and not isinstance(x, bool) for x in (sec, nanosec)) or not 0 <= nanosec < NANO:
+    if (
+        not all(isinstance(x, int) and not isinstance(x, bool) for x in (sec, nanosec))
+        or not 0 <= nanosec < NANOSECONDS_PER_SECOND
+    ):
         raise TrajectoryError(f"point {k}: time_from_start {{sec: {sec}, nanosec: {nanosec}}} is not a duration")
-    return sec + nanosec / NANO
+    return seconds(sec, nanosec)
 
 
 def _values(point: dict, field: str, k: int, names: list, required: bool) -> np.ndarray | None:

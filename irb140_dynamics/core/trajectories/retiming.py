@@ -41,8 +41,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..dynamics import gravity_batch, rnea_batch
-from ..model import RobotModel
+from irb140_dynamics.core.dynamics import gravity_batch, rnea_batch
+from irb140_dynamics.core.model.robot_model import RobotModel
+
 from .check import profiles
 from .interpolation import sample_times, spline
 from .limits import Limits, trajectory_limits
@@ -103,7 +104,8 @@ def retime(
     floor = _static_share(model, pg, dyn, limits)
     x0 = None
     worst, used = np.inf, 0
-    for used in range(1, rounds + 1):
+    while used < rounds:
+        used += 1
         x, u = _profile(model, pg, dyn, limits, factor, x0, floor)
         out, _ = _output(pg, x, u, tr, accelerations)
         ratio = _ratios(model, out, limits, verify)

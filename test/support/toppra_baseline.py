@@ -12,18 +12,15 @@ within every limit ("at 0 violations").
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 import toppra
 import toppra.algorithm as algo
 from toppra import constraint
 
-import irb140_dynamics.core.trajectories.retime  # noqa: F401  (the module, not the function)
 from irb140_dynamics.core.dynamics import rnea
+from irb140_dynamics.core.trajectories import retiming as retime_module
 from irb140_dynamics.core.trajectories.path import PathGrid
 
-retime_module = sys.modules["irb140_dynamics.core.trajectories.retime"]
 toppra.setup_logging("WARNING")
 FINITE = 1e9  # stands for "no limit": toppra wants numbers
 

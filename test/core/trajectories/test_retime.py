@@ -9,8 +9,8 @@ from irb140_dynamics.core import RigidBody, irb140, rnea
 from irb140_dynamics.core.trajectories import Trajectory, TrajectoryError, retime, trajectory_limits
 from irb140_dynamics.core.urdf import load_urdf
 
-from .paths import ROOT
-from .trajectory_support import limit_use, path_distance, smooth_trajectory, with_friction
+from ...support.paths import ROOT
+from ...support.trajectories import limit_use, path_distance, smooth_trajectory, with_friction
 
 Q0 = np.array([0.0, -0.3, 0.5, 0.0, 0.3, 0.0])
 AMPLITUDE = np.array([1.5, 0.6, 0.7, 2.0, 1.2, 2.5])
@@ -75,7 +75,7 @@ def test_with_accelerations_the_quintic_playback_keeps_every_limit_too():
 @pytest.mark.slow
 @pytest.mark.parametrize("payload", [0.0, 6.0])
 def test_as_fast_as_toppra_at_zero_violations(payload):
-    from .toppra_baseline import toppra_within_limits
+    from ...support.toppra_baseline import toppra_within_limits
 
     model = irb140().with_payload(RigidBody(payload))
     tr = smooth_trajectory(model.joint_names, Q0, AMPLITUDE, points=100, duration=10.0)

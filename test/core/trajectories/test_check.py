@@ -7,7 +7,7 @@ from irb140_dynamics.core import RigidBody, derive_torque_limits, irb140, rnea
 from irb140_dynamics.core.trajectories import Trajectory, check_trajectory, trajectory_limits
 from irb140_dynamics.core.trajectories.interpolation import spline
 
-from .trajectory_support import smooth_trajectory, with_friction
+from ...support.trajectories import smooth_trajectory, with_friction
 
 Q0 = np.array([0.0, -0.3, 0.5, 0.0, 0.3, 0.0])
 AMPLITUDE = np.array([1.5, 0.6, 0.7, 2.0, 1.2, 2.5])
