@@ -37,6 +37,7 @@ def _write(path, message):
     return str(path)
 
 
+@pytest.mark.slow  # the first re-timing compiles the kernels; the plot imports matplotlib
 def test_retime_writes_the_retimed_trajectory_and_the_plot(tmp_path, capsys):
     tr, message = _message()
     source = _write(tmp_path / "in.yaml", message)
