@@ -50,11 +50,19 @@ class Spline:
         t = np.asarray(t, dtype=float)
         seg = self.segment_of(t) if segment is None else np.asarray(segment)
         tau = np.clip(t - self.t0[seg], 0.0, self.T[seg])
-        c = self.c[seg]
-        powers = tau[:, None] ** np.arange(6)
-        return tuple(
-            np.einsum("nk,nkj->nj", powers[:, : 6 - d] * _FALLING[d, d:], c[:, d:, :]) for d in range(order + 1)
-        )
+        top = int(self.degree.max())
+        c = self.c[seg, : top + 1]
+        tau = tau[:, None]
+        out = []
+        for d in range(order + 1):  # Horner on the d-th derivative
+            if d > top:
+                out.append(np.zeros((len(t), c.shape[2])))
+                continue
+            value = c[:, top] * _FALLING[d, top]
+            for k in range(top - 1, d - 1, -1):
+                value = value * tau + c[:, k] * _FALLING[d, k]
+            out.append(value)
+        return tuple(out)
 
 
 _FALLING = np.array([[np.prod(np.arange(k - d + 1, k + 1)) for k in range(6)] for d in range(3)], dtype=float)
@@ -94,13 +102,16 @@ def spline(tr: Trajectory, start=None) -> Spline:
     return Spline(t[:-1], T, c, first[:-1], degree)
 
 
-def sample_times(sp: Spline, per_segment: int, max_step: float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Times (and their segments) covering every segment evenly, ends included: at least
-    ``per_segment`` intervals per segment and none longer than ``max_step`` [s]."""
-    m = np.full(len(sp.T), per_segment)
+def sample_times(sp: Spline, per_segment: int, max_step: float | None = None, segments=None):
+    """Times (and their segments) covering every segment (or those in ``segments``) evenly,
+    ends included: at least ``per_segment`` intervals per segment and none longer than
+    ``max_step`` [s]."""
+    index = np.arange(len(sp.T)) if segments is None else np.asarray(segments, dtype=int)
+    m = np.full(len(index), per_segment)
     if max_step:
-        m = np.maximum(m, np.ceil(sp.T / max_step).astype(int))
-    seg = np.repeat(np.arange(len(sp.T)), m + 1)
+        m = np.maximum(m, np.ceil(sp.T[index] / max_step).astype(int))
+    which = np.repeat(np.arange(len(index)), m + 1)
     first = np.repeat(np.r_[0, np.cumsum(m + 1)[:-1]], m + 1)
-    frac = (np.arange(len(seg)) - first) / m[seg]
+    frac = (np.arange(len(which)) - first) / m[which]
+    seg = index[which]
     return sp.t0[seg] + frac * sp.T[seg], seg

@@ -82,7 +82,7 @@ def path_grid(tr: Trajectory, steps: np.ndarray) -> PathGrid:
     return PathGrid(s, sigma, q, q1, q2, stops, point, knot)
 
 
-def _equal_lengths(sp, steps, fine: int = 8) -> np.ndarray:
+def _equal_lengths(sp, steps, fine: int = 4) -> np.ndarray:
     """Input times splitting each segment k into steps[k] steps of about equal path length
     (the first steps[k] of the steps[k] + 1 ends of each, all segments in a row)."""
     m = np.asarray(steps)

@@ -56,6 +56,7 @@ VERIFY = 10  # samples per output interval when verifying
 ROUNDS = 12  # verification rounds at most
 SHRINK = 0.999  # limits lowered a little more than the excess, so that a round ends it
 MARGIN = 0.995  # the limits' share the first round uses: between grid points they may be exceeded a little
+REACH = 2  # grid points on which an interval's playback depends, either side (the quintic's u: 2)
 WINDOW = 1  # grid points either side of an interval over a limit lowered with it
 
 
@@ -102,17 +103,26 @@ def retime(
     _refuse_static(model, pg, dyn, limits, tr)
     factor = np.full(len(pg.s), MARGIN)
     floor = _static_share(model, pg, dyn, limits)
-    x0 = None
+    x0 = previous = ratio = solved = solved_factor = None
     worst, used = np.inf, 0
     while used < rounds:
         used += 1
-        x, u = _profile(model, pg, dyn, limits, factor, x0, floor)
+        if solved is None:  # the first round, or the one with the friction's tangents at x
+            x, u, solved = _profile(model, pg, dyn, limits, factor, x0, floor)
+        else:  # only where the limits were lowered
+            changed = np.flatnonzero(factor != solved_factor)
+            x, u, solved = _profile(model, pg, dyn, limits, factor, x0, floor, solved, changed)
+        solved_factor = factor.copy()
         out, _ = _output(pg, x, u, tr, accelerations)
-        ratio = _ratios(model, out, limits, verify)
+        again = _changed(x, previous)  # an interval whose ends kept their x plays as before
+        fresh = _ratios(model, out, limits, verify, again)
+        ratio = fresh if again is None else np.where(np.isin(np.arange(len(fresh)), again), fresh, ratio)
+        previous = x
         worst = float(ratio.max())
         if worst <= 1.0 and (x0 is not None or model.friction is None):
             break
-        x0 = x
+        if x0 is None and model.friction is not None:
+            x0, solved = x, None  # the viscous friction's tangents at this profile: every row changes
         shrink = np.ones(len(pg.s))
         for i in np.flatnonzero(ratio > 1.0):  # the interval's points and WINDOW either side
             lo, hi = max(i - WINDOW, 0), min(i + 1 + WINDOW, len(shrink) - 1)
@@ -189,7 +199,7 @@ def _rows(model, pg, dyn, limits, factor, x0, X, floor):
     return alpha, beta, gamma
 
 
-def _profile(model, pg, dyn, limits, factor, x0, floor):
+def _profile(model, pg, dyn, limits, factor, x0, floor, warm=None, changed=None):
     """x, u on the grid with the limits times ``factor``; the viscous friction's tangent at x0."""
     V = limits.velocity[None, :] * factor[:, None]
     speed = np.abs(pg.q1[1])
@@ -200,7 +210,8 @@ def _profile(model, pg, dyn, limits, factor, x0, floor):
         X = np.where(np.isfinite(X), X, 4.0 * max_velocity_curve(*free, np.minimum(X, 1e12)))
     X = np.minimum(X, 1e12)
     x0 = X if x0 is None else x0
-    return topp(*_rows(model, pg, dyn, limits, factor, np.minimum(x0, X), X, floor), X, pg.delta, pg.stops)
+    rows = _rows(model, pg, dyn, limits, factor, np.minimum(x0, X), X, floor)
+    return topp(*rows, X, pg.delta, pg.stops, warm, changed)
 
 
 def _output(pg: PathGrid, x, u, tr: Trajectory, accelerations: bool = False) -> tuple[Trajectory, np.ndarray]:
@@ -229,15 +240,27 @@ def _output(pg: PathGrid, x, u, tr: Trajectory, accelerations: bool = False) -> 
     return Trajectory.of(tr.joint_names, t, pg.q, qd, qdd), t
 
 
-def _ratios(model, out: Trajectory, limits: Limits, verify: int) -> np.ndarray:
-    """The largest value / limit per output interval on ``verify`` samples each."""
+def _ratios(model, out: Trajectory, limits: Limits, verify: int, segments=None) -> np.ndarray:
+    """The largest value / limit per output interval (of those in ``segments``; 0 for the
+    others) on ``verify`` samples each."""
     sp = spline(out)
-    t, seg = sample_times(sp, verify)
+    t, seg = sample_times(sp, verify, segments=segments)
+    out_r = np.zeros(len(sp.T))
+    if len(t) == 0:
+        return out_r
     values = profiles(model, sp, t, seg)
     r = np.zeros(len(t))
     for name in ("torque", "velocity", "acceleration"):
-        with np.errstate(divide="ignore", invalid="ignore"):
-            r = np.maximum(r, np.nan_to_num(np.abs(values[name]) / getattr(limits, name), nan=0.0).max(axis=1))
-    out_r = np.zeros(len(sp.T))
-    np.maximum.at(out_r, seg, r)
+        inverse = 1.0 / getattr(limits, name)  # 0 where there is no limit
+        r = np.maximum(r, (np.abs(values[name]) * inverse).max(axis=1))
+    out_r[seg[:: verify + 1]] = r.reshape(-1, verify + 1).max(axis=1)  # verify + 1 samples a segment
     return out_r
+
+
+def _changed(x, previous) -> np.ndarray | None:
+    """The output intervals whose playback may differ from the previous round's: those with
+    a point within REACH of a grid point whose x changed (None: all)."""
+    if previous is None:
+        return None
+    moved = np.convolve((x != previous).astype(float), np.ones(2 * REACH + 1), mode="same") > 0
+    return np.flatnonzero(moved[:-1] | moved[1:])

@@ -18,6 +18,8 @@ optimal, Pham and Pham 2018, theorem 2).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 BIG = 1e300
@@ -42,39 +44,78 @@ def max_velocity_curve(alpha, beta, gamma, X) -> np.ndarray:
     return np.maximum(np.minimum(np.minimum(X, pair), alone), 0.0)
 
 
-def topp(alpha, beta, gamma, X, delta, stops) -> tuple[np.ndarray, np.ndarray]:
-    """x (N+1,) and u (N,) of the time-optimal profile from rest to rest; ``stops`` (N+1,)
-    forces x = 0 where True; delta (N,) the grid steps."""
-    A, B, up, low = _split(alpha, beta, gamma)
-    X = max_velocity_curve(alpha, beta, gamma, X)
+@dataclass
+class Profile:
+    """A solved grid: per point the cap on x, the backward and forward rows (lists, for
+    the loops), the controllable bounds k, and x, u; kept to solve again after a change."""
+
+    X: list
+    Q: list
+    invP: list
+    Au: list
+    Bu: list
+    k: list
+    x: list
+    u: list
+
+
+def topp(alpha, beta, gamma, X, delta, stops, warm: Profile | None = None, changed=None):
+    """x (N+1,), u (N,) of the time-optimal profile from rest to rest and its Profile;
+    ``stops`` (N+1,) forces x = 0 where True; delta (N,) the grid steps. With ``warm`` (the
+    profile before) and ``changed`` (the points whose rows changed; the others' rows as
+    before), only the part of the grid the change reaches is solved again."""
     N = len(delta)
-    # rows that can never be met at the next point's x >= 0 (too little deceleration) cap x
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        slope = B[:-1] - 1.0 / (2.0 * delta[:, None])
-        reach = np.where(up[:-1] & (slope > 0), A[:-1] / slope, np.inf).min(axis=1)
-    X = np.maximum(np.minimum(X, np.r_[reach, np.inf]), 0.0)
-    X[stops] = 0.0
+    points = np.arange(N + 1) if warm is None else np.unique(np.asarray(changed, dtype=int))
+    rows = _prepare(alpha[points], beta[points], gamma[points], X[points], np.r_[delta, 1.0][points], stops[points])
+    if warm is None:
+        p = Profile(*rows, k=[0.0] * (N + 1), x=[0.0] * (N + 1), u=[0.0] * N)
+        lo, hi = 0, N
+    else:
+        p = Profile(*(list(v) for v in (warm.X, warm.Q, warm.invP, warm.Au, warm.Bu, warm.k, warm.x, warm.u)))
+        for i, *values in zip(points.tolist(), *rows):
+            for field, value in zip((p.X, p.Q, p.invP, p.Au, p.Bu), values):
+                field[i] = value
+        lo, hi = int(points[0]), int(points[-1])
     # backward: x (1 - 2 delta B_q) <= k - 2 delta A_q for every lower row q with 1 - 2 delta B_q > 0
-    P = 1.0 - 2.0 * delta[:, None] * B[:-1]
-    use = low[:-1] & (P > 0)
-    Q = np.where(use, 2.0 * delta[:, None] * A[:-1], -BIG)  # unused rows: (k + BIG) * 1
-    invP = 1.0 / np.where(use, P, 1.0)
-    Q, invP = (_first(v, use).tolist() for v in (Q, invP))
-    Xl = X.tolist()
-    k = [0.0] * (N + 1)
-    for i in range(N - 1, -1, -1):
+    k, Q, invP, Xl = p.k, p.Q, p.invP, p.X
+    first_k = hi + 1
+    for i in range(min(hi, N - 1), -1, -1):
         nxt = k[i + 1]
-        k[i] = max(min(Xl[i], min([(nxt - q) * p for q, p in zip(Q[i], invP[i])])), 0.0)
+        value = max(min(Xl[i], min([(nxt - q) * w for q, w in zip(Q[i], invP[i])])), 0.0)
+        if value == k[i] and i < lo and warm is not None:
+            break
+        k[i], first_k = value, i
     # forward: the largest u, x_i+1 within K_i+1
-    Au, Bu = (_first(v, up).tolist() for v in (np.where(up, A, BIG), np.where(up, B, 0.0)))  # unused: BIG
-    dl = delta.tolist()
-    x, u = [0.0] * (N + 1), [0.0] * N
-    for i in range(N):
+    x, u, Au, Bu, dl = p.x, p.u, p.Au, p.Bu, delta.tolist()
+    last = hi if warm is None else max(hi, lo)
+    for i in range(max(min(lo, first_k) - 1, 0), N):
         xi, two = x[i], 2.0 * dl[i]
         umax = min([a - b * xi for a, b in zip(Au[i], Bu[i])])
         nxt = min(max(xi + two * min(umax, (k[i + 1] - xi) / two), 0.0), k[i + 1])
+        same = nxt == x[i + 1]
         x[i + 1], u[i] = nxt, (nxt - xi) / two
-    return np.array(x), np.array(u)
+        if same and i >= last and warm is not None:
+            break
+    return np.array(x), np.array(u), p
+
+
+def _prepare(alpha, beta, gamma, X, delta, stops):
+    """Per point: the cap on x (the max velocity curve and the rows that cannot decelerate
+    enough to reach x >= 0), the backward rows (Q, 1/P) and the upper rows (A, B) as lists;
+    ``delta`` each point's step ahead (any number for the last point)."""
+    A, B, up, low = _split(alpha, beta, gamma)
+    X = max_velocity_curve(alpha, beta, gamma, X)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        slope = B - 1.0 / (2.0 * delta[:, None])
+        reach = np.where(up & (slope > 0), A / slope, np.inf).min(axis=1)
+    X = np.maximum(np.minimum(X, reach), 0.0)
+    X[stops] = 0.0
+    P = 1.0 - 2.0 * delta[:, None] * B
+    use = low & (P > 0)
+    Q = np.where(use, 2.0 * delta[:, None] * A, -BIG)  # unused rows: (k + BIG) * 1
+    invP = 1.0 / np.where(use, P, 1.0)
+    Au, Bu = np.where(up, A, BIG), np.where(up, B, 0.0)  # unused rows: BIG
+    return (X.tolist(), *(_first(v, use).tolist() for v in (Q, invP)), *(_first(v, up).tolist() for v in (Au, Bu)))
 
 
 def _first(values, used):

@@ -97,3 +97,25 @@ def test_a_pose_no_timing_can_hold_is_refused_with_joint_point_and_amount():
     limit = trajectory_limits(model).torque[joint]
     held = max(abs(rnea(model, q, np.zeros(6), np.zeros(6))[joint]) for q in tr.q)
     assert held > limit
+
+
+def test_solving_again_after_a_local_change_gives_the_full_solution():
+    from irb140_dynamics.core.trajectories import retiming
+
+    model = irb140().with_payload(RigidBody(6.0))
+    tr = smooth_trajectory(model.joint_names, Q0, AMPLITUDE, points=40, duration=6.0)
+    limits = trajectory_limits(model)
+    pg = retime(model, tr, limits, grid=400).grid
+    dyn = retiming._dynamics(model, pg)
+    floor = retiming._static_share(model, pg, dyn, limits)
+    factor = np.ones(len(pg.s))
+    _, _, before = retiming._profile(model, pg, dyn, limits, factor, None, floor)
+    for where in (5, 150, len(pg.s) - 3):  # near the start, inside, near the end
+        lowered = factor.copy()
+        lowered[where - 2 : where + 2] = 0.9
+        changed = np.flatnonzero(lowered != factor)
+        x, u, _ = retiming._profile(model, pg, dyn, limits, lowered, None, floor, before, changed)
+        x_full, u_full, _ = retiming._profile(model, pg, dyn, limits, lowered, None, floor)
+        np.testing.assert_array_equal(x, x_full)
+        np.testing.assert_array_equal(u, u_full)
+        assert not np.array_equal(x, before.x)  # the change mattered
