@@ -139,8 +139,8 @@ def _velocity_steps(sp: Spline):
     if len(sp.T) < 2:
         return None
     k = np.arange(1, len(sp.T))
-    _, left, _ = sp.evaluate(sp.t0[k], k - 1, order=1) + (None,)
-    _, right, _ = sp.evaluate(sp.t0[k], k, order=1) + (None,)
+    left = sp.evaluate(sp.t0[k], k - 1, order=1)[1]
+    right = sp.evaluate(sp.t0[k], k, order=1)[1]
     step = np.abs(right - left)
     if step.max() <= 1e-9 * (1.0 + np.abs(left).max()):
         return None

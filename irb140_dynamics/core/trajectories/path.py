@@ -121,8 +121,8 @@ def _unit_derivatives(sp, sigma, seg):
 
 
 def _lengths(sp, sigma, seg) -> np.ndarray:
-    """Path length of each grid step (Gauss-Legendre, 5 nodes, on the step's segment)."""
-    nodes, weights = np.polynomial.legendre.leggauss(5)
+    """Path length of each grid step (Gauss-Legendre, 3 nodes, on the step's segment)."""
+    nodes, weights = np.polynomial.legendre.leggauss(3)
     h = np.diff(sigma)
     s0 = seg[:-1]
     total = np.zeros(len(h))

@@ -30,9 +30,7 @@ def max_velocity_curve(alpha, beta, gamma, X) -> np.ndarray:
     (N+1, R) -> (N+1,). An upper row p and a lower row q (on u) agree iff
     A_p - B_p x >= A_q - B_q x, linear in x; rows with alpha 0 bound x alone."""
     A, B, up, low = _split(alpha, beta, gamma)
-    half = max(int(up.sum(axis=1).max()), int(low.sum(axis=1).max()), 1)
-    pu = np.argsort(~up, axis=1, kind="stable")[:, :half]  # each point's upper rows first
-    pl = np.argsort(~low, axis=1, kind="stable")[:, :half]
+    pu, pl = _first(up), _first(low)  # each point's upper (lower) rows first
     take = np.take_along_axis
     Au, Bu, mu = take(A, pu, 1), take(B, pu, 1), take(up, pu, 1)
     Al, Bl, ml = take(A, pl, 1), take(B, pl, 1), take(low, pl, 1)
@@ -115,14 +113,15 @@ def _prepare(alpha, beta, gamma, X, delta, stops):
     Q = np.where(use, 2.0 * delta[:, None] * A, -BIG)  # unused rows: (k + BIG) * 1
     invP = 1.0 / np.where(use, P, 1.0)
     Au, Bu = np.where(up, A, BIG), np.where(up, B, 0.0)  # unused rows: BIG
-    return (X.tolist(), *(_first(v, use).tolist() for v in (Q, invP)), *(_first(v, up).tolist() for v in (Au, Bu)))
+    back, ahead = _first(use), _first(up)
+    take = np.take_along_axis
+    return (X.tolist(), *(take(v, back, 1).tolist() for v in (Q, invP)), *(take(v, ahead, 1).tolist() for v in (Au, Bu)))
 
 
-def _first(values, used):
-    """Each row's used entries first, the rest cut as far as no row needs them."""
+def _first(used) -> np.ndarray:
+    """Column indices putting each row's used entries first, cut as far as no row needs more."""
     width = max(int(used.sum(axis=1).max()), 1)
-    order = np.argsort(~used, axis=1, kind="stable")[:, :width]
-    return np.take_along_axis(values, order, 1)
+    return np.argsort(~used, axis=1, kind="stable")[:, :width]
 
 
 def _split(alpha, beta, gamma):
