@@ -115,7 +115,11 @@ def _prepare(alpha, beta, gamma, X, delta, stops):
     Au, Bu = np.where(up, A, BIG), np.where(up, B, 0.0)  # unused rows: BIG
     back, ahead = _first(use), _first(up)
     take = np.take_along_axis
-    return (X.tolist(), *(take(v, back, 1).tolist() for v in (Q, invP)), *(take(v, ahead, 1).tolist() for v in (Au, Bu)))
+    return (
+        X.tolist(),
+        *(take(v, back, 1).tolist() for v in (Q, invP)),
+        *(take(v, ahead, 1).tolist() for v in (Au, Bu)),
+    )
 
 
 def _first(used) -> np.ndarray:
