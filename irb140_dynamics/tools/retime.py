@@ -1,7 +1,7 @@
 """retime: check a JointTrajectory against the arm's limits, or re-time it time-optimally.
 
-    retime --params-file F [--urdf U] [--payload-mass M] IN.yaml OUT.yaml [--plot P.png]
-    retime --check-only --params-file F [--urdf U] [--payload-mass M] IN.yaml [--plot P.png]
+    retime --params-file F [--urdf U [--tip-link L]] [--payload-mass M] IN.yaml OUT.yaml [--plot P.png]
+    retime --check-only --params-file F [--urdf U [--tip-link L]] [--payload-mass M] IN.yaml [--plot P.png]
 
 IN.yaml: a trajectory_msgs/JointTrajectory as ``ros2 topic echo --once`` prints it (header,
 joint_names, points with positions, velocities, accelerations, effort, time_from_start
@@ -53,6 +53,8 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("output", metavar="OUT.yaml", nargs="?", help="the re-timed JointTrajectory to write")
     p.add_argument("--params-file", required=True, metavar="F", help="the model's parameter file")
     p.add_argument("--urdf", metavar="U", help="take the kinematics and inertials from this URDF")
+    p.add_argument("--base-link", help="the URDF link the chain starts from (default: the root)")
+    p.add_argument("--tip-link", help="the URDF link the chain ends at, the payload's frame (default: the only leaf)")
     p.add_argument("--payload-mass", type=float, metavar="KG", help="payload at the flange origin (default: F's)")
     p.add_argument("--check-only", action="store_true", help="only check IN.yaml; write nothing but --plot")
     p.add_argument("--plot", metavar="P.png", help="per joint the use of each limit over time, before and after")
@@ -65,7 +67,7 @@ def parser() -> argparse.ArgumentParser:
     return p
 
 
-def model_of(params_file: str, urdf: str | None, payload_mass: float | None) -> RobotModel:
+def model_of(params_file: str, urdf: str | None, payload_mass: float | None, chain=(None, None)) -> RobotModel:
     """The model of the params file, or of the URDF with the file's limits and friction."""
     path = Path(params_file)
     if not path.is_file():
@@ -73,7 +75,7 @@ def model_of(params_file: str, urdf: str | None, payload_mass: float | None) -> 
     try:
         params = read_parameter_file(path)
         if urdf is not None:
-            params = _with_urdf(params, urdf)
+            params = _with_urdf(params, urdf, chain)
         model = RobotModel.from_params(params)
     except (ValueError, OSError, yaml.YAMLError) as error:
         raise ToolError(f"{urdf or path}: {str(error).splitlines()[0]}") from None
@@ -87,14 +89,14 @@ def model_of(params_file: str, urdf: str | None, payload_mass: float | None) -> 
     return model
 
 
-def _with_urdf(params: dict, urdf: str) -> dict:
+def _with_urdf(params: dict, urdf: str, chain) -> dict:
     from ..core.urdf import load_urdf
 
     try:
         text = Path(urdf).read_text()
     except OSError as error:
         raise ToolError(f"{urdf}: cannot read: {error.strerror}") from None
-    model = load_urdf(text).model
+    model = load_urdf(text, *chain).model
     own = {f"{name}.{field}" for name in model.joint_names for field in _URDF_FIELDS}
     kept = {k: v for k, v in params.items() if k in own or k in _GLOBAL or k.startswith("payload.")}
     return {**model.to_params(), **kept}
@@ -132,7 +134,7 @@ def main(argv=None) -> int:
     def body() -> int:
         if not args.check_only and not args.output:
             raise ToolError("OUT.yaml: missing (or give --check-only)")
-        model = model_of(args.params_file, args.urdf, args.payload_mass)
+        model = model_of(args.params_file, args.urdf, args.payload_mass, (args.base_link, args.tip_link))
         tr = read_trajectory(args.input, model)
         limits = trajectory_limits(model)
         notes = _torque_notes(model, limits)

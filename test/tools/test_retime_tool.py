@@ -119,3 +119,19 @@ def test_runs_as_a_module_without_ros(tmp_path):
     done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "out.yaml").exists()
+
+
+def test_a_urdf_arm_with_the_params_files_globals(tmp_path, capsys):
+    from irb140_dynamics.core.urdf import load_urdf
+
+    urdf = ROOT / "test" / "data" / "urdf" / "ur5.urdf"
+    model = load_urdf(urdf.read_text(), tip_link="tool0").model
+    tr = smooth_trajectory(model.joint_names, np.array([0.0, -1.2, 1.0, -1.0, 0.5, 0.0]), np.full(6, 0.5), 12, 4.0)
+    source = _write(tmp_path / "in.yaml", tr.to_message())
+    out = tmp_path / "out.yaml"
+    args = ["--params-file", str(CONFIG), "--urdf", str(urdf), "--tip-link", "tool0", "--payload-mass", "3"]
+    assert main([*args, source, str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "re-timed:" in printed and "within every limit" in printed and "derived" not in printed  # URDF efforts
+    result = Trajectory.from_message(yaml.safe_load(out.read_text()), model.joint_names)
+    assert result.duration < tr.duration
