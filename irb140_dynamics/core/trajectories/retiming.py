@@ -53,7 +53,7 @@ from .topp import max_velocity_curve, topp
 
 GRID = 1000  # grid steps over the path, about
 VERIFY = 10  # samples per output interval when verifying
-ROUNDS = 12  # verification rounds at most
+ROUNDS = 20  # verification rounds at most
 SHRINK = 0.999  # limits lowered a little more than the excess, so that a round ends it
 MARGIN = 0.995  # the limits' share the first round uses: between grid points they may be exceeded a little
 REACH = 2  # grid points on which an interval's playback depends, either side (the quintic's u: 2)
@@ -128,6 +128,11 @@ def retime(
             lo, hi = max(i - WINDOW, 0), min(i + 1 + WINDOW, len(shrink) - 1)
             shrink[lo : hi + 1] = np.minimum(shrink[lo : hi + 1], SHRINK / ratio[i])
         factor = factor * shrink
+    if worst > 1.0:
+        raise TrajectoryError(
+            f"no timing kept every limit between grid points within {rounds} rounds (worst: {100 * worst:.2f} % "
+            "of a limit): try a finer grid"
+        )
     return Retimed(out, pg, x, u, worst, used)
 
 
