@@ -79,9 +79,9 @@ class Retimed:
 
 @dataclass(frozen=True, eq=False)
 class _Dynamics:
-    a: np.ndarray  # (2, G+1, n)
-    b: np.ndarray
-    c: np.ndarray  # (G+1, n)
+    a: np.ndarray  # (G+1, n): M q'
+    b: np.ndarray  # M q'' + C(q, q') q'
+    c: np.ndarray  # g(q)
 
 
 def retime(
@@ -137,16 +137,12 @@ def retime(
 
 
 def _dynamics(model: RobotModel, pg: PathGrid) -> _Dynamics:
-    G1, n = pg.q.shape
+    """a, b, c at every grid point, with the path's derivatives on the step ahead (the right)."""
+    q1, q2 = pg.q1[1], pg.q2[1]
     c = gravity_batch(model, pg.q)
-    zero = np.zeros((G1, n))
-    a, b = np.empty((2, G1, n)), np.empty((2, G1, n))
-    for side in (1,):
-        q1, q2 = pg.q1[side], pg.q2[side]
-        a[side] = rnea_batch(model, pg.q, zero, q1) - c
-        tau = rnea_batch(model, pg.q, q1, q2) - c
-        b[side] = tau if model.friction is None else tau - model.friction.torques(q1)
-    return _Dynamics(a, b, c)
+    a = rnea_batch(model, pg.q, np.zeros_like(q1), q1) - c
+    tau = rnea_batch(model, pg.q, q1, q2) - c
+    return _Dynamics(a, tau if model.friction is None else tau - model.friction.torques(q1), c)
 
 
 def _refuse_static(model, pg, dyn, limits, tr) -> None:
@@ -173,35 +169,30 @@ def _static_share(model, pg, dyn, limits) -> np.ndarray:
 
 
 def _rows(model, pg, dyn, limits, factor, x0, X, floor):
-    """alpha, beta, gamma (G+1, R) of every limit at every grid point, both sides."""
+    """alpha, beta, gamma (G+1, R) of every limit at every grid point: u over the step ahead
+    (a point's left side, where the path's q'' jumps, is left to the verification)."""
     L = limits.torque[None, :] * np.maximum(factor, floor)[:, None]  # torque: never below holding the pose
     A = limits.acceleration[None, :] * factor[:, None]
-    rows = []
     viscous = np.array([j.friction.viscous for j in model.joints])
     coulomb = np.array([j.friction.coulomb for j in model.joints])
-    for side in (1,):  # the right side: the rows constrain u over the step ahead
-        q1, q2, a, b, c = pg.q1[side], pg.q2[side], dyn.a[side], dyn.b[side], dyn.c
-        sign, d = np.sign(q1), viscous * np.abs(q1)
-        root0 = np.sqrt(np.maximum(x0, 1e-12))[:, None]
-        t_slope, t_icpt = d / (2 * root0), d * root0 / 2
-        ch_slope = d / np.sqrt(np.maximum(X, 1e-300))[:, None]
-        hi_slope = np.where(sign > 0, t_slope, -ch_slope * (sign < 0))
-        near = np.stack([sign, np.r_[sign[:1], sign[:-1]], np.r_[sign[1:], sign[-1:]]])  # Coulomb flips
-        hi_icpt = np.where(sign > 0, t_icpt, 0.0) + coulomb * (near.max(axis=0) > 0)  # where q'_j does
-        lo_slope = np.where(sign < 0, -t_slope, ch_slope * (sign > 0))
-        lo_icpt = np.where(sign < 0, -t_icpt, 0.0) - coulomb * (near.min(axis=0) < 0)
-        finite = np.isfinite(L)
-        rows += [
-            (a * finite, (b + hi_slope) * finite, np.where(finite, L - c - hi_icpt, 0.0)),
-            (-a * finite, (-b - lo_slope) * finite, np.where(finite, L + c + lo_icpt, 0.0)),
-        ]
-        finite = np.isfinite(A)
-        rows += [
-            (q1 * finite, q2 * finite, np.where(finite, A, 0.0)),
-            (-q1 * finite, -q2 * finite, np.where(finite, A, 0.0)),
-        ]
-    alpha, beta, gamma = (np.concatenate([r[k] for r in rows], axis=1) for k in range(3))
-    return alpha, beta, gamma
+    q1, q2, a, b, c = pg.q1[1], pg.q2[1], dyn.a, dyn.b, dyn.c
+    sign, d = np.sign(q1), viscous * np.abs(q1)
+    root0 = np.sqrt(np.maximum(x0, 1e-12))[:, None]
+    t_slope, t_icpt = d / (2 * root0), d * root0 / 2  # viscous: the tangent at x0, above
+    ch_slope = d / np.sqrt(np.maximum(X, 1e-300))[:, None]  # and the chord over [0, X], below
+    near = np.stack([sign, np.r_[sign[:1], sign[:-1]], np.r_[sign[1:], sign[-1:]]])  # where q'_j flips, Coulomb
+    hi_slope = np.where(sign > 0, t_slope, -ch_slope * (sign < 0))
+    hi_icpt = np.where(sign > 0, t_icpt, 0.0) + coulomb * (near.max(axis=0) > 0)
+    lo_slope = np.where(sign < 0, -t_slope, ch_slope * (sign > 0))
+    lo_icpt = np.where(sign < 0, -t_icpt, 0.0) - coulomb * (near.min(axis=0) < 0)
+    torque, acceleration = np.isfinite(L), np.isfinite(A)
+    rows = [
+        (a * torque, (b + hi_slope) * torque, np.where(torque, L - c - hi_icpt, 0.0)),
+        (-a * torque, (-b - lo_slope) * torque, np.where(torque, L + c + lo_icpt, 0.0)),
+        (q1 * acceleration, q2 * acceleration, np.where(acceleration, A, 0.0)),
+        (-q1 * acceleration, -q2 * acceleration, np.where(acceleration, A, 0.0)),
+    ]
+    return tuple(np.concatenate([r[k] for r in rows], axis=1) for k in range(3))
 
 
 def _profile(model, pg, dyn, limits, factor, x0, floor, warm=None, changed=None):
