@@ -14,7 +14,8 @@ branch and bound of ``certify`` proves how far above them the true maxima can be
 gap; CERTIFY_RTOL of the torque when it closes, always within the budget of
 ``certify.EVALUATIONS`` box bounds per proof). Models beyond harmonic.MAX_JOINTS joints
 get plain interval bounds within the budget of ``certify.interval_maxima``. Proofs are
-remembered per payload mass and joint ranges, families per arm and payload shape.
+remembered per payload mass and joint ranges, families per arm and payload shape; a proof
+the analysis' deadline cut short (see ``stop``) is not remembered.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from irb140_dynamics.core.payload.proof.harmonic import StaticForms
 from irb140_dynamics.core.scalars.interval import Interval, bounds_of
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.model.rigid_body import RigidBody
+from irb140_dynamics.core.payload.stop import ran_out
 from irb140_dynamics.core.payload.workspace import JointRanges
 
 RTOL = 1e-9  # a torque within RTOL of its limit is within it
@@ -99,12 +101,15 @@ class PayloadFamily:
         ``share`` of the proof's budget; ``found``: (values, poses) of a search at m done."""
         rows = np.arange(2 * self.empty.n) if rows is None else np.asarray(rows, dtype=int)
         key = (float(m), ranges.lower.tobytes(), ranges.upper.tobytes(), rows.tobytes())
-        if key not in self._proven:
-            values, poses = self.search(m, ranges, sample_torques, warm) if found is None else found
+        if key in self._proven:
+            return self._proven[key]
+        values, poses = self.search(m, ranges, sample_torques, warm) if found is None else found
+        proven = self._prove(m, ranges, values, poses, rows, share)
+        if not ran_out():  # cut short by the deadline: not the proof the budget would give
             if len(self._proven) >= 8:
                 self._proven.pop(next(iter(self._proven)))
-            self._proven[key] = self._prove(m, ranges, values, poses, rows, share)
-        return self._proven[key]
+            self._proven[key] = proven
+        return proven
 
     @cached_property
     def _proven(self) -> dict:
