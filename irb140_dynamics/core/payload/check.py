@@ -138,24 +138,25 @@ class PayloadCheck:
         worst = np.maximum(now, np.abs(self.workspace.torque))
         j = int(np.argmax(np.where(self.beyond, worst / np.where(highest > 0, highest, 1e-300), -np.inf)))
         where = "now" if now[j] >= abs(self.workspace.torque[j]) else f"at {_degrees(self.workspace.pose[j])} deg"
-        text = (f"{self.joint_names[j]} needs {worst[j]:.3f} N m {where}, {_share(worst[j], highest[j])} "
-                f"of {_limit_text(self.limit[j], highest[j])}")
+        text = f"{self.joint_names[j]} needs {worst[j]:.3f} N m {where}, {_of_limit(worst[j], self.limit[j], highest[j])}"
         others = [name for name in self.over if name != self.joint_names[j]]
         return text + (f"; also over: {', '.join(others)}" if others else "")
 
     def _most_unproven(self) -> str:
-        """The unproven joint whose bound is furthest over its limit, the reason, and the
-        others unproven, in words."""
+        """The unproven joint whose bound is furthest over its limit (of those whose limit
+        is > 0, if any), the reason, and the others unproven, in words."""
         unproven = ~self.within & ~self.beyond
+        if (unproven & (self.limit > 0)).any():
+            unproven &= self.limit > 0
         j = int(np.argmax(np.where(unproven, self.worst_use, -np.inf)))
         name, load, limit, highest = self.joint_names[j], self.workspace, self.limit[j], self.limits.highest[j]
         found = abs(load.torque[j])
         if self.torque is not None and abs(self.torque[j]) > limit * (1 + RTOL):  # between the ends of its limit
-            text = f"{name} needs {abs(self.torque[j]):.3f} N m now, over {_limit_text(limit, highest)}"
+            text = f"{name} needs {abs(self.torque[j]):.3f} N m now, {_of_limit(abs(self.torque[j]), limit, highest)}"
         else:
-            text = (f"{name}'s worst static torque is proven only up to {load.bound[j]:.3f} N m "
-                    f"({_share(load.bound[j], limit)} of {_limit_text(limit, highest)}; "
-                    f"found {found:.3f} N m, {_share(found, limit)})")
+            share = f" ({100 * found / limit:.1f} %)" if 0 < limit < math.inf else ""
+            text = (f"{name}'s worst static torque is proven only up to {load.bound[j]:.3f} N m, "
+                    f"{_of_limit(load.bound[j], limit, highest)}; found {found:.3f} N m{share}")
         others = len(self.unproven) - 1
         more = f"; {others} more joint{'s' * (others > 1)} unproven" if others else ""
         return f"{text}: {self.unfinished}{more}"
@@ -205,7 +206,7 @@ class PayloadCheck:
         figures = {"payload mass [kg]": f"{self.payload.mass:.3f}", "payload com [m]": _vector(self.payload.com)}
         for where, best in (("here", self.max_payload_here), ("over the workspace", self.workspace.max_payload)):
             if best is not None:
-                mass, joint, pose = _max_payload_figures(best, self.joint_names)
+                mass, joint, pose = _max_payload_figures(best, self.joint_names, self.limits)
                 label = f"max payload {where}"
                 figures.update({f"{label} [kg]": mass, f"{label}: limited by": joint, f"{label}: pose [deg]": pose})
         figures["max payload over the workspace: gap [kg]"] = f"{self.workspace.max_payload.gap:.2g}"
@@ -297,9 +298,10 @@ def _percent_of(torque, limit):
         return 100 * np.asarray(torque, dtype=float) / limit
 
 
-def _share(torque: float, limit: float) -> str:
-    """torque as a share of a limit in words: "81.0 %" ("-" for a limit 0 or none)."""
-    return f"{100 * torque / limit:.1f} %" if 0 < limit < math.inf else "-"
+def _of_limit(torque: float, limit: float, highest: float) -> str:
+    """A torque against its limit in words: "110.2 % of its 6.256 N m limit"."""
+    share = f"{100 * torque / limit:.1f} % of " if 0 < limit < math.inf else "against "
+    return share + _limit_text(limit, highest)
 
 
 def _limit_text(limit: float, highest: float) -> str:
@@ -314,12 +316,14 @@ def _percent(use: float, L: float) -> str:
     return "-" if L == math.inf else f"{use:.1f}%"
 
 
-def _max_payload_figures(best: MaxPayload, names) -> tuple[str, str, str]:
-    """(mass [kg]: a number, "none" or "unbounded"; the joint at or over its limit; the
-    pose [deg]), "-" where there is none."""
+def _max_payload_figures(best: MaxPayload, names, limits: TorqueLimits) -> tuple[str, str, str]:
+    """(mass [kg]: a number, "none", "none proven" (over a derived limit the proof left
+    open) or "unbounded"; the joint at or over its limit; the pose [deg]), "-" where there
+    is none."""
     if best.mass == math.inf:
         return "unbounded", "-", "-"
-    mass = "none" if math.isnan(best.mass) else f"{best.mass:.3f}"
+    certain = limits.highest[best.joint] <= limits.values[best.joint] * (1 + RTOL)
+    mass = ("none" if certain else "none proven") if math.isnan(best.mass) else f"{best.mass:.3f}"
     return mass, names[best.joint], _degrees(best.q)
 
 
@@ -332,6 +336,8 @@ def _max_payload_text(figures: dict[str, str], where: str) -> str:
     at = f" at {pose} deg" if where != "here" else ""
     if mass == "unbounded":
         return mass
+    if mass == "none proven":
+        return f"none proven ({joint}{at}: its derived limit is known only up to a gap)"
     if mass == "none" and gap > 0:
         return f"none proven ({joint}{at}; the search found {gap:.3f} kg, the proof's budget ran out)"
     if mass == "none":
