@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from irb140_dynamics.core.model.rigid_body import RigidBody
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.payload.limits import (
     RATED_PAYLOAD,
@@ -33,7 +34,6 @@ from irb140_dynamics.core.payload.limits import (
     payload_family,
     workspace_load,
 )
-from irb140_dynamics.core.model.rigid_body import RigidBody
 from irb140_dynamics.core.payload.proof.harmonic import MAX_JOINTS
 
 VISIBLE = 5e-4  # N m or kg: a gap the report's 3 decimals would show is worth a note
@@ -86,7 +86,7 @@ class PayloadCheck:
 
     @property
     def verdict(self) -> str:
-        """"OVER-LIMIT", "OK" or "UNPROVEN" (see the module)."""
+        """ "OVER-LIMIT", "OK" or "UNPROVEN" (see the module)."""
         return "OVER-LIMIT" if self.beyond.any() else "OK" if self.within.all() else "UNPROVEN"
 
     @property
@@ -138,7 +138,9 @@ class PayloadCheck:
         worst = np.maximum(now, np.abs(self.workspace.torque))
         j = int(np.argmax(np.where(self.beyond, worst / np.where(highest > 0, highest, 1e-300), -np.inf)))
         where = "now" if now[j] >= abs(self.workspace.torque[j]) else f"at {_degrees(self.workspace.pose[j])} deg"
-        text = f"{self.joint_names[j]} needs {worst[j]:.3f} N m {where}, {_of_limit(worst[j], self.limit[j], highest[j])}"
+        text = (
+            f"{self.joint_names[j]} needs {worst[j]:.3f} N m {where}, {_of_limit(worst[j], self.limit[j], highest[j])}"
+        )
         others = [name for name in self.over if name != self.joint_names[j]]
         return text + (f"; also over: {', '.join(others)}" if others else "")
 
@@ -155,8 +157,10 @@ class PayloadCheck:
             text = f"{name} needs {abs(self.torque[j]):.3f} N m now, {_of_limit(abs(self.torque[j]), limit, highest)}"
         else:
             share = f" ({100 * found / limit:.1f} %)" if 0 < limit < math.inf else ""
-            text = (f"{name}'s worst static torque is proven only up to {load.bound[j]:.3f} N m, "
-                    f"{_of_limit(load.bound[j], limit, highest)}; found {found:.3f} N m{share}")
+            text = (
+                f"{name}'s worst static torque is proven only up to {load.bound[j]:.3f} N m, "
+                f"{_of_limit(load.bound[j], limit, highest)}; found {found:.3f} N m{share}"
+            )
         others = len(self.unproven) - 1
         more = f"; {others} more joint{'s' * (others > 1)} unproven" if others else ""
         return f"{text}: {self.unfinished}{more}"
@@ -175,14 +179,18 @@ class PayloadCheck:
     def no_limit_note(self, j: int) -> str:
         """Why joint j (of loaded_without_limit) wants a given torque limit."""
         name = self.joint_names[j]
-        return (f"{name} has no limit, yet this payload loads it ({self.workspace.torque[j]:.3f} N m "
-                f"in its worst pose): set {name}.torque_limit")
+        return (
+            f"{name} has no limit, yet this payload loads it ({self.workspace.torque[j]:.3f} N m "
+            f"in its worst pose): set {name}.torque_limit"
+        )
 
     def gap_note(self, j: int) -> str:
         """What the proof left open at joint j (of open_gaps)."""
         load = self.workspace
-        return (f"{self.joint_names[j]}: worst static torque proven only up to {load.bound[j]:.3f} N m "
-                f"(gap {load.gap[j]:.3g} N m: {self.unfinished})")
+        return (
+            f"{self.joint_names[j]}: worst static torque proven only up to {load.bound[j]:.3f} N m "
+            f"(gap {load.gap[j]:.3g} N m: {self.unfinished})"
+        )
 
     # -- the figures, formatted once for the report and /diagnostics --------------------
 
@@ -191,7 +199,7 @@ class PayloadCheck:
         L, load, now = self.limit[j], self.workspace, self.torque is not None
         return {
             "torque now [N m]": f"{self.torque[j]:.3f}" if now else "-",
-            "limit [N m]": "none" if L == math.inf else f"{L:.3f}",
+            "limit [N m]": "none" if math.inf == L else f"{L:.3f}",
             "use now": _percent(self.use[j], L) if now else "-",
             "worst static torque [N m]": f"{load.torque[j]:.3f}",
             "worst use": _percent(self.worst_use[j], L),
@@ -313,7 +321,7 @@ def _limit_text(limit: float, highest: float) -> str:
 
 
 def _percent(use: float, L: float) -> str:
-    return "-" if L == math.inf else f"{use:.1f}%"
+    return "-" if math.inf == L else f"{use:.1f}%"
 
 
 def _max_payload_figures(best: MaxPayload, names, limits: TorqueLimits) -> tuple[str, str, str]:

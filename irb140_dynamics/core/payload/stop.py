@@ -18,9 +18,9 @@ import contextvars
 import math
 import threading
 import time
+from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Iterator
 
 
 class Cancelled(Exception):
@@ -35,14 +35,12 @@ class Stop:
     cancel: threading.Event | None = None
     deadline: float = math.inf
     ran_out: bool = False
-    outer: "Stop | None" = None
+    outer: Stop | None = None
 
     def out_of_time(self) -> bool:
         if self.cancel is not None and self.cancel.is_set():
             raise Cancelled("the analysis was cancelled")
-        if self.outer is not None and self.outer.out_of_time():
-            self.ran_out = True
-        elif time.monotonic() > self.deadline:
+        if self.outer is not None and self.outer.out_of_time() or time.monotonic() > self.deadline:
             self.ran_out = True
         return self.ran_out
 

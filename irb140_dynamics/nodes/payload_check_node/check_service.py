@@ -13,7 +13,7 @@ nobody waits).
 from __future__ import annotations
 
 import time
-from typing import Callable
+from collections.abc import Callable
 
 from std_srvs.srv import Trigger
 
@@ -90,6 +90,8 @@ class CheckService:
 
 def _still_running(response, waited: float):
     response.success = False
-    response.message = (f"UNPROVEN: the analysis of the new parameters is still running (waited {waited:.1f} s, "
-                        f"{WAIT_PARAMETER}): ask again later")
+    response.message = (
+        f"UNPROVEN: the analysis of the new parameters is still running (waited {waited:.1f} s, "
+        f"{WAIT_PARAMETER}): ask again later"
+    )
     return response

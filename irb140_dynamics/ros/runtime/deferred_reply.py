@@ -13,7 +13,8 @@ object's ``send_response``, which is what this takes over.
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 
 class Later:

@@ -11,7 +11,7 @@ import math
 
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 
-from irb140_dynamics.core.payload.limits import PayloadCheck
+from irb140_dynamics.core.payload import PayloadCheck
 
 OK, WARN, ERROR = DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR
 
@@ -32,7 +32,10 @@ def payload_statuses(
         level, message = max(level, WARN), f"{message}; stale joint_states"
         figures["stale joint_states"] = stale
     summary = DiagnosticStatus(
-        level=level, name=f"{node_name}: payload", hardware_id=node_name, message=message,
+        level=level,
+        name=f"{node_name}: payload",
+        hardware_id=node_name,
+        message=message,
         values=_key_values(figures),
     )
     return statuses + [summary]
@@ -52,7 +55,9 @@ def _joint_status(check: PayloadCheck, j: int, node_name: str, warn_use: float) 
     else:
         level = WARN if j in check.loaded_without_limit else OK
     if not check.beyond[j] and not check.within[j]:
-        message = f"unproven: {figures[most]} of its {figures['limit [N m]']} N m limit by the bound ({check.unfinished})"
+        message = (
+            f"unproven: {figures[most]} of its {figures['limit [N m]']} N m limit by the bound ({check.unfinished})"
+        )
     elif math.isfinite(limit):
         message = f"{figures[most]} of its {figures['limit [N m]']} N m limit"
     elif level == WARN:
@@ -60,8 +65,11 @@ def _joint_status(check: PayloadCheck, j: int, node_name: str, warn_use: float) 
     else:
         message = figures["limit source"]
     return DiagnosticStatus(
-        level=level, name=f"{node_name}: {check.joint_names[j]}", hardware_id=node_name,
-        message=message, values=_key_values(figures),
+        level=level,
+        name=f"{node_name}: {check.joint_names[j]}",
+        hardware_id=node_name,
+        message=message,
+        values=_key_values(figures),
     )
 
 
