@@ -48,6 +48,11 @@ class Stop:
 _CURRENT: contextvars.ContextVar[Stop | None] = contextvars.ContextVar("payload_analysis_stop", default=None)
 
 
+def current_stop() -> Stop | None:
+    """The stop in force on this thread (None outside any ``stopping``)."""
+    return _CURRENT.get()
+
+
 def out_of_time() -> bool:
     """Raise Cancelled if this thread's analysis was cancelled; True once past its deadline."""
     stop = _CURRENT.get()
