@@ -6,7 +6,6 @@ new model."""
 
 import threading
 
-import pytest
 from rclpy.parameter import Parameter
 from std_msgs.msg import String
 from std_srvs.srv import Trigger
