@@ -6,6 +6,7 @@ new model."""
 
 import threading
 
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rclpy.parameter import Parameter
 from std_msgs.msg import String
 from std_srvs.srv import Trigger
@@ -41,8 +42,14 @@ def test_a_long_chain_whose_payload_fits_is_unproven_not_over_limit():
     its bound taken for a torque. 12 joints here: the interval bounds' budget is spent."""
     text = chain_urdf(12)
     with running(PayloadCheckNode, parameter_overrides=from_urdf(robot_description=text, payload__mass=3.0)) as harness:
+        diagnostics = harness.listen(DiagnosticArray, "/diagnostics")
         reply = check(harness)
+        assert harness.spin_until(lambda: diagnostics)  # published with each check
     lines = reply.message.splitlines()
+    statuses = {status.name.split(": ")[-1]: status for status in diagnostics[-1].status}
+    assert statuses["payload"].message == lines[0]
+    assert statuses["joint_2"].level == DiagnosticStatus.WARN  # not ERROR: nothing is proven over
+    assert statuses["joint_2"].message.startswith("unproven: ")
     assert not reply.success and lines[0].startswith("UNPROVEN: 3.000 kg not proven to fit: "), lines[0]
     assert lines[1] == "payload 3.000 kg at (0.000, 0.000, 0.000) m"
     assert len([line for line in lines if line.startswith("joint_")]) == 12

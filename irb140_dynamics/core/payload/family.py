@@ -103,8 +103,9 @@ class PayloadFamily:
         ``share`` of the proof's budget; ``found``: (values, poses) of a search at m done."""
         rows = np.arange(2 * self.empty.n) if rows is None else np.asarray(rows, dtype=int)
         key = (float(m), ranges.lower.tobytes(), ranges.upper.tobytes(), rows.tobytes())
-        if key in self._proven:
-            return self._proven[key]
+        proven = self._proven.get(key)  # (a family may serve several threads: no check-then-get)
+        if proven is not None:
+            return proven
         values, poses = self.search(m, ranges, sample_torques, warm) if found is None else found
         proven = self._prove(m, ranges, values, poses, rows, share)
         if not ran_out():  # cut short by the deadline: not the proof the budget would give

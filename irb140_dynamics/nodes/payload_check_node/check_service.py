@@ -17,6 +17,7 @@ from collections.abc import Callable
 
 from std_srvs.srv import Trigger
 
+from irb140_dynamics.core.errors import one_line
 from irb140_dynamics.ros.runtime.builder import STEADY
 from irb140_dynamics.ros.runtime.deferred_reply import DeferredService, Later
 from irb140_dynamics.ros.runtime.guard import guarded
@@ -27,7 +28,7 @@ WAIT_PARAMETER = "check.wait_timeout"
 
 def _internal_error(request, response, error):
     response.success = False
-    response.message = f"UNPROVEN: not checked: internal error {type(error).__name__}: {error}"
+    response.message = f"UNPROVEN: not checked: internal error {type(error).__name__}: {one_line(error)}"
     return response
 
 
