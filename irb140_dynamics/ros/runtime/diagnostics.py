@@ -56,7 +56,7 @@ def _joint_status(check: PayloadCheck, j: int, node_name: str, warn_use: float) 
         level = WARN if j in check.loaded_without_limit else OK
     if not check.beyond[j] and not check.within[j]:
         message = (
-            f"unproven: {figures[most]} of its {figures['limit [N m]']} N m limit by the bound ({check.unfinished})"
+            f"unproven: {figures[most]} of its {figures['limit [N m]']} N m limit by its bound: {check.unfinished}"
         )
     elif math.isfinite(limit):
         message = f"{figures[most]} of its {figures['limit [N m]']} N m limit"
