@@ -7,7 +7,7 @@ parameter services and the timers) and answered as soon as nothing is pending an
 for the parameters then in force; or, after ``check.wait_timeout`` seconds, with
 ``UNPROVEN: the analysis of the new parameters is still running ...``. Held requests are
 looked at every POLL_PERIOD by a timer on the steady clock (made once, cancelled while
-nobody waits).
+nobody waits); at most MAX_HELD at once.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from irb140_dynamics.ros.runtime.deferred_reply import DeferredService, Later
 from irb140_dynamics.ros.runtime.guard import guarded
 
 POLL_PERIOD = 0.01  # s: how soon a held request is answered once its analysis is in force
+MAX_HELD = 1000  # requests held at once; more are answered at once, as after the wait
 WAIT_PARAMETER = "check.wait_timeout"
 
 
@@ -54,7 +55,7 @@ class CheckService:
             return self._answer(request, response)
         wait = float(self._node.get_parameter(WAIT_PARAMETER).value)
         now = time.monotonic()
-        if wait <= 0.0:
+        if wait <= 0.0 or len(self._held) >= MAX_HELD:
             return _still_running(response, 0.0)
         later = Later()
         self._held.append((later, now, now + wait))
