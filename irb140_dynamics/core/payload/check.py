@@ -125,7 +125,7 @@ class PayloadCheck:
     def _most_used(self) -> str:
         """The joint nearest its limit (proven use), in words."""
         use = np.fmax(self.worst_use, -np.inf if self.use is None else self.use)
-        use = np.where(np.isfinite(self.limit), use, -np.inf)
+        use = np.where(np.isfinite(self.limit) & (self.limit > 0), use, -np.inf)  # (a limit 0 held: nothing used)
         if not np.isfinite(use).any():
             return "no joint it loads has a limit"
         j = int(np.argmax(use))
