@@ -308,7 +308,8 @@ class PayloadCheckNode(Node):
         return result, stale
 
     def _not_ready(self) -> str | None:
-        """None when the parameters in force have been analysed; else why ~/check cannot answer."""
+        """None when the parameters in force have been analysed; else why not (yet), for
+        /diagnostics and ~/check (which first waits while an analysis is pending)."""
         status = self.parameters.status()
         if status is None and self.settings is not None:
             return None
@@ -319,7 +320,7 @@ class PayloadCheckNode(Node):
             return "no model yet: waiting for a URDF on the robot_description topic"
         return (
             f"pending: the limits and workspace analysis of the new parameters are running "
-            f"(for {time.monotonic() - since:.1f} s); ask again shortly"
+            f"(for {time.monotonic() - since:.1f} s); ~/check waits for them"
         )
 
     def _publish(self, statuses) -> None:
