@@ -39,7 +39,7 @@ def parse_report(text: str) -> dict:
 
 
 def _number(text: str):
-    return None if text in ("-", "none") else float(text.rstrip("%"))
+    return None if text in ("-", "none") else float(text.removeprefix("<=").rstrip("%"))  # <=: of a bound
 
 
 @pytest.fixture

@@ -197,12 +197,15 @@ class PayloadCheck:
     def joint_figures(self, j: int) -> dict[str, str]:
         """Joint j's figures by label, in the order of the report's columns."""
         L, load, now = self.limit[j], self.workspace, self.torque is not None
+        worst_use = _percent(self.worst_use[j], L)  # of the bound: "<=" where it is not the torque found
+        if load.gap[j] >= VISIBLE and worst_use != "-":
+            worst_use = "<=" + worst_use
         return {
             "torque now [N m]": f"{self.torque[j]:.3f}" if now else "-",
             "limit [N m]": "none" if math.inf == L else f"{L:.3f}",
             "use now": _percent(self.use[j], L) if now else "-",
             "worst static torque [N m]": f"{load.torque[j]:.3f}",
-            "worst use": _percent(self.worst_use[j], L),
+            "worst use": worst_use,
             "worst pose [deg]": _degrees(load.pose[j]),
             "limit source": self.limits.reason(j),
             "worst static bound [N m]": f"{load.bound[j]:.3f}",
