@@ -40,6 +40,7 @@ def record(controller, excitation) -> Samples:
     return Samples(t, np.array(positions), np.array(velocities), efforts, efforts)
 
 
+@pytest.mark.slow
 def test_identification_from_the_simulated_arm_tracks_five_times_better(tmp_path):
     report = irb140()
     excitation = optimise_excitation(report, iterations=3, seed=2)
