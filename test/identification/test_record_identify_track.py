@@ -5,6 +5,7 @@ bag; `identify` fits the model to the recording; then the demo's (different) mot
 tracked with the report's model and with the identified one."""
 
 import numpy as np
+import pytest
 from rosbags.typesys import Stores, get_typestore
 
 from irb140_dynamics.core import irb140
