@@ -6,6 +6,7 @@ new model."""
 
 import threading
 
+import pytest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rclpy.parameter import Parameter
 from std_msgs.msg import String
@@ -21,6 +22,7 @@ from ..support.chains import chain_urdf
 from ..support.ros_harness import TIMEOUT, running
 
 ANALYSIS = 120.0  # s: the longest an analysis here may take on a loaded 2-core machine
+pytestmark = pytest.mark.slow  # each some 3 s on an idle machine, over 5 s on a loaded one
 
 
 def from_urdf(**values) -> list[Parameter]:
