@@ -67,8 +67,8 @@ class _Work:
         """The worker thread: build jobs until there are none."""
         while True:
             with self.lock:
-                if self.job is None:
-                    self.thread = False
+                if self.job is None:  # (a job dropped by stop() leaves nothing to wait for)
+                    self.thread = self.busy = False
                     return
                 (generation, job), self.job = self.job, None
                 cancel = self.cancel = threading.Event()
