@@ -88,3 +88,24 @@ def test_the_context_shutting_down_cancels_the_build_under_way():
         assert started.wait(TIMEOUT)
         harness.context.try_shutdown()
         assert ended.wait(TIMEOUT) and builder.cancelled == 1
+
+
+def test_a_build_done_here_cancels_the_workers_and_the_poll_ends():
+    """A quick change built on the executor thread supersedes the worker's build under way."""
+    with running(lambda **kw: Node("builder_test", **kw)) as harness:
+        delivered, started = [], threading.Event()
+
+        def build(job, previous):
+            while job == "endless":
+                started.set()
+                out_of_time()  # raises once cancelled
+            return job
+
+        builder = Builder(harness.node, build, lambda g, result: delivered.append((g, result)), "test builder")
+        builder.submit(1, "endless")
+        assert started.wait(TIMEOUT)
+        builder.build_here(2, "quick")
+        assert delivered == [(2, "quick")]
+        assert harness.spin_until(lambda: builder.cancelled == 1 and not builder._work.thread)
+        assert harness.spin_until(lambda: all(timer.is_canceled() for timer in harness.node.timers))
+        assert delivered == [(2, "quick")]
