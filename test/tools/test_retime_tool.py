@@ -121,6 +121,7 @@ def test_runs_as_a_module_without_ros(tmp_path):
     assert (tmp_path / "out.yaml").exists()
 
 
+@pytest.mark.slow  # the UR5's kernels compiled, several rounds
 def test_a_urdf_arm_with_the_params_files_globals(tmp_path, capsys):
     from irb140_dynamics.core.urdf import load_urdf
 
