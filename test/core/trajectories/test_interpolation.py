@@ -82,6 +82,23 @@ def test_messages_are_refused_naming_the_point():
             "points": [point, {**later, "accelerations": [0, 0, 0]}],
         },
     }
-    for reason, message in cases.items():
-        with pytest.raises(TrajectoryError, match=reason):
+    odd = {
+        "not a JointTrajectory": ["points"],
+        "joint_names: must be a list": {"joint_names": "a b c", "points": [point, later]},
+        "need at least 2 points": {"joint_names": names, "points": [point]},
+        "point 1: not a mapping": {"joint_names": names, "points": [point, [0.1, 0, 0]]},
+        "positions of b is '0'": {"joint_names": names, "points": [point, {**later, "positions": [0.1, "0", 0]}]},
+        "positions of a is True": {"joint_names": names, "points": [point, {**later, "positions": [True, 0, 0]}]},
+        "must be 3 numbers": {"joint_names": names, "points": [point, {**later, "velocities": [0.0, 0.0]}]},
+        "is not a duration": {
+            "joint_names": names,
+            "points": [point, {**later, "time_from_start": {"sec": 1, "nanosec": 10**9}}],
+        },
+        "must be .sec, nanosec.": {"joint_names": names, "points": [point, {**later, "time_from_start": 1.0}]},
+        "duplicates": {"joint_names": ["a", "a", "b"], "points": [point, later]},
+        "no c": {"joint_names": ["a", "b"], "points": [{**point, "positions": [0, 0]}, {**later, "positions": [0, 0]}]},
+    }
+    for reason, message in {**cases, **odd}.items():
+        with pytest.raises(TrajectoryError, match=reason) as error:
             Trajectory.from_message(message, names)
+        assert "\n" not in str(error.value)
