@@ -45,7 +45,7 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
         finite_result(tau, "rnea", q=q, qd=qd, qdd=qdd, **({} if f_ext is None else {"f_ext": f_ext}))
     if model.friction is None:
         return np.array(tau)
-    return np.array(tau) + model.friction.torques(args[1])
+    return np.array(model.friction.added(tau, args[1]))
 
 
 def gravity(model: RobotModel, q: ArrayLike) -> np.ndarray:
