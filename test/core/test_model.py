@@ -148,8 +148,10 @@ def test_invalid_joint_name(bad_name):
     assert_rejected(changed("joint_names", names), "joint_names")
 
 
-@pytest.mark.parametrize("name, prefix", [("2nd", "j_2nd"), ("arm-left.1", "arm_left_1"), ("_joint", "j__joint"),
-                                          ("panda_joint1", "panda_joint1")])
+@pytest.mark.parametrize(
+    "name, prefix",
+    [("2nd", "j_2nd"), ("arm-left.1", "arm_left_1"), ("_joint", "j__joint"), ("panda_joint1", "panda_joint1")],
+)
 def test_any_printable_joint_name_has_parameters_under_its_prefix(name, prefix):
     params = {k.replace("joint_2.", f"{prefix}.", 1): v for k, v in irb140().to_params().items()}
     params["joint_names"] = ["joint_1", name, "joint_3", "joint_4", "joint_5", "joint_6"]

@@ -68,6 +68,11 @@ class LoadedUrdf:
     held_joints: tuple[str, ...]  # moving joints off the chain, held at zero, bodies lumped
     warnings: tuple[str, ...] = ()  # the chain's inertials taken as given though not physical
     notes: tuple[str, ...] = ()  # invalid inertials off the chain, ignored
+    base_rotation: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))  # base_link's axes in the root's
+
+    def in_base(self, vector) -> tuple[float, float, float]:
+        """A vector given in the root link's frame (gravity) in base_link's frame."""
+        return tuple(float(x) + 0.0 for x in np.asarray(self.base_rotation).T @ np.asarray(vector, dtype=float))
 
 
 def load_urdf(
@@ -137,7 +142,8 @@ def load_urdf(
         for name, body in tree.inertials.items()
         if name not in on_chain and (problem := inertial_problem(name, body))
     ]
-    return LoadedUrdf(model, base, tip, tuple(held), tuple(warnings), tuple(notes))
+    rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
+    return LoadedUrdf(model, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation)
 
 
 def _checked_inertials(tree: UrdfTree, carried: list[list[str]]) -> tuple[list[str], list[bool]]:
@@ -159,12 +165,17 @@ def _checked_inertials(tree: UrdfTree, carried: list[list[str]]) -> tuple[list[s
     return warnings, physical
 
 
-def base_gravity(tree: UrdfTree, base: str) -> tuple[float, float, float]:
-    """The root link's -z gravity in ``base``'s frame, the joints between them at zero."""
+def base_rotation(tree: UrdfTree, base: str) -> np.ndarray:
+    """base_link's axes in the root link's frame, the joints between them at zero."""
     R = np.eye(3)
     for joint in tree.path_from_root(base):
         R = R @ joint.origin.rotation()
-    g = R.T @ np.array([0.0, 0.0, -GRAVITY])
+    return R
+
+
+def base_gravity(tree: UrdfTree, base: str) -> tuple[float, float, float]:
+    """The root link's -z gravity in ``base``'s frame, the joints between them at zero."""
+    g = base_rotation(tree, base).T @ np.array([0.0, 0.0, -GRAVITY])
     g[np.abs(g) < 1e-12] = 0.0
     return tuple(float(x) + 0.0 for x in g)
 
