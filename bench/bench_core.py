@@ -22,6 +22,7 @@ from __future__ import annotations
 import importlib.metadata
 import math
 import time
+import timeit
 from dataclasses import replace
 
 import numpy as np
@@ -61,6 +62,7 @@ FRESH_MODELS = 3  # kernel generation is timed on this many fresh models
 KERNELS = ("rnea", "rnea_wrench", "gravity_torques", "coriolis", "mass_matrix", "coriolis_matrix")
 TOLERANCE = dict(rtol=1e-9, atol=1e-9)
 SEED = 140
+PAIRED_BLOCKS = 300  # alternating blocks of the URDF arms' timings
 
 
 # -- the baselines ----------------------------------------------------------------------
@@ -248,9 +250,23 @@ def urdf_arms() -> list[Row]:
         ]
         group = "URDF arms of example-robot-data (ours: load_urdf; Pinocchio: buildModelFromXML), per call"
         for label, ours, baseline, limit in cases:
-            timed = (Figure.cost(seconds_per_call(fn)) for fn in (ours, baseline))
-            rows.append(Row(group, label, *timed, Target(limit)))
+            rows.append(
+                Row(group, label, *(Figure.cost(t) for t in paired_seconds_per_call(ours, baseline)), Target(limit))
+            )
     return rows
+
+
+def paired_seconds_per_call(ours, baseline, blocks: int = PAIRED_BLOCKS, calls: int = 200):
+    """Seconds per call of each in ``blocks`` blocks of ``calls``, the two alternating block
+    by block: on a shared machine both then meet the same load (their best blocks compare)."""
+    timers = timeit.Timer(ours), timeit.Timer(baseline)
+    for timer in timers:
+        timer.timeit(calls)  # warm up
+    times = ([], [])
+    for _ in range(blocks):
+        for timer, samples in zip(timers, times):
+            samples.append(timer.timeit(calls) / calls)
+    return times
 
 
 def _urdf_arms() -> dict[str, tuple[str, str]]:

@@ -32,7 +32,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from irb140_dynamics.core.model.joints import snap
+from irb140_dynamics.core.model.joints import Z_AXIS, snap
 from irb140_dynamics.core.model.rigid_body import ZERO3, Inertia6, Vector3, shift_inertia
 from irb140_dynamics.core.scalars.dual import Dual, dual_angles, partial  # noqa: F401 (Dual: part of this module's interface)
 
@@ -302,14 +302,32 @@ def crba(links, cs):
 
 
 def _rotate_inertia(link, rot, inertia):
-    """R I R^T for the joint rotation R_i: columns of R I, then R (R I)^T."""
+    """R I R^T for the joint rotation R_i = R0 Rot R1, one factor after the other (a turn
+    about z in closed form, fewer operations than by columns)."""
+    if link.R1 is not None:
+        inertia = _turned(link.R1, inertia)
+    if rot is not None:
+        inertia = _turned_about_z(rot, inertia) if link.u == Z_AXIS else _turned(rot, inertia)
+    return inertia if link.R0 is None else _turned(link.R0, inertia)
+
+
+def _turned(R, inertia):
+    """R I R^T: columns of R I, then R (R I)^T."""
     xx, yy, zz, xy, xz, yz = inertia
-    columns = [to_parent(link, rot, col) for col in ((xx, xy, xz), (xy, yy, yz), (xz, yz, zz))]
-    rows_of_ri = list(zip(*columns))
-    col0 = to_parent(link, rot, rows_of_ri[0])
-    col1 = to_parent(link, rot, rows_of_ri[1])
-    col2 = to_parent(link, rot, rows_of_ri[2])
+    rows_of_ri = list(zip(*(rotate(R, col) for col in ((xx, xy, xz), (xy, yy, yz), (xz, yz, zz)))))
+    col0, col1, col2 = (rotate(R, row) for row in rows_of_ri)
     return (col0[0], col1[1], col2[2], col1[0], col2[0], col2[1])
+
+
+def _turned_about_z(rot, inertia):
+    """Rot_z I Rot_z^T by the double angle: with C = cos 2t, S = sin 2t, the xx, yy, xy
+    block turns by 2t about its mean; xz, yz turn by t."""
+    c, s = rot[0][0], rot[1][0]
+    xx, yy, zz, xy, xz, yz = inertia
+    C, S = c * c - s * s, (c * s) * 2.0
+    mean, half = (xx + yy) * 0.5, (xx - yy) * 0.5
+    x = half * C - xy * S
+    return (mean + x, mean - x, zz, half * S + xy * C, c * xz - s * yz, s * xz + c * yz)
 
 
 def christoffel_coriolis(links, cs, qd):

@@ -78,6 +78,13 @@ class Sym:
             if self.op == "neg":  # (-x) c = x (-c)
                 return Sym("*", (self.args[0], -float(other)))
             return Sym("*", (self, float(other)))
+        # (-x) y = -(x y), exactly: the negation moves out, where a sum takes it as a subtraction
+        if self.op == "neg" and other.op == "neg":
+            return Sym("*", (self.args[0], other.args[0]))
+        if self.op == "neg":
+            return -(self.args[0] * other)
+        if other.op == "neg":
+            return -(self * other.args[0])
         return Sym("*", (self, other))
 
     def __rmul__(self, other):
