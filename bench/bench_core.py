@@ -62,7 +62,7 @@ FRESH_MODELS = 3  # kernel generation is timed on this many fresh models
 KERNELS = ("rnea", "rnea_wrench", "gravity_torques", "coriolis", "mass_matrix", "coriolis_matrix")
 TOLERANCE = dict(rtol=1e-9, atol=1e-9)
 SEED = 140
-PAIRED_BLOCKS = 300  # alternating blocks of the URDF arms' timings
+PAIRED_BLOCKS = 800  # alternating blocks of the URDF arms' timings
 
 
 # -- the baselines ----------------------------------------------------------------------
@@ -256,7 +256,7 @@ def urdf_arms() -> list[Row]:
     return rows
 
 
-def paired_seconds_per_call(ours, baseline, blocks: int = PAIRED_BLOCKS, calls: int = 200):
+def paired_seconds_per_call(ours, baseline, blocks: int = PAIRED_BLOCKS, calls: int = 40):
     """Seconds per call of each in ``blocks`` blocks of ``calls``, the two alternating block
     by block: on a shared machine both then meet the same load (their best blocks compare)."""
     timers = timeit.Timer(ours), timeit.Timer(baseline)
