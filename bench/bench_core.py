@@ -223,21 +223,19 @@ def batch(model, pm, data) -> list[Row]:
 
 def urdf_arms() -> list[Row]:
     """Per-call cost on the UR5 and the Panda of example-robot-data, as our loader and
-    Pinocchio's parser read the same file (Pinocchio's Panda with its fingers locked). The
-    joints' friction (the Panda's damping) is left out of our model: pin.rnea has none."""
+    Pinocchio's parser read the same file (Pinocchio's Panda with its fingers locked), and
+    on the DH IRB-140 the same way (no target: no slower than before). The joints'
+    friction (the Panda's damping) is left out of our model: pin.rnea has none."""
     rows = []
-    for name, (text, tip) in URDF_ARMS.items():
-        loaded = load_urdf(text, tip_link=tip)
-        model = replace(loaded.model, joints=tuple(replace(j, friction=Friction()) for j in loaded.model.joints))
-        pm = pin.buildModelFromXML(text)
-        held = [pm.getJointId(joint) for joint in loaded.held_joints]
-        pm = pin.buildReducedModel(pm, held, pin.neutral(pm)) if held else pm
-        pm.gravity.linear = np.array(model.gravity)
+    arms = {"IRB-140 (DH)": (irb140(), None), **URDF_ARMS}
+    for name, (text, tip) in arms.items():
+        model, pm = _paired_models(text, tip)
         data = pm.createData()
         q, qd, qdd = (x[0] for x in random_states(model, 1, np.random.default_rng(SEED + 2)))
         check_same(f"{name} rnea", rnea(model, q, qd, qdd), pin.rnea(pm, data, q, qd, qdd))
         check_same(f"{name} gravity", gravity(model, q), pin.computeGeneralizedGravity(pm, data, q))
         check_same(f"{name} mass_matrix", mass_matrix(model, q), symmetric_from_upper(pin.crba(pm, data, q)))
+        urdf = tip is not None
         cases = [
             (f"{name} rnea vs pin.rnea", lambda: rnea(model, q, qd, qdd), lambda: pin.rnea(pm, data, q, qd, qdd), 5),
             (
@@ -248,12 +246,24 @@ def urdf_arms() -> list[Row]:
             ),
             (f"{name} mass_matrix vs pin.crba", lambda: mass_matrix(model, q), lambda: pin.crba(pm, data, q), 6),
         ]
-        group = "URDF arms of example-robot-data (ours: load_urdf; Pinocchio: buildModelFromXML), per call"
+        group = "arms, alternating blocks (URDF: load_urdf vs buildModelFromXML), per call"
         for label, ours, baseline, limit in cases:
-            rows.append(
-                Row(group, label, *(Figure.cost(t) for t in paired_seconds_per_call(ours, baseline)), Target(limit))
-            )
+            timed = (Figure.cost(t) for t in paired_seconds_per_call(ours, baseline))
+            rows.append(Row(group, label, *timed, Target(limit) if urdf else None))
     return rows
+
+
+def _paired_models(text, tip):
+    """(our model without friction, Pinocchio's) of a URDF's chain to ``tip``, or of a model."""
+    if tip is None:
+        return text, pinocchio_model(text)
+    loaded = load_urdf(text, tip_link=tip)
+    model = replace(loaded.model, joints=tuple(replace(j, friction=Friction()) for j in loaded.model.joints))
+    pm = pin.buildModelFromXML(text)
+    held = [pm.getJointId(joint) for joint in loaded.held_joints]
+    pm = pin.buildReducedModel(pm, held, pin.neutral(pm)) if held else pm
+    pm.gravity.linear = np.array(model.gravity)
+    return model, pm
 
 
 def paired_seconds_per_call(ours, baseline, blocks: int = PAIRED_BLOCKS, calls: int = 40):
