@@ -12,8 +12,10 @@
   nothing) until a valid model arrives; each later URDF is checked whole, with the current
   parameters, and then swapped in at once, or refused (logged) keeping the model in use.
   The per-joint parameters are not declared in this mode: the URDF gives the joints, their
-  names, inertials, limits and friction; ``gravity``, ``friction.smoothing_velocity``,
-  ``payload.*`` (on the tip link) and the node's own parameters work as with parameters.
+  names, inertials, limits and friction; ``gravity`` (here in the URDF's root frame, turned
+  into base_link's), ``friction.smoothing_velocity``, ``payload.*`` (on the tip link) and
+  the node's own parameters work as with parameters. The loader's warnings (inertials
+  taken as given) are logged as warnings, its notes (invalid inertials off the chain) as info.
 """
 
 from __future__ import annotations
