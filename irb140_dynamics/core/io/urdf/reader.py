@@ -30,15 +30,13 @@
 from __future__ import annotations
 
 import math
-import os
-import stat
 from dataclasses import dataclass
 from functools import reduce
 
 import numpy as np
 
+from irb140_dynamics.core.io.text_files import InputFileError, read_text_file
 from irb140_dynamics.core.io.urdf.tree import (
-    MAX_URDF_CHARS,
     UrdfError,
     UrdfJoint,
     UrdfTree,
@@ -79,11 +77,12 @@ def load_urdf(
     text: str,
     base_link: str | None = None,
     tip_link: str | None = None,
-    max_chars: int = MAX_URDF_CHARS,
+    max_chars: int | None = None,
     max_joints: int = MAX_JOINTS,
 ) -> LoadedUrdf:
     """The chain from ``base_link`` (default: the root link) to ``tip_link`` (default: the
-    only leaf below base_link) as a RobotModel (gravity: the root's -z; payload: none)."""
+    only leaf below base_link) as a RobotModel (gravity: the root's -z; payload: none).
+    ``max_chars``: the text's size limit (default: MAX_URDF_CHARS, or IRB140_MAX_FILE_BYTES)."""
     tree = parse_tree(text, max_chars)
     base, tip, path = tree.chain(base_link, tip_link)
     span = f"from {clipped(repr(base), 60)} to {clipped(repr(tip), 60)}"
@@ -180,29 +179,18 @@ def base_gravity(tree: UrdfTree, base: str) -> tuple[float, float, float]:
     return tuple(float(x) + 0.0 for x in g)
 
 
-def read_urdf(path, max_chars: int = MAX_URDF_CHARS) -> str:
+def read_urdf(path, max_chars: int | None = None) -> str:
     """The text of a URDF file, or UrdfError in one line: a regular file (not a device, a
-    pipe or a directory) of at most ``max_chars`` bytes of UTF-8 text."""
-    shown = clipped(repr(str(path)), 120)
+    pipe or a folder) of at most ``max_chars`` bytes (default: the input files' limit) of
+    UTF-8 text without control characters (``core.io.text_files``)."""
     try:
-        with open(path, "rb") as stream:
-            if not stat.S_ISREG(os.fstat(stream.fileno()).st_mode):
-                raise UrdfError("file", f"{shown} is not a regular file (a device, a pipe or a directory?)")
-            data = stream.read(max_chars + 1)
-    except OSError as error:
-        raise UrdfError("file", f"cannot read {shown}: {error.strerror or error}") from None
-    if len(data) > max_chars:
-        raise UrdfError("file", f"{shown} is larger than the limit of {max_chars} bytes (max_chars)")
-    if b"\0" in data:
-        raise UrdfError("file", f"{shown} is binary data, not URDF text")
+        text = read_text_file(path, "URDF file", max_chars)
+    except InputFileError as error:
+        raise UrdfError("file", clipped(str(error), 250)) from None
     try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as error:
-        raise UrdfError("file", f"{shown} is not UTF-8 text (byte {error.start})") from None
-    try:
-        return checked_text(text, max_chars)
+        return checked_text(text, len(text))
     except UrdfError as error:
-        raise UrdfError("file", f"{shown}: {error.reason}") from None
+        raise UrdfError("file", f"{clipped(str(path), 120)}: {error.reason}") from None
 
 
 def compose(a: Placement, b: Placement) -> Placement:

@@ -6,7 +6,8 @@ gazebo tags are ignored (a <transmission>'s <joint> is not a joint of the tree).
 
 Inertials are read as written, not checked here: the loader checks those its chain
 carries (``inertial_problem``), the others do not matter. The input is bounded: at most
-``max_chars`` characters (MAX_URDF_CHARS), text only, and no walk of the tree recurses.
+``max_chars`` characters (default MAX_URDF_CHARS, or the environment's IRB140_MAX_FILE_BYTES,
+as every input file: ``core.io.text_files``), text only, and no walk of the tree recurses.
 """
 
 from __future__ import annotations
@@ -18,11 +19,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from irb140_dynamics.core.io.text_files import MAX_TEXT_BYTES, size_limit
 from irb140_dynamics.core.model.joints import Placement
 from irb140_dynamics.core.model.rigid_body import ZERO3, ModelError, RigidBody, Vector3, physical_inertia, placed
 
 KINDS = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
-MAX_URDF_CHARS = 20_000_000  # characters of URDF text read at most (the largest public URDFs: ~2 MB)
+MAX_URDF_CHARS = MAX_TEXT_BYTES  # characters of URDF text at most (IRB140_MAX_FILE_BYTES changes it)
 MAX_LINE = 299  # characters of a refusal line at most
 RIGHT_ANGLE_TOLERANCE = 1e-10  # rad: an <origin rpy> angle this close to a multiple of pi/2 is taken as it
 
@@ -127,9 +129,11 @@ class UrdfTree:
             raise UrdfError(what, f"no link {clipped(repr(link), 80)} in the URDF (links: {listed(self.inertials)})")
 
 
-def checked_text(text, max_chars: int = MAX_URDF_CHARS) -> str:
-    """``text`` if it can be URDF text: a str of at most ``max_chars`` characters without
-    NUL or other control characters (binary data); else UrdfError in one line."""
+def checked_text(text, max_chars: int | None = None) -> str:
+    """``text`` if it can be URDF text: a str of at most ``max_chars`` characters (default:
+    the input files' limit, ``text_files.size_limit()``) without NUL or other control
+    characters (binary data); else UrdfError in one line."""
+    max_chars = size_limit(MAX_URDF_CHARS) if max_chars is None else max_chars
     if isinstance(text, (bytes, bytearray)):
         raise UrdfError("document", "bytes given, not text (decode it first)")
     if not isinstance(text, str):
@@ -147,7 +151,7 @@ def checked_text(text, max_chars: int = MAX_URDF_CHARS) -> str:
 _CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")
 
 
-def parse_tree(text: str, max_chars: int = MAX_URDF_CHARS) -> UrdfTree:
+def parse_tree(text: str, max_chars: int | None = None) -> UrdfTree:
     """The tree of a URDF document, or UrdfError naming what is wrong."""
     text = checked_text(text, max_chars)
     try:
