@@ -2,7 +2,7 @@
 
 import pytest
 
-from irb140_dynamics.core import ModelError
+from irb140_dynamics.core import ModelError, RobotModel
 from irb140_dynamics.core.io.urdf import UrdfError, load_urdf
 
 LIMIT = '<limit lower="-1" upper="1" effort="10" velocity="1"/>'
@@ -217,6 +217,8 @@ def test_accepted_with_one_warning_naming_the_link(text, message):
     assert loaded.model.joint_names == ("j1", "j2")
     assert len(loaded.warnings) == 1 and loaded.warnings[0].startswith(message)
     assert "\n" not in loaded.warnings[0] and len(loaded.warnings[0]) < 300
+    again = RobotModel.from_params(loaded.model.to_params())  # the nodes' path: the parameter form
+    assert again == loaded.model
 
 
 def test_invalid_inertials_off_the_chain_are_notes():
