@@ -1,7 +1,7 @@
 """URDF input is bounded: a size limit before parsing, binary data and device files
 refused, no recursion in any walk of the tree (a 10,000-link chain loads or is refused
 in one line), every refusal one line under 300 characters; and a seeded, bounded fuzz
-of ``load_urdf`` (the longer run: bench/fuzz_urdf.py)."""
+of ``load_urdf`` (200 cases; the longer run: bench/fuzz_urdf.py)."""
 
 import os
 import sys
@@ -44,6 +44,7 @@ def test_the_seed_text_loads():
     assert outcome(SEED_TEXT, {"base_link": "base", "tip_link": "tool0"}) == "loaded"
 
 
+@pytest.mark.slow
 def test_a_10000_link_chain_loads_without_recursion():
     limit = sys.getrecursionlimit()
     sys.setrecursionlimit(200)  # a recursive walk would fail at once
@@ -117,7 +118,8 @@ def test_long_names_and_long_lists_stay_within_a_line():
 EDITS = st.lists(st.tuples(st.sampled_from(KINDS), st.floats(0, 0.999), st.integers(0, 1000)), min_size=1, max_size=4)
 
 
-@settings(max_examples=300, derandomize=True, deadline=None, suppress_health_check=list(HealthCheck))
+@pytest.mark.slow
+@settings(max_examples=200, derandomize=True, deadline=None, suppress_health_check=list(HealthCheck))
 @given(EDITS, st.booleans())
 def test_fuzz_load_urdf(edits, with_ends):
     """Whatever the edits, the loader loads a model that computes, or refuses in one line."""

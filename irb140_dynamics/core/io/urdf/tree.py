@@ -21,7 +21,17 @@ import numpy as np
 
 from irb140_dynamics.core.io.text_files import MAX_TEXT_BYTES, size_limit
 from irb140_dynamics.core.model.joints import Placement
-from irb140_dynamics.core.model.rigid_body import ZERO3, ModelError, RigidBody, Vector3, physical_inertia, placed
+from irb140_dynamics.core.model.rigid_body import (
+    MAX_INERTIA,
+    MAX_LENGTH,
+    MAX_MASS,
+    ZERO3,
+    ModelError,
+    RigidBody,
+    Vector3,
+    physical_inertia,
+    placed,
+)
 
 KINDS = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 MAX_URDF_CHARS = MAX_TEXT_BYTES  # characters of URDF text at most (IRB140_MAX_FILE_BYTES changes it)
@@ -279,6 +289,8 @@ def inertial_problem(name: str, body: RigidBody | UrdfError | None) -> tuple[str
         return None
     if isinstance(body, UrdfError):
         return "refused", body
+    if _plainly_fine(body):
+        return None
     where = f'link "{clipped(name, 100)}" <inertial>'
     try:
         RigidBody.validated("", body.mass, body.com, body.inertia, physical=False)
@@ -289,6 +301,19 @@ def inertial_problem(name: str, body: RigidBody | UrdfError | None) -> tuple[str
     except ModelError as error:
         return "unphysical", UrdfError(f"{where} <inertia>", error.reason)
     return None
+
+
+def _plainly_fine(body: RigidBody) -> bool:
+    """Whether the inertial is finite, within the caps and physical, decided without NumPy
+    for the common case of principal axes (no products of inertia): a tree of thousands of
+    links is checked quickly. False: see ``inertial_problem``'s full checks."""
+    m, (cx, cy, cz), (xx, yy, zz, xy, xz, yz) = body.mass, body.com, body.inertia
+    if xy or xz or yz or not all(map(math.isfinite, (m, cx, cy, cz, xx, yy, zz))):
+        return False
+    if not (0.0 <= m <= MAX_MASS and math.hypot(cx, cy, cz) <= MAX_LENGTH and max(xx, yy, zz) <= MAX_INERTIA):
+        return False
+    a, b, c = sorted((xx, yy, zz))
+    return a >= 0.0 and a + b >= c
 
 
 def _joint(element: ET.Element, links) -> UrdfJoint:
