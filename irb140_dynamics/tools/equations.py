@@ -23,6 +23,7 @@ from pathlib import Path
 
 from ..core import RigidBody, load_model
 from ..core.equations import DEFAULT_QUANTITIES, FORMS, QUANTITIES, generate
+from ..core.errors import one_line
 from ..core.urdf import load_urdf
 from .common import ToolError, run
 
@@ -45,9 +46,14 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--form", required=True, help=f"one of {', '.join(FORMS)}")
     parser.add_argument("--out", required=True, help="the folder to write into")
     parser.add_argument("--what", default=",".join(DEFAULT_QUANTITIES), help=f"of {','.join(QUANTITIES)}")
-    parser.add_argument("--symbolic-parameters", action="store_true",
-                        help="masses, first moments, inertias, friction, armature and payload as named symbols")
-    parser.add_argument("--payload-mass", type=float, help="kg: a point mass at the flange origin, replacing the model's payload")
+    parser.add_argument(
+        "--symbolic-parameters",
+        action="store_true",
+        help="masses, first moments, inertias, friction, armature and payload as named symbols",
+    )
+    parser.add_argument(
+        "--payload-mass", type=float, help="kg: a point mass at the flange origin, replacing the model's payload"
+    )
     parser.add_argument("--prefix", help="name of the C functions and the files (default: the input file's stem)")
     return parser
 
@@ -63,7 +69,9 @@ def _main(argv: list[str]) -> int:
     what = tuple(w.strip() for w in args.what.split(",") if w.strip())
     unknown = [w for w in what if w not in QUANTITIES]
     if unknown or not what:
-        raise ToolError(f"unknown quantity {unknown[0] if unknown else args.what!r}: choose from {','.join(QUANTITIES)}")
+        raise ToolError(
+            f"unknown quantity {unknown[0] if unknown else args.what!r}: choose from {','.join(QUANTITIES)}"
+        )
     if args.urdf is None and (args.base or args.tip):
         raise ToolError("--base and --tip go with --urdf")
     model, path = _model(args)
@@ -74,7 +82,7 @@ def _main(argv: list[str]) -> int:
     staging = _staging_folder(out)
     try:
         with _Progress() as progress:
-            files = generate(model, args.form, what, args.symbolic_parameters, prefix, path.name, progress)
+            files = generate(model, (args.form,), what, args.symbolic_parameters, prefix, path.name, progress)
         for name, text in files.items():
             _write_synced(staging / name, text)
         for name in files:
@@ -98,7 +106,7 @@ def _model(args):
         if args.payload_mass is not None:
             model = model.with_payload(RigidBody(args.payload_mass))
     except (ValueError, OSError) as error:  # ModelError, UrdfError, YAML errors are ValueErrors
-        raise ToolError(f"{path}: {str(error).splitlines()[0] if str(error) else type(error).__name__}") from None
+        raise ToolError(f"{path}: {one_line(error) or type(error).__name__}") from None
     return model, path
 
 

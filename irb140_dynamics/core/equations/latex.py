@@ -11,14 +11,19 @@ from __future__ import annotations
 
 import sympy as sp
 
-from .. import algorithms
+from ..algorithms import recursions as algorithms
 from . import trig_series as ts
 from .printing import header_lines
 from .symbolic import Equations, links_of
 
 MAX_TERMS = 50  # per entry on average, for the series form
-TITLES = {"M": "The mass matrix $M(q)$", "Cqd": r"Coriolis and centrifugal torques $C(q,\dot q)\,\dot q$",
-          "g": "Gravity torques $g(q)$", "tau": r"Joint torques $\tau$", "regressor": "The regressor $Y$"}
+TITLES = {
+    "M": "The mass matrix $M(q)$",
+    "Cqd": r"Coriolis and centrifugal torques $C(q,\dot q)\,\dot q$",
+    "g": "Gravity torques $g(q)$",
+    "tau": r"Joint torques $\tau$",
+    "regressor": "The regressor $Y$",
+}
 SYMBOL = {"M": "M", "Cqd": r"(C\dot q)", "g": "g", "tau": r"\tau", "regressor": "Y"}
 TERMS_PER_LINE = 3
 
@@ -79,8 +84,18 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str, expanded: dic
 
 
 def _text(s: str) -> str:
-    for a, b in (("\\", r"\textbackslash{}"), ("_", r"\_"), ("&", r"\&"), ("%", r"\%"), ("#", r"\#"),
-                 ("$", r"\$"), ("{", r"\{"), ("}", r"\}"), ("~", r"\~{}"), ("^", r"\^{}")):
+    for a, b in (
+        ("\\", r"\textbackslash{}"),
+        ("_", r"\_"),
+        ("&", r"\&"),
+        ("%", r"\%"),
+        ("#", r"\#"),
+        ("$", r"\$"),
+        ("{", r"\{"),
+        ("}", r"\}"),
+        ("~", r"\~{}"),
+        ("^", r"\^{}"),
+    ):
         s = s.replace(a, b)
     return s
 
@@ -126,7 +141,7 @@ def _series_text(n: int, terms) -> str:
         return "0"
     pieces = []
     for v, parts in by_velocity.items():
-        chunks = [" ".join(parts[i:i + TERMS_PER_LINE]) for i in range(0, len(parts), TERMS_PER_LINE)]
+        chunks = [" ".join(parts[i : i + TERMS_PER_LINE]) for i in range(0, len(parts), TERMS_PER_LINE)]
         body = r" \\ &\qquad ".join(chunks)
         body = body[1:] if body.startswith("+") else body
         if not v:
@@ -173,8 +188,9 @@ def _reduced_entries(eq: Equations, name: str, replacements, outputs) -> list[st
 
     lines = [r"\begin{align*}"]
     lines += [rf"{names[s]} &= {tex(e)} \\" for s, e in replacements]
-    lines += [rf"{SYMBOL[name]}_{{{_index(eq, name, k)}}} &= {tex(sp.sympify(outputs[k]))} \\"
-              for k in _entries(eq, name)]
+    lines += [
+        rf"{SYMBOL[name]}_{{{_index(eq, name, k)}}} &= {tex(sp.sympify(outputs[k]))} \\" for k in _entries(eq, name)
+    ]
     if name == "M":
         lines.append(r"M_{ji} &= M_{ij} \\")
     lines[-1] = lines[-1].removesuffix(r" \\")
@@ -183,7 +199,7 @@ def _reduced_entries(eq: Equations, name: str, replacements, outputs) -> list[st
 
 def _symbol_latex(name: str) -> str:
     for prefix, tex in (("qdd", r"\ddot q"), ("qd", r"\dot q"), ("q", "q")):
-        if name.startswith(prefix) and name[len(prefix):].isdigit():
-            return f"{tex}_{{{name[len(prefix):]}}}"
+        if name.startswith(prefix) and name[len(prefix) :].isdigit():
+            return f"{tex}_{{{name[len(prefix) :]}}}"
     head = name.rstrip("0123456789P")
-    return f"{head}_{{{name[len(head):]}}}"
+    return f"{head}_{{{name[len(head) :]}}}"

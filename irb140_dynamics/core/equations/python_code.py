@@ -59,7 +59,9 @@ def _function(eq: Equations, name: str, replacements, outputs) -> list[str]:
     lines = [f"def {name}({signature}):", f'    """{DESCRIPTIONS[name]}"""']
     if eq.parameters:
         lines.append("    p = np.asarray(p, dtype=float)")
-        lines.append(f"    return _run(lambda {', '.join(args)}: _{name}({', '.join(args)}, p), {shape!r}, {', '.join(args)})")
+        lines.append(
+            f"    return _run(lambda {', '.join(args)}: _{name}({', '.join(args)}, p), {shape!r}, {', '.join(args)})"
+        )
     else:
         lines.append(f"    return _run(_{name}, {shape!r}, {', '.join(args)})")
     lines += ["", "", f"def _{name}({', '.join(kernel_args)}):"]

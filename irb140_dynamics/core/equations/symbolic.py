@@ -19,15 +19,16 @@ armature, and the payload's are named symbols (``Parameter``); otherwise the mod
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
-from typing import Callable
 
 import sympy as sp
 from sympy.core.parameters import distribute
 
-from .. import algorithms
-from ..regressor import LINK_PARAMETERS, rigid_body_regressor
-from ..rigid_body import shift_inertia
+from ..algorithms import recursions as algorithms
+from ..algorithms.regressor import rigid_body_regressor
+from ..model.rigid_body import shift_inertia
+from ..regressor import LINK_PARAMETERS
 
 QUANTITIES = ("tau", "M", "C", "g", "regressor")
 DEFAULT_QUANTITIES = ("tau", "M", "C", "g")
@@ -115,8 +116,19 @@ def derive(model, what=DEFAULT_QUANTITIES, symbolic: bool = False, progress: Cal
             quantities["regressor"] = _with_joint_columns(Y, qd, qdd, model.smoothing_velocity)
             shapes["regressor"], arguments["regressor"] = (n, 13 * n), ("q", "qd", "qdd")
     columns = _regressor_columns(n) if "regressor" in what else ()
-    return Equations(n, model.joint_names, q, qd, qdd, tuple(model.gravity), parameters,
-                     {k: [sp.sympify(x) for x in v] for k, v in quantities.items()}, shapes, arguments, columns)
+    return Equations(
+        n,
+        model.joint_names,
+        q,
+        qd,
+        qdd,
+        tuple(model.gravity),
+        parameters,
+        {k: [sp.sympify(x) for x in v] for k, v in quantities.items()},
+        shapes,
+        arguments,
+        columns,
+    )
 
 
 def reduced(expressions: list, prefix: str = "x"):
@@ -155,18 +167,28 @@ def links_of(model, symbolic: bool, scalar: Callable = None):
 
     symbolic_links, friction = [], []
     for i, (link, joint) in enumerate(zip(arm, model.joints), start=1):
-        symbolic_links.append(replace(
-            link,
-            m=named(f"m{i}", link.m, f"link {i} mass [kg]"),
-            h=tuple(named(f"m{axis}{i}", x, f"link {i} first moment m c_{axis} [kg m]")
-                    for axis, x in zip("xyz", link.h)),
-            I=tuple(named(f"{name}{i}", x, f"link {i} inertia {name} about its frame's origin [kg m^2]")
-                    for name, x in zip(INERTIA_NAMES, link.I)),
-            armature=named(f"Ia{i}", joint.armature, f"joint {i} armature [kg m^2]"),
-        ))
-        friction.append((named(f"fv{i}", joint.friction.viscous, f"joint {i} viscous friction [N m s/rad]"),
-                         named(f"fc{i}", joint.friction.coulomb, f"joint {i} Coulomb friction [N m]"),
-                         model.smoothing_velocity))
+        symbolic_links.append(
+            replace(
+                link,
+                m=named(f"m{i}", link.m, f"link {i} mass [kg]"),
+                h=tuple(
+                    named(f"m{axis}{i}", x, f"link {i} first moment m c_{axis} [kg m]")
+                    for axis, x in zip("xyz", link.h)
+                ),
+                I=tuple(
+                    named(f"{name}{i}", x, f"link {i} inertia {name} about its frame's origin [kg m^2]")
+                    for name, x in zip(INERTIA_NAMES, link.I)
+                ),
+                armature=named(f"Ia{i}", joint.armature, f"joint {i} armature [kg m^2]"),
+            )
+        )
+        friction.append(
+            (
+                named(f"fv{i}", joint.friction.viscous, f"joint {i} viscous friction [N m s/rad]"),
+                named(f"fc{i}", joint.friction.coulomb, f"joint {i} Coulomb friction [N m]"),
+                model.smoothing_velocity,
+            )
+        )
     symbolic_links[-1] = _with_payload(symbolic_links[-1], model, named)
     return tuple(symbolic_links), tuple(parameters), friction
 
@@ -190,18 +212,20 @@ def _with_payload(last, model, named):
     flange frame) rigidly added."""
     m_p, h_p, i_p = model.payload.about_origin()
     m = named("mP", m_p, "payload mass [kg]")
-    h = tuple(named(f"m{axis}P", x, f"payload first moment m c_{axis} [kg m], flange frame")
-              for axis, x in zip("xyz", h_p))
-    inertia = tuple(named(f"{name}P", x, f"payload inertia {name} about the flange origin [kg m^2]")
-                    for name, x in zip(INERTIA_NAMES, i_p))
+    h = tuple(
+        named(f"m{axis}P", x, f"payload first moment m c_{axis} [kg m], flange frame") for axis, x in zip("xyz", h_p)
+    )
+    inertia = tuple(
+        named(f"{name}P", x, f"payload inertia {name} about the flange origin [kg m^2]")
+        for name, x in zip(INERTIA_NAMES, i_p)
+    )
     if not model.flange.is_identity:
         R = [[float(x) for x in row] for row in model.flange.rotation()]
         h = algorithms.rotate(R, h)
         inertia = _rotated_inertia(R, inertia)
         # from the flange origin F to the link's L = F - r: r = L -> F, the flange's position
         m, h, inertia = shift_inertia(m, h, inertia, tuple(float(x) for x in model.flange.xyz))
-    return replace(last, m=last.m + m, h=algorithms.add(last.h, h),
-                   I=tuple(a + b for a, b in zip(last.I, inertia)))
+    return replace(last, m=last.m + m, h=algorithms.add(last.h, h), I=tuple(a + b for a, b in zip(last.I, inertia)))
 
 
 def _rotated_inertia(R, inertia):
@@ -227,7 +251,7 @@ def _with_joint_columns(Y, qd, qdd, smoothing):
     rows = []
     for i in range(n):
         joint = [0] * (3 * n)
-        joint[3 * i: 3 * i + 3] = [qd[i], sp.tanh(qd[i] / sp.Float(smoothing)), qdd[i]]
+        joint[3 * i : 3 * i + 3] = [qd[i], sp.tanh(qd[i] / sp.Float(smoothing)), qdd[i]]
         rows += list(Y[i]) + joint
     return rows
 

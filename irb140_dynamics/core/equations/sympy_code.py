@@ -22,10 +22,14 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str) -> dict[str, 
         "",
         f"N_JOINTS = {n}",
         f"JOINT_NAMES = {tuple(eq.joint_names)!r}",
-        *(f"{group} = tuple(Symbol(f'{group}{{i}}', real=True) for i in range(1, {n + 1}))"
-          for group in ("q", "qd", "qdd")),
-        *(f"{', '.join(f'{group}{i + 1}' for i in range(n))}{',' if n == 1 else ''} = {group}"
-          for group in ("q", "qd", "qdd")),
+        *(
+            f"{group} = tuple(Symbol(f'{group}{{i}}', real=True) for i in range(1, {n + 1}))"
+            for group in ("q", "qd", "qdd")
+        ),
+        *(
+            f"{', '.join(f'{group}{i + 1}' for i in range(n))}{',' if n == 1 else ''} = {group}"
+            for group in ("q", "qd", "qdd")
+        ),
     ]
     if eq.parameters:
         lines += [f"{p.symbol.name} = Symbol({p.symbol.name!r}, real=True)  # {p.meaning}" for p in eq.parameters]
