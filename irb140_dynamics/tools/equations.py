@@ -132,18 +132,24 @@ def _write_synced(path: Path, text: str) -> None:
 
 
 class _Progress:
-    """stage(text): noted; after QUIET_SECONDS a line on stderr shows the stage and the time."""
+    """stage(text): noted; once the work has taken QUIET_SECONDS, each stage and the time
+    are shown on stderr (redrawn in place on a terminal, a line per stage otherwise)."""
 
     def __init__(self, stream=None):
         self.stream = stream or sys.stderr
-        self.stage = "starting"
+        self.tty = self.stream.isatty()
+        self.stage, self.last = "starting", None
         self.start = time.monotonic()
         self.shown = False
+        self._lock = threading.Lock()
         self._done = threading.Event()
         self._thread = threading.Thread(target=self._show, daemon=True)
 
     def __call__(self, stage: str) -> None:
-        self.stage = stage
+        with self._lock:
+            self.stage = stage
+            if self.shown:
+                self._draw()
 
     def __enter__(self):
         self._thread.start()
@@ -154,23 +160,29 @@ class _Progress:
         self._thread.join()
         if self.shown:
             line = f"{NAME}: done in {time.monotonic() - self.start:.0f} s"
-            self.stream.write(f"\r{line}\033[K\n" if self.stream.isatty() else f"{line}\n")
+            self.stream.write(f"\r{line}\033[K\n" if self.tty else f"{line}\n")
             self.stream.flush()
 
     def _show(self):
         if self._done.wait(QUIET_SECONDS):
             return
-        tty, last = self.stream.isatty(), None
-        while not self._done.is_set():
-            self.shown = True
-            elapsed = time.monotonic() - self.start
-            if tty:
-                self.stream.write(f"\r{NAME}: {self.stage}, {elapsed:.0f} s\033[K")
-            elif self.stage != last:
-                self.stream.write(f"{NAME}: {self.stage} ({elapsed:.0f} s)\n")
-            last = self.stage
-            self.stream.flush()
-            self._done.wait(1.0)
+        while True:
+            with self._lock:
+                if self._done.is_set():
+                    return
+                self.shown = True
+                self._draw()
+            if self._done.wait(1.0):
+                return
+
+    def _draw(self):
+        elapsed = time.monotonic() - self.start
+        if self.tty:
+            self.stream.write(f"\r{NAME}: {self.stage}, {elapsed:.0f} s\033[K")
+        elif self.stage != self.last:
+            self.stream.write(f"{NAME}: {self.stage} ({elapsed:.0f} s)\n")
+        self.last = self.stage
+        self.stream.flush()
 
 
 if __name__ == "__main__":
