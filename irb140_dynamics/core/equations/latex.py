@@ -16,7 +16,7 @@ from . import trig_series as ts
 from .printing import header_lines
 from .symbolic import Equations, links_of
 
-MAX_TERMS = 50  # per entry on average, for the series form
+MAX_TERMS = 150  # sines and cosines per entry on average, for the series form
 TITLES = {
     "M": "The mass matrix $M(q)$",
     "Cqd": r"Coriolis and centrifugal torques $C(q,\dot q)\,\dot q$",
@@ -47,7 +47,7 @@ def series(model, names) -> dict[str, list]:
 
 
 def _count(entries) -> int:
-    return sum(len(x.terms) for x in entries if isinstance(x, ts.Series))
+    return sum(len(x.terms) for x in entries if isinstance(x, ts.Series)) // 2  # exp(+-i k q): one sine or cosine
 
 
 def render(eq: Equations, reduced: dict, prefix: str, source: str, expanded: dict) -> dict[str, str]:
@@ -66,7 +66,7 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str, expanded: dic
         r"\end{verbatim}",
         "",
         r"$q_i$, $\dot q_i$, $\ddot q_i$: position, velocity and acceleration of joint $i$ "
-        r"(order above); $s_{i}$, $c_{i}$: $\sin q_i$, $\cos q_i$. "
+        r"(order above). "
         r"$\tau_{f,i} = f_{v,i}\,\dot q_i + f_{c,i} \tanh(\dot q_i / v_s)$ is the joint friction.",
     ]
     if expanded:
@@ -118,7 +118,10 @@ def _series_entries(eq: Equations, name: str, entries) -> list[str]:
     lines = [r"\begin{align*}"]
     for k in _entries(eq, name):
         x = entries[k]
-        terms = x.real_terms(tolerance) if isinstance(x, ts.Series) else []
+        if isinstance(x, ts.Series):
+            terms = x.real_terms(tolerance)
+        else:  # a constant: the recursion folded it to a number
+            terms = [(-1, (), (0,) * eq.n, float(x), 0.0)] if abs(x) > tolerance else []
         lines.append(rf"{SYMBOL[name]}_{{{_index(eq, name, k)}}} &= {_series_text(eq.n, terms)} \\")
     if name == "M":
         lines.append(r"M_{ji} &= M_{ij} \\")
