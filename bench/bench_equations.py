@@ -55,7 +55,7 @@ DRIVER = r"""
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
-#include "irb140_dynamics.h"
+#include "irb140_eom.h"
 
 int main(int argc, char **argv)
 {
@@ -103,8 +103,9 @@ def c_rows(model, folder: Path) -> list[Row]:
     if compiler is None:
         return [Row("C tau (IRB-140)", "C tau", Figure(0, 0, "us"), None, None)]
     library = folder / "libirb140.so"
-    subprocess.run([compiler, *CC, "-shared", "-fPIC", str(folder / "irb140_dynamics.c"), "-o", str(library), "-lm"],
-                   check=True)
+    subprocess.run(
+        [compiler, *CC, "-shared", "-fPIC", str(folder / "irb140_eom.c"), "-o", str(library), "-lm"], check=True
+    )
     fn = ctypes.CDLL(str(library)).irb140_tau
     fn.restype = None
     pointer = ctypes.POINTER(ctypes.c_double)
@@ -117,10 +118,24 @@ def c_rows(model, folder: Path) -> list[Row]:
 
     (folder / "driver.c").write_text(DRIVER)
     driver = folder / "driver"
-    subprocess.run([compiler, *CC, f"-DSTATES={LOOP_STATES}", "-I", str(folder), str(folder / "driver.c"),
-                    str(folder / "irb140_dynamics.c"), "-o", str(driver), "-lm"], check=True)
-    lines = subprocess.run([str(driver), str(LOOP_CALLS // 10), "15"], check=True, capture_output=True,
-                           text=True).stdout.split()
+    subprocess.run(
+        [
+            compiler,
+            *CC,
+            f"-DSTATES={LOOP_STATES}",
+            "-I",
+            str(folder),
+            str(folder / "driver.c"),
+            str(folder / "irb140_eom.c"),
+            "-o",
+            str(driver),
+            "-lm",
+        ],
+        check=True,
+    )
+    lines = subprocess.run(
+        [str(driver), str(LOOP_CALLS // 10), "15"], check=True, capture_output=True, text=True
+    ).stdout.split()
     in_c = Figure.cost([float(x) for x in lines], "us")
     return [
         Row("C tau (IRB-140)", "C tau in a C loop vs pin.rnea from Python", in_c, baseline, Target(1.0)),
@@ -131,32 +146,55 @@ def c_rows(model, folder: Path) -> list[Row]:
 def python_rows(model, folder: Path) -> list[Row]:
     import importlib.util
 
-    spec = importlib.util.spec_from_file_location("irb140_dynamics_generated", folder / "irb140_dynamics.py")
+    spec = importlib.util.spec_from_file_location("irb140_eom", folder / "irb140_eom.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     rng = np.random.default_rng(SEED)
-    Q, QD, QDD = rng.uniform(-3, 3, (BATCH_STATES, 6)), rng.normal(0, 2, (BATCH_STATES, 6)), rng.normal(0, 5, (BATCH_STATES, 6))
-    check_same("Python batch tau vs rnea_batch", module.tau(Q[:1000], QD[:1000], QDD[:1000]),
-               rnea_batch(model, Q[:1000], QD[:1000], QDD[:1000]))
+    Q, QD, QDD = (
+        rng.uniform(-3, 3, (BATCH_STATES, 6)),
+        rng.normal(0, 2, (BATCH_STATES, 6)),
+        rng.normal(0, 5, (BATCH_STATES, 6)),
+    )
+    check_same(
+        "Python batch tau vs rnea_batch",
+        module.tau(Q[:1000], QD[:1000], QDD[:1000]),
+        rnea_batch(model, Q[:1000], QD[:1000], QDD[:1000]),
+    )
     ours = seconds_per_call(lambda: module.tau(Q, QD, QDD), blocks=7, number=1)
     theirs = seconds_per_call(lambda: rnea_batch(model, Q, QD, QDD), blocks=7, number=1)
-    return [Row("Python batch (IRB-140, 100k states)", "generated tau(Q, QD, QDD) vs rnea_batch",
-                Figure.rate(ours, BATCH_STATES), Figure.rate(theirs, BATCH_STATES), Target(1.0, at_least=True))]
+    return [
+        Row(
+            "Python batch (IRB-140, 100k states)",
+            "generated tau(Q, QD, QDD) vs rnea_batch",
+            Figure.rate(ours, BATCH_STATES),
+            Figure.rate(theirs, BATCH_STATES),
+            Target(1.0, at_least=True),
+        )
+    ]
 
 
 def generation_rows() -> tuple[list[Row], dict]:
     rows, files = [], {}
     arms = {
         "IRB-140 (6 joints)": (irb140(), 60.0),
-        "Panda (7 joints)": (load_urdf((REPO / "test/data/urdf/panda.urdf").read_text(), tip_link="panda_link8").model,
-                             180.0),
+        "Panda (7 joints)": (
+            load_urdf((REPO / "test/data/urdf/panda.urdf").read_text(), tip_link="panda_link8").model,
+            180.0,
+        ),
     }
     for name, (model, limit) in arms.items():
         wall, cpu = time.perf_counter(), time.process_time()
         generated = generate(model, ("c", "python"), prefix="irb140")
         wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-        rows.append(Row("generation (tau, M, C, g; C and Python)", f"{name}, wall", Value.of(wall, "s"), None,
-                        Target(limit, absolute=True)))
+        rows.append(
+            Row(
+                "generation (tau, M, C, g; C and Python)",
+                f"{name}, wall",
+                Value.of(wall, "s"),
+                None,
+                Target(limit, absolute=True),
+            )
+        )
         rows.append(Row("generation (tau, M, C, g; C and Python)", f"{name}, CPU", Value.of(cpu, "s")))
         files = files or generated
     return rows, files
@@ -171,8 +209,9 @@ def main() -> None:
             (folder / name).write_text(text)
         rows = c_rows(model, folder) + python_rows(model, folder) + generation
     print_table(rows, "Generated equations of motion (IRB-140)")
-    path = write_results("equations", {"machine": machine_info(("numpy", "pinocchio", "sympy")),
-                                       "rows": [row.as_dict() for row in rows]})
+    path = write_results(
+        "equations", {"machine": machine_info(("numpy", "pinocchio", "sympy")), "rows": [row.as_dict() for row in rows]}
+    )
     print(f"\nwritten: {path.relative_to(REPO)}")
 
 

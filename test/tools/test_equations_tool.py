@@ -26,15 +26,15 @@ def test_writes_its_files_and_leaves_the_rest(tmp_path, capsys):
     out = tmp_path / "gen"
     out.mkdir()
     (out / "mine.txt").write_text("not the tool's")
-    (out / "irb140_dynamics.py").write_text("an older version")
+    (out / "irb140_eom.py").write_text("an older version")
     status, printed, err = run(
         capsys, "--params-file", CONFIG, "--form", "python", "--what", "g", "--payload-mass", "6", "--out", out
     )
     assert status == 0, err
-    assert sorted(p.name for p in out.iterdir()) == ["irb140_dynamics.py", "mine.txt"]  # no temp folder left
+    assert sorted(p.name for p in out.iterdir()) == ["irb140_eom.py", "mine.txt"]  # no temp folder left
     assert (out / "mine.txt").read_text() == "not the tool's"
-    assert printed.split() == [str(out / "irb140_dynamics.py")]
-    g = import_file(out / "irb140_dynamics.py", "tool_irb140").g(STRETCHED)
+    assert printed.split() == [str(out / "irb140_eom.py")]
+    g = import_file(out / "irb140_eom.py", "tool_irb140").g(STRETCHED)
     # the report's torques with 6 kg at the flange, as printed
     assert np.allclose(g[[1, 2, 4]], [290.765, 105.348, 6.25594], rtol=0, atol=[5e-4, 5e-4, 5e-6])
 
@@ -56,7 +56,7 @@ def test_urdf_chain_and_prefix(tmp_path, capsys):
         tmp_path,
     )
     assert status == 0, err
-    header = (tmp_path / "ur_dynamics.h").read_text()
+    header = (tmp_path / "ur_eom.h").read_text()
     assert "void ur_g(const double q[6], double g[6]);" in header
     assert "shoulder_pan_joint" in header
 
@@ -144,4 +144,4 @@ def test_same_input_same_bytes(tmp_path):
             )
         outputs.append({p.name: p.read_bytes() for p in sorted(out.iterdir())})
     assert outputs[0] == outputs[1]
-    assert sorted(outputs[0]) == ["irb140_dynamics.c", "irb140_dynamics.h", "irb140_dynamics.tex"]
+    assert sorted(outputs[0]) == ["irb140_eom.c", "irb140_eom.h", "irb140_eom.tex"]

@@ -13,7 +13,7 @@ from .symbolic import Equations
 
 def render(eq: Equations, reduced: dict, prefix: str, source: str) -> dict[str, str]:
     """{file name: text} of the .h and .c pair."""
-    guard = f"{prefix.upper()}_DYNAMICS_H"
+    guard = f"{prefix.upper()}_EOM_H"
     comment = _comment(header_lines(eq, source))
     h = [comment, f"#ifndef {guard}", f"#define {guard}", "", f"#define {prefix.upper()}_N {eq.n}"]
     if eq.parameters:
@@ -22,13 +22,13 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str) -> dict[str, 
         h.append(f"/* The model's parameter values, as an initializer: double p[] = {prefix.upper()}_PARAMETERS; */")
         h.append(f"#define {prefix.upper()}_PARAMETERS {{{values}}}")
     h += ["", "#ifdef __cplusplus", 'extern "C" {', "#endif", ""]
-    c = [comment, f'#include "{prefix}_dynamics.h"', "", "#include <math.h>", ""]
+    c = [comment, f'#include "{prefix}_eom.h"', "", "#include <math.h>", ""]
     for name, (replacements, outputs) in reduced.items():
         signature = _signature(eq, name, prefix)
         h += [f"/* {DESCRIPTIONS[name]} */", f"{signature};", ""]
         c += [signature, "{", *_body(eq, name, replacements, outputs), "}", ""]
     h += ["#ifdef __cplusplus", "}", "#endif", "", f"#endif /* {guard} */", ""]
-    return {f"{prefix}_dynamics.h": "\n".join(h), f"{prefix}_dynamics.c": "\n".join(c)}
+    return {f"{prefix}_eom.h": "\n".join(h), f"{prefix}_eom.c": "\n".join(c)}
 
 
 def _comment(lines: list[str]) -> str:

@@ -80,7 +80,7 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str, expanded: dic
         else:
             lines += _reduced_entries(eq, name, *reduced[name])
     lines += ["", r"\end{document}", ""]
-    return {f"{prefix}_dynamics.tex": "\n".join(lines)}
+    return {f"{prefix}_eom.tex": "\n".join(lines)}
 
 
 def _text(s: str) -> str:

@@ -46,7 +46,7 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str) -> dict[str, 
         lines.append(f"REGRESSOR_COLUMNS = {eq.regressor_columns!r}")
     for name, (replacements, outputs) in reduced.items():
         lines += ["", ""] + _function(eq, name, replacements, outputs)
-    return {f"{prefix}_dynamics.py": "\n".join(lines) + "\n"}
+    return {f"{prefix}_eom.py": "\n".join(lines) + "\n"}
 
 
 def _function(eq: Equations, name: str, replacements, outputs) -> list[str]:

@@ -44,7 +44,7 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str) -> dict[str, 
         lines += [f"{name}_{symbol} = {_renamed(printer.doprint(expr), name)}" for symbol, expr in replacements]
         entries = ",\n    ".join(_renamed(printer.doprint(expr), name) for expr in outputs)
         lines.append(f"{name} = Matrix({rows}, {cols}, [\n    {entries},\n])")
-    return {f"{prefix}_sympy.py": "\n".join(lines) + "\n"}
+    return {f"{prefix}_eom_sympy.py": "\n".join(lines) + "\n"}
 
 
 def _renamed(text: str, name: str) -> str:

@@ -51,7 +51,7 @@ def compiler() -> str | None:
 
 def compile_c(folder, prefix: str) -> ctypes.CDLL:
     """The generated .c compiled as the issue asks (warnings are errors) into a shared library."""
-    source, library = folder / f"{prefix}_dynamics.c", folder / f"lib{prefix}.so"
+    source, library = folder / f"{prefix}_eom.c", folder / f"lib{prefix}.so"
     subprocess.run(
         [compiler(), *CC_FLAGS, "-shared", "-fPIC", str(source), "-o", str(library), "-lm"],
         check=True,
@@ -85,3 +85,13 @@ def c_function(library, name: str, arguments: int, out_size: int, n_parameters: 
         return out
 
     return call
+
+
+def prismatic_arm():
+    """The test arm with a prismatic joint, or the reason the core cannot load it."""
+    from irb140_dynamics.core.urdf import UrdfError
+
+    try:
+        return load_urdf((URDF_DATA / "prismatic_arm.urdf").read_text()).model, None
+    except UrdfError as error:
+        return None, f"the core does not load a prismatic joint yet ({error})"

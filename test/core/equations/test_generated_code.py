@@ -40,7 +40,7 @@ def generated(request, tmp_path_factory):
     folder = tmp_path_factory.mktemp(f"equations_{name}")
     for file, text in generate(model, ("c", "python"), prefix=name).items():
         (folder / file).write_text(text)
-    module = import_file(folder / f"{name}_dynamics.py", f"generated_{name}")
+    module = import_file(folder / f"{name}_eom.py", f"generated_{name}")
     library = compile_c(folder, name) if compiler() else None
     return name, model, module, library
 
@@ -90,7 +90,7 @@ def test_the_reports_stretched_pose_torques_to_every_printed_digit(arm, request)
     folder = request.getfixturevalue("tmp_path")
     for file, text in generate(model, ("c", "python"), what=("tau", "g"), prefix=arm).items():
         (folder / file).write_text(text)
-    module = import_file(folder / f"{arm}_dynamics.py", f"stretched_{arm}")
+    module = import_file(folder / f"{arm}_eom.py", f"stretched_{arm}")
     zeros = np.zeros(6)
     results = {"Python g": module.g(STRETCHED), "Python tau": module.tau(STRETCHED, zeros, zeros)}
     if compiler():
@@ -108,7 +108,7 @@ def test_regressor_equals_the_core(tmp_path):
     files = generate(model, ("c", "python"), what=("regressor",), prefix="arm")
     for file, text in files.items():
         (tmp_path / file).write_text(text)
-    module = import_file(tmp_path / "arm_dynamics.py", "generated_regressor")
+    module = import_file(tmp_path / "arm_eom.py", "generated_regressor")
     Q, QD, QDD = random_states(model.n, seed=2, count=200)
     want = regressor_batch(model, Q, QD, QDD)
     assert_close(module.regressor(Q, QD, QDD), want, "regressor (Python)")
@@ -127,7 +127,7 @@ def test_symbolic_parameters_take_any_values(tmp_path):
     files = generate(arm, ("c", "python"), symbolic=True, prefix="ur5")
     for file, text in files.items():
         (tmp_path / file).write_text(text)
-    module = import_file(tmp_path / "ur5_dynamics.py", "generated_symbolic")
+    module = import_file(tmp_path / "ur5_eom.py", "generated_symbolic")
     p = np.array([x.value for x in derive(loaded, ("g",), symbolic=True).parameters])
     assert not np.array_equal(p, module.PARAMETERS)
     Q, QD, QDD = random_states(arm.n, seed=3, count=200)
@@ -158,8 +158,8 @@ def test_friction_is_in_tau(tmp_path):
         model, joints=tuple(replace(j, friction=Friction(0.5 + k, 2.0 + k)) for k, j in enumerate(model.joints))
     )
     files = generate(model, ("python",), what=("tau",), prefix="arm")
-    (tmp_path / "arm_dynamics.py").write_text(files["arm_dynamics.py"])
-    module = import_file(tmp_path / "arm_dynamics.py", "generated_friction")
+    (tmp_path / "arm_eom.py").write_text(files["arm_eom.py"])
+    module = import_file(tmp_path / "arm_eom.py", "generated_friction")
     Q, QD, QDD = random_states(model.n, seed=4, count=200)
     QD[:5] *= 1e-3  # near zero velocity, where the tanh bends
     assert_close(module.tau(Q, QD, QDD), rnea_batch(model, Q, QD, QDD), "tau with friction")

@@ -22,8 +22,8 @@ ARMS = arms()
 def test_sympy_module_rebuilds_the_expressions(tmp_path):
     model = ARMS["irb140_6kg"]
     files = generate(model, ("sympy",), prefix="irb140")
-    (tmp_path / "irb140_sympy.py").write_text(files["irb140_sympy.py"])
-    module = import_file(tmp_path / "irb140_sympy.py", "generated_sympy")
+    (tmp_path / "irb140_eom_sympy.py").write_text(files["irb140_eom_sympy.py"])
+    module = import_file(tmp_path / "irb140_eom_sympy.py", "generated_sympy")
     assert [s.name for s in module.q] == [f"q{i}" for i in range(1, 7)]
     assert module.M.shape == (6, 6) and module.tau.shape == (6, 1)
     Q, QD, QDD = random_states(6, seed=5, count=20)
@@ -64,7 +64,7 @@ def test_the_series_equal_the_core(arm):
 def test_products_of_angles_become_sums():
     """The IRB-140's joints 2 and 3 turn about parallel axes: g_2 holds cos(q2 + q3), no c2 c3."""
     files = generate(ARMS["irb140"], ("latex",), what=("g",), prefix="irb140")
-    tex = files["irb140_dynamics.tex"]
+    tex = files["irb140_eom.tex"]
     g2 = next(line for line in tex.splitlines() if line.startswith("g_{2} &="))
     assert r"\cos(q_{2} + q_{3})" in g2 and r"\sin(q_{2})" in g2, g2
     assert r"\cos(q_{2}) \cos(q_{3})" not in tex
@@ -73,7 +73,7 @@ def test_products_of_angles_become_sums():
 def test_constant_entries_are_written():
     """The IRB-140's M_66 (joint 6 turns only its own link: a constant) is the core's."""
     model = ARMS["irb140"]
-    tex = generate(model, ("latex",), what=("M",), prefix="irb140")["irb140_dynamics.tex"]
+    tex = generate(model, ("latex",), what=("M",), prefix="irb140")["irb140_eom.tex"]
     m66 = next(line for line in tex.splitlines() if line.startswith("M_{66} &="))
     assert m66.split("=")[1].split()[0] == f"{mass_matrix(model, [0.3] * 6)[5, 5]:.6g}", m66
 
@@ -84,13 +84,13 @@ def test_the_document_compiles(tmp_path):
         pytest.skip("pdflatex is not installed (texlive-latex-base): the .tex is not compiled")
     for arm, symbolic in (("irb140", False), ("ur5", True)):
         files = generate(ARMS[arm], ("latex",), symbolic=symbolic, prefix=arm)
-        (tmp_path / f"{arm}_dynamics.tex").write_text(files[f"{arm}_dynamics.tex"])
+        (tmp_path / f"{arm}_eom.tex").write_text(files[f"{arm}_eom.tex"])
         result = subprocess.run(
-            ["pdflatex", "-interaction=nonstopmode", "-halt-on-error", f"{arm}_dynamics.tex"],
+            ["pdflatex", "-interaction=nonstopmode", "-halt-on-error", f"{arm}_eom.tex"],
             cwd=tmp_path,
             capture_output=True,
             text=True,
             timeout=240,
         )
         assert result.returncode == 0, result.stdout[-2000:]
-        assert (tmp_path / f"{arm}_dynamics.pdf").stat().st_size > 0
+        assert (tmp_path / f"{arm}_eom.pdf").stat().st_size > 0
