@@ -1,8 +1,8 @@
 """LaTeX form: a document (article, amsmath) with the model's symbols, M, C qd and g per entry.
 
-With the model's numbers, each entry is written out as a trigonometric series (see
-``trig_series``: products of sines and cosines become sines and cosines of sums of
-angles, as one would simplify by hand), numbers to 6 significant digits, when that stays
+With the model's numbers, each entry is written out as a polynomial in the sines and
+cosines of the joint angles, those of joints about parallel axes summed (see
+``trig_series`` and ``trig_products``), numbers to 6 significant digits, when that stays
 short (``MAX_TERMS`` per entry on average); otherwise, and with symbolic parameters, the
 common subexpressions x_k are defined first and the entries written with them.
 """
@@ -12,6 +12,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..algorithms import recursions as algorithms
+from . import trig_products as tp
 from . import trig_series as ts
 from .printing import header_lines
 from .symbolic import Equations, links_of
@@ -69,14 +70,16 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str, expanded: dic
         r"(order above). "
         r"$\tau_{f,i} = f_{v,i}\,\dot q_i + f_{c,i} \tanh(\dot q_i / v_s)$ is the joint friction.",
     ]
+    runs = tp.angle_runs(list(expanded.values()), eq.n) if expanded else []
     if expanded:
+        lines.append(" " + _notation(runs, eq.n))
         lines.append(r" Numbers rounded to 6 significant digits; the C, Python and SymPy forms carry them in full.")
     for name in ("M", "Cqd", "g", "tau", "regressor"):
         if name not in reduced:
             continue
         lines += ["", rf"\subsection*{{{TITLES[name]}}}"]
         if name in expanded:
-            lines += _series_entries(eq, name, expanded[name])
+            lines += _series_entries(eq, name, expanded[name], runs)
         else:
             lines += _reduced_entries(eq, name, *reduced[name])
     lines += ["", r"\end{document}", ""]
@@ -112,63 +115,62 @@ def _entries(eq, name):
     return [k for k in range(count) if name != "M" or k // n <= k % n]
 
 
-def _series_entries(eq: Equations, name: str, entries) -> list[str]:
-    largest = max((abs(c) for x in entries if isinstance(x, ts.Series) for c in x.terms.values()), default=0.0)
-    tolerance = 1e-10 * largest
+def _series_entries(eq: Equations, name: str, entries, runs) -> list[str]:
+    numbers = [abs(c) for x in entries if isinstance(x, ts.Series) for c in x.terms.values()]
+    numbers += [abs(x) for x in entries if not isinstance(x, ts.Series)]
+    tolerance = 1e-10 * max(numbers, default=0.0)
+    labels = [_label(joints, eq.n) for joints in tp.angle_sums(runs)]
     lines = [r"\begin{align*}"]
     for k in _entries(eq, name):
-        x = entries[k]
-        if isinstance(x, ts.Series):
-            terms = x.real_terms(tolerance)
-        else:  # a constant: the recursion folded it to a number
-            terms = [(-1, (), (0,) * eq.n, float(x), 0.0)] if abs(x) > tolerance else []
-        lines.append(rf"{SYMBOL[name]}_{{{_index(eq, name, k)}}} &= {_series_text(eq.n, terms)} \\")
+        form = tp.products(entries[k], runs, tolerance)
+        lines.append(rf"{SYMBOL[name]}_{{{_index(eq, name, k)}}} &= {_form_text(eq.n, form, labels)} \\")
     if name == "M":
         lines.append(r"M_{ji} &= M_{ij} \\")
     lines[-1] = lines[-1].removesuffix(r" \\")
     return lines + [r"\end{align*}"]
 
 
-def _series_text(n: int, terms) -> str:
-    by_velocity: dict[tuple, list[str]] = {}
-    for _, v, k, a, b in terms:
-        parts = by_velocity.setdefault(v, [])
-        if not any(k):
-            parts.append(_number(a))
-            continue
-        if a:
-            parts.append(rf"{_number(a)} \cos({_angle(k)})")
-        if b:
-            parts.append(rf"{_number(b)} \sin({_angle(k)})")
-    if not by_velocity:
-        return "0"
+def _label(joints, n: int) -> str:
+    return ("," if n >= 10 else "").join(str(j + 1) for j in joints)
+
+
+def _form_text(n: int, form: dict, labels: list[str]) -> str:
     pieces = []
-    for v, parts in by_velocity.items():
+    for v, poly in form.items():
+        parts = [f"{_number(c)} {_monomial(m, labels)}".rstrip() for m, c in poly.items()]
         chunks = [" ".join(parts[i : i + TERMS_PER_LINE]) for i in range(0, len(parts), TERMS_PER_LINE)]
         body = r" \\ &\qquad ".join(chunks)
-        body = body[1:] if body.startswith("+") else body
         if not v:
             pieces.append(body)
         else:
-            pieces.append(rf"+ {_velocities(n, v)} \big( {body} \big)")
+            pieces.append(rf"+ {_velocities(n, v)} \big( {body.removeprefix('+ ')} \big)")
     text = r" \\ &\quad ".join(pieces)
-    return text[2:] if text.startswith("+ ") else text
+    return text.removeprefix("+ ") or "0"
+
+
+def _monomial(monomial, labels) -> str:
+    factors = []
+    for (a, b), label in zip(monomial, labels):
+        for letter, power in (("c", a), ("s", b)):
+            if power:
+                factors.append(f"{letter}_{{{label}}}" + (f"^{{{power}}}" if power > 1 else ""))
+    return " ".join(factors)
+
+
+def _notation(runs, n: int) -> str:
+    text = r"$c_{i} = \cos q_i$, $s_{i} = \sin q_i$"
+    for joints in tp.angle_sums(runs):
+        if len(joints) > 1:
+            angle = " + ".join(f"q_{{{j + 1}}}" for j in joints)
+            label = _label(joints, n)
+            text += rf", $c_{{{label}}} = \cos({angle})$, $s_{{{label}}} = \sin({angle})$"
+    return text + "."
 
 
 def _number(x: float) -> str:
     mantissa, _, exponent = f"{abs(x):.6g}".partition("e")
     text = mantissa if not exponent else rf"{mantissa} \times 10^{{{int(exponent)}}}"
     return ("- " if x < 0 else "+ ") + text
-
-
-def _angle(k) -> str:
-    text = ""
-    for i, c in enumerate(k):
-        if c:
-            sign = "-" if c < 0 else "+"
-            text += f" {sign} {abs(c) if abs(c) != 1 else ''}q_{{{i + 1}}}"
-    text = text.strip()
-    return text[2:] if text.startswith("+ ") else text
 
 
 def _velocities(n: int, v) -> str:

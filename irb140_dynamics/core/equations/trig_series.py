@@ -1,4 +1,4 @@
-"""The equations written out as trigonometric series, for reading (see ``latex``).
+"""The equations as trigonometric series, for reading (see ``trig_products`` and ``latex``).
 
 A ``Series`` is a scalar for the core's recursions (``+ - *`` with numbers and each other):
 a finite sum of terms

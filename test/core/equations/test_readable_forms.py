@@ -11,7 +11,7 @@ import sympy as sp
 
 from irb140_dynamics.core import coriolis_batch, gravity_batch, mass_matrix, mass_matrix_batch, rnea_batch
 from irb140_dynamics.core.equations import generate, latex
-from irb140_dynamics.core.equations import trig_series as ts
+from irb140_dynamics.core.equations import trig_products as tp
 
 from .support import arms, assert_close, import_file, random_states
 
@@ -44,30 +44,32 @@ def test_sympy_module_rebuilds_the_expressions(tmp_path):
 
 
 @pytest.mark.parametrize("arm", ["irb140_6kg", "ur5"])
-def test_the_series_equal_the_core(arm):
+def test_the_written_forms_equal_the_core(arm):
+    """The polynomials in sines and cosines the LaTeX prints (before rounding) are the core's."""
     model = ARMS[arm]
     series = latex.series(model, {"M", "Cqd", "g"})
     assert set(series) == {"M", "Cqd", "g"}, "the series are short enough for these arms"
+    runs = tp.angle_runs(list(series.values()), model.n)
     Q, QD, _ = random_states(model.n, seed=6, count=50)
 
-    def values(entries, q, qd):
-        return np.array([x.value(q, qd) if isinstance(x, ts.Series) else x for x in entries])
+    def values(name, q, qd=()):
+        return [tp.value(tp.products(x, runs, 0.0), runs, q, qd) for x in series[name]]
 
-    assert_close(np.array([values(series["g"], q, ()) for q in Q]), gravity_batch(model, Q), "g series")
-    M = np.array([values(series["M"], q, ()) for q in Q]).reshape(-1, model.n, model.n)
-    assert_close(M, mass_matrix_batch(model, Q), "M series")
-    assert_close(
-        np.array([values(series["Cqd"], q, qd) for q, qd in zip(Q, QD)]), coriolis_batch(model, Q, QD), "Cqd series"
-    )
+    assert_close(np.array([values("g", q) for q in Q]), gravity_batch(model, Q), "g written")
+    M = np.array([values("M", q) for q in Q]).reshape(-1, model.n, model.n)
+    assert_close(M, mass_matrix_batch(model, Q), "M written")
+    assert_close(np.array([values("Cqd", q, qd) for q, qd in zip(Q, QD)]), coriolis_batch(model, Q, QD), "Cqd written")
 
 
-def test_products_of_angles_become_sums():
-    """The IRB-140's joints 2 and 3 turn about parallel axes: g_2 holds cos(q2 + q3), no c2 c3."""
-    files = generate(ARMS["irb140"], ("latex",), what=("g",), prefix="irb140")
-    tex = files["irb140_eom.tex"]
+def test_parallel_joints_angles_are_summed():
+    """The IRB-140's joints 2 and 3 turn about parallel axes: its g_2 is written with
+    c23 = cos(q2 + q3), no product c2 c3; the UR5's joints 2, 3, 4 likewise."""
+    tex = generate(ARMS["irb140"], ("latex",), what=("g",), prefix="irb140")["irb140_eom.tex"]
     g2 = next(line for line in tex.splitlines() if line.startswith("g_{2} &="))
-    assert r"\cos(q_{2} + q_{3})" in g2 and r"\sin(q_{2})" in g2, g2
-    assert r"\cos(q_{2}) \cos(q_{3})" not in tex
+    assert "c_{23}" in g2 and "s_{2}" in g2, g2
+    assert "c_{2} c_{3}" not in tex and r"$c_{23} = \cos(q_{2} + q_{3})$" in tex
+    series = latex.series(ARMS["ur5"], {"g"})
+    assert [len(joints) for joints in tp.angle_sums(tp.angle_runs(list(series.values()), 6))] == [1, 1, 2, 3, 1, 1]
 
 
 def test_constant_entries_are_written():
