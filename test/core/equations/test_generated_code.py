@@ -33,16 +33,25 @@ REPORT = {
 }
 
 
+_GENERATED = {}
+
+
+def generated_arm(name, tmp_path_factory):
+    """(name, model, Python module, C library or None) of one arm, generated once per module."""
+    if name not in _GENERATED:
+        model = ARMS[name]
+        folder = tmp_path_factory.mktemp(f"equations_{name}")
+        for file, text in generate(model, ("c", "python"), prefix=name).items():
+            (folder / file).write_text(text)
+        module = import_file(folder / f"{name}_eom.py", f"generated_{name}")
+        library = compile_c(folder, name) if compiler() else None
+        _GENERATED[name] = name, model, module, library
+    return _GENERATED[name]
+
+
 @pytest.fixture(scope="module", params=sorted(ARMS))
 def generated(request, tmp_path_factory):
-    """(name, model, Python module, C library or None) of one arm."""
-    name, model = request.param, ARMS[request.param]
-    folder = tmp_path_factory.mktemp(f"equations_{name}")
-    for file, text in generate(model, ("c", "python"), prefix=name).items():
-        (folder / file).write_text(text)
-    module = import_file(folder / f"{name}_eom.py", f"generated_{name}")
-    library = compile_c(folder, name) if compiler() else None
-    return name, model, module, library
+    return generated_arm(request.param, tmp_path_factory)
 
 
 def reference(model, Q, QD, QDD):
@@ -85,16 +94,11 @@ def test_c_equals_the_core(generated):
 
 
 @pytest.mark.parametrize("arm", sorted(REPORT))
-def test_the_reports_stretched_pose_torques_to_every_printed_digit(arm, request):
-    model = ARMS[arm]
-    folder = request.getfixturevalue("tmp_path")
-    for file, text in generate(model, ("c", "python"), what=("tau", "g"), prefix=arm).items():
-        (folder / file).write_text(text)
-    module = import_file(folder / f"{arm}_eom.py", f"stretched_{arm}")
+def test_the_reports_stretched_pose_torques_to_every_printed_digit(arm, tmp_path_factory):
+    _, _, module, library = generated_arm(arm, tmp_path_factory)
     zeros = np.zeros(6)
     results = {"Python g": module.g(STRETCHED), "Python tau": module.tau(STRETCHED, zeros, zeros)}
-    if compiler():
-        library = compile_c(folder, arm)
+    if library is not None:
         results["C g"] = c_function(library, f"{arm}_g", 1, 6)(STRETCHED)
         results["C tau"] = c_function(library, f"{arm}_tau", 3, 6)(STRETCHED, zeros, zeros)
     for what, torques in results.items():
