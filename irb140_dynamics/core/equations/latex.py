@@ -30,9 +30,12 @@ TERMS_PER_LINE = 3
 
 
 def series(model, names) -> dict[str, list]:
-    """The quantities among M, Cqd, g as Series entries (row-major), those that stay short."""
+    """The quantities among M, Cqd, g as Series entries (row-major), those that stay short
+    (none for an arm with a prismatic joint)."""
     n = model.n
     links, _, _ = links_of(model, False)
+    if any(getattr(link, "prismatic", False) for link in links):
+        return {}  # a slide enters as a polynomial, not a series: the subexpression form
     cs = [ts.angle(i, n, link.theta_offset) for i, link in enumerate(links)]
     zeros = [0.0] * n
     out = {}

@@ -79,6 +79,14 @@ def angle_pair(q: sp.Symbol, offset: float):
     return sp.cos(theta), sp.sin(theta)
 
 
+def joint_input(q: sp.Symbol, link):
+    """What the recursions take for joint i, as the core's kernels give it: (cos, sin) of
+    q + offset for a revolute joint, (q,) for a prismatic one (a Link marked ``prismatic``)."""
+    if getattr(link, "prismatic", False):
+        return (q,)
+    return angle_pair(q, link.theta_offset)
+
+
 def derive(model, what=DEFAULT_QUANTITIES, symbolic: bool = False, progress: Callable[[str], None] = None):
     """The Equations of ``model`` for the quantities ``what`` (names from QUANTITIES)."""
     unknown = [w for w in what if w not in QUANTITIES]
@@ -88,7 +96,7 @@ def derive(model, what=DEFAULT_QUANTITIES, symbolic: bool = False, progress: Cal
     n = model.n
     q, qd, qdd = joint_symbols(n)
     links, parameters, friction = links_of(model, symbolic)
-    cs = [angle_pair(q_i, link.theta_offset) for q_i, link in zip(q, links)]
+    cs = [joint_input(q_i, link) for q_i, link in zip(q, links)]
     zeros = [0] * n
     quantities, shapes, arguments = {}, {}, {}
     with distribute(False):
