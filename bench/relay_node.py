@@ -47,8 +47,9 @@ class RelayNode(Node):
         reliability = RELIABILITIES[self.declare_parameter("qos.reliability", "best_effort").value]
         self.declare_parameter("payload.mass", 0.0)  # set like id_node's in the benchmark; changes nothing here
         self._publisher = self.create_publisher(JointState, "feedforward_torques", depth)
-        self.create_subscription(JointState, "joint_states", self._publisher.publish,
-                                 QoSProfile(depth=depth, reliability=reliability))
+        self.create_subscription(
+            JointState, "joint_states", self._publisher.publish, QoSProfile(depth=depth, reliability=reliability)
+        )
         self.get_logger().info("ready: relaying joint_states to feedforward_torques")
 
 
@@ -79,7 +80,7 @@ def without_event_handlers() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv if argv is None else argv
-    ours = argv[1:argv.index("--ros-args")] if "--ros-args" in argv else argv[1:]
+    ours = argv[1 : argv.index("--ros-args")] if "--ros-args" in argv else argv[1:]
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("node", choices=("relay", "id_node"))
     parser.add_argument("--executor", choices=EXECUTORS, default="events")
@@ -87,7 +88,7 @@ def main(argv: list[str] | None = None) -> int:
     options = parser.parse_args(ours)
     if options.no_event_handlers:
         without_event_handlers()
-    ros_args = argv[argv.index("--ros-args"):] if "--ros-args" in argv else []
+    ros_args = argv[argv.index("--ros-args") :] if "--ros-args" in argv else []
     return run(options.node, make_node(options.node), [argv[0], *ros_args], options.executor)
 
 

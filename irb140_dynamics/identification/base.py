@@ -90,7 +90,11 @@ def random_states(model: RobotModel, count: int, rng) -> tuple[np.ndarray, np.nd
     speed = np.array([j.velocity_limit or 2.0 for j in model.joints])
     acceleration = np.array([j.acceleration_limit or 10.0 for j in model.joints])
     shape = (count, model.n)
-    return rng.uniform(lower, upper, shape), rng.uniform(-speed, speed, shape), rng.uniform(-acceleration, acceleration, shape)
+    return (
+        rng.uniform(lower, upper, shape),
+        rng.uniform(-speed, speed, shape),
+        rng.uniform(-acceleration, acceleration, shape),
+    )
 
 
 def find_base_parameters(model: RobotModel, states: int = DEFAULT_STATES, seed: int = 0) -> BaseParameters:

@@ -103,8 +103,10 @@ def weighted_least_squares(data: NormalEquations, base: BaseParameters, correlat
     singular = np.linalg.svd(unweighted, compute_uv=False)
     condition = float(np.sqrt(singular[0] / singular[-1])) if singular[-1] > 0 else float("inf")
     if singular[-1] <= singular[0] * 1e-14:
-        raise ValueError("the recording does not excite every base parameter (singular regressor): "
-                         "run an excitation trajectory (`excitation`)")
+        raise ValueError(
+            "the recording does not excite every base parameter (singular regressor): "
+            "run an excitation trajectory (`excitation`)"
+        )
     weights = np.ones_like(rows)
     beta = None
     used = rows > 0

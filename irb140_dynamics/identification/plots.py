@@ -38,10 +38,22 @@ def write_plots(result: Result, directory) -> list[Path]:
                 axis.plot(time, predicted["prior"][:, j], color="tab:orange", linewidth=0.8, label="prior model")
                 axis.plot(time, predicted["identified"][:, j], color="tab:blue", linewidth=0.8, label="identified")
             else:
-                axis.plot(time, measured[:, j] - predicted["prior"][:, j], ".", color="tab:orange", markersize=1.5,
-                          label="measured - prior")
-                axis.plot(time, measured[:, j] - predicted["identified"][:, j], ".", color="tab:blue", markersize=1.5,
-                          label="measured - identified")
+                axis.plot(
+                    time,
+                    measured[:, j] - predicted["prior"][:, j],
+                    ".",
+                    color="tab:orange",
+                    markersize=1.5,
+                    label="measured - prior",
+                )
+                axis.plot(
+                    time,
+                    measured[:, j] - predicted["identified"][:, j],
+                    ".",
+                    color="tab:blue",
+                    markersize=1.5,
+                    label="measured - identified",
+                )
                 axis.axhline(0.0, color="k", linewidth=0.5)
             axis.set_ylabel(f"{names[j]}\n[N m]")
             axis.grid(True, linewidth=0.3)

@@ -25,8 +25,13 @@ def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="record", description=__doc__.split("\n\n")[0].split(": ", 1)[1])
     p.add_argument("--out", required=True, metavar="DIR", help="the bag directory to write (must not exist)")
     p.add_argument("--topic", default=DEFAULT_TOPIC, help=f"the topic (default {DEFAULT_TOPIC})")
-    p.add_argument("--duration", type=float, default=0.0, metavar="S",
-                   help="stop this long after the first message, node clock (default 0: at Ctrl-C)")
+    p.add_argument(
+        "--duration",
+        type=float,
+        default=0.0,
+        metavar="S",
+        help="stop this long after the first message, node clock (default 0: at Ctrl-C)",
+    )
     p.add_argument("--depth", type=int, default=DEFAULT_DEPTH, help=f"queue depth (default {DEFAULT_DEPTH})")
     return p
 

@@ -27,9 +27,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from irb140_dynamics.core.scalars.dual import Dual, dual_angles, partial  # noqa: F401 (Dual: part of this module's interface)
 from irb140_dynamics.core.model.joints import snap
-from irb140_dynamics.core.model.rigid_body import ZERO3, Vector3, Inertia6, shift_inertia
+from irb140_dynamics.core.model.rigid_body import ZERO3, Inertia6, Vector3, shift_inertia
+from irb140_dynamics.core.scalars.dual import Dual, dual_angles, partial  # noqa: F401 (Dual: part of this module's interface)
 
 Rotation = tuple[tuple[float, float, float], ...]
 
@@ -53,8 +53,10 @@ class Link:
 
 def chain(model) -> tuple[Link, ...]:
     """The per-link constants of a RobotModel (payload merged into the last link)."""
-    return tuple(Link(*_joint_constants(joint), *body.about_origin(), joint.armature)
-                 for joint, body in zip(model.joints, model.bodies))
+    return tuple(
+        Link(*_joint_constants(joint), *body.about_origin(), joint.armature)
+        for joint, body in zip(model.joints, model.bodies)
+    )
 
 
 @lru_cache(maxsize=256)  # a model rebuilt with another payload recomputes no joint's
@@ -285,9 +287,6 @@ def christoffel_coriolis(links, cs, qd):
     M = crba(links, dual_angles(cs))
     dM = [[[partial(M[i][j], k) for k in range(n)] for j in range(n)] for i in range(n)]
     return [
-        [
-            sum(0.5 * (dM[i][j][k] + dM[i][k][j] - dM[j][k][i]) * qd[k] for k in range(n))
-            for j in range(n)
-        ]
+        [sum(0.5 * (dM[i][j][k] + dM[i][k][j] - dM[j][k][i]) * qd[k] for k in range(n)) for j in range(n)]
         for i in range(n)
     ]

@@ -20,15 +20,22 @@ NumPy ufunc call each with an ``out`` argument:
 
 from __future__ import annotations
 
-from typing import Callable, Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from irb140_dynamics.core.codegen.trace import Sym, angle_lines, input_lines, operand, operands_first, trace
 
 _UFUNCS = {"*": "mul", "+": "add", "-": "sub"}
-_NAMESPACE = {"cos": np.cos, "sin": np.sin, "mul": np.multiply, "add": np.add, "sub": np.subtract,
-              "neg": np.negative, "empty": np.empty}
+_NAMESPACE = {
+    "cos": np.cos,
+    "sin": np.sin,
+    "mul": np.multiply,
+    "add": np.add,
+    "sub": np.subtract,
+    "neg": np.negative,
+    "empty": np.empty,
+}
 
 
 def compile_into(

@@ -15,6 +15,8 @@ from dataclasses import dataclass, replace
 from functools import cached_property, lru_cache
 
 from irb140_dynamics.core.algorithms import recursions as algorithms
+from irb140_dynamics.core.algorithms.momentum import momentum_terms
+from irb140_dynamics.core.algorithms.regressor import rigid_body_regressor
 from irb140_dynamics.core.codegen.array_code import compile_into
 from irb140_dynamics.core.codegen.trace import compile_kernel
 from irb140_dynamics.core.model.rigid_body import ZERO3, ZERO6
@@ -31,7 +33,7 @@ class Kernel:
         self._unbound, self._constants = self, None
         self.source, self.scalar, self.array = compile_kernel(*self._recipe)
 
-    def bound(self, constants: tuple) -> "Kernel":
+    def bound(self, constants: tuple) -> Kernel:
         """This kernel with ``k`` defaulting to ``constants`` (one model's payload and gravity)."""
         kernel = object.__new__(Kernel)
         kernel._unbound, kernel._constants = self, constants
@@ -131,8 +133,18 @@ class Kernels:
         return self._arm.monitor.bound(self.constants)
 
 
+def kernels_of(model) -> Kernels:
+    """The model's kernels, made on first use and kept with the model (models are immutable,
+    so they never go stale; a changed model is a new model, with kernels of its own)."""
+    try:
+        return model.__dict__["_kernels"]
+    except KeyError:
+        kernels = model.__dict__["_kernels"] = Kernels(model)
+        return kernels
+
+
 @lru_cache(maxsize=ARMS_CACHED)
-def _arm(links, flange, nonzero: tuple[bool, ...]) -> "_ArmKernels":
+def _arm(links, flange, nonzero: tuple[bool, ...]) -> _ArmKernels:
     return _ArmKernels(links, flange, nonzero)
 
 
@@ -185,7 +197,11 @@ class _ArmKernels:
         return self._kernel(
             "rnea_wrench",
             lambda cs, qd, qdd, wrench, k: algorithms.rnea(
-                self._links(k), cs, qd, qdd, self._gravity(k),
+                self._links(k),
+                cs,
+                qd,
+                qdd,
+                self._gravity(k),
                 *algorithms.flange_wrench(self.flange, wrench[:3], wrench[3:]),
             ),
             qd=self.n,
@@ -227,8 +243,6 @@ class _ArmKernels:
 
     @cached_property
     def regressor(self) -> Kernel:
-        from irb140_dynamics.core.regressor import rigid_body_regressor
-
         def flat(cs, qd, qdd, k):  # column by column, as the algorithm computes them: then the
             # array form (see array_code) keeps few intermediates alive (29 buffers for the IRB-140
             # instead of 138 row by row)
@@ -239,19 +253,18 @@ class _ArmKernels:
 
     @cached_property
     def momentum(self) -> Kernel:
-        from irb140_dynamics.core.monitoring.observer import momentum_terms
-
         return self._kernel("momentum", lambda cs, qd, k: momentum_terms(self._links(k), cs, qd), qd=self.n)
 
     @cached_property
     def monitor(self) -> Kernel:
-        from irb140_dynamics.core.monitoring.observer import momentum_terms
-
         zeros = [0.0] * self.n
 
         def terms(cs, qd, qdd, k):
             links, gravity = self._links(k), self._gravity(k)
-            return [*algorithms.rnea(links, cs, qd, qdd, gravity), *algorithms.rnea(links, cs, zeros, zeros, gravity),
-                    *momentum_terms(links, cs, qd)]
+            return [
+                *algorithms.rnea(links, cs, qd, qdd, gravity),
+                *algorithms.rnea(links, cs, zeros, zeros, gravity),
+                *momentum_terms(links, cs, qd),
+            ]
 
         return self._kernel("monitor", terms, qd=self.n, qdd=self.n)

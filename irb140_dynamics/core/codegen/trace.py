@@ -14,7 +14,7 @@ on floats, so its results are identical to it, bit for bit.
 from __future__ import annotations
 
 import math
-from typing import Callable, Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -115,9 +115,7 @@ def trace(algorithm: Callable[..., Sequence], inputs: dict[str, int], angles: Se
     params = []
     if angles is not None:
         params.append("q")
-        args["cs"] = [
-            (Sym("var", name=f"c{i}"), Sym("var", name=f"s{i}")) for i in range(len(angles))
-        ]
+        args["cs"] = [(Sym("var", name=f"c{i}"), Sym("var", name=f"s{i}")) for i in range(len(angles))]
     for group, length in inputs.items():
         params.append(group)
         args[group] = [Sym("var", name=f"{group}{i}") for i in range(length)]

@@ -1,43 +1,43 @@
-"""The files the tools write: ROS 2 parameter files and JointTrajectory messages, as YAML.
+"""ROS 2 parameter files (YAML), read and written: the flat parameters of a model and a node.
 
-Numbers are written so that every reader types them right: a double always has a decimal
-point or an exponent with one (``0.0``, ``1.5e-05``): rcl's parameter parser would take
-``0`` for an integer, and PyYAML (``ros2 topic pub``) takes ``1e-05`` for a string.
+Reading merges the ``/**`` section with the node's own; writing gives every node (``/**``)
+the parameters, doubles written as doubles (see ``yaml_numbers``).
 """
 
 from __future__ import annotations
 
-import json
-import math
-import os
-from pathlib import Path
-from typing import Any, Iterable, Mapping
+from collections.abc import Iterable, Mapping
+from typing import Any
 
-import numpy as np
+from irb140_dynamics.core.io.yaml_numbers import yaml_value
+from irb140_dynamics.core.model.robot_model import RobotModel
 
 
-def yaml_float(x: float, digits: int | None = None) -> str:
-    """A double as YAML that parses back as that double (17 significant digits by default)."""
-    x = float(x)
-    if not math.isfinite(x):
-        raise ValueError(f"cannot write the non-finite number {x}")
-    text = repr(x) if digits is None else f"{x:.{digits}g}"
-    mantissa, _, exponent = text.partition("e")
-    if "." not in mantissa:
-        mantissa += ".0"
-    return mantissa + (f"e{exponent}" if exponent else "")
+def read_parameter_file(path, node_name: str | None = None) -> dict[str, Any]:
+    """The flat parameters of a ROS 2 parameter file (``/**`` merged with ``node_name``)."""
+    import yaml
+
+    with open(path) as stream:
+        document = yaml.safe_load(stream) or {}
+    params: dict[str, Any] = {}
+    for key in ("/**", node_name, f"/{node_name}" if node_name else None):
+        if key and key in document:
+            _flatten(document[key].get("ros__parameters", {}), "", params)
+    return params
 
 
-def _value(value: Any) -> str:
-    if isinstance(value, str):
-        return json.dumps(value)  # a double-quoted YAML string
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (list, tuple, np.ndarray)):
-        return "[" + ", ".join(_value(v) for v in value) + "]"
-    if isinstance(value, (int, np.integer)):
-        return str(int(value))
-    return yaml_float(value)
+def _flatten(tree: Mapping[str, Any], prefix: str, out: dict[str, Any]) -> None:
+    for key, value in tree.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, Mapping):
+            _flatten(value, f"{name}.", out)
+        else:
+            out[name] = value
+
+
+def load_model(path, node_name: str | None = None) -> RobotModel:
+    """The model described by a ROS 2 parameter file."""
+    return RobotModel.from_params(read_parameter_file(path, node_name))
 
 
 def nested(flat: Mapping[str, Any]) -> dict:
@@ -66,32 +66,7 @@ def parameter_file_text(params: Mapping[str, Any], comments: Iterable[str] = ())
                 lines.append(f"{' ' * indent}{key}:")
                 emit(value, indent + 2)
             else:
-                lines.append(f"{' ' * indent}{key}: {_value(value)}")
+                lines.append(f"{' ' * indent}{key}: {yaml_value(value)}")
 
     emit(nested(params), 4)
     return "\n".join(lines) + "\n"
-
-
-def joint_trajectory_text(joint_names, times, Q, QD, QDD, comments: Iterable[str] = ()) -> str:
-    """A trajectory_msgs/JointTrajectory as the YAML ``ros2 topic pub`` takes (one point a line)."""
-    lines = [f"# {line}".rstrip() for line in comments]
-    lines.append(f"joint_names: {_value(list(joint_names))}")
-    lines.append("points:")
-    for t, q, qd, qdd in zip(times, Q, QD, QDD):
-        sec, nanosec = divmod(int(round(float(t) * 1e9)), 10**9)
-        fields = [f"{name}: [{', '.join(yaml_float(v, 12) for v in values)}]"
-                  for name, values in (("positions", q), ("velocities", qd), ("accelerations", qdd))]
-        lines.append(f"- {{{', '.join(fields)}, time_from_start: {{sec: {sec}, nanosec: {nanosec}}}}}")
-    return "\n".join(lines) + "\n"
-
-
-def write_text(path, text: str) -> Path:
-    """Write ``text`` to ``path`` whole or not at all (a temporary file renamed)."""
-    path = Path(path)
-    temporary = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    try:
-        temporary.write_text(text)
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
-    return path

@@ -24,7 +24,7 @@ class JointFriction:
     smoothing_velocity: float  # rad/s
 
     @classmethod
-    def of(cls, model) -> "JointFriction":
+    def of(cls, model) -> JointFriction:
         return cls(
             np.array([j.friction.viscous for j in model.joints]),
             np.array([j.friction.coulomb for j in model.joints]),

@@ -8,11 +8,11 @@ density is solved so that the moving links weigh 78 kg (98 kg arm less a 20 kg b
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
-from irb140_dynamics.core.model.robot_model import DH, Joint, RobotModel
 from irb140_dynamics.core.model.rigid_body import RigidBody
+from irb140_dynamics.core.model.robot_model import DH, Joint, RobotModel
 
 _AXES = "xyz"
 
@@ -84,13 +84,14 @@ IRB140_SHAPES = {
 }
 
 
-def irb140_volumes(
-    link1=IRB140_LINK1, link2=IRB140_LINK2, link4=IRB140_LINK4, link6=IRB140_LINK6
-) -> list[float]:
+def irb140_volumes(link1=IRB140_LINK1, link2=IRB140_LINK2, link4=IRB140_LINK4, link6=IRB140_LINK6) -> list[float]:
     return [cylinder_volume(**link1), box_volume(link2), box_volume(link4), cylinder_volume(**link6)]
 
 
-def irb140(density: float = IRB140_DENSITY, payload: RigidBody = RigidBody()) -> RobotModel:
+NO_PAYLOAD = RigidBody()
+
+
+def irb140(density: float = IRB140_DENSITY, payload: RigidBody = NO_PAYLOAD) -> RobotModel:
     """The report's IRB-140 model (its DH table and shapes) at the given density."""
     m1 = density * cylinder_volume(**IRB140_LINK1)
     m2 = density * box_volume(IRB140_LINK2)
@@ -115,8 +116,12 @@ def irb140(density: float = IRB140_DENSITY, payload: RigidBody = RigidBody()) ->
     ]
     joints = tuple(
         Joint(
-            f"joint_{i + 1}", row, link, tuple(math.radians(x) for x in limits),
-            velocity_limit=math.radians(speed), acceleration_limit=acceleration,
+            f"joint_{i + 1}",
+            row,
+            link,
+            tuple(math.radians(x) for x in limits),
+            velocity_limit=math.radians(speed),
+            acceleration_limit=acceleration,
         )
         for i, (row, link, limits, speed, acceleration) in enumerate(
             zip(dh, links, IRB140_RANGES_DEG, IRB140_SPEEDS_DEG, IRB140_ACCELERATIONS)

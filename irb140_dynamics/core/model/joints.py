@@ -83,7 +83,7 @@ class Placement:
         return [*self.xyz, *self.rpy]
 
     @classmethod
-    def validated(cls, field: str, value) -> "Placement":
+    def validated(cls, field: str, value) -> Placement:
         """From [x, y, z, roll, pitch, yaw] (or a Placement), or ModelError naming ``field``."""
         if value in _validated:
             return value
@@ -226,7 +226,15 @@ def _validate_joint(j: Joint) -> Joint:
         capped(f"{name}.{field}", "", values[field], MAX_FRICTION, unit)
     link = RigidBody.validated(f"{name}.link", j.link.mass, j.link.com, j.link.inertia)
     return Joint(
-        name, dh, link, (lower, upper), values["torque_limit"], origin, axis,
-        values["velocity_limit"], values["acceleration_limit"],
-        Friction(values["friction.viscous"], values["friction.coulomb"]), values["armature"],
+        name,
+        dh,
+        link,
+        (lower, upper),
+        values["torque_limit"],
+        origin,
+        axis,
+        values["velocity_limit"],
+        values["acceleration_limit"],
+        Friction(values["friction.viscous"], values["friction.coulomb"]),
+        values["armature"],
     )

@@ -15,9 +15,9 @@ from __future__ import annotations
 
 import math
 import weakref
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Sequence
 
 import numpy as np
 
@@ -108,9 +108,7 @@ def validate_inertia(field: str, inertia: Sequence[float]) -> Inertia6:
     if moments[0] < -tol:
         raise ModelError(field, f"not positive semi-definite (principal moments {moments.tolist()})")
     if moments[0] + moments[1] < moments[2] - tol:
-        raise ModelError(
-            field, f"principal moments {moments.tolist()} break the triangle inequality"
-        )
+        raise ModelError(field, f"principal moments {moments.tolist()} break the triangle inequality")
     return inertia
 
 
@@ -123,7 +121,7 @@ class RigidBody:
     inertia: Inertia6 = ZERO6
 
     @classmethod
-    def validated(cls, field: str, mass, com=ZERO3, inertia=ZERO6) -> "RigidBody":
+    def validated(cls, field: str, mass, com=ZERO3, inertia=ZERO6) -> RigidBody:
         """Build from raw values; errors name ``field.mass``, ``field.com``, ``field.inertia``."""
         m = checked_mass(f"{field}.mass", mass)
         c = finite_numbers(f"{field}.com", com, 3)
@@ -131,7 +129,7 @@ class RigidBody:
         return VALIDATED_BODIES.add(cls(m, c, validate_inertia(f"{field}.inertia", inertia)))
 
     @classmethod
-    def checked(cls, field: str, body: "RigidBody") -> "RigidBody":
+    def checked(cls, field: str, body: RigidBody) -> RigidBody:
         """``body`` validated (see ``validated``); at once if it came from there."""
         if body in VALIDATED_BODIES:
             return body

@@ -34,16 +34,28 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import Any, Mapping
+from typing import Any
 
+from irb140_dynamics.core.model.friction import JointFriction
 from irb140_dynamics.core.model.joints import DH, Friction, Joint, Placement, validated_joint
-from irb140_dynamics.core.model.rigid_body import MAX_GRAVITY, ZERO3, ModelError, RigidBody, capped, combine, finite_number, finite_numbers, placed
+from irb140_dynamics.core.model.rigid_body import (
+    MAX_GRAVITY,
+    ZERO3,
+    ModelError,
+    RigidBody,
+    capped,
+    combine,
+    finite_number,
+    finite_numbers,
+    placed,
+)
 
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 DEFAULT_SMOOTHING_VELOCITY = 0.01  # rad/s: Coulomb friction reaches 76 % of its level at 0.01 rad/s
-__all__ = ["DH", "Friction", "Joint", "ModelError", "Placement", "RobotModel", "load_model", "read_parameter_file"]
+__all__ = ["DH", "Friction", "Joint", "ModelError", "Placement", "RobotModel"]
 
 
 @dataclass(frozen=True)
@@ -93,24 +105,15 @@ class RobotModel:
     @cached_property
     def friction(self):
         """The joints' friction (see ``friction``), or None when all of it is zero."""
-        from irb140_dynamics.core.model.friction import JointFriction
-
         if not any(j.friction.viscous or j.friction.coulomb for j in self.joints):
             return None
         return JointFriction.of(self)
 
-    def with_payload(self, payload: RigidBody) -> "RobotModel":
+    def with_payload(self, payload: RigidBody) -> RobotModel:
         return replace(self, payload=payload)
 
-    def with_gravity(self, gravity) -> "RobotModel":
+    def with_gravity(self, gravity) -> RobotModel:
         return replace(self, gravity=tuple(gravity))
-
-    @cached_property
-    def kernels(self):
-        """Generated straight-line code for this model's algorithms (see codegen)."""
-        from irb140_dynamics.core.codegen.kernels import Kernels
-
-        return Kernels(self)
 
     # -- flat parameter form --------------------------------------------------------
 
@@ -140,7 +143,7 @@ class RobotModel:
         return params
 
     @classmethod
-    def from_params(cls, params: Mapping[str, Any]) -> "RobotModel":
+    def from_params(cls, params: Mapping[str, Any]) -> RobotModel:
         """Build from flat parameter names (as in ``to_params``); unknown names are ignored."""
 
         def get(name, default=None):
@@ -162,8 +165,21 @@ class RobotModel:
         )
 
 
-JOINT_FIELDS = ("dh", "origin", "axis", "link.mass", "link.com", "link.inertia", "position_limits", "torque_limit",
-                "velocity_limit", "acceleration_limit", "friction.viscous", "friction.coulomb", "armature")
+JOINT_FIELDS = (
+    "dh",
+    "origin",
+    "axis",
+    "link.mass",
+    "link.com",
+    "link.inertia",
+    "position_limits",
+    "torque_limit",
+    "velocity_limit",
+    "acceleration_limit",
+    "friction.viscous",
+    "friction.coulomb",
+    "armature",
+)
 JOINTS_KEPT = 256  # joints remembered by their parameter values
 _joints_by_values: dict[tuple, Joint] = {}
 
@@ -239,30 +255,3 @@ def _body_from_params(prefix: str, get, optional=False) -> RigidBody:
         get(f"{prefix}.com", ZERO3 if optional else None),
         get(f"{prefix}.inertia", zeros),
     )
-
-
-def read_parameter_file(path, node_name: str | None = None) -> dict[str, Any]:
-    """The flat parameters of a ROS 2 parameter file (``/**`` merged with ``node_name``)."""
-    import yaml
-
-    with open(path) as stream:
-        document = yaml.safe_load(stream) or {}
-    params: dict[str, Any] = {}
-    for key in ("/**", node_name, f"/{node_name}" if node_name else None):
-        if key and key in document:
-            _flatten(document[key].get("ros__parameters", {}), "", params)
-    return params
-
-
-def _flatten(tree: Mapping[str, Any], prefix: str, out: dict[str, Any]) -> None:
-    for key, value in tree.items():
-        name = f"{prefix}{key}"
-        if isinstance(value, Mapping):
-            _flatten(value, f"{name}.", out)
-        else:
-            out[name] = value
-
-
-def load_model(path, node_name: str | None = None) -> RobotModel:
-    """The model described by a ROS 2 parameter file."""
-    return RobotModel.from_params(read_parameter_file(path, node_name))

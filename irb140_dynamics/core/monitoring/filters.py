@@ -37,8 +37,6 @@ class VelocityDifferentiator:
         else:
             dt = t - self._t
             alpha = dt / (dt + self.time_constant)
-            self.qdd = [
-                y + alpha * ((v - v_prev) / dt - y) for y, v, v_prev in zip(self.qdd, qd, self._qd)
-            ]
+            self.qdd = [y + alpha * ((v - v_prev) / dt - y) for y, v, v_prev in zip(self.qdd, qd, self._qd)]
         self._t, self._qd = t, list(qd)
         return self.qdd

@@ -23,72 +23,11 @@ import math
 
 import numpy as np
 
-from irb140_dynamics.core.algorithms.recursions import add, cross, dot, inertia_times, scale, to_child, to_parent_wrench, turns
-from irb140_dynamics.core.scalars.dual import dual_angles, partial
+from irb140_dynamics.core.algorithms.momentum import energy_gradient, kinetic_energy, momentum_terms  # noqa: F401 (part of this module's interface)
+from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.dynamics import gravity
-from irb140_dynamics.core.model.states import finite_result, state
 from irb140_dynamics.core.model.robot_model import RobotModel
-from irb140_dynamics.core.model.rigid_body import ZERO3
-
-
-def kinetic_energy(links, cs, qd):
-    """T = sum over links of 1/2 m v.v + v.(w x h) + 1/2 w.(I w), v the velocity of o_i."""
-    rots = turns(links, cs)
-    w, v = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
-    energy = 0.0
-    for link, rot, qd_i in zip(links, rots, qd):
-        if link.p0 is not None:
-            v = add(v, cross(w, link.p0))
-        w_parent = to_child(link, rot, w)
-        w = add(w_parent, scale(qd_i, link.b))
-        v = add(to_child(link, rot, v), cross(w, link.p))
-        energy = energy + 0.5 * (link.m * dot(v, v) + dot(w, inertia_times(link.I, w))) + dot(v, cross(w, link.h))
-    return energy
-
-
-def energy_gradient(links, cs, qd):
-    """dT/dq = C(q, qd)^T qd, exact: T on dual numbers carrying d/dq_k."""
-    T = kinetic_energy(links, dual_angles(cs), qd)
-    return [partial(T, k) for k in range(len(links))]
-
-
-def momentum_terms(links, cs, qd):
-    """[p, dT/dq]: the generalized momentum M qd and C^T qd, O(n).
-
-    With h_i the spatial momentum of link i, H_k the sum over the subtree k..n and v_k the
-    spatial velocity of link k: turning joint k at fixed qd turns the subtree about S_k,
-    dv_i/dq_k = S_k x (v_i - v_k) and dI_i/dq_k = S_k x* I_i - I_i S_k x, which leaves
-    (Featherstone's notation, x* the force cross product)
-
-        p_k = S_k . H_k,    dT/dq_k = -S_k . (v_k x* H_k).
-
-    Forward: each link's velocity (w; u at the joint origin o'_i, v at o_i). Backward: H
-    (linear L, angular A about o'_k) gathered like RNEA's wrenches; S_k . (v_k x* H_k) is
-    b . (w x A + u x L).
-    """
-    rots = turns(links, cs)
-    w, v = ZERO3, ZERO3
-    frames = []
-    for link, rot, qd_i in zip(links, rots, qd):  # velocities, as forward_motion's
-        if link.p0 is not None:
-            v = add(v, cross(w, link.p0))
-        w = add(to_child(link, rot, w), scale(qd_i, link.b))
-        u = to_child(link, rot, v)  # the joint origin's velocity, in frame i
-        v = add(u, cross(w, link.p))
-        frames.append((w, u, v))
-    n_links = len(links)
-    p, gradient = [0.0] * n_links, [0.0] * n_links
-    L, A = ZERO3, ZERO3  # the subtree's momentum
-    for i in reversed(range(n_links)):
-        link, (w, u, v) = links[i], frames[i]
-        if i + 1 < n_links:
-            L, A = to_parent_wrench(links[i + 1], rots[i + 1], L, A)
-        L_i = add(scale(link.m, v), cross(w, link.h))
-        L = add(L, L_i)
-        A = add(A, inertia_times(link.I, w), cross(link.h, v), cross(link.p, L))  # about o'_i
-        p[i] = dot(link.b, A) + link.armature * qd[i]
-        gradient[i] = -dot(link.b, add(cross(w, A), cross(u, L)))
-    return p + gradient
+from irb140_dynamics.core.model.states import finite_result, state
 
 
 def monitor_terms(model: RobotModel, q, qd, qdd) -> tuple[list, list, list, list]:
@@ -98,8 +37,8 @@ def monitor_terms(model: RobotModel, q, qd, qdd) -> tuple[list, list, list, list
     What a node that monitors the arm needs per sample, at about the cost of one rnea."""
     n = model.n
     q, qd, qdd = state(q, n, "q"), state(qd, n, "qd"), state(qdd, n, "qdd")
-    terms = model.kernels.monitor.scalar(q, qd, qdd)
-    tau, g, p, c = list(terms[:n]), list(terms[n:2 * n]), list(terms[2 * n:3 * n]), terms[3 * n:]
+    terms = kernels_of(model).monitor.scalar(q, qd, qdd)
+    tau, g, p, c = list(terms[:n]), list(terms[n : 2 * n]), list(terms[2 * n : 3 * n]), terms[3 * n :]
     if not math.isfinite(sum(tau) + sum(g)):
         finite_result(tau, "rnea", q=q, qd=qd, qdd=qdd)
         finite_result(g, "gravity", q=q)
@@ -171,8 +110,10 @@ class MomentumObserver:
         # t_k): r_k = K (p_k - p_0 - I_k), I_k = I_{k-1} + dt (drive) + dt r_k, so r_k is
         # K (p_k - p_0 - I_{k-1} - dt drive) / (1 + K dt), stable for any K dt (the
         # explicit step, with r_{k-1}, diverges beyond K dt = 2: K 2000 1/s at 1 kHz)
-        partial_sum = [i + 0.5 * (d + d0) * dt  # Python floats: an overflow is inf, checked below
-                       for i, d, d0 in zip(self._integral, drive, self._drive)]
+        partial_sum = [
+            i + 0.5 * (d + d0) * dt  # Python floats: an overflow is inf, checked below
+            for i, d, d0 in zip(self._integral, drive, self._drive)
+        ]
         r = [K * (x - x0 - i) / (1.0 + K * dt) for x, x0, i in zip(p, self._p0, partial_sum)]
         integral = [i + ri * dt for i, ri in zip(partial_sum, r)]
         if not math.isfinite(sum(r)) and not all(map(math.isfinite, r)):
@@ -185,7 +126,7 @@ class MomentumObserver:
     def _momentum_terms(self, q, qd, g=None) -> tuple[list, list]:
         """p = M qd and C^T qd - g - tau_f: what the observer integrates besides tau and r."""
         model = self.model
-        terms = model.kernels.momentum.scalar(q, qd)
+        terms = kernels_of(model).momentum.scalar(q, qd)
         n = model.n
         g = gravity(model, q) if g is None else g
         friction = None if model.friction is None else model.friction.torques(qd).tolist()

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from irb140_dynamics.core.model.rigid_body import RigidBody
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.payload.limits import (
     RATED_PAYLOAD,
@@ -27,7 +28,6 @@ from irb140_dynamics.core.payload.limits import (
     payload_family,
     workspace_load,
 )
-from irb140_dynamics.core.model.rigid_body import RigidBody
 
 VISIBLE = 5e-4  # N m or kg: a gap the report's 3 decimals would show is worth a note
 
@@ -91,14 +91,18 @@ class PayloadCheck:
     def no_limit_note(self, j: int) -> str:
         """Why joint j (of loaded_without_limit) wants a given torque limit."""
         name = self.joint_names[j]
-        return (f"{name} has no limit, yet this payload loads it ({self.workspace.torque[j]:.3f} N m "
-                f"in its worst pose): set {name}.torque_limit")
+        return (
+            f"{name} has no limit, yet this payload loads it ({self.workspace.torque[j]:.3f} N m "
+            f"in its worst pose): set {name}.torque_limit"
+        )
 
     def gap_note(self, j: int) -> str:
         """What the proof left open at joint j (of open_gaps)."""
         load = self.workspace
-        return (f"{self.joint_names[j]}: worst static torque proven only up to {load.bound[j]:.3f} N m "
-                f"(gap {load.gap[j]:.3g} N m, the proof's budget ran out): the check uses the bound")
+        return (
+            f"{self.joint_names[j]}: worst static torque proven only up to {load.bound[j]:.3f} N m "
+            f"(gap {load.gap[j]:.3g} N m, the proof's budget ran out): the check uses the bound"
+        )
 
     # -- the figures, formatted once for the report and /diagnostics --------------------
 
@@ -107,7 +111,7 @@ class PayloadCheck:
         L, load, now = self.limit[j], self.workspace, self.torque is not None
         return {
             "torque now [N m]": f"{self.torque[j]:.3f}" if now else "-",
-            "limit [N m]": "none" if L == math.inf else f"{L:.3f}",
+            "limit [N m]": "none" if math.inf == L else f"{L:.3f}",
             "use now": _percent(self.use[j], L) if now else "-",
             "worst static torque [N m]": f"{load.torque[j]:.3f}",
             "worst use": _percent(self.worst_use[j], L),
@@ -209,7 +213,7 @@ def _degrees(q) -> str:
 
 
 def _percent(use: float, L: float) -> str:
-    return "-" if L == math.inf else f"{use:.1f}%"
+    return "-" if math.inf == L else f"{use:.1f}%"
 
 
 def _max_payload_figures(best: MaxPayload, names) -> tuple[str, str, str]:

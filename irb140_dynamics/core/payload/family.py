@@ -27,14 +27,15 @@ from functools import cached_property
 import numpy as np
 
 from irb140_dynamics.core.algorithms import recursions as algorithms
+from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.dynamics import gravity_batch, rnea
+from irb140_dynamics.core.model.rigid_body import RigidBody
+from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.payload.proof import certify
 from irb140_dynamics.core.payload.proof.certify import Objective, certify_maxima, interval_maxima
-from irb140_dynamics.core.dynamics import gravity_batch, rnea
 from irb140_dynamics.core.payload.proof.harmonic import StaticForms
-from irb140_dynamics.core.scalars.interval import Interval, bounds_of
-from irb140_dynamics.core.model.robot_model import RobotModel
-from irb140_dynamics.core.model.rigid_body import RigidBody
 from irb140_dynamics.core.payload.workspace import JointRanges
+from irb140_dynamics.core.scalars.interval import Interval, bounds_of
 
 RTOL = 1e-9  # a torque within RTOL of its limit is within it
 CERTIFY_RTOL = 5e-10  # the gap the proof aims at, relative to the torque (half of RTOL)
@@ -92,8 +93,9 @@ class PayloadFamily:
         n = self.empty.n
         return ranges.maximize(self.static_torque(m), np.vstack([np.eye(n), -np.eye(n)]), sample_torques, warm)
 
-    def extremes(self, m: float, ranges: JointRanges, sample_torques=None, warm=None, rows=None,
-                 share: float = 1.0, found=None) -> Extremes:
+    def extremes(
+        self, m: float, ranges: JointRanges, sample_torques=None, warm=None, rows=None, share: float = 1.0, found=None
+    ) -> Extremes:
         """The worst static torques at m kg, searched and proven (remembered per m and
         ranges): all 2n of them, or only ``rows`` proven (the others' bounds inf), within
         ``share`` of the proof's budget; ``found``: (values, poses) of a search at m done."""
@@ -120,18 +122,21 @@ class PayloadFamily:
         n, torque = self.empty.n, self.static_torque(m)
         bounds = np.full(2 * n, np.inf)
         weights = np.vstack([np.eye(n), -np.eye(n)])
-        offsets = np.array(self.empty.kernels.angles)
+        offsets = np.array(kernels_of(self.empty).angles)
         scale = max(1.0, float(np.max(np.abs(values))))
         tol = CERTIFY_RTOL * np.maximum(np.abs(values), 1e-3 * scale)
         lower, upper = ranges.lower + offsets, ranges.upper + offsets
         joints, signs = rows % n, np.where(rows < n, 1.0, -1.0)
         if self.forms is None:
-            bounds[rows] = interval_maxima(self._interval_torques(m, offsets), joints, signs,
-                                           ranges.lower, ranges.upper, values[rows], tol[rows])
+            bounds[rows] = interval_maxima(
+                self._interval_torques(m, offsets), joints, signs, ranges.lower, ranges.upper, values[rows], tol[rows]
+            )
             return Extremes(values, poses, bounds)
         forms = self.forms[0].affine(self.forms[1], m)
-        objectives = [Objective((forms.torque[j] * sign).reduced(merge=True), forms.omega[j].reduced(), forms.gravity_norm)
-                      for j, sign in zip(joints, signs)]
+        objectives = [
+            Objective((forms.torque[j] * sign).reduced(merge=True), forms.omega[j].reduced(), forms.gravity_norm)
+            for j, sign in zip(joints, signs)
+        ]
         boxes = [objective.value.box(lower, upper) for objective in objectives]
 
         def angles(k, theta):  # the joint angles of objective k's box (parallel joints merged)
@@ -141,8 +146,15 @@ class PayloadFamily:
             found, pose = ranges.climb(torque, weights[rows[k]], angles(k, theta) - offsets)
             return found, np.array([objectives[i].value.fold(t)[0] for i, t in zip(k, pose + offsets)])
 
-        proof = certify_maxima(objectives, np.array([b[0] for b in boxes]), np.array([b[1] for b in boxes]),
-                               values[rows], tol[rows], polish, int(share * certify.EVALUATIONS))
+        proof = certify_maxima(
+            objectives,
+            np.array([b[0] for b in boxes]),
+            np.array([b[1] for b in boxes]),
+            values[rows],
+            tol[rows],
+            polish,
+            int(share * certify.EVALUATIONS),
+        )
         bounds[rows] = proof.bound
         values, poses = values.copy(), poses.copy()
         better = np.flatnonzero(proof.value > values[rows])
@@ -157,7 +169,7 @@ class PayloadFamily:
     def _interval_torques(self, m, offsets):
         """(lo, hi) per joint (n, B) of the static torques at m kg over boxes of q (B, n)."""
         model = self.empty.with_payload(RigidBody(m, self.empty.payload.com, self.empty.payload.inertia))
-        links, gravity, n = model.kernels.links, model.kernels.gravity, model.n
+        links, gravity, n = kernels_of(model).links, kernels_of(model).gravity, model.n
 
         def evaluate(lo, hi):
             theta = [Interval(lo[:, k], hi[:, k]) + offsets[k] for k in range(n)]

@@ -19,33 +19,43 @@ The permissible torques follow the report (section 10): the torques of the rated
 6 kg at the flange origin, in the pose that loads each joint most. A given torque limit
 (``Joint.torque_limit`` > 0) always overrides.
 
-Cost (the IRB-140): a first check_payload some 0.2 s (kernels compiled, limits and the
-payload's workspace load proven), about 10 ms after (the proofs are remembered per payload
-shape and mass); a payload whose proofs spend their budget (see ``certify``: about 1 s per
-proof whatever the model, the largest payload's with MASS_PROOF_SHARE of it), such as 3 kg
-off the flange axis, 1.0 s; the worst 6-joint model seen (random, gravity tilted) 6 s.
+Cost: a first check_payload compiles the kernels and proves the limits and the payload's
+workspace load; later ones reuse the proofs (remembered per payload shape and mass). A
+payload whose proofs spend their budget (see ``certify``; the largest payload's proof with
+MASS_PROOF_SHARE of it), such as 3 kg off the flange axis, takes longest. Figures:
+docs/benchmarks.md.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
-from irb140_dynamics.core.model.robot_model import RobotModel
-from irb140_dynamics.core.payload.family import RTOL, Extremes, PayloadFamily, at_most, loads, max_mass, payload_family
 from irb140_dynamics.core.model.rigid_body import MAX_MASS, ModelError, RigidBody, checked_body
+from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.model.states import real_numbers, state
+from irb140_dynamics.core.payload.family import RTOL, Extremes, PayloadFamily, at_most, loads, max_mass, payload_family
 from irb140_dynamics.core.payload.workspace import JointRanges
 
 RATED_PAYLOAD = RigidBody(6.0)  # the IRB-140's rated payload: 6 kg at the flange origin
 _PROOF_ROUNDS = 4  # Dinkelbach restarts from poses the proof finds worse than the search did
 MASS_PROOF_SHARE = 1 / 3  # of the proof's budget for the largest payload (a gap only lowers it a little)
 
-__all__ = ["RATED_PAYLOAD", "RTOL", "MaxPayload", "PayloadCheck", "TorqueLimits", "WorkspaceLoad",
-           "check_payload", "derive_torque_limits", "loads", "max_payload_at", "payload_family", "workspace_load"]
+__all__ = [
+    "RATED_PAYLOAD",
+    "RTOL",
+    "MaxPayload",
+    "TorqueLimits",
+    "WorkspaceLoad",
+    "derive_torque_limits",
+    "loads",
+    "max_payload_at",
+    "payload_family",
+    "workspace_load",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -254,7 +264,3 @@ def checked_payload_arguments(model, payload, rated_payload, q, qd):
     q = np.array(state(q, model.n, "q"), dtype=float)
     qd = np.zeros(model.n) if qd is None else np.array(state(qd, model.n, "qd"), dtype=float)
     return payload, rated_payload, q, qd
-
-
-# The check lives in payload_check; its names are here too, as before the split.
-from irb140_dynamics.core.payload.check import PayloadCheck, check_payload  # noqa: E402

@@ -31,10 +31,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from irb140_dynamics.core.dynamics import gravity
-from irb140_dynamics.core.model.friction import JointFriction
 from irb140_dynamics.core.kinematics import flange_jacobian, flange_pose
-from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.model.friction import JointFriction
 from irb140_dynamics.core.model.rigid_body import RigidBody
+from irb140_dynamics.core.model.robot_model import RobotModel
 
 MIN_POSES = 3  # 4 unknowns; each pose sees the payload through 2-3 independent torques
 MAX_CONDITION = 1e3  # of Y with columns scaled to unit norm
@@ -127,8 +127,13 @@ def estimate_payload(model: RobotModel, samples: list[RestSample]) -> PayloadEst
     gradient = np.hstack([-com[:, None] / mass, np.eye(3) / mass])
     com_std = np.sqrt(np.maximum(np.diag(gradient @ covariance @ gradient.T), 0.0))
     return PayloadEstimate(
-        mass, tuple(com.tolist()), float(math.sqrt(max(covariance[0, 0], 0.0))), tuple(com_std.tolist()),
-        float(math.sqrt(np.mean((residual / weights) ** 2))), len(samples), float(condition),
+        mass,
+        tuple(com.tolist()),
+        float(math.sqrt(max(covariance[0, 0], 0.0))),
+        tuple(com_std.tolist()),
+        float(math.sqrt(np.mean((residual / weights) ** 2))),
+        len(samples),
+        float(condition),
     )
 
 
@@ -145,9 +150,11 @@ def _advice(weak: np.ndarray, scale: np.ndarray) -> str:
         return "the mass is not determined: stop the arm in poses with the flange at different reaches"
     line = weak[1:] / scale[1:]  # in m c, the flange frame: where gravity pointed in every pose
     line = np.round(line / np.linalg.norm(line) * np.sign(line[np.argmax(np.abs(line))]), 2) + 0.0  # no -0.00
-    what = (f"the CoM along ({line[0]:.2f}, {line[1]:.2f}, {line[2]:.2f}) in the flange frame is not "
-            "determined (gravity pulled the same way in the flange frame in every pose: poses that differ "
-            "only in joint 1 do): ")
+    what = (
+        f"the CoM along ({line[0]:.2f}, {line[1]:.2f}, {line[2]:.2f}) in the flange frame is not "
+        "determined (gravity pulled the same way in the flange frame in every pose: poses that differ "
+        "only in joint 1 do): "
+    )
     if abs(line[2]) > 0.9:
         return what + "tilt the wrist (joint 5) so that the flange z axis points in different directions"
     return what + "turn the flange about its axis (joint 6) and tilt the wrist (joint 5) between poses"
@@ -164,8 +171,14 @@ class RestDetector:
     of its level at 0.01 rad/s, 96 % at 0.02); at qd = 0 it is exactly 0. A rest whose joint states carry no effort
     is no sample; its pose is counted in ``without_effort`` (until a sample of it comes)."""
 
-    def __init__(self, rest_velocity: float, rest_time: float, same_pose: float = 1e-3, max_samples: int = 100,
-                 friction: JointFriction | None = None):
+    def __init__(
+        self,
+        rest_velocity: float,
+        rest_time: float,
+        same_pose: float = 1e-3,
+        max_samples: int = 100,
+        friction: JointFriction | None = None,
+    ):
         self.rest_velocity, self.rest_time = rest_velocity, rest_time
         self.same_pose, self.max_samples = same_pose, max_samples
         self.friction = friction
@@ -232,7 +245,7 @@ class RestDetector:
     def _others(self, kept: list, q: np.ndarray, pose_of) -> list:
         """``kept`` without the entries of pose q, leaving room for one more (at most max_samples)."""
         others = [x for x in kept if np.max(np.abs(pose_of(x) - q)) > self.same_pose]
-        return others[len(others) - self.max_samples + 1:] if len(others) >= self.max_samples else others
+        return others[len(others) - self.max_samples + 1 :] if len(others) >= self.max_samples else others
 
     def flush(self) -> bool:
         """Close a rest still going on (e.g. before an estimate): True if it became a sample."""

@@ -17,8 +17,8 @@ where maxima often lie; of equal maxima the simplest pose is returned.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
@@ -68,7 +68,7 @@ class JointRanges:
     samples: np.ndarray  # (S, n)
 
     @classmethod
-    def of(cls, model: RobotModel, count: int = 2048) -> "JointRanges":
+    def of(cls, model: RobotModel, count: int = 2048) -> JointRanges:
         """The model's joint ranges; samples: ``count`` quasi-random poses and the right angles."""
         lower, upper = np.array([j.position_limits for j in model.joints]).T
         spread = lower + quasi_random(count, model.n) * (upper - lower)
@@ -98,7 +98,7 @@ class JointRanges:
             X = np.concatenate([X, np.asarray(warm, dtype=float)[None]])
         tol = rtol * max(1.0, float(np.max(np.abs(sample_torques))))
         X, F = self._ascend(torque, W, X, tol)
-        simplest = np.where(F >= F.max(axis=0) - tol, np.sum(_wrapped(X) ** 2, axis=-1), np.inf)
+        simplest = np.where(F.max(axis=0) - tol <= F, np.sum(_wrapped(X) ** 2, axis=-1), np.inf)
         poses = X[np.argmin(simplest, axis=0), np.arange(K)]  # of equal maxima the nearest q = 0
         return self._canonical(torque, W, poses, tol)
 

@@ -46,7 +46,7 @@ class Interval:
     def __repr__(self) -> str:
         return f"Interval({self.lo!r}, {self.hi!r})"
 
-    def __neg__(self) -> "Interval":
+    def __neg__(self) -> Interval:
         return Interval(-self.hi, -self.lo)
 
     def __add__(self, other):
@@ -86,11 +86,11 @@ class Interval:
 
     __rmul__ = __mul__
 
-    def cos(self) -> "Interval":
+    def cos(self) -> Interval:
         """An enclosure of cos over [lo, hi]."""
         return _trig(np.cos, self.lo, self.hi, 0.0)
 
-    def sin(self) -> "Interval":
+    def sin(self) -> Interval:
         """An enclosure of sin over [lo, hi] (cos shifted by pi/2)."""
         return _trig(np.sin, self.lo, self.hi, math.pi / 2)
 

@@ -20,6 +20,7 @@ from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
+from irb140_dynamics.core.io.stamps import nanoseconds, sec_nanosec
 from irb140_dynamics.ros.runtime.spin import run
 
 NAMES = [f"joint_{i}" for i in range(1, 7)]
@@ -42,10 +43,15 @@ def reference_message(period: float) -> JointTrajectory:
     Q, QD, QDD = motion(t, period)
     msg = JointTrajectory(joint_names=NAMES)
     for ti, q, qd, qdd in zip(t, Q, QD, QDD):
-        sec, nanosec = divmod(int(round(ti * 1e9)), 10**9)
-        msg.points.append(JointTrajectoryPoint(
-            positions=q.tolist(), velocities=qd.tolist(), accelerations=qdd.tolist(),
-            time_from_start=Duration(sec=sec, nanosec=nanosec)))
+        sec, nanosec = sec_nanosec(ti)
+        msg.points.append(
+            JointTrajectoryPoint(
+                positions=q.tolist(),
+                velocities=qd.tolist(),
+                accelerations=qdd.tolist(),
+                time_from_start=Duration(sec=sec, nanosec=nanosec),
+            )
+        )
     return msg
 
 
@@ -85,7 +91,7 @@ class DemoNode(Node):
 
     @staticmethod
     def _ns(msg) -> int:
-        return msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
+        return nanoseconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
 
     def _on_joint_state(self, msg: JointState) -> None:
         stamp = self._ns(msg)
@@ -128,7 +134,9 @@ class DemoNode(Node):
         for j, axis in enumerate(axes.flat):
             axis.plot(t, reference[:, j], label="reference")
             axis.plot(t, actual[:, j], "--", label="actual")
-            axis.set_title(f"{NAMES[j]}: error RMS {np.sqrt(np.mean((reference[:, j] - actual[:, j]) ** 2)) * 1e3:.2f} mrad")
+            axis.set_title(
+                f"{NAMES[j]}: error RMS {np.sqrt(np.mean((reference[:, j] - actual[:, j]) ** 2)) * 1e3:.2f} mrad"
+            )
             axis.set_ylabel("q [rad]")
         axes.flat[0].legend()
         for axis in axes[-1]:

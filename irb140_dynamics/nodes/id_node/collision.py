@@ -21,10 +21,10 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Bool
 
 from irb140_dynamics.core.monitoring.observer import MomentumObserver
-from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage
-from irb140_dynamics.ros.runtime.listened import ListenedPublisher
 from irb140_dynamics.ros.messages.joint_messages import publish_efforts
+from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage
 from irb140_dynamics.ros.parameters.specs import Spec
+from irb140_dynamics.ros.runtime.listened import ListenedPublisher
 
 MAX_GAIN = 1e4  # 1/s: beyond any sampling rate a joint state stream has
 OBSERVER_GAP = 0.1  # s: a longer gap between stamps restarts the observer
@@ -35,16 +35,26 @@ RESTARTS = {  # MomentumObserver.restarted: what restarted it
 }
 
 COLLISION_PARAMETERS = [
-    Spec("collision.observer_gain", 100.0,
-         "gain K of the momentum observer: external torques are seen through a lag of time constant 1/K",
-         "1/s", minimum=1e-3, maximum=MAX_GAIN),
+    Spec(
+        "collision.observer_gain",
+        100.0,
+        "gain K of the momentum observer: external torques are seen through a lag of time constant 1/K",
+        "1/s",
+        minimum=1e-3,
+        maximum=MAX_GAIN,
+    ),
 ]
 
 
 def collision_threshold_specs(joint_names) -> list[Spec]:
     return [
-        Spec(f"{name}.collision_threshold", 0.0,
-             "a collision is flagged while |external torque| exceeds this; 0 = off", "N m", minimum=0.0)
+        Spec(
+            f"{name}.collision_threshold",
+            0.0,
+            "a collision is flagged while |external torque| exceeds this; 0 = off",
+            "N m",
+            minimum=0.0,
+        )
         for name in joint_names
     ]
 
@@ -73,7 +83,9 @@ class CollisionMonitor:
         self._names = list(joint_names)
         self._external_msg = EffortMessage(self._names)
         self._external_pub = ListenedPublisher(node, JointState, "external_torques", depth)
-        latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        latched = QoSProfile(
+            depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+        )
         self._collision_pub = node.create_publisher(Bool, "collision", latched)
         self.colliding: list[int] = []  # indices of the joints over their thresholds
         self._peaks = [0.0] * len(self._names)  # N m: the largest |r_j| over threshold since the last report
@@ -141,6 +153,7 @@ class CollisionMonitor:
             KeyValue(key=f"{name} external torque [N m]", value=f"{value:.3f}") for name, value in zip(names, r)
         ] + [
             KeyValue(key=f"{names[j]} peak |external torque| since last report [N m]", value=f"{peak:.3f}")
-            for j, peak in enumerate(peaks) if peak > 0.0
+            for j, peak in enumerate(peaks)
+            if peak > 0.0
         ]
         return status

@@ -35,12 +35,19 @@ from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
 from irb140_dynamics.core import gravity, rnea
-from irb140_dynamics.core.monitoring.observer import monitor_terms
+from irb140_dynamics.core.io.stamps import seconds
 from irb140_dynamics.core.monitoring.filters import VelocityDifferentiator
-from irb140_dynamics.ros.runtime.diagnostics import message_status
-from irb140_dynamics.ros.runtime.guard import Tally, guarded
-from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage, read_joint_state_cdr
-from irb140_dynamics.ros.runtime.listened import ListenedPublisher
+from irb140_dynamics.core.monitoring.observer import monitor_terms
+from irb140_dynamics.nodes.id_node.collision import RESTARTS, CollisionMonitor
+from irb140_dynamics.nodes.id_node.settings import (  # noqa: F401 (finish_settings, compiled: looked up here, tests patch them)
+    NODE_PARAMETERS,
+    PER_JOINT_PARAMETERS,
+    IdNodeSettings,
+    check_settings,
+    compiled,
+    finish_settings,
+)
+from irb140_dynamics.nodes.id_node.tracking import ReferenceTracker
 from irb140_dynamics.ros.messages.joint_messages import (
     BadMessage,
     JointOrder,
@@ -52,34 +59,30 @@ from irb140_dynamics.ros.messages.joint_messages import (
     read_joint_state,
     read_trajectory,
 )
-from irb140_dynamics.nodes.id_node.collision import RESTARTS, CollisionMonitor
-from irb140_dynamics.nodes.id_node.settings import (  # noqa: F401 (finish_settings, compiled: looked up here, tests patch them)
-    NODE_PARAMETERS,
-    PER_JOINT_PARAMETERS,
-    Settings,
-    check_settings,
-    compiled,
-    finish_settings,
-)
+from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage, read_joint_state_cdr
 from irb140_dynamics.ros.parameters.model_source import declare_model_source
 from irb140_dynamics.ros.parameters.specs import joint_states_qos
+from irb140_dynamics.ros.runtime.diagnostics import message_status
+from irb140_dynamics.ros.runtime.guard import Tally, guarded
+from irb140_dynamics.ros.runtime.listened import ListenedPublisher
 from irb140_dynamics.ros.runtime.spin import run
-from irb140_dynamics.nodes.id_node.tracking import ReferenceTracker
+
 
 class IdNode(Node):
     """Joint states in; feed-forward and gravity torques out."""
 
     def __init__(self, **kwargs):
         super().__init__("id_node", **kwargs)
-        self.settings: Settings | None = None  # None: waiting for the model (robot_description topic)
+        self.settings: IdNodeSettings | None = None  # None: waiting for the model (robot_description topic)
         self._started = False
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
         self._reported = self.counts.copy()  # the counts at the last diagnostics
         self.tracker = ReferenceTracker()
         self._differentiator = None
-        self.parameters = declare_model_source(self, NODE_PARAMETERS, check_settings, PER_JOINT_PARAMETERS,
-                                               finish=finish_settings, quick=compiled)
+        self.parameters = declare_model_source(
+            self, NODE_PARAMETERS, check_settings, PER_JOINT_PARAMETERS, finish=finish_settings, quick=compiled
+        )
         self.parameters.on_change(self._use)
         self.collision = CollisionMonitor(self, [], self.get_parameter("qos.depth").value)  # joints: by _use
         self._command_msg = Float64MultiArray()
@@ -101,7 +104,7 @@ class IdNode(Node):
         if self.settings is not None:
             self._log_ready()
 
-    def _use(self, settings: Settings) -> None:
+    def _use(self, settings: IdNodeSettings) -> None:
         """Switch to new (validated, compiled) settings; new joints come with a new model. A
         held reference the new model gives no finite torques for is let go."""
         first, names = self.settings is None, list(settings.model.joint_names)
@@ -167,15 +170,18 @@ class IdNode(Node):
         msg.velocity = (np.asarray(qd_ref) - qd).tolist()
         self._tracking_pub.publish(msg)
 
-    def _torques(self, msg, t: float, q, qd, settings: Settings):
+    def _torques(self, msg, t: float, q, qd, settings: IdNodeSettings):
         """(feed-forward, gravity, command torques or None, the reference in force or None,
         the observer's terms or None), the torques all finite, or BadMessage. With efforts
         and no reference, one pass gives the torques and the observer's terms."""
         model = settings.model
         estimate = self._estimated_acceleration(t, qd, settings)
         tracker = self.tracker
-        reference = tracker.sample(self.get_clock().now().nanoseconds * 1e-9, settings.reference_timeout) \
-            if tracker.trajectory is not None else None  # no clock read without one
+        reference = (
+            tracker.sample(self.get_clock().now().nanoseconds * 1e-9, settings.reference_timeout)
+            if tracker.trajectory is not None
+            else None
+        )  # no clock read without one
         q_ff, qd_ff, qdd_ref = reference or (q, qd, None)
         try:
             terms = None
@@ -222,7 +228,7 @@ class IdNode(Node):
             self.counts[f"collision.restart_{restarted}"] += 1
             self.tally.warn("collision", f"observer restarted at r = 0 ({RESTARTS[restarted]})")
 
-    def _estimated_acceleration(self, t: float, qd, settings: Settings):
+    def _estimated_acceleration(self, t: float, qd, settings: IdNodeSettings):
         if settings.acceleration_mode == "zero":
             return self._zeros
         qdd = self._differentiator.update(t, qd)
@@ -234,7 +240,7 @@ class IdNode(Node):
     def _time_of(self, msg) -> float:
         """The message's stamp [s]; for an unstamped stream, the time of arrival."""
         stamp = msg.header.stamp
-        t = stamp.sec + 1e-9 * stamp.nanosec
+        t = seconds(stamp.sec, stamp.nanosec)
         return t if t != 0.0 else self.get_clock().now().nanoseconds * 1e-9
 
     @guarded("reference")
@@ -252,7 +258,7 @@ class IdNode(Node):
         except BadMessage as error:
             self.tally.drop("reference", error)
             return
-        start = (msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec) * 1e-9
+        start = seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         self.tracker.follow(trajectory, start or self.get_clock().now().nanoseconds * 1e-9)
 
     @guarded("diagnostics")

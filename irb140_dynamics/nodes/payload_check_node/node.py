@@ -30,27 +30,57 @@ from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import RigidBody, RobotModel, gravity, rnea
+from irb140_dynamics.core.io.stamps import seconds
+from irb140_dynamics.core.payload import (
+    TorqueLimits,
+    WorkspaceLoad,
+    check_payload,
+    derive_torque_limits,
+    workspace_load,
+)
 from irb140_dynamics.core.payload.mass_com_estimation import EstimationError
-from irb140_dynamics.core.payload.limits import TorqueLimits, WorkspaceLoad, check_payload, derive_torque_limits, workspace_load
-from irb140_dynamics.ros.runtime.diagnostics import payload_statuses
-from irb140_dynamics.nodes.payload_check_node.payload_estimator import ESTIMATION_PARAMETERS, PayloadEstimator, check_estimation
-from irb140_dynamics.ros.runtime.guard import Tally, guarded
-from irb140_dynamics.ros.messages.joint_messages import BadMessage, JointOrder, NotForThisModel, finite_torques, read_effort, read_joint_state
+from irb140_dynamics.nodes.payload_check_node.payload_estimator import (
+    ESTIMATION_PARAMETERS,
+    PayloadEstimator,
+    check_estimation,
+)
+from irb140_dynamics.ros.messages.joint_messages import (
+    BadMessage,
+    JointOrder,
+    NotForThisModel,
+    finite_torques,
+    read_effort,
+    read_joint_state,
+)
 from irb140_dynamics.ros.parameters.model_source import declare_model_source
 from irb140_dynamics.ros.parameters.specs import QOS_PARAMETERS, Spec, check_number, check_qos, joint_states_qos
+from irb140_dynamics.ros.runtime.diagnostics import payload_statuses
+from irb140_dynamics.ros.runtime.guard import Tally, guarded
 from irb140_dynamics.ros.runtime.spin import run
 
 MIN_DIAGNOSTICS_PERIOD, MAX_DIAGNOSTICS_PERIOD = 0.1, 3600.0  # s
 MAX_WARN_USE = 1e6  # %
 NODE_PARAMETERS = [
-    Spec("rated_payload.mass", 6.0, "the rated payload the torque limits are derived from", "kg",
-         minimum=0.0),
+    Spec("rated_payload.mass", 6.0, "the rated payload the torque limits are derived from", "kg", minimum=0.0),
     Spec("rated_payload.com", [0.0, 0.0, 0.0], "its centre of mass, in the flange frame", "m"),
-    Spec("diagnostics.warn_use", 90.0, "a joint using more of its limit than this is a WARN", "%",
-         minimum=0.0, maximum=MAX_WARN_USE),
-    Spec("diagnostics.period", 1.0,
-         f"check and publish /diagnostics this often, {MIN_DIAGNOSTICS_PERIOD:g} to {MAX_DIAGNOSTICS_PERIOD:g}; "
-         "0 = only on ~/check", "s", minimum=0.0, maximum=MAX_DIAGNOSTICS_PERIOD, read_only=True),
+    Spec(
+        "diagnostics.warn_use",
+        90.0,
+        "a joint using more of its limit than this is a WARN",
+        "%",
+        minimum=0.0,
+        maximum=MAX_WARN_USE,
+    ),
+    Spec(
+        "diagnostics.period",
+        1.0,
+        f"check and publish /diagnostics this often, {MIN_DIAGNOSTICS_PERIOD:g} to {MAX_DIAGNOSTICS_PERIOD:g}; "
+        "0 = only on ~/check",
+        "s",
+        minimum=0.0,
+        maximum=MAX_DIAGNOSTICS_PERIOD,
+        read_only=True,
+    ),
     *ESTIMATION_PARAMETERS,
     *QOS_PARAMETERS,
 ]
@@ -70,7 +100,7 @@ class Draft:
 
 
 @dataclass(frozen=True)
-class Settings:
+class PayloadCheckSettings:
     """What a check needs that depends only on the parameters, the workspace sweep included."""
 
     model: RobotModel  # with the payload under test
@@ -89,14 +119,16 @@ def check_settings(values: dict) -> Draft:
     warn_use = check_number("diagnostics.warn_use", values["diagnostics.warn_use"], 0.0, MAX_WARN_USE, "%")
     period = values["diagnostics.period"]
     if period != 0.0 and not MIN_DIAGNOSTICS_PERIOD <= period <= MAX_DIAGNOSTICS_PERIOD:
-        raise ValueError(f"diagnostics.period: must be 0 (only on ~/check) or between {MIN_DIAGNOSTICS_PERIOD:g} "
-                         f"and {MAX_DIAGNOSTICS_PERIOD:g} s, got {period}")
+        raise ValueError(
+            f"diagnostics.period: must be 0 (only on ~/check) or between {MIN_DIAGNOSTICS_PERIOD:g} "
+            f"and {MAX_DIAGNOSTICS_PERIOD:g} s, got {period}"
+        )
     check_qos(values)
     check_estimation(values)
     return Draft(model, rated, warn_use, values["estimation.rest_velocity"], values["estimation.rest_time"])
 
 
-def finish_settings(draft: Draft, previous: Settings | None) -> Settings:
+def finish_settings(draft: Draft, previous: PayloadCheckSettings | None) -> PayloadCheckSettings:
     """Derive the limits and analyse the workspace (seconds for a large model: runs off the
     executor); what the previous settings computed for the same arm is reused."""
     model, rated = draft.model, draft.rated_payload
@@ -105,16 +137,19 @@ def finish_settings(draft: Draft, previous: Settings | None) -> Settings:
         workspace = previous.workspace
     else:
         workspace = workspace_load(model, model.payload, limits)
-    return Settings(model, rated, draft.warn_use, limits, workspace, draft.rest_velocity, draft.rest_time)
+    return PayloadCheckSettings(model, rated, draft.warn_use, limits, workspace, draft.rest_velocity, draft.rest_time)
 
 
-def _same_arm(draft: Draft, previous: Settings | None) -> bool:
+def _same_arm(draft: Draft, previous: PayloadCheckSettings | None) -> bool:
     """The same torque limits as before: the same joints, gravity and rated payload."""
     return previous is not None and (previous.model.joints, previous.model.gravity, previous.rated_payload) == (
-        draft.model.joints, draft.model.gravity, draft.rated_payload)
+        draft.model.joints,
+        draft.model.gravity,
+        draft.rated_payload,
+    )
 
 
-def analysed(draft: Draft, previous: Settings | None) -> bool:
+def analysed(draft: Draft, previous: PayloadCheckSettings | None) -> bool:
     """Nothing to analyse: the previous settings had the same arm and payload."""
     return _same_arm(draft, previous) and previous.model.payload == draft.model.payload
 
@@ -128,13 +163,14 @@ def _failed_check(request, response, error):
 class PayloadCheckNode(Node):
     def __init__(self, **kwargs):
         super().__init__("payload_check_node", **kwargs)
-        self.settings: Settings | None = None  # None: waiting for the model (robot_description topic)
+        self.settings: PayloadCheckSettings | None = None  # None: waiting for the model (robot_description topic)
         self._started = False
         self._state = None  # (q, qd, time received [node clock]) of the latest good joint state
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
-        self.parameters = declare_model_source(self, NODE_PARAMETERS, check_settings, finish=finish_settings,
-                                               startup_wait=STARTUP_WAIT, quick=analysed)
+        self.parameters = declare_model_source(
+            self, NODE_PARAMETERS, check_settings, finish=finish_settings, startup_wait=STARTUP_WAIT, quick=analysed
+        )
         self.parameters.on_change(self._use)
         self.estimator = PayloadEstimator(self, self._model)
         if self.parameters.current is not None:
@@ -151,10 +187,12 @@ class PayloadCheckNode(Node):
             self._log_ready()
         elif self.parameters.pending_since is not None:
             mass, com = self.get_parameter("payload.mass").value, list(self.get_parameter("payload.com").value)
-            self.get_logger().info(f"ready: ~/check for a {mass} kg payload at {com} m "
-                                   "(its workspace analysis still running: ~/check says pending)")
+            self.get_logger().info(
+                f"ready: ~/check for a {mass} kg payload at {com} m "
+                "(its workspace analysis still running: ~/check says pending)"
+            )
 
-    def _use(self, settings: Settings) -> None:
+    def _use(self, settings: PayloadCheckSettings) -> None:
         """Switch to new settings (built, limits and workspace sweep included, when checked)."""
         first, names = self.settings is None, settings.model.joint_names
         if first or names != self.settings.model.joint_names:
@@ -217,7 +255,7 @@ class PayloadCheckNode(Node):
             self.tally.warn("estimation", f"no effort of a joint state for the payload estimate ({error})")
             effort = None
         stamp = msg.header.stamp
-        t = stamp.sec + 1e-9 * stamp.nanosec
+        t = seconds(stamp.sec, stamp.nanosec)
         try:
             self.estimator.update(t if t != 0.0 else now.nanoseconds * 1e-9, q, qd, effort)
         except ValueError as error:  # an absurd effort: not averaged
@@ -250,8 +288,10 @@ class PayloadCheckNode(Node):
         since = self.parameters.pending_since
         if since is None:
             return "no model yet: waiting for a URDF on the robot_description topic"
-        return (f"pending: the limits and workspace analysis of the new parameters are running "
-                f"(for {time.monotonic() - since:.1f} s); ask again shortly")
+        return (
+            f"pending: the limits and workspace analysis of the new parameters are running "
+            f"(for {time.monotonic() - since:.1f} s); ask again shortly"
+        )
 
     def _publish(self, statuses) -> None:
         diagnostics = DiagnosticArray(status=statuses)

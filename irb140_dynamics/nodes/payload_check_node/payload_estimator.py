@@ -12,15 +12,24 @@ from rclpy.parameter import Parameter
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.core.model.friction import JointFriction
-from irb140_dynamics.core.payload.mass_com_estimation import EstimationError, PayloadEstimate, RestDetector, estimate_payload
-from irb140_dynamics.ros.runtime.guard import guarded
+from irb140_dynamics.core.payload.mass_com_estimation import (
+    EstimationError,
+    PayloadEstimate,
+    RestDetector,
+    estimate_payload,
+)
 from irb140_dynamics.ros.parameters.specs import Spec
+from irb140_dynamics.ros.runtime.guard import guarded
 
 ESTIMATION_PARAMETERS = [
-    Spec("estimation.rest_velocity", 0.02, "a joint state is at rest when every joint is slower than this",
-         "rad/s", minimum=1e-6),
-    Spec("estimation.rest_time", 0.5, "a rest this long becomes a sample (one per distinct pose)", "s",
-         minimum=0.0),
+    Spec(
+        "estimation.rest_velocity",
+        0.02,
+        "a joint state is at rest when every joint is slower than this",
+        "rad/s",
+        minimum=1e-6,
+    ),
+    Spec("estimation.rest_time", 0.5, "a rest this long becomes a sample (one per distinct pose)", "s", minimum=0.0),
     Spec("estimation.apply", False, "on a successful ~/estimate_payload, set payload.mass and payload.com"),
 ]
 
@@ -102,10 +111,12 @@ class PayloadEstimator:
 
     def _apply(self, estimate: PayloadEstimate) -> tuple[bool, str]:
         """Set payload.mass and payload.com through the validated parameter path."""
-        result = self._node.set_parameters_atomically([
-            Parameter("payload.mass", Parameter.Type.DOUBLE, float(estimate.mass)),
-            Parameter("payload.com", Parameter.Type.DOUBLE_ARRAY, [float(x) for x in estimate.com]),
-        ])
+        result = self._node.set_parameters_atomically(
+            [
+                Parameter("payload.mass", Parameter.Type.DOUBLE, float(estimate.mass)),
+                Parameter("payload.com", Parameter.Type.DOUBLE_ARRAY, [float(x) for x in estimate.com]),
+            ]
+        )
         if result.successful:
             return True, "applied: payload.mass and payload.com set"
         return False, f"not applied: {result.reason}"
@@ -130,6 +141,9 @@ class PayloadEstimator:
                 KeyValue(key="estimated CoM [m]", value=", ".join(f"{x:.4f}" for x in self.last.com)),
             ]
         return DiagnosticStatus(
-            level=DiagnosticStatus.OK, name=f"{node_name}: payload estimation", hardware_id=node_name,
-            message=message, values=values,
+            level=DiagnosticStatus.OK,
+            name=f"{node_name}: payload estimation",
+            hardware_id=node_name,
+            message=message,
+            values=values,
         )

@@ -35,10 +35,10 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 
-from irb140_dynamics.ros.runtime.guard import Tally, guarded
+from irb140_dynamics.nodes.sim_node.settings import NODE_PARAMETERS, SimNodeSettings, build_settings, read_command  # noqa: F401 (NODE_PARAMETERS: read by ros.overrides)
 from irb140_dynamics.ros.messages.joint_messages import BadMessage
 from irb140_dynamics.ros.parameters.model_source import declare_model_source
-from irb140_dynamics.nodes.sim_node.settings import NODE_PARAMETERS, Settings, build_settings, read_command  # noqa: F401 (NODE_PARAMETERS: read by ros.overrides)
+from irb140_dynamics.ros.runtime.guard import Tally, guarded
 from irb140_dynamics.ros.runtime.spin import run
 from irb140_dynamics.sim.engine import SimulatedArm, SimulationError
 from irb140_dynamics.sim.lockstep import TICKS, LockstepClock
@@ -57,7 +57,7 @@ class SimNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__("sim_node", **kwargs)
-        self.settings: Settings | None = None  # None: waiting for the model (robot_description topic)
+        self.settings: SimNodeSettings | None = None  # None: waiting for the model (robot_description topic)
         self.arm: SimulatedArm | None = None  # the engine, stepped under self._lock
         self._lock = threading.Lock()  # the arm and settings: the stepping thread against callbacks
         self.tally = Tally(self.get_logger())
@@ -86,8 +86,11 @@ class SimNode(Node):
             self.lockstep = LockstepClock(period)
             self._clock_pub = self.create_publisher(ClockMessage, "/clock", QoSProfile(depth=1))
             self._clock_msg = ClockMessage()
-            self.create_timer(self.get_parameter("lockstep_timeout").value / TICKS, self._republish,
-                              clock=Clock(clock_type=ClockType.STEADY_TIME))
+            self.create_timer(
+                self.get_parameter("lockstep_timeout").value / TICKS,
+                self._republish,
+                clock=Clock(clock_type=ClockType.STEADY_TIME),
+            )
         self.loop = RealTimeLoop(period, self._step, self._on_step_error)
         self.schedule = self.loop.schedule
         if self.parameters.current is not None:
@@ -97,7 +100,7 @@ class SimNode(Node):
         self.loop.stop()
         return super().destroy_node()
 
-    def _use(self, settings: Settings) -> None:
+    def _use(self, settings: SimNodeSettings) -> None:
         """Switch to new settings: a new model of the same joints continues from the current
         state; other joints (a new URDF) start at initial_positions. The first starts the
         loop (lockstep: publishes the first state)."""
@@ -123,8 +126,10 @@ class SimNode(Node):
             refused = self.loop.start(self.get_parameter("thread_priority").value)
             if refused:
                 self.get_logger().warning(f"thread_priority refused ({refused}): ordinary scheduling")
-        self.get_logger().info(f"ready: {len(names)} joints {names}, {1.0 / self.schedule.period:g} Hz ({mode}), "
-                               f"payload {settings.model.payload.mass} kg")
+        self.get_logger().info(
+            f"ready: {len(names)} joints {names}, {1.0 / self.schedule.period:g} Hz ({mode}), "
+            f"payload {settings.model.payload.mass} kg"
+        )
 
     def _now(self) -> int:
         """ns: simulated time (of the state published last) in lockstep, else monotonic."""
@@ -266,8 +271,10 @@ class SimNode(Node):
         steps = recent["steps"]
         problems = [] if self.settings is not None else ["waiting for the model (robot_description)"]
         if recent["late_steps"] > WARN_LATE_SHARE * steps or recent["skipped_steps"]:
-            problems.append(f"cannot keep real time: {recent['late_steps']} of {steps} steps late, "
-                            f"{recent['skipped_steps']} skipped in the last period")
+            problems.append(
+                f"cannot keep real time: {recent['late_steps']} of {steps} steps late, "
+                f"{recent['skipped_steps']} skipped in the last period"
+            )
         dropped = sum(n for key, n in recent.items() if key.endswith((".dropped", ".errors")))
         if dropped:
             problems.append(f"{dropped} messages dropped or callbacks failed in the last period")

@@ -8,10 +8,21 @@ import numpy as np
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
 
+from irb140_dynamics.core.io.stamps import seconds
 from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder, NotForThisModel
 
-__all__ = ["BadMessage", "JointOrder", "NotForThisModel", "core_result", "finite_torques",
-           "publish_efforts", "read_effort", "read_joint_state", "read_reference", "read_trajectory"]
+__all__ = [
+    "BadMessage",
+    "JointOrder",
+    "NotForThisModel",
+    "core_result",
+    "finite_torques",
+    "publish_efforts",
+    "read_effort",
+    "read_joint_state",
+    "read_reference",
+    "read_trajectory",
+]
 
 
 def core_result(function, model, *state):
@@ -100,7 +111,7 @@ def read_trajectory(msg: JointTrajectory, order: JointOrder):
         QD.append(_pick(point.velocities, index, f"points[{k}].velocities", length, required=False))
         if len(point.accelerations):
             QDD.append(_pick(point.accelerations, index, f"points[{k}].accelerations", length, required=True))
-        times.append(point.time_from_start.sec + 1e-9 * point.time_from_start.nanosec)
+        times.append(seconds(point.time_from_start.sec, point.time_from_start.nanosec))
     if QDD and len(QDD) != len(Q):
         raise BadMessage("length_mismatch", "accelerations must be given on every point or on none")
     try:

@@ -1,11 +1,10 @@
 """sensor_msgs/JointState as the bytes DDS carries (CDR), for id_node's path per message.
 
-rclpy turns every message taken into a Python object field by field (18 us for a 6-joint
-JointState) and every message published back into C (11 us). id_node reads its joint
-states from the serialized bytes with ``struct`` instead (3 us; strings read as rclpy reads
-them), and publishes its torque
-messages as bytes: the message written once, then only the stamp and the efforts written
-into a copy (1 us). bench/bench_nodes.py measures what that saves.
+rclpy turns every message taken into a Python object field by field, and every message
+published back into C. id_node reads its joint states from the serialized bytes with
+``struct`` instead (strings read as rclpy reads them), and publishes its torque messages as
+bytes: the message written once, then only the stamp and the efforts written into a copy.
+bench/bench_nodes.py measures what that saves (docs/benchmarks.md).
 
 The layout is XCDR1 (what rmw_fastrtps and rmw_cyclonedds send for ROS 2 types): a
 4-byte encapsulation header, then the fields in order, each primitive aligned to its size
@@ -70,7 +69,7 @@ def _read_plain_le(raw: bytes) -> JointStateView:
     end = len(raw)
     sec, nanosec = _STAMP.unpack_from(raw, HEADER)
     seen = _names_seen
-    if seen is not None and raw.startswith(seen[0], _FRAME_ID):  # a stream repeats them: 5 us less
+    if seen is not None and raw.startswith(seen[0], _FRAME_ID):  # a stream repeats them: decoded once
         block, frame_id, names = seen
         at = _FRAME_ID + len(block)
     else:

@@ -7,23 +7,21 @@ given value into one line naming the parameter.
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING, Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.exceptions import (
-    InvalidParameterTypeException,
-    InvalidParameterValueException,
     ParameterNotDeclaredException,
 )
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from irb140_dynamics.ros.runtime.builder import Builder, Failed
+from irb140_dynamics.core.errors import one_line
 from irb140_dynamics.ros.parameters.overrides import warn_unknown_overrides
 from irb140_dynamics.ros.parameters.services import guard_parameter_services
-
-if TYPE_CHECKING:
-    from irb140_dynamics.ros.parameters.specs import Spec
+from irb140_dynamics.ros.parameters.spec import declare
+from irb140_dynamics.ros.runtime.builder import Builder, Failed
 
 
 class LiveParameters:
@@ -46,9 +44,16 @@ class LiveParameters:
     (the configuration before stays).
     """
 
-    def __init__(self, node: Node, specs: list, check: Callable[[dict], Any],
-                 finish: Callable[[Any, Any], Any] | None = None, declared=(), startup_wait: float | None = None,
-                 quick: Callable[[Any, Any], bool] | None = None):
+    def __init__(
+        self,
+        node: Node,
+        specs: list,
+        check: Callable[[dict], Any],
+        finish: Callable[[Any, Any], Any] | None = None,
+        declared=(),
+        startup_wait: float | None = None,
+        quick: Callable[[Any, Any], bool] | None = None,
+    ):
         """``finish`` None: ``check`` builds the whole configuration (then always quick);
         ``declared``: names of parameters the caller has declared already; ``quick(draft,
         previous)``: True when finish will be quick (nothing to compile): then it runs at
@@ -59,8 +64,9 @@ class LiveParameters:
         finish = finish or (lambda draft, previous: draft)
         for spec in specs:
             declare(node, spec)
-        self._values = {name: node.get_parameter_or(name).value
-                        for name in [spec.name for spec in specs] + list(declared)}  # kept in step by _apply
+        self._values = {
+            name: node.get_parameter_or(name).value for name in [spec.name for spec in specs] + list(declared)
+        }  # kept in step by _apply
         warn_unknown_overrides(node)
         self.current = None
         self.failure: str | None = None
@@ -158,7 +164,7 @@ class LiveParameters:
             self._refuse_undeclared([p for p in parameters if not p.name])  # others: rclpy's check, above
             self._checked = (_changes(parameters), self._check_values(self.values(parameters)))
         except (ValueError, ParameterNotDeclaredException) as error:
-            return SetParametersResult(successful=False, reason=_one_line(error))
+            return SetParametersResult(successful=False, reason=one_line(error))
         except Exception as error:  # noqa: BLE001  (a defect of ours must not end the node)
             self._node.get_logger().error(f"validating {[p.name for p in parameters]}: {type(error).__name__}: {error}")
             return SetParametersResult(successful=False, reason=f"internal error: {type(error).__name__}: {error}")
@@ -213,38 +219,9 @@ def _changes(parameters: list[Parameter]) -> list[tuple[str, Any]]:
     return [(p.name, p.value) for p in parameters]
 
 
-def _one_line(error: BaseException) -> str:
-    return str(error).replace("\n", " ")
-
-
 def _error_text(error: BaseException) -> str:
     """A ValueError's text (it names the parameter); for anything else, its type too."""
-    return _one_line(error) if isinstance(error, ValueError) else f"{type(error).__name__}: {_one_line(error)}"
-
-
-def _range_text(spec: Spec) -> str:
-    if spec.minimum is not None and spec.maximum is not None:
-        return f"must be between {spec.minimum:g} and {spec.maximum:g}"
-    if spec.minimum is not None:
-        return f"must be >= {spec.minimum:g}"
-    return f"must be <= {spec.maximum:g}"
-
-
-def declare(node: Node, spec) -> Any:
-    """Declare a parameter of a Spec; a value rclpy refuses is a ValueError naming it."""
-    try:
-        return node.declare_parameter(spec.name, spec.default, spec.descriptor()).value
-    except InvalidParameterTypeException:
-        kind = spec.default
-        if not isinstance(kind, Parameter.Type):
-            kind = Parameter.Type.from_parameter_value(kind)
-        hint = "; write doubles with a decimal point, e.g. 2.0" if "DOUBLE" in kind.name else ""
-        raise ValueError(f"{spec.name}: expected a value of type {kind.name.lower()}{hint}") from None
-    except InvalidParameterValueException as error:
-        given = node._parameter_overrides.get(spec.name)  # the value rclpy refused (its range)
-        if given is None or (spec.minimum is None and spec.maximum is None):
-            raise ValueError(f"{spec.name}: {error}") from None
-        raise ValueError(f"{spec.name}: {_range_text(spec)}, got {given.value}") from None
+    return one_line(error) if isinstance(error, ValueError) else f"{type(error).__name__}: {one_line(error)}"
 
 
 def _or_none(finish: Callable[[Any, Any], Any]) -> Callable[[Any, Any], Any]:

@@ -18,8 +18,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import rclpy
 from rclpy.context import Context
@@ -30,6 +31,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import String
 
 from irb140_dynamics.core import Joint, RigidBody, RobotModel
+from irb140_dynamics.core.errors import one_line
 from irb140_dynamics.core.io.urdf import LoadedUrdf, load_urdf
 from irb140_dynamics.ros.parameters.live import LiveParameters
 from irb140_dynamics.ros.parameters.specs import Spec, _declare, check_choice, declare_model, model_specs
@@ -41,23 +43,42 @@ DESCRIPTION_QOS = QoSProfile(
     depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
 )
 STAND_IN = RobotModel((Joint("stand_in", link=RigidBody(1.0)),))  # checks the parameters before a URDF comes
-SOURCE = Spec("model.source", "parameters",
-              "where the model comes from: 'parameters' (joint_names and <joint>.*) or 'robot_description' (URDF)",
-              read_only=True)
+SOURCE = Spec(
+    "model.source",
+    "parameters",
+    "where the model comes from: 'parameters' (joint_names and <joint>.*) or 'robot_description' (URDF)",
+    read_only=True,
+)
 DESCRIPTION_PARAMETERS = [
-    Spec("robot_description", "", "the URDF text (model.source robot_description); empty: model.urdf_file, "
-         "else the robot_description topic", read_only=True),
-    Spec("model.urdf_file", "", "a URDF file, when robot_description is empty; empty: the robot_description topic",
-         read_only=True),
+    Spec(
+        "robot_description",
+        "",
+        "the URDF text (model.source robot_description); empty: model.urdf_file, else the robot_description topic",
+        read_only=True,
+    ),
+    Spec(
+        "model.urdf_file",
+        "",
+        "a URDF file, when robot_description is empty; empty: the robot_description topic",
+        read_only=True,
+    ),
     Spec("model.base_link", "", "the URDF link the chain starts from (fixed); empty: the root link", read_only=True),
-    Spec("model.tip_link", "", "the URDF link where the chain ends, the payload's frame; empty: the only leaf",
-         read_only=True),
+    Spec(
+        "model.tip_link",
+        "",
+        "the URDF link where the chain ends, the payload's frame; empty: the only leaf",
+        read_only=True,
+    ),
 ]
 
 
 def declare_model_source(
-    node: Node, extra: list[Spec], check: Callable[[dict], Any], per_joint: PerJoint | None = None,
-    finish: Callable[[Any, Any], Any] | None = None, startup_wait: float | None = None,
+    node: Node,
+    extra: list[Spec],
+    check: Callable[[dict], Any],
+    per_joint: PerJoint | None = None,
+    finish: Callable[[Any, Any], Any] | None = None,
+    startup_wait: float | None = None,
     quick: Callable[[Any, Any], bool] | None = None,
 ) -> LiveParameters:
     """Declare ``model.source`` and the model's parameters of that source, and a node's own
@@ -76,8 +97,14 @@ def declare_model_source(
 class RobotDescription:
     """The model of a node from a URDF: parameter, file or topic (see the module)."""
 
-    def __init__(self, node: Node, extra: list[Spec], check: Callable[[dict], Any], per_joint: PerJoint,
-                 later: dict | None = None):
+    def __init__(
+        self,
+        node: Node,
+        extra: list[Spec],
+        check: Callable[[dict], Any],
+        per_joint: PerJoint,
+        later: dict | None = None,
+    ):
         """``later``: LiveParameters' finish, startup_wait and quick."""
         self._node, self._build_node, self._per_joint = node, check, per_joint
         text, path, base, tip = (_declare(node, spec) for spec in DESCRIPTION_PARAMETERS)
@@ -133,10 +160,10 @@ class RobotDescription:
             urdf = self._load(msg.data, "robot_description topic")
             self.parameters.declare(self._per_joint(urdf.model.joint_names))
             draft = self._build_with(urdf, self.parameters.values())
-        except Exception as error:  # noqa: BLE001: nothing of ours may leave a callback
+        except Exception as error:  # noqa: BLE001 (nothing of ours may leave a callback)
             self.refused += 1
             kind = "" if isinstance(error, ValueError) else f"{type(error).__name__}: "
-            self.last_refusal = f"{kind}{_one_line(error)}"
+            self.last_refusal = f"{kind}{one_line(error)}"
             logger.error(f"refused a robot_description ({keeping}): {self.last_refusal}")
             return
         self.urdf = urdf
@@ -156,8 +183,10 @@ def model_from_arguments(args: list[str], name: str) -> RobotModel:
         node.get_logger().set_level(LoggingSeverity.WARN)  # stderr for errors only
         model = declare_model_source(node, [], RobotModel.from_params).current
         if model is None:
-            raise ValueError(f"robot_description: {name} does not read the topic; give the robot_description "
-                             "parameter or model.urdf_file")
+            raise ValueError(
+                f"robot_description: {name} does not read the topic; give the robot_description "
+                "parameter or model.urdf_file"
+            )
         return model
     except rclpy_implementation.RCLError as error:
         raise ValueError(init_error(error)) from None
@@ -172,7 +201,3 @@ def _read(path: str) -> str:
         return Path(path).read_text()
     except (OSError, UnicodeDecodeError) as error:
         raise ValueError(f"model.urdf_file: cannot read {path}: {getattr(error, 'strerror', None) or error}") from None
-
-
-def _one_line(error: Exception) -> str:
-    return str(error).replace("\n", " ")

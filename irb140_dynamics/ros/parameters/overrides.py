@@ -9,13 +9,12 @@ would otherwise leave the default in force without a word. A parameter of a sibl
 from __future__ import annotations
 
 import difflib
-import importlib
 
 from rclpy.node import Node
 
+from irb140_dynamics.ros.parameters.catalog import PER_JOINT_SUFFIXES, sibling_parameter_names
+
 MAX_UNKNOWN_WARNINGS = 10
-SIBLINGS = ("irb140_dynamics.nodes.id_node.node", "irb140_dynamics.nodes.payload_check_node.node", "irb140_dynamics.nodes.sim_node.node",
-            "irb140_dynamics.nodes.demo_node.node")
 
 
 def warn_unknown_overrides(node: Node) -> None:
@@ -26,7 +25,7 @@ def warn_unknown_overrides(node: Node) -> None:
     if not unknown:
         return
     joint_names = node.get_parameter("joint_names").value if node.has_parameter("joint_names") else None
-    known, per_joint_suffixes = _sibling_names(joint_names)
+    known, per_joint_suffixes = sibling_parameter_names(joint_names), PER_JOINT_SUFFIXES
     known |= declared
     lines, by_parent = [], {}
     for name in unknown:
@@ -41,8 +40,10 @@ def warn_unknown_overrides(node: Node) -> None:
         lines.append(f"unknown parameter {name} (ignored){hint}")
     for parent, names in by_parent.items():
         what = node.describe_parameter(parent).description
-        lines.append(f"unknown parameter{'s' if len(names) > 1 else ''} {', '.join(names)} (ignored): "
-                     f"{parent} is one parameter, not a mapping: {what}")
+        lines.append(
+            f"unknown parameter{'s' if len(names) > 1 else ''} {', '.join(names)} (ignored): "
+            f"{parent} is one parameter, not a mapping: {what}"
+        )
     for line in lines[:MAX_UNKNOWN_WARNINGS]:
         node.get_logger().warning(line)
     if len(lines) > MAX_UNKNOWN_WARNINGS:
@@ -57,21 +58,3 @@ def _known_parent(name: str, declared: set[str]) -> str | None:
         if parent in declared:
             return parent
     return None
-
-
-def _sibling_names(joint_names) -> tuple[set[str], tuple[str, ...]]:
-    """The parameters of the package's nodes (for these joints), and the suffixes of their
-    per-joint parameters (``.collision_threshold``)."""
-    names, suffixes = set(), set()
-    for module_name in SIBLINGS:
-        try:
-            module = importlib.import_module(module_name)
-        except Exception:  # noqa: BLE001  (sim_node needs MuJoCo: without it, no sim_node either)
-            continue
-        names |= {spec.name for spec in getattr(module, "NODE_PARAMETERS", [])}
-        names |= set(getattr(module, "PARAMETER_NAMES", ()))  # a node declaring its own by hand
-        per_joint = getattr(module, "PER_JOINT_PARAMETERS", None)
-        if per_joint is not None:
-            names |= {spec.name for spec in per_joint(joint_names or [])}
-            suffixes |= {spec.name[len("_"):] for spec in per_joint(["_"])}
-    return names, tuple(sorted(suffixes))

@@ -34,8 +34,9 @@ def guard_parameter_services(node: Node) -> None:
 def _unknown_type(parameter) -> SetParametersResult | None:
     if parameter.value.type in PARAMETER_TYPES:
         return None
-    return SetParametersResult(successful=False,
-                               reason=f"{parameter.name!r}: {parameter.value.type} is not a parameter type")
+    return SetParametersResult(
+        successful=False, reason=f"{parameter.name!r}: {parameter.value.type} is not a parameter type"
+    )
 
 
 def _one_by_one(callback):
@@ -72,8 +73,9 @@ def _answered(node: Node, callback, srv_type):
         try:
             return callback(request, response)
         except Exception as error:  # noqa: BLE001  (rclpy's, but it would end our node)
-            node.get_logger().warning(f"{srv_type.__name__} request failed: {type(error).__name__}: {error}",
-                                      throttle_duration_sec=2.0)
+            node.get_logger().warning(
+                f"{srv_type.__name__} request failed: {type(error).__name__}: {error}", throttle_duration_sec=2.0
+            )
             return srv_type.Response()
 
     return answered

@@ -15,63 +15,40 @@ with the nearest known name.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
-from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-from irb140_dynamics.core.model.robot_model import check_joint_names, read_parameter_file
+from irb140_dynamics.core.io.params_file import read_parameter_file
+from irb140_dynamics.core.model.robot_model import check_joint_names
 from irb140_dynamics.package_files import CONFIG_NAME, PACKAGE, default_config_path  # noqa: F401 (PACKAGE, CONFIG_NAME: re-exported)
-from irb140_dynamics.ros.parameters.live import LiveParameters, declare
+from irb140_dynamics.ros.parameters.live import LiveParameters
+from irb140_dynamics.ros.parameters.spec import Spec, declare
 
 _declare = declare  # the name model_source imports
-
-
-
-@dataclass(frozen=True)
-class Spec:
-    """One parameter: its name, default (or type when it has none) and descriptor text."""
-
-    name: str
-    default: Any
-    description: str
-    unit: str = ""
-    read_only: bool = False
-    minimum: float | None = None  # for double and integer parameters
-    maximum: float | None = None
-
-    def descriptor(self) -> ParameterDescriptor:
-        unit = f" [{self.unit}]" if self.unit else ""
-        descriptor = ParameterDescriptor(description=self.description + unit, read_only=self.read_only)
-        if isinstance(self.default, int) and not isinstance(self.default, bool):
-            if self.minimum is not None or self.maximum is not None:
-                descriptor.integer_range = [IntegerRange(
-                    from_value=-2**63 if self.minimum is None else int(self.minimum),
-                    to_value=2**63 - 1 if self.maximum is None else int(self.maximum),
-                    step=1,
-                )]
-        elif self.minimum is not None or self.maximum is not None:
-            descriptor.floating_point_range = [
-                FloatingPointRange(
-                    from_value=-math.inf if self.minimum is None else self.minimum,
-                    to_value=math.inf if self.maximum is None else self.maximum,
-                    step=0.0,
-                )
-            ]
-        return descriptor
 
 
 MAX_QOS_DEPTH = 10_000  # messages: 10 s at 1 kHz; DDS may reserve memory for the whole depth
 RELIABILITIES = {"best_effort": ReliabilityPolicy.BEST_EFFORT, "reliable": ReliabilityPolicy.RELIABLE}
 QOS_PARAMETERS = [
-    Spec("qos.reliability", "best_effort",
-         "joint_states subscription reliability: 'best_effort' (takes reliable and best-effort publishers) "
-         "or 'reliable'", read_only=True),
-    Spec("qos.depth", 10, "queue depth of joint_states, ~/reference and the torque topics", read_only=True,
-         minimum=1, maximum=MAX_QOS_DEPTH),
+    Spec(
+        "qos.reliability",
+        "best_effort",
+        "joint_states subscription reliability: 'best_effort' (takes reliable and best-effort publishers) "
+        "or 'reliable'",
+        read_only=True,
+    ),
+    Spec(
+        "qos.depth",
+        10,
+        "queue depth of joint_states, ~/reference and the torque topics",
+        read_only=True,
+        minimum=1,
+        maximum=MAX_QOS_DEPTH,
+    ),
 ]
 
 
@@ -109,29 +86,74 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
 
     specs = [
         Spec("gravity", defaults.get("gravity", [0.0, 0.0, -9.81]), "gravity in the base frame", "m/s^2"),
-        Spec("friction.smoothing_velocity", defaults.get("friction.smoothing_velocity", 0.01),
-             "Coulomb friction is coulomb * tanh(qd / this)", "rad/s", minimum=1e-9),
-        *_body_specs("payload", "the payload on the flange", "flange frame", lambda name, kind: defaults.get(name, kind)),
+        Spec(
+            "friction.smoothing_velocity",
+            defaults.get("friction.smoothing_velocity", 0.01),
+            "Coulomb friction is coulomb * tanh(qd / this)",
+            "rad/s",
+            minimum=1e-9,
+        ),
+        *_body_specs(
+            "payload", "the payload on the flange", "flange frame", lambda name, kind: defaults.get(name, kind)
+        ),
     ]
     for joint in joint_names:
         specs += [
-            Spec(f"{joint}.dh", default(f"{joint}.dh", Parameter.Type.DOUBLE_ARRAY),
-                 "standard DH row [a, alpha, d, theta_offset]", "m, rad, m, rad"),
+            Spec(
+                f"{joint}.dh",
+                default(f"{joint}.dh", Parameter.Type.DOUBLE_ARRAY),
+                "standard DH row [a, alpha, d, theta_offset]",
+                "m, rad, m, rad",
+            ),
             *_body_specs(f"{joint}.link", f"the link {joint} moves", "its DH frame", default),
-            Spec(f"{joint}.position_limits", default(f"{joint}.position_limits", [-math.pi, math.pi]),
-                 "[lower, upper] joint position", "rad"),
-            Spec(f"{joint}.torque_limit", default(f"{joint}.torque_limit", 0.0),
-                 "joint torque limit, 0 = none given", "N m", minimum=0.0),
-            Spec(f"{joint}.velocity_limit", default(f"{joint}.velocity_limit", 0.0),
-                 "joint speed limit, 0 = none given", "rad/s", minimum=0.0),
-            Spec(f"{joint}.acceleration_limit", default(f"{joint}.acceleration_limit", 0.0),
-                 "joint acceleration limit, 0 = none given", "rad/s^2", minimum=0.0),
-            Spec(f"{joint}.friction.viscous", default(f"{joint}.friction.viscous", 0.0),
-                 "viscous friction coefficient", "N m s/rad", minimum=0.0),
-            Spec(f"{joint}.friction.coulomb", default(f"{joint}.friction.coulomb", 0.0),
-                 "Coulomb friction level (smoothed, see friction.smoothing_velocity)", "N m", minimum=0.0),
-            Spec(f"{joint}.armature", default(f"{joint}.armature", 0.0),
-                 "rotor inertia reflected through the gear, added to M's diagonal", "kg m^2", minimum=0.0),
+            Spec(
+                f"{joint}.position_limits",
+                default(f"{joint}.position_limits", [-math.pi, math.pi]),
+                "[lower, upper] joint position",
+                "rad",
+            ),
+            Spec(
+                f"{joint}.torque_limit",
+                default(f"{joint}.torque_limit", 0.0),
+                "joint torque limit, 0 = none given",
+                "N m",
+                minimum=0.0,
+            ),
+            Spec(
+                f"{joint}.velocity_limit",
+                default(f"{joint}.velocity_limit", 0.0),
+                "joint speed limit, 0 = none given",
+                "rad/s",
+                minimum=0.0,
+            ),
+            Spec(
+                f"{joint}.acceleration_limit",
+                default(f"{joint}.acceleration_limit", 0.0),
+                "joint acceleration limit, 0 = none given",
+                "rad/s^2",
+                minimum=0.0,
+            ),
+            Spec(
+                f"{joint}.friction.viscous",
+                default(f"{joint}.friction.viscous", 0.0),
+                "viscous friction coefficient",
+                "N m s/rad",
+                minimum=0.0,
+            ),
+            Spec(
+                f"{joint}.friction.coulomb",
+                default(f"{joint}.friction.coulomb", 0.0),
+                "Coulomb friction level (smoothed, see friction.smoothing_velocity)",
+                "N m",
+                minimum=0.0,
+            ),
+            Spec(
+                f"{joint}.armature",
+                default(f"{joint}.armature", 0.0),
+                "rotor inertia reflected through the gear, added to M's diagonal",
+                "kg m^2",
+                minimum=0.0,
+            ),
         ]
     return specs
 
@@ -140,18 +162,35 @@ def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
     zeros3, zeros6 = [0.0] * 3, [0.0] * 6
     optional = prefix == "payload"
     return [
-        Spec(f"{prefix}.mass", default(f"{prefix}.mass", 0.0 if optional else Parameter.Type.DOUBLE),
-             f"mass of {what}", "kg", minimum=0.0),
-        Spec(f"{prefix}.com", default(f"{prefix}.com", zeros3 if optional else Parameter.Type.DOUBLE_ARRAY),
-             f"centre of mass of {what}, in {frame}", "m"),
-        Spec(f"{prefix}.inertia", default(f"{prefix}.inertia", zeros6 if optional else Parameter.Type.DOUBLE_ARRAY),
-             f"inertia of {what} about its centre of mass, [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]", "kg m^2"),
+        Spec(
+            f"{prefix}.mass",
+            default(f"{prefix}.mass", 0.0 if optional else Parameter.Type.DOUBLE),
+            f"mass of {what}",
+            "kg",
+            minimum=0.0,
+        ),
+        Spec(
+            f"{prefix}.com",
+            default(f"{prefix}.com", zeros3 if optional else Parameter.Type.DOUBLE_ARRAY),
+            f"centre of mass of {what}, in {frame}",
+            "m",
+        ),
+        Spec(
+            f"{prefix}.inertia",
+            default(f"{prefix}.inertia", zeros6 if optional else Parameter.Type.DOUBLE_ARRAY),
+            f"inertia of {what} about its centre of mass, [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]",
+            "kg m^2",
+        ),
     ]
 
 
 def declare_model(
-    node: Node, extra: list[Spec], check: Callable[[dict], Any], per_joint: Callable[[list[str]], list[Spec]] = None,
-    finish: Callable[[Any, Any], Any] | None = None, startup_wait: float | None = None,
+    node: Node,
+    extra: list[Spec],
+    check: Callable[[dict], Any],
+    per_joint: Callable[[list[str]], list[Spec]] = None,
+    finish: Callable[[Any, Any], Any] | None = None,
+    startup_wait: float | None = None,
     quick: Callable[[Any, Any], bool] | None = None,
 ) -> LiveParameters:
     """Declare the robot model's parameters and a node's own (``extra``, and ``per_joint``

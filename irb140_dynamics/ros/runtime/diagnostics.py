@@ -11,7 +11,7 @@ import math
 
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 
-from irb140_dynamics.core.payload.limits import PayloadCheck
+from irb140_dynamics.core.payload import PayloadCheck
 
 OK, WARN, ERROR = DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR
 
@@ -31,7 +31,10 @@ def payload_statuses(
         level, message = max(level, WARN), f"{message}; stale joint_states"
         figures["stale joint_states"] = stale
     summary = DiagnosticStatus(
-        level=level, name=f"{node_name}: payload", hardware_id=node_name, message=message,
+        level=level,
+        name=f"{node_name}: payload",
+        hardware_id=node_name,
+        message=message,
         values=_key_values(figures),
     )
     return statuses + [summary]
@@ -55,8 +58,11 @@ def _joint_status(check: PayloadCheck, j: int, node_name: str, warn_use: float) 
     else:
         message = figures["limit source"]
     return DiagnosticStatus(
-        level=level, name=f"{node_name}: {check.joint_names[j]}", hardware_id=node_name,
-        message=message, values=_key_values(figures),
+        level=level,
+        name=f"{node_name}: {check.joint_names[j]}",
+        hardware_id=node_name,
+        message=message,
+        values=_key_values(figures),
     )
 
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 import functools
 import time
 from collections import Counter
-from typing import Callable
+from collections.abc import Callable
 
 WARN_PERIOD = 2.0  # s between two warnings about the same topic
 

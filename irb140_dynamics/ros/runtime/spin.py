@@ -7,8 +7,8 @@ import re
 import signal
 import sys
 import threading
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Callable, Iterator
 
 import rclpy
 import rclpy.logging
@@ -22,6 +22,8 @@ from rclpy.signals import (
     uninstall_signal_handlers,
 )
 from rclpy.utilities import remove_ros_args
+
+from irb140_dynamics.core.errors import one_line
 
 EXECUTORS = ("events", "single_threaded")
 
@@ -63,9 +65,8 @@ INTERRUPTED = "cannot start: interrupted (Ctrl-C) before the node was ready"
 
 def freeze_startup_objects() -> None:
     """Keep the objects of startup (modules, rclpy, NumPy, the model: some 40,000) out of
-    the garbage collector's full passes: each pass over them takes ~10 ms (more on a busy
-    machine), a stall in which a 1 kHz stream overflows its queue (bench/bench_nodes.py,
-    the run with parameter changes). Objects made later are collected as ever."""
+    the garbage collector's full passes: a pass over them all is a stall in which a 1 kHz
+    stream can overflow its queue (bench/bench_nodes.py, the run with parameter changes). Objects made later are collected as ever."""
     gc.collect()
     gc.freeze()
 
@@ -85,7 +86,7 @@ def _start(make_node: Callable[[], Node], args: list[str], logger) -> Node | Non
         except Exception as error:  # noqa: BLE001  (sorted here: ours, or Ctrl-C half-way)
             if rclpy.ok() and not isinstance(error, ValueError):
                 raise
-            why = f"cannot start: {_one_line(error)}" if rclpy.ok() else INTERRUPTED
+            why = f"cannot start: {one_line(error)}" if rclpy.ok() else INTERRUPTED
     except KeyboardInterrupt:
         why = INTERRUPTED
     # out of the except blocks: the half-built node is gone with the traceback, and with it
@@ -157,10 +158,6 @@ def ctrl_c_as_a_flag() -> Iterator[list]:
         uninstall_signal_handlers()
         signal.signal(signal.SIGINT, previous)
         install_signal_handlers(options)
-
-
-def _one_line(error: Exception) -> str:
-    return str(error).replace("\n", " ")
 
 
 _PARAMS_FILE_ERROR = re.compile(

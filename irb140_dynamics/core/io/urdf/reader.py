@@ -25,10 +25,10 @@ from functools import reduce
 
 import numpy as np
 
-from irb140_dynamics.core.model.joints import Friction, Joint, Placement, matrix_rpy
-from irb140_dynamics.core.model.robot_model import RobotModel
-from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, combine, placed
 from irb140_dynamics.core.io.urdf.tree import UrdfError, UrdfJoint, UrdfTree, number, parse_tree
+from irb140_dynamics.core.model.joints import Friction, Joint, Placement, matrix_rpy
+from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, combine, placed
+from irb140_dynamics.core.model.robot_model import RobotModel
 
 MOVING = ("revolute", "continuous")
 CONTINUOUS_LIMITS = (-4 * math.pi, 4 * math.pi)  # rad: two turns either way, every angle within
@@ -51,8 +51,11 @@ def load_urdf(text: str, base_link: str | None = None, tip_link: str | None = No
     base, tip, path = tree.chain(base_link, tip_link)
     for joint in path:
         if joint.kind not in ("fixed", *MOVING):
-            raise UrdfError(joint.label, f"a {joint.kind} joint in the chain from {base!r} to {tip!r}: only "
-                            "revolute, continuous and fixed joints are supported there")
+            raise UrdfError(
+                joint.label,
+                f"a {joint.kind} joint in the chain from {base!r} to {tip!r}: only "
+                "revolute, continuous and fixed joints are supported there",
+            )
         if joint.element.find("mimic") is not None:
             raise UrdfError(f"{joint.label} <mimic>", "a mimic joint in the chain is not supported")
     moving = [joint for joint in path if joint.kind in MOVING]
@@ -73,8 +76,10 @@ def load_urdf(text: str, base_link: str | None = None, tip_link: str | None = No
     ]
     for k, (joint, (_, has_inertial)) in enumerate(zip(moving, bodies)):
         if not has_inertial and sum(body.mass for body, _ in bodies[k:]) == 0.0:
-            raise UrdfError(f'link "{joint.child}"', f'moved by joint "{joint.name}": no <inertial>, and nothing '
-                            "it carries has mass")
+            raise UrdfError(
+                f'link "{joint.child}"',
+                f'moved by joint "{joint.name}": no <inertial>, and nothing it carries has mass',
+            )
     joints = [_joint(joint, placement, body) for joint, placement, (body, _) in zip(moving, origins, bodies)]
     try:
         model = RobotModel(tuple(joints), flange=since_last)
@@ -129,11 +134,21 @@ def _joint(joint: UrdfJoint, origin: Placement, body: RigidBody) -> Joint:
     dynamics = joint.element.find("dynamics")
     damping = number(dynamics, "damping", f"{joint.label} <dynamics>", 0.0)
     friction = number(dynamics, "friction", f"{joint.label} <dynamics>", 0.0)
-    for what, value, element in (("effort", effort, "limit"), ("velocity", velocity, "limit"),
-                                 ("damping", damping, "dynamics"), ("friction", friction, "dynamics")):
+    for what, value, element in (
+        ("effort", effort, "limit"),
+        ("velocity", velocity, "limit"),
+        ("damping", damping, "dynamics"),
+        ("friction", friction, "dynamics"),
+    ):
         if value < 0.0:
             raise UrdfError(f"{joint.label} <{element}>", f"{what} must be >= 0, got {value}")
     return Joint(
-        joint.name, link=body, position_limits=(lower, upper), torque_limit=effort, origin=origin,
-        axis=joint.axis, velocity_limit=velocity, friction=Friction(damping, friction),
+        joint.name,
+        link=body,
+        position_limits=(lower, upper),
+        torque_limit=effort,
+        origin=origin,
+        axis=joint.axis,
+        velocity_limit=velocity,
+        friction=Friction(damping, friction),
     )

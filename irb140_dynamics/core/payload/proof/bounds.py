@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 
@@ -98,8 +98,9 @@ def quadratic_max(g, Q, sigma, enough=None):
     off = absQ.sum(axis=2) - np.abs(diagonal)
     with np.errstate(divide="ignore", invalid="ignore"):
         vertex = (diagonal < 0) & (np.abs(g) <= -diagonal * sigma)
-        alone = np.where(vertex, g * g / np.where(diagonal < 0, -2 * diagonal, 1.0),
-                         np.abs(g) * sigma + 0.5 * diagonal * sigma**2)
+        alone = np.where(
+            vertex, g * g / np.where(diagonal < 0, -2 * diagonal, 1.0), np.abs(g) * sigma + 0.5 * diagonal * sigma**2
+        )
     cross = np.einsum("bkl,bk,bl->b", absQ, sigma, sigma) - (np.abs(diagonal) * sigma**2).sum(axis=1)
     bound = alone.sum(axis=1) + 0.5 * cross
     rows = np.arange(B) if enough is None else np.flatnonzero(bound > enough)
@@ -151,7 +152,7 @@ class Layout:
     pair: np.ndarray  # s_k s_l, k < l
 
 
-@lru_cache(maxsize=None)
+@cache
 def layout(d: int) -> Layout:
     digits = np.indices((3,) * d, dtype=int).reshape(d, -1).T if d else np.zeros((1, 0), int)
     degree = np.where(digits == 1, 2, np.where(digits == 2, 1, 0)).sum(axis=1)
@@ -165,4 +166,3 @@ def layout(d: int) -> Layout:
         single_v=place,
         pair=2 * place[k] + 2 * place[l],
     )
-

@@ -24,10 +24,9 @@ floating-point rounding of a bound: both are added to each bound. The result is 
 bound of the exact maxima of the model's static torques.
 
 Cost: at most EVALUATIONS box bounds per call, each counted in units of a sum of TERMS
-terms (a box over a sum of d joints costs O(d 3^d): some 30 us for the IRB-140, where a
-sum has 3 to 5 joints; 200 us for 6), in batches of at most BATCH boxes: about 1 s when
-the budget is spent, whatever the model; some 3,000 bounds (0.1 s) for the IRB-140 and its
-rated payload, where the proof closes long before.
+terms (a box over a sum of d joints costs O(d 3^d)), in batches of at most BATCH boxes:
+the budget bounds the time whatever the model; for the IRB-140 and its rated payload the
+proof closes long before it is spent.
 """
 
 from __future__ import annotations
@@ -37,7 +36,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from irb140_dynamics.core.payload.proof.bounds import U, expand, layout, model, quadratic_max, rounding, sizes, sizes_of_s
+from irb140_dynamics.core.payload.proof.bounds import (
+    U,
+    expand,
+    layout,
+    model,
+    quadratic_max,
+    rounding,
+    sizes,
+    sizes_of_s,
+)
 from irb140_dynamics.core.payload.proof.harmonic import Reduced
 
 EVALUATIONS = 50_000  # box bounds per call, shared by the groups of objectives, counted in

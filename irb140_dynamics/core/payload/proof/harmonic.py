@@ -20,7 +20,7 @@ are linear in gravity, so tau_j = g_j . omega_j with g_j the gravity in frame j,
 not depend on theta_j, which is set to 0 (the subchain from link j, by rnea too).
 
 Cost: 3^n torques for tau and about 3^n / 2 for the omegas, each one rnea pass on Interval
-arrays; 3^6 = 729 states, some 30 ms. Beyond MAX_JOINTS joints the sums grow too large
+arrays (3^6 = 729 states for six joints). Beyond MAX_JOINTS joints the sums grow too large
 and ``certify`` falls back to plain interval bounds.
 """
 
@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from irb140_dynamics.core.algorithms import recursions as algorithms
+from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.scalars.interval import Interval, bounds_of
 
 MAX_JOINTS = 8  # 3^8 = 6561 coefficients per sum
@@ -48,21 +49,21 @@ class HarmonicSum:
     dims: tuple[int, ...]
     coefficients: Interval
 
-    def __add__(self, other: "HarmonicSum") -> "HarmonicSum":
+    def __add__(self, other: HarmonicSum) -> HarmonicSum:
         assert self.dims == other.dims
         return HarmonicSum(self.dims, self.coefficients + other.coefficients)
 
-    def __sub__(self, other: "HarmonicSum") -> "HarmonicSum":
+    def __sub__(self, other: HarmonicSum) -> HarmonicSum:
         return self + other * -1.0
 
-    def __mul__(self, k: float) -> "HarmonicSum":
+    def __mul__(self, k: float) -> HarmonicSum:
         return HarmonicSum(self.dims, self.coefficients * float(k))
 
-    def __getitem__(self, index) -> "HarmonicSum":
+    def __getitem__(self, index) -> HarmonicSum:
         c = self.coefficients
         return HarmonicSum(self.dims, Interval(c.lo[index], c.hi[index]))
 
-    def reduced(self, merge: bool = False) -> "Reduced":
+    def reduced(self, merge: bool = False) -> Reduced:
         """Midpoint coefficients and an error bound, without the joints it hardly depends on
         (whose terms then count in the error: |phi| <= 1); with ``merge`` (a single sum),
         joints it depends on only through theta_a +- theta_b become one (``merge_parallel``)."""
@@ -148,14 +149,14 @@ class StaticForms:
     gravity_norm: float
 
     @classmethod
-    def of(cls, model) -> "StaticForms | None":
+    def of(cls, model) -> StaticForms | None:
         """The forms of ``model`` (None beyond MAX_JOINTS joints)."""
         if model.n > MAX_JOINTS:
             return None
-        kernels = model.kernels
+        kernels = kernels_of(model)
         return _forms(kernels.links, tuple(kernels.gravity))
 
-    def affine(self, other: "StaticForms", k: float) -> "StaticForms":
+    def affine(self, other: StaticForms, k: float) -> StaticForms:
         """self + k (other - self): the forms of a payload at k kg from those at 0 and 1 kg."""
         torque = self.torque + (other.torque - self.torque) * k
         omega = tuple(a + (b - a) * k for a, b in zip(self.omega, other.omega))
