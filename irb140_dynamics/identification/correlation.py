@@ -58,3 +58,18 @@ def correlation_factor(residuals: np.ndarray, floor: float = 1.0) -> tuple[float
             taus[j] = integrated_autocorrelation(column)
     finite = taus[np.isfinite(taus)]
     return max(floor, float(finite.max())) if len(finite) else floor, taus
+
+
+def residual_correlation(model, base, beta, points, use, offsets=None, floor: float = 1.0) -> tuple[float, np.ndarray]:
+    """``correlation_factor`` of the base estimate beta's residuals on consecutive fit
+    points (``signals.FitPoints``); ``use`` (K, n): the rows that were fitted (others left out)."""
+    from irb140_dynamics.core.regressor import regressor_batch
+
+    residuals = np.empty(points.tau.shape)
+    for start in range(0, len(points), 2048):
+        part = slice(start, start + 2048)
+        Y = base.columns(regressor_batch(model, points.q[part], points.qd[part], points.qdd[part]))
+        residuals[part] = Y @ beta - points.tau[part]
+    if offsets is not None:
+        residuals += offsets
+    return correlation_factor(np.where(use, residuals, np.nan), floor)

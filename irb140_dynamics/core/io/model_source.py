@@ -28,8 +28,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.core.io.urdf import LoadedUrdf, load_urdf
-from irb140_dynamics.core.model.robot_model import RobotModel, read_parameter_file
+from irb140_dynamics.core.model.robot_model import RobotModel
 
 SOURCES = ("parameters", "robot_description")
 DESCRIPTION_PARAMETERS = ("gravity", "friction.smoothing_velocity")  # and payload.*: what a URDF's model takes
@@ -97,8 +98,10 @@ def tool_model(
     if urdf_file is not None or source == "robot_description":
         return _from_urdf(values, params_file, urdf_file, base_link, tip_link)
     if base_link or tip_link:
-        raise ValueError("--base and --tip choose a URDF's chain: give --urdf, or a parameter file with "
-                         "model.source: robot_description")
+        raise ValueError(
+            "--base and --tip choose a URDF's chain: give --urdf, or a parameter file with "
+            "model.source: robot_description"
+        )
     defaults = _parameters(defaults_file)
     if list(values.get("joint_names", defaults.get("joint_names", []))) != list(defaults.get("joint_names", [])):
         defaults = description_values(defaults)  # other joints: every per-joint value must be given
@@ -118,8 +121,10 @@ def _from_urdf(values, params_file, urdf_file, base_link, tip_link) -> ToolModel
         path = _beside(values["model.urdf_file"], params_file)
         where, text = str(path), read_urdf_file(path, "model.urdf_file")
     else:
-        raise ValueError(f"{params_file or 'parameters'}: model.source is robot_description but neither "
-                         "robot_description nor model.urdf_file is given (or give --urdf FILE)")
+        raise ValueError(
+            f"{params_file or 'parameters'}: model.source is robot_description but neither "
+            "robot_description nor model.urdf_file is given (or give --urdf FILE)"
+        )
     base = base_link or values.get("model.base_link") or None
     tip = tip_link or values.get("model.tip_link") or None
     try:
