@@ -7,6 +7,7 @@ from datetime import UTC, datetime
 import numpy as np
 
 from irb140_dynamics.core.io.params_file import parameter_file_text
+from irb140_dynamics.core.io.urdf import export_urdf
 from irb140_dynamics.identification.consistent import PHYSICAL_CONFIDENCE
 from irb140_dynamics.identification.pipeline import Result, SampleTally
 
@@ -129,3 +130,14 @@ def identified_file(result: Result, command: str) -> str:
         "",
     ]
     return parameter_file_text(result.identified.to_params(), comments)
+
+
+def identified_urdf(result: Result, prior_urdf: str | None, command: str) -> str:
+    """The identified arm as URDF (``export_urdf``), named as the prior's URDF robot."""
+    import xml.etree.ElementTree as ET
+
+    name = (ET.fromstring(prior_urdf).get("name") if prior_urdf else None) or "robot"  # read once already
+    text = export_urdf(result.identified, name)
+    note = f"<!-- identified by irb140_dynamics `identify`: {command.replace('--', '- -')} -->\n"
+    head, separator, rest = text.partition("?>\n")
+    return head + separator + note + rest if separator else note + text

@@ -108,8 +108,8 @@ def tool_model(
     origin = str(params_file or defaults_file or "parameters")
     try:
         return ToolModel(RobotModel.from_params({**defaults, **values}), origin)
-    except ValueError as error:
-        raise ValueError(f"{origin}: {error}") from None
+    except ValueError as error:  # it names the parameter; the file, when there is one
+        raise ValueError(f"{params_file}: {error}" if params_file else str(error)) from None
 
 
 def _from_urdf(values, params_file, urdf_file, base_link, tip_link) -> ToolModel:
