@@ -6,7 +6,8 @@ part go into the training normal equations, the others into the held-out ones (t
 held-out RMS error then follows from those sums exactly, so nothing has to be read twice.
 A torque row is left out when its joint is too slow for the Coulomb model: |qd| below
 ``min_speed`` (default 3 smoothing velocities, where tanh is 99.5 % of its level) anywhere
-in the filter window, judged by |qd| < min_speed + |qdd| half-window: there a joint may be
+in the filter window, judged by |qd| < min_speed + |qdd| half-window (min_speed 0: every row
+is used): there a joint may be
 stuck (stiction holds it at any torque within the Coulomb level), which the model does not
 describe; such rows would bias the friction and everything correlated with it.
 
@@ -203,7 +204,7 @@ def _add(prior, points: FitPoints, split, where, min_speed, tally, keeper) -> No
     tally.fit_points += len(points)
     Y = regressor_batch(prior, points.q, points.qd, points.qdd)
     half_window = tally.design.half / tally.design.rate
-    use = np.abs(points.qd) >= min_speed + np.abs(points.qdd) * half_window
+    use = np.abs(points.qd) >= min_speed + np.abs(points.qdd) * half_window if min_speed > 0 else np.isfinite(points.qd)
     tally.slow_rows += np.sum(~use, axis=0)
     training = int(np.searchsorted(points.index, split))  # the points are in the recording's order
     for part, equations in ((slice(0, training), where[0]), (slice(training, None), where[1])):

@@ -45,7 +45,7 @@ def parser() -> argparse.ArgumentParser:
         "--min-speed",
         type=float,
         metavar="RAD_S",
-        help="leave out torque rows of joints slower than this (default 3 smoothing velocities)",
+        help="leave out torque rows of joints slower than this (default 3 smoothing velocities; 0: keep every row)",
     )
     p.add_argument(
         "--held-out",
