@@ -52,6 +52,12 @@ def test_a_params_file_naming_a_urdf_gives_the_urdf_model(tmp_path):
     overridden = tool_model(urdf_file=UR5_URDF, base_link=BASE, tip_link=TIP, overrides={"payload.mass": 2.0})
     assert overridden.model.payload.mass == 2.0
     assert tool_model(defaults_file=CONFIG).model.n == 6  # no file: the package's IRB-140
+    # what URDF has no place for, for the chain's joints, from the params file; defaults never
+    extra = {"shoulder_pan_joint.acceleration_limit": 5.0, "shoulder_pan_joint.armature": 0.2, "joint_1.armature": 9.0}
+    given = tool_model(described(tmp_path, **extra), defaults_file=CONFIG).model
+    assert given.joints[0].acceleration_limit == 5.0 and given.joints[0].armature == 0.2
+    assert given.joints[1].acceleration_limit == direct.model.joints[1].acceleration_limit
+    assert [j.armature for j in given.joints[1:]] == [j.armature for j in direct.model.joints[1:]]
 
 
 @pytest.mark.parametrize(

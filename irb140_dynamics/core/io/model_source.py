@@ -14,9 +14,12 @@ One place turns what a user gives a tool into a RobotModel, the way the nodes re
 - a URDF file given directly (``urdf_file``, with ``base_link``/``tip_link``): the same,
   the parameter file (if any) giving the rest.
 
-A URDF's model takes from the parameters only what URDF has no place for: ``gravity``,
-``friction.smoothing_velocity`` and ``payload.*``, and only when given (the file or an
-override), never from the defaults. Overrides (``-p name:=value``, the value as YAML)
+A URDF's model takes from the parameters what URDF has no (or no sure) place for, only
+when given (the file or an override), never from the defaults: ``gravity``,
+``friction.smoothing_velocity``, ``payload.*``, and for the chain's own joints
+``<joint>.position_limits``, ``torque_limit``, ``velocity_limit``, ``acceleration_limit``,
+``friction.viscous``, ``friction.coulomb`` and ``armature`` (URDF has no acceleration
+limit nor armature; vendors' damping and friction are often placeholders). Overrides (``-p name:=value``, the value as YAML)
 apply last. Errors are ValueErrors in one line naming the file or the parameter.
 No ROS.
 """
@@ -34,6 +37,15 @@ from irb140_dynamics.core.model.robot_model import RobotModel
 
 SOURCES = ("parameters", "robot_description")
 DESCRIPTION_PARAMETERS = ("gravity", "friction.smoothing_velocity")  # and payload.*: what a URDF's model takes
+JOINT_PARAMETERS = (  # and of each of its joints
+    "position_limits",
+    "torque_limit",
+    "velocity_limit",
+    "acceleration_limit",
+    "friction.viscous",
+    "friction.coulomb",
+    "armature",
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -46,14 +58,15 @@ class ToolModel:
     urdf_text: str | None = None
 
 
-def description_values(values: Mapping[str, Any]) -> dict[str, Any]:
-    """Of the parameters, those a URDF's model takes (see the module's docstring)."""
-    return {k: v for k, v in values.items() if k in DESCRIPTION_PARAMETERS or k.startswith("payload.")}
+def description_values(values: Mapping[str, Any], joint_names=()) -> dict[str, Any]:
+    """Of the parameters, those a URDF's model of these joints takes (see the module's docstring)."""
+    own = {f"{name}.{field}" for name in joint_names for field in JOINT_PARAMETERS}
+    return {k: v for k, v in values.items() if k in DESCRIPTION_PARAMETERS or k in own or k.startswith("payload.")}
 
 
 def urdf_model(loaded: LoadedUrdf, values: Mapping[str, Any]) -> RobotModel:
-    """The URDF chain's model with the description parameters of ``values`` applied."""
-    given = description_values(values)
+    """The URDF chain's model with the parameters of ``values`` it takes applied."""
+    given = description_values(values, loaded.model.joint_names)
     if not given:
         return loaded.model
     return RobotModel.from_params({**loaded.model.to_params(), **given})
@@ -141,9 +154,9 @@ def _parameters(path) -> dict[str, Any]:
     if not Path(path).is_file():
         raise ValueError(f"{path}: no such parameter file")
     try:
-        return read_parameter_file(path)
-    except (ValueError, OSError, AttributeError) as error:  # YAML errors are ValueErrors
-        raise ValueError(f"{path}: not a ROS 2 parameter file ({str(error).splitlines()[0]})") from None
+        return read_parameter_file(path)  # a ValueError naming the file when it is no parameter file
+    except OSError as error:
+        raise ValueError(f"{path}: cannot be read ({error.strerror or error})") from None
 
 
 def _beside(path, params_file) -> Path:
