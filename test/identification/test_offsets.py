@@ -39,7 +39,8 @@ def test_centred_sums_are_least_squares_with_a_free_offset_per_joint():
 
 @pytest.fixture(scope="module")
 def biased(tmp_path_factory):
-    """The UR5's torques (rnea on the true arm) with a constant offset per joint and 0.1 % noise (offsets of joints 2 and 3, carrying gravity, are the least determined)."""
+    """The UR5's torques (rnea on the true arm) with a constant offset per joint and 0.1 %
+    noise (the offsets of joints 2 and 3, which carry gravity, are the least determined)."""
     arm = true_ur5()
     t = np.arange(int(24.0 * 200.0)) / 200.0
     Q, QD, QDD = excitation(arm, 1).evaluate(t)
