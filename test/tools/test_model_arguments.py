@@ -63,7 +63,7 @@ def test_a_params_file_naming_a_urdf_gives_the_urdf_model(tmp_path):
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        (dict(urdf_file="/no/such.urdf"), "URDF: cannot read /no/such.urdf"),
+        (dict(urdf_file="/no/such.urdf"), "URDF: /no/such.urdf: no such URDF file"),
         (dict(urdf_file=UR5_URDF), "leaf links below"),
         (dict(urdf_file=UR5_URDF, base_link="nowhere"), "nowhere"),
         (dict(base_link=BASE), "--base and --tip choose a URDF's chain"),
@@ -124,7 +124,7 @@ def test_identify_refuses_a_bad_urdf_in_one_line_and_writes_nothing(tmp_path, ca
     out = tmp_path / "out.yaml"
     assert identify_tool.main(["x.csv", "--out", str(out), "--urdf", str(tmp_path / "none.urdf"), "--quiet"]) == 1
     error = capsys.readouterr().err
-    assert error.count("\n") == 1 and "cannot read" in error and not out.exists()
+    assert error.count("\n") == 1 and "no such URDF file" in error and not out.exists()
 
 
 BLOCK_ROS = """

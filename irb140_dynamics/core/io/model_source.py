@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from irb140_dynamics.core.io.params_file import read_parameter_file
-from irb140_dynamics.core.io.urdf import LoadedUrdf, load_urdf
+from irb140_dynamics.core.io.urdf import LoadedUrdf, UrdfError, load_urdf, read_urdf
 from irb140_dynamics.core.model.robot_model import RobotModel
 
 SOURCES = ("parameters", "robot_description")
@@ -73,10 +73,12 @@ def urdf_model(loaded: LoadedUrdf, values: Mapping[str, Any]) -> RobotModel:
 
 
 def read_urdf_file(path, what: str = "URDF") -> str:
+    """The text of a URDF file (``urdf.read_urdf``: bounded, a regular file, UTF-8), or
+    ValueError in one line starting with ``what``."""
     try:
-        return Path(path).read_text()
-    except (OSError, UnicodeDecodeError) as error:
-        raise ValueError(f"{what}: cannot read {path}: {getattr(error, 'strerror', None) or error}") from None
+        return read_urdf(path)
+    except UrdfError as error:
+        raise ValueError(f"{what}: {error.reason}") from None
 
 
 def parse_override(text: str) -> tuple[str, Any]:
