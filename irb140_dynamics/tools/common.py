@@ -28,7 +28,7 @@ def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model"
         "--urdf",
         metavar="FILE",
         help="the model from this URDF's chain (the parameter file, if "
-        "any, gives gravity, friction.smoothing_velocity and payload.*)",
+        "any, gives gravity, payload.* and the chain's limits, friction, armature)",
     )
     group.add_argument("--base", metavar="LINK", help="the URDF link the chain starts from (default: the root)")
     group.add_argument("--tip", metavar="LINK", help="the URDF link the chain ends at (default: the only leaf)")
