@@ -7,7 +7,9 @@ May import: ``core``. Never ``ros``, ``nodes``, ``tools``.
     recording   ROS 2 bags (rosbags) and CSV files, read in chunks
     signals     zero-phase filtering, differentiation and decimation, chunk by chunk
     least_squares  normal equations; weighted least squares on the base parameters
-    consistent  the physically consistent full set closest to the data (log-Cholesky)
+    correlation how correlated the residuals are: the estimate's covariance depends on it
+    consistent  the physically consistent full set closest to the data (log-Cholesky);
+                whether a physical arm is within the estimate's uncertainty
     pipeline    all of it over a recording; report, plots, files: its outputs
 
 The command-line tools (``irb140_dynamics.tools``) are thin wrappers; see

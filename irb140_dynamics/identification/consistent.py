@@ -131,6 +131,7 @@ class ConsistentFit:
     deviation: np.ndarray  # (K pi - beta_hat) / std, per base parameter
     consistent: bool
     solver_message: str
+    misfit: float = 0.0  # | L^T (K pi - beta_hat) |^2: the data's chi-square of pi
 
 
 def consistent_parameters(
@@ -139,6 +140,7 @@ def consistent_parameters(
     estimate: Estimate,
     prior_weight: float = 1.0,
     max_evaluations: int = MAX_EVALUATIONS,
+    start: np.ndarray | None = None,
 ) -> ConsistentFit:
     """The physically consistent parameters of the module's docstring, as a model."""
     n = prior.n
@@ -170,8 +172,12 @@ def consistent_parameters(
 
     # start: the unconstrained optimum (a linear least-squares problem), each link's
     # pseudo-inertia's eigenvalues raised to a small floor, friction and armature to 0
-    normal = data_map.T @ data_map + np.diag(regularisation**2)
-    unconstrained = np.linalg.solve(normal, data_map.T @ data_target + regularisation**2 * pi_prior)
+    # (or ``start``, a full parameter set: e.g. another fit's)
+    if start is None:
+        normal = data_map.T @ data_map + np.diag(regularisation**2)
+        unconstrained = np.linalg.solve(normal, data_map.T @ data_target + regularisation**2 * pi_prior)
+    else:
+        unconstrained = np.asarray(start, dtype=float)
     start = [
         log_cholesky_of(_positive(pseudo_inertia(unconstrained[10 * i : 10 * i + 10]), spread[10 * i : 10 * i + 10]))
         for i in range(n)
@@ -193,7 +199,41 @@ def consistent_parameters(
     pi, _ = evaluate(result.x)
     pi[10 * n :] = np.maximum(pi[10 * n :], 0.0)
     deviation = (K @ pi - estimate.beta) / estimate.std
-    return ConsistentFit(pi, with_inertial_parameters(prior, pi), deviation, is_consistent(pi, n), result.message)
+    misfit = float(np.sum((data_map @ pi - data_target) ** 2))
+    model = with_inertial_parameters(prior, pi)
+    return ConsistentFit(pi, model, deviation, is_consistent(pi, n), result.message, misfit)
+
+
+@dataclass(frozen=True)
+class PhysicalCheck:
+    """Is there a physical arm the estimate's uncertainty allows? chi2: the squared distance,
+    in the estimate's covariance, from the estimate to the nearest physical arm (a fit
+    with a vanishing pull to the prior); bound: the chi-square quantile PHYSICAL_CONFIDENCE
+    for r base parameters. The true arm's own chi2 is below the bound with that
+    probability, and the nearest arm's is smaller than the true one's: a chi2 beyond the
+    bound says no rigid arm explains the data, whatever the noise drew."""
+
+    chi2: float
+    bound: float
+    base_parameters: int
+
+    @property
+    def physical(self) -> bool:
+        return self.chi2 <= self.bound
+
+
+PHYSICAL_CONFIDENCE = 0.999
+NEAREST_WEIGHT = 1e-6  # the pull to the prior that only settles what the data do not see
+
+
+def physical_check(prior: RobotModel, base: BaseParameters, estimate: Estimate, fit: ConsistentFit) -> PhysicalCheck:
+    """The PhysicalCheck of an estimate, starting the search for the nearest arm at ``fit``."""
+    from scipy.special import gammaincinv
+
+    nearest = consistent_parameters(prior, base, estimate, NEAREST_WEIGHT, start=fit.pi)
+    chi2 = min(nearest.misfit, fit.misfit)
+    r = base.count
+    return PhysicalCheck(chi2, float(2.0 * gammaincinv(r / 2.0, PHYSICAL_CONFIDENCE)), r)
 
 
 def _positive(J: np.ndarray, spread10: np.ndarray) -> np.ndarray:

@@ -32,6 +32,8 @@ class NormalEquations:
         self.c = np.zeros(n)
         self.rows = np.zeros(n, dtype=np.int64)
         self.peak = np.zeros(n)  # largest |tau| seen, N m
+        self.s = np.zeros((n, parameters))  # sum y: with t and rows, what a constant offset per joint needs
+        self.t = np.zeros(n)  # sum tau
 
     def add(self, Y: np.ndarray, tau: np.ndarray, use: np.ndarray) -> None:
         """Add fit points: Y (K, n, P), tau (K, n), use (K, n) which rows count.
@@ -50,21 +52,42 @@ class NormalEquations:
             X = Yt[columns] * w
             self.A[j][np.ix_(columns, columns)] += X @ X.T
             self.b[j][columns] += X @ tau[:, j]
+            self.s[j][columns] += X.sum(axis=1)
             tj = tau[w, j]
             self.c[j] += tj @ tj
+            self.t[j] += tj.sum()
             self.rows[j] += rows
             self.peak[j] = max(self.peak[j], float(np.abs(tj).max()))
 
-    def rss(self, pi: np.ndarray) -> np.ndarray:
-        """Residual sum of squares per joint of the full parameters pi (13 n,)."""
+    def rss(self, pi: np.ndarray, offsets: np.ndarray | None = None) -> np.ndarray:
+        """Residual sum of squares per joint of the full parameters pi (13 n,), the model's
+        torque Y pi + offsets when offsets (n,) are given."""
         pi = np.asarray(pi, dtype=float)
         rss = np.einsum("p,jpq,q->j", pi, self.A, pi) - 2.0 * self.b @ pi + self.c
+        if offsets is not None:
+            rss = rss + 2.0 * offsets * (self.s @ pi - self.t) + self.rows * offsets**2
         return np.maximum(rss, 0.0)
 
-    def rms(self, pi: np.ndarray) -> np.ndarray:
+    def rms(self, pi: np.ndarray, offsets: np.ndarray | None = None) -> np.ndarray:
         """RMS torque error per joint [N m] (nan for a joint without rows)."""
         with np.errstate(invalid="ignore", divide="ignore"):
-            return np.sqrt(self.rss(pi) / self.rows)
+            return np.sqrt(self.rss(pi, offsets) / self.rows)
+
+    def offsets(self, pi: np.ndarray) -> np.ndarray:
+        """Each joint's constant torque offset [N m] that best fits these rows with pi: the
+        mean of tau - Y pi (0 for a joint without rows)."""
+        return (self.t - self.s @ np.asarray(pi, dtype=float)) / np.maximum(self.rows, 1)
+
+    def centred(self) -> NormalEquations:
+        """The sums with each joint's mean row taken out: least squares on them is least
+        squares with a free constant offset per joint (eliminated, Frisch-Waugh-Lovell)."""
+        out = NormalEquations(*self.b.shape)
+        count = np.maximum(self.rows, 1).astype(float)
+        out.A = self.A - np.einsum("jp,jq->jpq", self.s, self.s) / count[:, None, None]
+        out.b = self.b - self.s * (self.t / count)[:, None]
+        out.c = self.c - self.t**2 / count
+        out.rows, out.peak = self.rows.copy(), self.peak.copy()
+        return out
 
     def base(self, base: BaseParameters) -> tuple[np.ndarray, np.ndarray]:
         """(A_j,b (n, r, r), b_j,b (n, r)): the sums of the base regressor's rows."""

@@ -6,22 +6,38 @@ part go into the training normal equations, the others into the held-out ones (t
 held-out RMS error then follows from those sums exactly, so nothing has to be read twice.
 A torque row is left out when its joint is too slow for the Coulomb model: |qd| below
 ``min_speed`` (default 3 smoothing velocities, where tanh is 99.5 % of its level) anywhere
-in the filter window, judged by |qd| < min_speed + |qdd| half-window. Memory holds one
-chunk, the sums and at most ``plot_points`` held-out fit points for the plots.
+in the filter window, judged by |qd| < min_speed + |qdd| half-window (min_speed 0: every row
+is used): there a joint may be
+stuck (stiction holds it at any torque within the Coulomb level), which the model does not
+describe; such rows would bias the friction and everything correlated with it.
+
+The estimate's covariance is scaled by the measured correlation of its residuals
+(``correlation``: on a real arm, what the model lacks correlates them far more than the
+filter does), so that the pull toward the prior is weighed against what the data really
+tell. With ``offsets``, each joint's torque gets a constant offset (a torque sensor's
+bias), fitted and eliminated from the sums (``NormalEquations.centred``); off by default.
+Memory holds one chunk, the sums, at most ``plot_points`` held-out fit points for the plots
+and the first ``correlation_points`` training fit points.
 """
 
 from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.regressor import inertial_parameters, regressor_batch
 from irb140_dynamics.identification.base import BaseParameters, find_base_parameters
-from irb140_dynamics.identification.consistent import ConsistentFit, consistent_parameters
+from irb140_dynamics.identification.consistent import (
+    ConsistentFit,
+    PhysicalCheck,
+    consistent_parameters,
+    physical_check,
+)
+from irb140_dynamics.identification.correlation import residual_correlation
 from irb140_dynamics.identification.least_squares import Estimate, NormalEquations, weighted_least_squares
 from irb140_dynamics.identification.recording import CHUNK_SIZE, DEFAULT_TOPIC, Recording, RecordingError
 from irb140_dynamics.identification.signals import DEFAULT_CUTOFF, Differentiator, FilterDesign, FitPoints, _joined
@@ -36,8 +52,10 @@ class IdentificationSettings:
     cutoff: float = DEFAULT_CUTOFF  # Hz
     min_speed: float | None = None  # rad/s; None: SLOW_SPEEDS smoothing velocities
     held_out: float = 0.2  # fraction at the end of the recording, without a validation recording
-    prior_weight: float = 1.0
+    prior_weight: float = 1.0  # the pull toward the prior (see consistent.py and docs/identification.md)
+    offsets: bool = False  # a constant torque offset per joint
     plot_points: int = 20_000
+    correlation_points: int = 8192  # training fit points kept to measure the residuals' correlation
     chunk_size: int = CHUNK_SIZE
 
 
@@ -73,11 +91,15 @@ class Result:
     tallies: list[SampleTally]
     plot_points: FitPoints | None
     held_out_source: str
+    physical: PhysicalCheck
+    correlation: float = 1.0  # the factor the covariance was scaled by (see correlation.py)
+    offsets: np.ndarray | None = None  # (n,) N m, with settings.offsets
 
     def rms(self, which: str) -> np.ndarray:
         """Held-out RMS torque error per joint [N m] of 'prior' or 'identified'."""
-        pi = inertial_parameters(self.prior) if which == "prior" else self.fit.pi
-        return self.held_out.rms(pi)
+        if which == "prior":
+            return self.held_out.rms(inertial_parameters(self.prior))
+        return self.held_out.rms(self.fit.pi, self.offsets)
 
 
 Progress = Callable[[str, int, int], None]  # (path, samples done, samples expected)
@@ -101,7 +123,7 @@ def identify(
     P = 13 * prior.n
     train, held_out = NormalEquations(prior.n, P), NormalEquations(prior.n, P)
     min_speed = settings.min_speed if settings.min_speed is not None else SLOW_SPEEDS * prior.smoothing_velocity
-    keeper = _PlotKeeper(settings.plot_points)
+    keeper = _Keeper(settings.plot_points, settings.correlation_points)
     recordings = [Recording(path, prior.joint_names, settings.topic, settings.chunk_size)]
     if validate is not None:
         recordings.append(Recording(validate, prior.joint_names, settings.topic, settings.chunk_size))
@@ -121,10 +143,32 @@ def identify(
     for tally, equations, use in ((tallies[0], train, "to fit"), (tallies[-1], held_out, "to validate")):
         if equations.rows.sum() == 0:
             raise RecordingError(tally.path, _nothing_usable(tally, use))
-    estimate = weighted_least_squares(train, base, tallies[0].design.noise_correlation())
+    filter_correlation = tallies[0].design.noise_correlation()
+    estimate = weighted_least_squares(train.centred() if settings.offsets else train, base, filter_correlation)
+    beta_offsets = (train.t - train.s[:, base.independent] @ estimate.beta) / np.maximum(train.rows, 1)
+    correlation, _ = residual_correlation(
+        prior, base, estimate.beta, *keeper.training(), beta_offsets if settings.offsets else None, filter_correlation
+    )
+    estimate = replace(estimate, covariance=estimate.covariance * (correlation / filter_correlation))
     fit = consistent_parameters(prior, base, estimate, settings.prior_weight)
+    offsets = train.offsets(fit.pi) if settings.offsets else None
+    check = physical_check(prior, base, estimate, fit)
     source = str(validate) if validate is not None else f"the last {100 * settings.held_out:g} % of the recording"
-    return Result(prior, fit.model, base, estimate, fit, train, held_out, tallies, keeper.points(), source)
+    return Result(
+        prior,
+        fit.model,
+        base,
+        estimate,
+        fit,
+        train,
+        held_out,
+        tallies,
+        keeper.points(),
+        source,
+        check,
+        correlation,
+        offsets,
+    )
 
 
 def _accumulate(prior, recording, split, where, min_speed, settings, keeper, progress) -> SampleTally:
@@ -160,7 +204,7 @@ def _add(prior, points: FitPoints, split, where, min_speed, tally, keeper) -> No
     tally.fit_points += len(points)
     Y = regressor_batch(prior, points.q, points.qd, points.qdd)
     half_window = tally.design.half / tally.design.rate
-    use = np.abs(points.qd) >= min_speed + np.abs(points.qdd) * half_window
+    use = np.abs(points.qd) >= min_speed + np.abs(points.qdd) * half_window if min_speed > 0 else np.isfinite(points.qd)
     tally.slow_rows += np.sum(~use, axis=0)
     training = int(np.searchsorted(points.index, split))  # the points are in the recording's order
     for part, equations in ((slice(0, training), where[0]), (slice(training, None), where[1])):
@@ -168,6 +212,8 @@ def _add(prior, points: FitPoints, split, where, min_speed, tally, keeper) -> No
             equations.add(Y[part], points.tau[part], use[part])  # views, not copies
     if training < len(points):
         keeper.add(points.take(slice(training, None)))
+    if training > 0:
+        keeper.add_training(points.take(slice(0, training)), use[:training])
 
 
 def _rate(recording: Recording, chunk) -> float:
@@ -190,11 +236,23 @@ def _nothing_usable(tally: SampleTally, use: str) -> str:
     )
 
 
-class _PlotKeeper:
-    """Every k-th held-out fit point, at most about ``limit`` of them."""
+class _Keeper:
+    """Every k-th held-out fit point, at most about ``limit`` of them; the first
+    ``training_limit`` training fit points and their used rows."""
 
-    def __init__(self, limit: int):
+    def __init__(self, limit: int, training_limit: int):
         self.limit, self.every, self.parts, self.seen = limit, 1, [], 0
+        self.training_limit, self.training_parts, self.training_use, self.training_count = training_limit, [], [], 0
+
+    def add_training(self, points: FitPoints, use: np.ndarray) -> None:
+        room = self.training_limit - self.training_count
+        if room > 0:
+            self.training_parts.append(points.take(slice(0, room)))
+            self.training_use.append(use[:room])
+            self.training_count += len(self.training_parts[-1])
+
+    def training(self) -> tuple[FitPoints, np.ndarray]:
+        return _joined(self.training_parts), np.concatenate(self.training_use)
 
     def expect(self, count: float) -> None:
         self.every = max(1, int(np.ceil(count / max(self.limit, 1))))

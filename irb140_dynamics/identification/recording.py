@@ -10,7 +10,9 @@ reason; velocities or efforts a sample lacks are NaN (the caller leaves it out).
 Time: the header stamp, or the bag's receive time when the stamp is zero (s, from the
 first sample). CSV columns, in any order, others ignored (``docs/identification.md``):
 ``time`` [s], ``position_<joint>`` [rad], ``velocity_<joint>`` [rad/s] (optional),
-``effort_<joint>`` [N m]; an empty cell is a missing value.
+``effort_<joint>`` [N m]; an empty cell is a missing value. Short names work too (``CSV_NAMES``):
+``t``, ``q_<joint>``, ``qd_<joint>``, ``tau_<joint>``, where ``<joint>`` is the joint's name
+or its number in the model (1 for the first joint), as in ``t,q_1,...,qd_1,...,tau_1,...``.
 """
 
 from __future__ import annotations
@@ -242,13 +244,14 @@ class _CsvSource:
             raise RecordingError(path, "empty: expected a header row (time, position_<joint>, ..., effort_<joint>)")
         where = {name.strip(): i for i, name in enumerate(header)}
         joints = recording.order.joint_names
-        needed = ["time"] + [f"{field}_{j}" for field in ("position", "effort") for j in joints]
-        missing = [name for name in needed if name not in where]
+        needed = [("time", None)] + [(field, (k, j)) for field in ("position", "effort") for k, j in enumerate(joints)]
+        found = [_column(where, field, joint) for field, joint in needed]
+        missing = [_name(field, joint) for (field, joint), column in zip(needed, found) if column is None]
         if missing:
             raise RecordingError(path, f"no column {', '.join(missing)} (columns: {', '.join(header)})")
-        velocity = [f"velocity_{j}" for j in joints]
-        self.has_velocity = all(name in where for name in velocity)
-        self.columns = [where[name] for name in needed + (velocity if self.has_velocity else [])]
+        velocity = [_column(where, "velocity", (k, j)) for k, j in enumerate(joints)]
+        self.has_velocity = all(column is not None for column in velocity)
+        self.columns = found + (velocity if self.has_velocity else [])
         self.width = len(header)
 
     def chunks(self) -> Iterator[RawChunk]:
@@ -285,3 +288,26 @@ class _CsvSource:
             except ValueError:
                 raise RecordingError(self.recording.path, f"line {first_line + k}: not a number in {row}") from None
         return np.array(rows, dtype=float).reshape(-1, len(self.columns))
+
+
+CSV_NAMES = {
+    "time": ("time", "t"),
+    "position": ("position", "q"),
+    "velocity": ("velocity", "qd"),
+    "effort": ("effort", "tau"),
+}  # each field's column prefixes: the long name first
+
+
+def _name(field: str, joint) -> str:
+    return field if joint is None else f"{field}_{joint[1]}"
+
+
+def _column(where: dict, field: str, joint) -> int | None:
+    """The column of ``field`` of joint (index, name) (None: time): by the long or short
+    prefix, with the joint's name or its number from 1."""
+    for prefix in CSV_NAMES[field]:
+        names = [prefix] if joint is None else [f"{prefix}_{joint[1]}", f"{prefix}_{joint[0] + 1}"]
+        for name in names:
+            if name in where:
+                return where[name]
+    return None

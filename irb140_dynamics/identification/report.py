@@ -7,9 +7,9 @@ from datetime import UTC, datetime
 import numpy as np
 
 from irb140_dynamics.core.io.params_file import parameter_file_text
+from irb140_dynamics.core.io.urdf import export_urdf
+from irb140_dynamics.identification.consistent import PHYSICAL_CONFIDENCE
 from irb140_dynamics.identification.pipeline import Result, SampleTally
-
-LARGE_DEVIATION = 3.0  # standard deviations
 
 
 def _count(x: int) -> str:
@@ -66,21 +66,37 @@ def summary(result: Result) -> str:
             f"{e_identified:>20.4f} {_percent(e_identified, p):>9}"
         )
     lines.append("")
-    worst = int(np.argmax(np.abs(fit.deviation)))
+    if result.offsets is not None:
+        offsets = ", ".join(f"{name} {x:+.3f}" for name, x in zip(names, result.offsets))
+        lines.append(f"torque offsets [N m] (fitted, added to the model's torques above): {offsets}")
+    lines.append(
+        f"residual correlation: {result.correlation:.1f} fit points (the estimate's covariance scaled by "
+        f"{result.correlation / result.tallies[0].design.noise_correlation():.1f} over the filter's own)"
+    )
     consistent = "yes" if fit.consistent else "NO"
     lines.append(
         f"physically consistent: {consistent} (every link's pseudo-inertia positive semidefinite, "
         f"friction and armature >= 0)"
     )
-    verdict = (
-        "the data agree with a physical arm"
-        if abs(fit.deviation[worst]) <= LARGE_DEVIATION
-        else "the data ask for an unphysical arm: check the recording (effort units, joint names, payload)"
-    )
+    check = result.physical
+    worst = int(np.argmax(np.abs(fit.deviation)))
     lines.append(
         f"its base parameters vs the least-squares estimate: at most {abs(fit.deviation[worst]):.2f} sigma "
-        f"({result.base.labels()[worst]}): {verdict}"
+        f"({result.base.labels()[worst]})"
     )
+    if check.physical:
+        lines.append(
+            f"the nearest physical arm is within the estimate's uncertainty (chi2 {check.chi2:.1f}, "
+            f"{100 * PHYSICAL_CONFIDENCE:g} % bound {check.bound:.1f} for {check.base_parameters} base parameters): "
+            "the data agree with a physical arm"
+        )
+    else:
+        lines.append(
+            f"WARNING: the data ask for an unphysical arm: the nearest physical one is beyond the estimate's "
+            f"uncertainty (chi2 {check.chi2:.1f} > {100 * PHYSICAL_CONFIDENCE:g} % bound {check.bound:.1f}); a mass "
+            "< 0 or an inertia that is no body's: check the recording (effort units and signs, joint names, a "
+            "payload) and the prior's kinematics"
+        )
     return "\n".join(lines)
 
 
@@ -114,3 +130,14 @@ def identified_file(result: Result, command: str) -> str:
         "",
     ]
     return parameter_file_text(result.identified.to_params(), comments)
+
+
+def identified_urdf(result: Result, prior_urdf: str | None, command: str) -> str:
+    """The identified arm as URDF (``export_urdf``), named as the prior's URDF robot."""
+    import xml.etree.ElementTree as ET
+
+    name = (ET.fromstring(prior_urdf).get("name") if prior_urdf else None) or "robot"  # read once already
+    text = export_urdf(result.identified, name)
+    note = f"<!-- identified by irb140_dynamics `identify`: {command.replace('--', '- -')} -->\n"
+    head, separator, rest = text.partition("?>\n")
+    return head + separator + note + rest if separator else note + text

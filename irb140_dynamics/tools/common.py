@@ -1,13 +1,13 @@
-"""What the command-line tools share: the prior model, errors in one line, a progress bar."""
+"""What the command-line tools share: the model's arguments, errors in one line, a progress bar."""
 
 from __future__ import annotations
 
+import argparse
 import sys
 import time
 from pathlib import Path
 
-from irb140_dynamics.core.io.params_file import load_model
-from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.io.model_source import ToolModel, parse_override, tool_model
 from irb140_dynamics.package_files import default_config_path
 
 
@@ -15,15 +15,37 @@ class ToolError(Exception):
     """An error the tool reports in one line (exit status 1)."""
 
 
-def prior_model(params_file: str | None) -> tuple[RobotModel, Path]:
-    """The model of ``params_file`` (its ``/**`` section), by default the package's IRB-140."""
-    path = Path(params_file) if params_file else default_config_path()
-    if not path.is_file():
-        raise ToolError(f"{path}: no such parameter file")
-    try:
-        return load_model(path), path
-    except (ValueError, OSError) as error:  # ModelError, YAML errors are ValueErrors
-        raise ToolError(f"{path}: {error}") from None
+def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model") -> None:
+    """--params-file, --urdf, --base, --tip and -p: the model, read as ``core.io.model_source`` says."""
+    group = parser.add_argument_group(role)
+    group.add_argument(
+        "--params-file",
+        metavar="F",
+        help="a ROS 2 parameter file: the model's parameters, or "
+        "model.source: robot_description with model.urdf_file (default: the package's IRB-140)",
+    )
+    group.add_argument(
+        "--urdf",
+        metavar="FILE",
+        help="the model from this URDF's chain (the parameter file, if "
+        "any, gives gravity, payload.* and the chain's limits, friction, armature)",
+    )
+    group.add_argument("--base", metavar="LINK", help="the URDF link the chain starts from (default: the root)")
+    group.add_argument("--tip", metavar="LINK", help="the URDF link the chain ends at (default: the only leaf)")
+    group.add_argument(
+        "-p",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="NAME:=VALUE",
+        help="a parameter over the file's (value as YAML), e.g. -p gravity:=[0.0,0.0,-9.81]",
+    )
+
+
+def model_of(args: argparse.Namespace) -> ToolModel:
+    """The model of the arguments that ``add_model_arguments`` declared (ValueError in one line)."""
+    overrides = dict(parse_override(text) for text in args.overrides)
+    return tool_model(args.params_file, args.urdf, args.base, args.tip, overrides, default_config_path())
 
 
 def run(tool: str, body) -> int:

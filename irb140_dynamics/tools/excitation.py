@@ -1,6 +1,7 @@
 """excitation: a periodic trajectory that makes the arm's dynamic parameters identifiable.
 
-    ros2 run irb140_dynamics excitation --out FILE [--params-file F] [--rate HZ] [--period S]
+    ros2 run irb140_dynamics excitation --out FILE [--params-file F | --urdf FILE [--base L] [--tip L]]
+                                        [-p NAME:=VALUE] [--rate HZ] [--period S]
                                         [--harmonics K] [--periods P] [--seed N] [--iterations N]
 
 Writes FILE, a trajectory_msgs/JointTrajectory in YAML (the form `ros2 topic pub` takes),
@@ -26,7 +27,7 @@ from irb140_dynamics.identification.excitation import (
     check_limits,
     optimise_excitation,
 )
-from irb140_dynamics.tools.common import ToolError, prior_model, run
+from irb140_dynamics.tools.common import ToolError, add_model_arguments, model_of, run
 
 SHELL_ARGUMENT_LIMIT = 128 * 1024  # bytes: Linux's MAX_ARG_STRLEN
 
@@ -34,7 +35,6 @@ SHELL_ARGUMENT_LIMIT = 128 * 1024  # bytes: Linux's MAX_ARG_STRLEN
 def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="excitation", description=__doc__.split("\n\n")[0].split(": ", 1)[1])
     p.add_argument("--out", required=True, metavar="FILE", help="JointTrajectory YAML file to write")
-    p.add_argument("--params-file", metavar="F", help="the model and its limits (default: the package's IRB-140)")
     p.add_argument("--rate", type=float, default=20.0, metavar="HZ", help="points per second (default 20)")
     p.add_argument(
         "--period", type=float, default=DEFAULT_PERIOD, metavar="S", help=f"period [s] (default {DEFAULT_PERIOD:g})"
@@ -55,6 +55,7 @@ def parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--seed", type=int, default=0, help="random start of the optimisation (default 0)")
     p.add_argument("--iterations", type=int, default=40, help="optimiser iterations (default 40)")
+    add_model_arguments(p, "the model and its limits (default: the package's IRB-140)")
     return p
 
 
@@ -64,7 +65,8 @@ def main(argv=None) -> int:
     def body() -> int:
         if not args.rate > 0 or args.periods < 1 or not 0 <= args.margin < 0.5 or args.iterations < 0:
             raise ToolError("--rate must be > 0, --periods >= 1, --margin within [0, 0.5), --iterations >= 0")
-        model, path = prior_model(args.params_file)
+        source = model_of(args)
+        model, path = source.model, source.origin
         base = find_base_parameters(model)
         print(f"model: {path}; {base.count} base parameters; optimising ({args.iterations} iterations)...")
         result = optimise_excitation(

@@ -1,12 +1,16 @@
 """identify: the arm's dynamic parameters from a recording of its joint states.
 
-    ros2 run irb140_dynamics identify BAG [--topic /joint_states] [--params-file PRIOR.yaml]
-                                          --out IDENTIFIED.yaml [--plots DIR] [--validate BAG2]
+    ros2 run irb140_dynamics identify BAG --out IDENTIFIED.yaml [--topic /joint_states]
+        [--params-file PRIOR.yaml | --urdf PRIOR.urdf [--base LINK] [--tip LINK]] [-p NAME:=VALUE]
+        [--urdf-out IDENTIFIED.urdf] [--plots DIR] [--validate BAG2] [--offsets]
 
 BAG: a ROS 2 bag (directory, .mcap or .db3) with sensor_msgs/JointState including effort,
 or a CSV file (see docs/identification.md). Prints a progress bar while reading (stderr),
-then the summary; writes IDENTIFIED.yaml, a parameter file both nodes load with
---params-file. Exit status 0, or 1 with one line naming the file and the problem.
+then the summary; writes IDENTIFIED.yaml, a parameter file the nodes load with
+--params-file, and, when the prior is a URDF (or with --urdf-out), the identified arm as a
+URDF (IDENTIFIED.urdf beside it by default: the prior's kinematics and limits, the
+identified inertials and friction; armature has no place in URDF). Exit status 0, or 1
+with one line naming the file and the problem.
 """
 
 from __future__ import annotations
@@ -14,13 +18,14 @@ from __future__ import annotations
 import argparse
 import shlex
 import sys
+from pathlib import Path
 
 from irb140_dynamics.core.io.atomic import write_text
 from irb140_dynamics.identification.pipeline import IdentificationSettings, identify
 from irb140_dynamics.identification.recording import DEFAULT_TOPIC
-from irb140_dynamics.identification.report import identified_file, summary
+from irb140_dynamics.identification.report import identified_file, identified_urdf, summary
 from irb140_dynamics.identification.signals import DEFAULT_CUTOFF
-from irb140_dynamics.tools.common import ProgressBar, prior_model, run
+from irb140_dynamics.tools.common import ProgressBar, add_model_arguments, model_of, run
 
 
 def parser() -> argparse.ArgumentParser:
@@ -28,11 +33,6 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("recording", metavar="BAG", help="ROS 2 bag (directory, .mcap, .db3) or .csv file")
     p.add_argument("--out", required=True, metavar="IDENTIFIED.yaml", help="parameter file to write")
     p.add_argument("--topic", default=DEFAULT_TOPIC, help=f"JointState topic in the bag (default {DEFAULT_TOPIC})")
-    p.add_argument(
-        "--params-file",
-        metavar="PRIOR.yaml",
-        help="the prior model: kinematics, limits and starting inertials (default: the package's IRB-140)",
-    )
     p.add_argument("--plots", metavar="DIR", help="write torques.png and residuals.png of the held-out data here")
     p.add_argument("--validate", metavar="BAG2", help="validate on this recording instead of the last 20 %% of BAG")
     p.add_argument(
@@ -45,7 +45,7 @@ def parser() -> argparse.ArgumentParser:
         "--min-speed",
         type=float,
         metavar="RAD_S",
-        help="leave out torque rows of joints slower than this (default 3 smoothing velocities)",
+        help="leave out torque rows of joints slower than this (default 3 smoothing velocities; 0: keep every row)",
     )
     p.add_argument(
         "--held-out",
@@ -60,7 +60,18 @@ def parser() -> argparse.ArgumentParser:
         default=1.0,
         help="strength of the pull toward the prior (default 1; see docs/identification.md)",
     )
+    p.add_argument(
+        "--offsets", action="store_true", help="fit a constant torque offset per joint (a sensor's bias; default off)"
+    )
+    p.add_argument(
+        "--urdf-out",
+        metavar="FILE",
+        help="the identified arm as URDF (default with a URDF prior: IDENTIFIED.urdf beside --out)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_model_arguments(
+        p, "the prior model: kinematics, limits and starting inertials (default: the package's IRB-140)"
+    )
     return p
 
 
@@ -68,21 +79,29 @@ def main(argv=None) -> int:
     args = parser().parse_args(sys.argv[1:] if argv is None else argv)
 
     def body() -> int:
-        prior, prior_path = prior_model(args.params_file)
+        source = model_of(args)
+        prior, prior_path = source.model, source.origin
         settings = IdentificationSettings(
             topic=args.topic,
             cutoff=args.cutoff,
             min_speed=args.min_speed,
             held_out=args.held_out,
             prior_weight=args.prior_weight,
+            offsets=args.offsets,
         )
         progress = None if args.quiet else ProgressBar()
         result = identify(prior, args.recording, settings, validate=args.validate, progress=progress)
         print(f"prior: {prior_path}")
         print(summary(result))
         command = shlex.join(["identify", *(sys.argv[1:] if argv is None else argv)])
-        write_text(args.out, identified_file(result, command))
+        urdf_out = args.urdf_out or (Path(args.out).with_suffix(".urdf") if source.urdf is not None else None)
+        parameters = identified_file(result, command)
+        urdf = identified_urdf(result, source.urdf_text, command) if urdf_out else None
+        write_text(args.out, parameters)
         print(f"wrote {args.out}")
+        if urdf is not None:
+            write_text(urdf_out, urdf)
+            print(f"wrote {urdf_out}")
         if args.plots:
             from irb140_dynamics.identification.plots import write_plots
 

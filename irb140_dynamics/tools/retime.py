@@ -23,28 +23,16 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from pathlib import Path
 
-import yaml
-
-from ..core import RigidBody, RobotModel, read_parameter_file
+from ..core import RigidBody, RobotModel
 from ..core.io.atomic import write_files
+from ..core.io.model_source import tool_model
 from ..core.io.trajectory_file import joint_trajectory_yaml, read_joint_trajectory
 from ..core.trajectories import Trajectory, TrajectoryError, check_trajectory, retime, trajectory_limits
 from .common import ToolError, run
 
 NAME = "retime"
 OVER_LIMIT = 3
-_URDF_FIELDS = (
-    "position_limits",
-    "torque_limit",
-    "velocity_limit",
-    "acceleration_limit",
-    "friction.viscous",
-    "friction.coulomb",
-    "armature",
-)
-_GLOBAL = ("gravity", "friction.smoothing_velocity")
 
 
 def parser() -> argparse.ArgumentParser:
@@ -68,17 +56,12 @@ def parser() -> argparse.ArgumentParser:
 
 
 def model_of(params_file: str, urdf: str | None, payload_mass: float | None, chain=(None, None)) -> RobotModel:
-    """The model of the params file, or of the URDF with the file's limits and friction."""
-    path = Path(params_file)
-    if not path.is_file():
-        raise ToolError(f"{path}: no such parameter file")
+    """The model of the params file, or of the URDF with the file's limits and friction
+    (``core.io.model_source``, as every tool reads its model)."""
     try:
-        params = read_parameter_file(path)
-        if urdf is not None:
-            params = _with_urdf(params, urdf, chain)
-        model = RobotModel.from_params(params)
-    except (ValueError, OSError, yaml.YAMLError) as error:
-        raise ToolError(f"{urdf or path}: {str(error).splitlines()[0]}") from None
+        model = tool_model(params_file, urdf, *chain).model
+    except ValueError as error:
+        raise ToolError(str(error).splitlines()[0]) from None
     if payload_mass is not None:
         if not (math.isfinite(payload_mass) and payload_mass >= 0):
             raise ToolError(f"--payload-mass: must be a mass >= 0 kg, got {payload_mass}")
@@ -87,19 +70,6 @@ def model_of(params_file: str, urdf: str | None, payload_mass: float | None, cha
         except ValueError as error:
             raise ToolError(f"--payload-mass: {error}") from None
     return model
-
-
-def _with_urdf(params: dict, urdf: str, chain) -> dict:
-    from ..core.urdf import load_urdf
-
-    try:
-        text = Path(urdf).read_text()
-    except OSError as error:
-        raise ToolError(f"{urdf}: cannot read: {error.strerror}") from None
-    model = load_urdf(text, *chain).model
-    own = {f"{name}.{field}" for name in model.joint_names for field in _URDF_FIELDS}
-    kept = {k: v for k, v in params.items() if k in own or k in _GLOBAL or k.startswith("payload.")}
-    return {**model.to_params(), **kept}
 
 
 def read_trajectory(path: str, model: RobotModel) -> Trajectory:

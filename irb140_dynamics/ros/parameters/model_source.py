@@ -24,10 +24,6 @@ import contextlib
 from collections.abc import Callable
 from typing import Any
 
-import rclpy
-from rclpy.context import Context
-from rclpy.impl.implementation_singleton import rclpy_implementation
-from rclpy.logging import LoggingSeverity
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import String
@@ -37,7 +33,6 @@ from irb140_dynamics.core.errors import one_line
 from irb140_dynamics.core.io.urdf import LoadedUrdf, UrdfError, load_urdf, read_urdf
 from irb140_dynamics.ros.parameters.live import LiveParameters
 from irb140_dynamics.ros.parameters.specs import Spec, _declare, check_choice, declare_model, model_specs
-from irb140_dynamics.ros.runtime.spin import init_error
 
 PerJoint = Callable[[list[str]], list[Spec]]  # a node's parameters for each joint of a model
 SOURCES = ("parameters", "robot_description")
@@ -180,31 +175,6 @@ class RobotDescription:
         self.urdf = urdf
         self.parameters.submit(draft)  # finished (compiled, analysed) off the executor when slow
         self._announce("robot_description topic")
-
-
-def model_from_arguments(args: list[str], name: str) -> RobotModel:
-    """The model a node would run on with these (ROS) arguments, read once by a node
-    ``name`` that is never spun (no topic: robot_description from the parameter or
-    model.urdf_file), or ValueError in one line."""
-    context = Context()
-    node = None
-    try:
-        rclpy.init(args=args, context=context)
-        node = Node(name, context=context, start_parameter_services=False, enable_rosout=False)
-        node.get_logger().set_level(LoggingSeverity.WARN)  # stderr for errors only
-        model = declare_model_source(node, [], RobotModel.from_params).current
-        if model is None:
-            raise ValueError(
-                f"robot_description: {name} does not read the topic; give the robot_description "
-                "parameter or model.urdf_file"
-            )
-        return model
-    except rclpy_implementation.RCLError as error:
-        raise ValueError(init_error(error)) from None
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown(context=context)
 
 
 def _read(path: str) -> str:
