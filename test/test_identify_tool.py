@@ -108,11 +108,11 @@ def test_summary_reports_counts_errors_and_consistency(workflow):
     assert workflow["status"] == 0, printed
     assert f"{workflow['bag']}: 3,001 samples read, " in printed
     used, left_out, edges = (int(x.replace(",", "")) for x in re.search(
-        r"samples read, ([\d,]+) used, ([\d,]+) left out \(0 without effort \(or another value\), ([\d,]+) at gaps", printed).groups())
+        r"samples read, ([\d,]+) used, ([\d,]+) left out \(0 invalid \(a value missing, not finite or beyond 1e6\), ([\d,]+) at gaps", printed).groups())
     assert used + left_out == 3001 and left_out == edges > 0
     assert "torque rows too slow for Coulomb friction, left out: joint_1 " in printed
     assert "base parameters: 52 of 78; condition number of the base regressor: " in printed
-    assert "held out: the last 20 % of the recording" in printed
+    assert "held out: the last 20 % of the moving fit points of the recording" in printed
     table = re.findall(r"^(joint_\d) +(\S+) +(\S+) +\((\S+) %\) +(\S+) +\((\S+) %\)$", printed, flags=re.M)
     assert [row[0] for row in table] == list(NAMES)
     for name, peak, prior, prior_percent, identified, identified_percent in table:

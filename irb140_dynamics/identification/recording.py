@@ -29,6 +29,7 @@ from ..core.joint_order import BadMessage, JointOrder
 JOINT_STATE = "sensor_msgs/msg/JointState"
 DEFAULT_TOPIC = "/joint_states"
 CHUNK_SIZE = 20_000
+CSV_LINE_LIMIT = 1 << 20  # bytes: a longer CSV line is refused (a joint-state row has a few hundred)
 BAG_SUFFIXES = (".mcap", ".db3")
 
 
@@ -221,11 +222,13 @@ class _CsvSource:
     def __init__(self, recording: Recording):
         self.recording = recording
         path = recording.path
+        if not path.is_file():
+            raise RecordingError(path, "not a regular file")
+        self.total = _scan(path) - 1
         try:
             with open(path, newline="") as stream:
                 header = next(csv.reader(stream), None)
-                self.total = sum(1 for line in stream if line.strip())
-        except (OSError, UnicodeDecodeError) as error:
+        except (OSError, UnicodeDecodeError, csv.Error) as error:
             raise RecordingError(path, f"cannot be read ({error})") from None
         if not header:
             raise RecordingError(path, "empty: expected a header row (time, position_<joint>, ..., effort_<joint>)")
@@ -241,6 +244,12 @@ class _CsvSource:
         self.width = len(header)
 
     def chunks(self) -> Iterator[RawChunk]:
+        try:
+            yield from self._chunks()
+        except (OSError, UnicodeDecodeError, csv.Error) as error:
+            raise RecordingError(self.recording.path, f"cannot be read ({error})") from None
+
+    def _chunks(self) -> Iterator[RawChunk]:
         recording, n = self.recording, self.recording.n
         first = 0
         with open(recording.path, newline="") as stream:
@@ -270,5 +279,35 @@ class _CsvSource:
             try:
                 rows.append([float(row[i]) if row[i].strip() else np.nan for i in self.columns])
             except ValueError:
-                raise RecordingError(self.recording.path, f"line {first_line + k}: not a number in {row}") from None
+                bad = next(row[i] for i in self.columns if not _is_number(row[i]))
+                raise RecordingError(self.recording.path, f"line {first_line + k}: not a number: {bad[:40]!r}") from None
         return np.array(rows, dtype=float).reshape(-1, len(self.columns))
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text) if text.strip() else None
+        return True
+    except ValueError:
+        return False
+
+
+def _scan(path: Path) -> int:
+    """A CSV file's lines, counted in blocks; a line over CSV_LINE_LIMIT bytes or a NUL byte
+    (binary data) refused before anything is parsed."""
+    lines, carry = 0, 0  # newlines so far, bytes of the line in progress
+    try:
+        with open(path, "rb") as stream:
+            while block := stream.read(1 << 20):
+                if b"\0" in block:
+                    raise RecordingError(path, "binary data (a NUL byte): not a CSV file")
+                parts = block.split(b"\n")
+                for k, part in enumerate(parts):
+                    if len(part) + (carry if k == 0 else 0) > CSV_LINE_LIMIT:
+                        raise RecordingError(path, f"line {lines + k + 1}: longer than {CSV_LINE_LIMIT} bytes: "
+                                             "not a CSV file of joint states")
+                lines += len(parts) - 1
+                carry = len(parts[-1]) + (carry if len(parts) == 1 else 0)
+    except OSError as error:
+        raise RecordingError(path, f"cannot be read ({error.strerror})") from None
+    return lines + (1 if carry else 0)

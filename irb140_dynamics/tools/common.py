@@ -1,4 +1,4 @@
-"""What the command-line tools share: the prior model, errors in one line, a progress bar."""
+"""What the command-line tools share: the prior model, a progress bar (see cli.py for the rest)."""
 
 from __future__ import annotations
 
@@ -8,10 +8,7 @@ from pathlib import Path
 
 from ..core.model import RobotModel, load_model
 from ..package_files import default_config_path
-
-
-class ToolError(Exception):
-    """An error the tool reports in one line (exit status 1)."""
+from .cli import ToolError, open_line
 
 
 def prior_model(params_file: str | None) -> tuple[RobotModel, Path]:
@@ -23,18 +20,6 @@ def prior_model(params_file: str | None) -> tuple[RobotModel, Path]:
         return load_model(path), path
     except (ValueError, OSError) as error:  # ModelError, YAML errors are ValueErrors
         raise ToolError(f"{path}: {error}") from None
-
-
-def run(tool: str, body) -> int:
-    """body() -> exit status; a ToolError or bad input becomes 'tool: error: ...' and status 1."""
-    try:
-        return body()
-    except (ToolError, ValueError, OSError) as error:
-        print(f"{tool}: error: {error}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt:
-        print(f"{tool}: interrupted", file=sys.stderr)
-        return 130
 
 
 class ProgressBar:
@@ -60,6 +45,7 @@ class ProgressBar:
         bar = "#" * int(self.WIDTH * fraction)
         self.stream.write(f"\rreading {Path(path).name}: [{bar:<{self.WIDTH}}] {100 * fraction:3.0f} % "
                           f"{done:,}/{total:,} samples, {now - self.start:.0f} s")
+        open_line[0] = not finished and self.stream is sys.stderr
         if finished:
             self.stream.write("\n")
         self.stream.flush()
