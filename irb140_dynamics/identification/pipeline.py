@@ -16,26 +16,26 @@ default cut-off), the sums and at most ``plot_points`` held-out points for the p
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
-from ..core.model import RobotModel
-from ..core.regressor import inertial_parameters, regressor_batch
-from .base import BaseParameters, find_base_parameters
-from .consistent import ConsistentFit, consistent_parameters
-from .estimation import Estimate, NormalEquations, weighted_least_squares
-from .recording import CHUNK_SIZE, DEFAULT_TOPIC, Recording, RecordingError
-from .selection import Selection, rows_used, select
-from .signals import DEFAULT_CUTOFF, Differentiator, FilterDesign, FitPoints, _joined
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.regressor import inertial_parameters, regressor_batch
+from irb140_dynamics.identification.base import BaseParameters, find_base_parameters
+from irb140_dynamics.identification.consistent import ConsistentFit, consistent_parameters
+from irb140_dynamics.identification.least_squares import Estimate, NormalEquations, weighted_least_squares
+from irb140_dynamics.identification.recording import CHUNK_SIZE, DEFAULT_TOPIC, Recording, RecordingError
+from irb140_dynamics.identification.selection import Selection, rows_used, select
+from irb140_dynamics.identification.signals import DEFAULT_CUTOFF, Differentiator, FilterDesign, FitPoints, _joined
 
 SLOW_SPEEDS = 3.0  # min_speed in smoothing velocities
 FIT_BATCH = 8192  # fit points gathered before the regressor and the sums run: few, large array operations
 
 
 @dataclass(frozen=True)
-class Settings:
+class IdentificationSettings:
     topic: str = DEFAULT_TOPIC
     cutoff: float = DEFAULT_CUTOFF  # Hz
     min_speed: float | None = None  # rad/s; None: SLOW_SPEEDS smoothing velocities
@@ -46,7 +46,7 @@ class Settings:
 
 
 @dataclass
-class Tally:
+class SampleTally:
     """What became of a recording's samples."""
 
     path: str
@@ -80,7 +80,7 @@ class Result:
     fit: ConsistentFit
     train: NormalEquations
     held_out: NormalEquations
-    tallies: list[Tally]
+    tallies: list[SampleTally]
     plot_points: FitPoints | None
     held_out_source: str
 
@@ -93,13 +93,20 @@ class Result:
 Progress = Callable[[str, int, int], None]  # (path, samples done, samples expected)
 
 
-def identify(prior: RobotModel, path, settings: Settings = Settings(), validate=None,
-             progress: Progress | None = None) -> Result:
+def identify(
+    prior: RobotModel,
+    path,
+    settings: IdentificationSettings = IdentificationSettings(),
+    validate=None,
+    progress: Progress | None = None,
+) -> Result:
     """Identify ``prior``'s parameters from the recording at ``path`` (see the module's docstring)."""
     if not 0.0 < settings.held_out < 1.0 and validate is None:
         raise ValueError(f"held_out: must be within (0, 1), got {settings.held_out}")
     if not settings.prior_weight > 0.0 or not (settings.min_speed is None or settings.min_speed >= 0.0):
-        raise ValueError(f"prior_weight must be > 0 and min_speed >= 0, got {settings.prior_weight}, {settings.min_speed}")
+        raise ValueError(
+            f"prior_weight must be > 0 and min_speed >= 0, got {settings.prior_weight}, {settings.min_speed}"
+        )
     base = find_base_parameters(prior)
     P = 13 * prior.n
     train, held_out = NormalEquations(prior.n, P), NormalEquations(prior.n, P)
@@ -119,15 +126,22 @@ def identify(prior: RobotModel, path, settings: Settings = Settings(), validate=
             raise RecordingError(tally.path, _nothing_usable(tally, use, min_speed))
     estimate = weighted_least_squares(train, base, tallies[0].design.noise_correlation())
     fit = consistent_parameters(prior, base, estimate, settings.prior_weight)
-    source = (f"{validate} (rest trimmed)" if validate is not None else
-              f"the last {100 * settings.held_out:g} % of the moving fit points of the recording")
-    plots = None if held_points is None else held_points.take(slice(None, None, _every(len(held_points), settings.plot_points)))
+    source = (
+        f"{validate} (rest trimmed)"
+        if validate is not None
+        else f"the last {100 * settings.held_out:g} % of the moving fit points of the recording"
+    )
+    plots = (
+        None
+        if held_points is None
+        else held_points.take(slice(None, None, _every(len(held_points), settings.plot_points)))
+    )
     return Result(prior, fit.model, base, estimate, fit, train, held_out, tallies, plots, source)
 
 
-def _read(prior, recording, settings, progress) -> tuple[Tally, FitPoints | None]:
+def _read(prior, recording, settings, progress) -> tuple[SampleTally, FitPoints | None]:
     """A recording's fit points (all of them, in order) and its tally."""
-    tally = Tally(str(recording.path), recording.total, slow_rows=np.zeros(prior.n, dtype=np.int64))
+    tally = SampleTally(str(recording.path), recording.total, slow_rows=np.zeros(prior.n, dtype=np.int64))
     differentiator, parts, times = None, [], []
     if progress:
         progress(tally.path, 0, tally.expected)
@@ -156,8 +170,14 @@ def _read(prior, recording, settings, progress) -> tuple[Tally, FitPoints | None
     return tally, points
 
 
-def _accumulate(prior, tally: Tally, points: FitPoints | None, held_out: float, min_speed: float,
-                where: tuple[NormalEquations, NormalEquations]) -> FitPoints | None:
+def _accumulate(
+    prior,
+    tally: SampleTally,
+    points: FitPoints | None,
+    held_out: float,
+    min_speed: float,
+    where: tuple[NormalEquations, NormalEquations],
+) -> FitPoints | None:
     """Select ``points`` (rest trimmed, the last ``held_out`` fraction of the moving ones held
     out), add them to the training and held-out sums ``where``; the held-out points."""
     if points is None or len(points) == 0:
@@ -172,8 +192,14 @@ def _accumulate(prior, tally: Tally, points: FitPoints | None, held_out: float, 
     tally.held_from = float(points.time[min(selection.split, selection.end - 1)] - tally.start)
     for part, equations in ((selection.train, where[0]), (selection.held, where[1])):
         for batch in range(part.start, part.stop, FIT_BATCH):
-            _add(prior, points.take(slice(batch, min(batch + FIT_BATCH, part.stop))), min_speed, half_window,
-                 tally, equations)
+            _add(
+                prior,
+                points.take(slice(batch, min(batch + FIT_BATCH, part.stop))),
+                min_speed,
+                half_window,
+                tally,
+                equations,
+            )
     return points.take(selection.held) if selection.split < selection.end else None
 
 
@@ -197,14 +223,18 @@ def _rate(recording: Recording, chunk) -> float:
     return 1.0 / float(np.median(steps))
 
 
-def _nothing_usable(tally: Tally, use: str, min_speed: float) -> str:
+def _nothing_usable(tally: SampleTally, use: str, min_speed: float) -> str:
     if tally.read == 0:
         reasons = ", ".join(f"{count} {kind.replace('_', ' ')}" for kind, count in tally.skipped.items())
         return f"no usable joint states of the model's joints ({reasons or 'no messages'})"
     if tally.invalid == tally.read:
         return "no sample has efforts (and positions) for every joint of the model"
     if tally.fit_points and tally.selection is None:
-        return (f"nothing moves: every joint is slower than {min_speed:.3g} rad/s throughout ({tally.read} samples); "
-                "record a motion (or lower --min-speed)")
-    return (f"no torque rows left {use}: {tally.read} samples, {tally.invalid} without effort, {tally.edges} at "
-            f"gaps and ends, the rest too slow; record a longer, faster motion")
+        return (
+            f"nothing moves: every joint is slower than {min_speed:.3g} rad/s throughout ({tally.read} samples); "
+            "record a motion (or lower --min-speed)"
+        )
+    return (
+        f"no torque rows left {use}: {tally.read} samples, {tally.invalid} without effort, {tally.edges} at "
+        f"gaps and ends, the rest too slow; record a longer, faster motion"
+    )

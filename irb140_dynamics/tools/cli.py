@@ -12,8 +12,8 @@ import math
 import os
 import signal
 import sys
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 LINE_LIMIT = 300  # characters: the longest error line a tool prints
 INTERRUPTED = 130  # exit status after Ctrl-C (128 + SIGINT), 143 after SIGTERM
@@ -37,8 +37,9 @@ class Parser(argparse.ArgumentParser):
         self.exit(2, one_line(f"{self.prog}: error: {message}; see --help") + "\n")
 
 
-def number(low: float | None = None, high: float | None = None, *, above: bool = False,
-           integer: bool = False) -> Callable[[str], float]:
+def number(
+    low: float | None = None, high: float | None = None, *, above: bool = False, integer: bool = False
+) -> Callable[[str], float]:
     """An argparse type: a finite number (an integer with ``integer``) within [low, high]
     (above low with ``above``); NaN, inf and anything outside refused."""
 

@@ -6,9 +6,10 @@ import sys
 import time
 from pathlib import Path
 
-from ..core.model import RobotModel, load_model
-from ..package_files import default_config_path
-from .cli import ToolError, open_line
+from irb140_dynamics.core.io.params_file import load_model
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.package_files import default_config_path
+from irb140_dynamics.tools.cli import ToolError, open_line
 
 
 def prior_model(params_file: str | None) -> tuple[RobotModel, Path]:
@@ -43,8 +44,10 @@ class ProgressBar:
         self.last = now
         fraction = min(done / total, 1.0) if total > 0 else 0.0
         bar = "#" * int(self.WIDTH * fraction)
-        self.stream.write(f"\rreading {Path(path).name}: [{bar:<{self.WIDTH}}] {100 * fraction:3.0f} % "
-                          f"{done:,}/{total:,} samples, {now - self.start:.0f} s")
+        self.stream.write(
+            f"\rreading {Path(path).name}: [{bar:<{self.WIDTH}}] {100 * fraction:3.0f} % "
+            f"{done:,}/{total:,} samples, {now - self.start:.0f} s"
+        )
         open_line[0] = not finished and self.stream is sys.stderr
         if finished:
             self.stream.write("\n")

@@ -17,32 +17,53 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .cli import Parser, ToolError, input_path, number, output_file, run
+from irb140_dynamics.tools.cli import Parser, ToolError, input_path, number, output_file, run
 
 MAX_POINTS = 1_000_000  # points written: 100 MB of YAML
 SHELL_ARGUMENT_LIMIT = 128 * 1024  # bytes: Linux's MAX_ARG_STRLEN
 
 
 def parser() -> Parser:
-    from ..identification.excitation import DEFAULT_HARMONICS, DEFAULT_MARGIN, DEFAULT_PERIOD
+    from irb140_dynamics.identification.excitation import DEFAULT_HARMONICS, DEFAULT_MARGIN, DEFAULT_PERIOD
 
     p = Parser(prog="excitation", description=__doc__.split("\n\n")[0].split(": ", 1)[1])
     p.add_argument("--out", required=True, metavar="FILE", help="JointTrajectory YAML file to write")
     p.add_argument("--params-file", metavar="F", help="the model and its limits (default: the package's IRB-140)")
-    p.add_argument("--rate", type=number(0.0, 1e4, above=True), default=20.0, metavar="HZ",
-                   help="points per second (default 20)")
-    p.add_argument("--period", type=number(0.0, 1e4, above=True), default=DEFAULT_PERIOD, metavar="S",
-                   help=f"period [s] (default {DEFAULT_PERIOD:g})")
-    p.add_argument("--harmonics", type=number(1, 50, integer=True), default=DEFAULT_HARMONICS, metavar="K",
-                   help=f"Fourier harmonics per joint (default {DEFAULT_HARMONICS})")
-    p.add_argument("--periods", type=number(1, 10_000, integer=True), default=1, metavar="P",
-                   help="periods written (default 1)")
-    p.add_argument("--margin", type=number(0.0, 0.49), default=DEFAULT_MARGIN,
-                   help=f"fraction of each position range kept free at both ends, below 0.5 (default {DEFAULT_MARGIN:g})")
-    p.add_argument("--seed", type=number(0, 2**32 - 1, integer=True), default=0,
-                   help="random start of the optimisation (default 0)")
-    p.add_argument("--iterations", type=number(0, 10_000, integer=True), default=40,
-                   help="optimiser iterations (default 40)")
+    p.add_argument(
+        "--rate", type=number(0.0, 1e4, above=True), default=20.0, metavar="HZ", help="points per second (default 20)"
+    )
+    p.add_argument(
+        "--period",
+        type=number(0.0, 1e4, above=True),
+        default=DEFAULT_PERIOD,
+        metavar="S",
+        help=f"period [s] (default {DEFAULT_PERIOD:g})",
+    )
+    p.add_argument(
+        "--harmonics",
+        type=number(1, 50, integer=True),
+        default=DEFAULT_HARMONICS,
+        metavar="K",
+        help=f"Fourier harmonics per joint (default {DEFAULT_HARMONICS})",
+    )
+    p.add_argument(
+        "--periods", type=number(1, 10_000, integer=True), default=1, metavar="P", help="periods written (default 1)"
+    )
+    p.add_argument(
+        "--margin",
+        type=number(0.0, 0.49),
+        default=DEFAULT_MARGIN,
+        help=f"fraction of each position range kept free at both ends, below 0.5 (default {DEFAULT_MARGIN:g})",
+    )
+    p.add_argument(
+        "--seed",
+        type=number(0, 2**32 - 1, integer=True),
+        default=0,
+        help="random start of the optimisation (default 0)",
+    )
+    p.add_argument(
+        "--iterations", type=number(0, 10_000, integer=True), default=40, help="optimiser iterations (default 40)"
+    )
     return p
 
 
@@ -61,17 +82,18 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
 
     import numpy as np
 
-    from ..identification.base import find_base_parameters
-    from ..identification.excitation import check_limits, optimise_excitation
-    from ..identification.files import joint_trajectory_text
-    from .common import prior_model
-    from .outputs import Outputs
+    from irb140_dynamics.core.io.trajectory_file import joint_trajectory_text
+    from irb140_dynamics.identification.base import find_base_parameters
+    from irb140_dynamics.identification.excitation import check_limits, optimise_excitation
+    from irb140_dynamics.tools.common import prior_model
+    from irb140_dynamics.tools.outputs import Outputs
 
     model, path = prior_model(args.params_file)
     base = find_base_parameters(model)
     print(f"model: {path}; {base.count} base parameters; optimising ({args.iterations} iterations)...", flush=True)
-    result = optimise_excitation(model, args.period, args.harmonics, args.seed, args.iterations,
-                                 margin=args.margin, base=base)
+    result = optimise_excitation(
+        model, args.period, args.harmonics, args.seed, args.iterations, margin=args.margin, base=base
+    )
     trajectory = result.trajectory
     problems = check_limits(model, trajectory, args.rate)
     if problems:  # cannot happen by construction; refuse rather than write a bad file
@@ -87,7 +109,7 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
         f"{len(times)} points; starts and ends at rest at the first point",
         "Move the arm to the first point first. Publish it, e.g.:",
         "  ros2 topic pub --once /joint_trajectory_controller/joint_trajectory "
-        "trajectory_msgs/msg/JointTrajectory \"$(cat FILE)\"   (or --yaml-file FILE)",
+        'trajectory_msgs/msg/JointTrajectory "$(cat FILE)"   (or --yaml-file FILE)',
         "and record: ros2 bag record /joint_states",
     ]
     text = joint_trajectory_text(model.joint_names, times, Q, QD, QDD, comments)
@@ -95,11 +117,15 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
         outputs.text(out, args.out, text)
         outputs.commit()
     print(f"condition number: {result.condition_number:.2f} (random start {result.start_condition_number:.2f})")
-    print(f"wrote {args.out}: {len(times)} points over {times[-1]:g} s; start at "
-          f"[{', '.join(f'{x:.4f}' for x in Q[0])}] rad")
+    print(
+        f"wrote {args.out}: {len(times)} points over {times[-1]:g} s; start at "
+        f"[{', '.join(f'{x:.4f}' for x in Q[0])}] rad"
+    )
     if len(text) > SHELL_ARGUMENT_LIMIT:
-        print(f"note: {len(text) // 1024} kB is too long for one shell argument (\"$(cat {args.out})\"): "
-              "publish it with --yaml-file, or lower --rate")
+        print(
+            f'note: {len(text) // 1024} kB is too long for one shell argument ("$(cat {args.out})"): '
+            "publish it with --yaml-file, or lower --rate"
+        )
     return 0
 
 

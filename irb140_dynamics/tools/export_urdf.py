@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 import sys
 
-from .cli import Parser, ToolError, output_file, run
+from irb140_dynamics.tools.cli import Parser, ToolError, output_file, run
 
 NAME = "export_urdf"
 # ABB IRB 140 product specification, axis speeds [deg/s], axes 1 to 6 (also config/irb140.yaml)
@@ -33,8 +33,11 @@ POSES = 2000  # seeded random poses searched for a dynamic effort limit
 
 
 def parser() -> Parser:
-    p = Parser(prog=NAME, description=__doc__.split("\n\n")[0].split(": ", 1)[1],
-               epilog="ROS arguments (after --ros-args) choose the model, as for the nodes.")
+    p = Parser(
+        prog=NAME,
+        description=__doc__.split("\n\n")[0].split(": ", 1)[1],
+        epilog="ROS arguments (after --ros-args) choose the model, as for the nodes.",
+    )
     p.add_argument("--out", metavar="FILE", help="write the URDF here (default: stdout)")
     return p
 
@@ -44,8 +47,8 @@ def limits(model) -> tuple[list[float], list[float], list[str]]:
     where they come from (see the module's docstring); ToolError when a velocity is unknown."""
     import numpy as np
 
-    from ..core import irb140
-    from ..core.payload import RATED_PAYLOAD, derive_torque_limits
+    from irb140_dynamics.core import irb140
+    from irb140_dynamics.core.payload import RATED_PAYLOAD, derive_torque_limits
 
     is_irb140 = model.joint_names == irb140().joint_names
     velocity, effort, sources = [], [], []
@@ -58,8 +61,10 @@ def limits(model) -> tuple[list[float], list[float], list[str]]:
             velocity.append(math.radians(DATA_SHEET_SPEEDS[k]))
             source = "velocity: IRB 140 data sheet"
         else:
-            raise ToolError(f"{joint.name}: no velocity_limit in the model and no data sheet for this arm; "
-                            f"give one (-p {joint.name}.velocity_limit:=RAD_S)")
+            raise ToolError(
+                f"{joint.name}: no velocity_limit in the model and no data sheet for this arm; "
+                f"give one (-p {joint.name}.velocity_limit:=RAD_S)"
+            )
         if joint.torque_limit > 0:
             effort.append(joint.torque_limit)
             sources.append(source + ", effort: model")
@@ -79,7 +84,7 @@ def _dynamic_effort(model, k: int) -> float:
     at rest, joint k at its acceleration limit (others still): gravity and inertia."""
     import numpy as np
 
-    from ..core import rnea_batch
+    from irb140_dynamics.core import rnea_batch
 
     rng = np.random.default_rng(k)
     lower, upper = np.array([j.position_limits for j in model.joints]).T
@@ -90,8 +95,10 @@ def _dynamic_effort(model, k: int) -> float:
     tau = rnea_batch(model, q, np.zeros_like(q), qdd)
     value = float(np.abs(tau[:, k]).max())
     if not value > 0 or not math.isfinite(value):
-        raise ToolError(f"{model.joints[k].name}: no torque_limit and none can be derived; "
-                        f"give one (-p {model.joints[k].name}.torque_limit:=N_M)")
+        raise ToolError(
+            f"{model.joints[k].name}: no torque_limit and none can be derived; "
+            f"give one (-p {model.joints[k].name}.torque_limit:=N_M)"
+        )
     return value
 
 
@@ -99,9 +106,9 @@ def urdf_of(model) -> str:
     """The model's URDF with positive limits; the IRB-140's named irb140 and drawn with its shapes."""
     from dataclasses import replace
 
-    from ..core import irb140
-    from ..core.geometry import IRB140_SHAPES
-    from ..core.urdf import export_urdf
+    from irb140_dynamics.core import irb140
+    from irb140_dynamics.core.io.urdf import export_urdf
+    from irb140_dynamics.core.model.irb140 import IRB140_SHAPES
 
     effort, velocity, _ = limits(model)
     joints = [replace(j, torque_limit=e, velocity_limit=v) for j, e, v in zip(model.joints, effort, velocity)]
@@ -117,13 +124,13 @@ def main(args: list[str] | None = None) -> int:
 
 
 def _export(args: list[str], interrupts) -> int:
-    from ..ros.spin import tool_arguments
+    from irb140_dynamics.ros.runtime.spin import tool_arguments
 
     options = parser().parse_args(tool_arguments(args))
     out = output_file(options.out) if options.out else None
 
-    from ..ros.model_source import model_from_arguments
-    from .outputs import Outputs
+    from irb140_dynamics.ros.parameters.model_source import model_from_arguments
+    from irb140_dynamics.tools.outputs import Outputs
 
     text = urdf_of(model_from_arguments(args, NAME))
     if out is None:

@@ -24,34 +24,63 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .cli import Parser, ToolError, input_path, number, output_directory, output_file, run
+from irb140_dynamics.tools.cli import Parser, ToolError, input_path, number, output_directory, output_file, run
 
 DEFAULT_HELD_OUT = 0.2
 
 
 def parser() -> Parser:
-    from ..identification.recording import DEFAULT_TOPIC  # light: no NumPy work at import
-    from ..identification.signals import DEFAULT_CUTOFF
+    from irb140_dynamics.identification.recording import DEFAULT_TOPIC  # light: no NumPy work at import
+    from irb140_dynamics.identification.signals import DEFAULT_CUTOFF
 
-    p = Parser(prog="identify", description=__doc__.split("\n\n")[0].split(": ", 1)[1],
-               epilog="\n\n".join(__doc__.split("\n\n")[2:4]), formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = Parser(
+        prog="identify",
+        description=__doc__.split("\n\n")[0].split(": ", 1)[1],
+        epilog="\n\n".join(__doc__.split("\n\n")[2:4]),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("recording", metavar="BAG", help="ROS 2 bag (directory, .mcap, .db3) or .csv file")
     p.add_argument("--out", required=True, metavar="IDENTIFIED.yaml", help="parameter file to write")
     p.add_argument("--topic", default=DEFAULT_TOPIC, help=f"JointState topic in the bag (default {DEFAULT_TOPIC})")
-    p.add_argument("--params-file", metavar="PRIOR.yaml",
-                   help="the prior model: kinematics, limits and starting inertials (default: the package's IRB-140)")
+    p.add_argument(
+        "--params-file",
+        metavar="PRIOR.yaml",
+        help="the prior model: kinematics, limits and starting inertials (default: the package's IRB-140)",
+    )
     p.add_argument("--plots", metavar="DIR", help="write torques.png and residuals.png of the held-out data here")
-    p.add_argument("--validate", metavar="BAG2", help="validate on this recording (rest trimmed) instead of the "
-                   "last --held-out of BAG's moving fit points")
-    p.add_argument("--cutoff", type=number(0.0, 1e6, above=True), default=DEFAULT_CUTOFF, metavar="HZ",
-                   help=f"filter cut-off [Hz] for smoothing and differentiation (default {DEFAULT_CUTOFF:g})")
-    p.add_argument("--min-speed", type=number(0.0, 1e3), metavar="RAD_S",
-                   help="a joint's torque row is used (and the point moves) from this speed on "
-                   "(default 3 smoothing velocities of the prior)")
-    p.add_argument("--held-out", type=number(0.0, 1.0, above=True), default=DEFAULT_HELD_OUT, metavar="FRACTION",
-                   help=f"fraction of BAG's moving fit points, at its end, held out (default {DEFAULT_HELD_OUT:g})")
-    p.add_argument("--prior-weight", type=number(0.0, 1e6, above=True), default=1.0, metavar="W",
-                   help="strength of the pull toward the prior (default 1; see docs/identification.md)")
+    p.add_argument(
+        "--validate",
+        metavar="BAG2",
+        help="validate on this recording (rest trimmed) instead of the last --held-out of BAG's moving fit points",
+    )
+    p.add_argument(
+        "--cutoff",
+        type=number(0.0, 1e6, above=True),
+        default=DEFAULT_CUTOFF,
+        metavar="HZ",
+        help=f"filter cut-off [Hz] for smoothing and differentiation (default {DEFAULT_CUTOFF:g})",
+    )
+    p.add_argument(
+        "--min-speed",
+        type=number(0.0, 1e3),
+        metavar="RAD_S",
+        help="a joint's torque row is used (and the point moves) from this speed on "
+        "(default 3 smoothing velocities of the prior)",
+    )
+    p.add_argument(
+        "--held-out",
+        type=number(0.0, 1.0, above=True),
+        default=DEFAULT_HELD_OUT,
+        metavar="FRACTION",
+        help=f"fraction of BAG's moving fit points, at its end, held out (default {DEFAULT_HELD_OUT:g})",
+    )
+    p.add_argument(
+        "--prior-weight",
+        type=number(0.0, 1e6, above=True),
+        default=1.0,
+        metavar="W",
+        help="strength of the pull toward the prior (default 1; see docs/identification.md)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     return p
 
@@ -76,14 +105,19 @@ def _identify(argv: list[str], interrupts) -> int:
 
     import shlex
 
-    from ..identification.pipeline import Settings, identify
-    from ..identification.report import identified_file, summary
-    from .common import ProgressBar, prior_model
-    from .outputs import Outputs
+    from irb140_dynamics.identification.pipeline import IdentificationSettings, identify
+    from irb140_dynamics.identification.report import identified_file, summary
+    from irb140_dynamics.tools.common import ProgressBar, prior_model
+    from irb140_dynamics.tools.outputs import Outputs
 
     prior, prior_path = prior_model(args.params_file)
-    settings = Settings(topic=args.topic, cutoff=args.cutoff, min_speed=args.min_speed,
-                        held_out=args.held_out, prior_weight=args.prior_weight)
+    settings = IdentificationSettings(
+        topic=args.topic,
+        cutoff=args.cutoff,
+        min_speed=args.min_speed,
+        held_out=args.held_out,
+        prior_weight=args.prior_weight,
+    )
     progress = None if args.quiet else ProgressBar()
     with Outputs(interrupts) as outputs:
         result = identify(prior, args.recording, settings, validate=args.validate, progress=progress)
@@ -91,7 +125,7 @@ def _identify(argv: list[str], interrupts) -> int:
         print(summary(result), flush=True)
         outputs.text(out, args.out, identified_file(result, shlex.join(["identify", *argv])))
         if plots is not None:
-            from ..identification.plots import write_plots
+            from irb140_dynamics.identification.plots import write_plots
 
             outputs.directory(plots, args.plots)
             names = write_plots(result, lambda name, save: outputs.stage(plots / name, f"{args.plots}/{name}", save))

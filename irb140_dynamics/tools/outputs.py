@@ -12,11 +12,12 @@ from __future__ import annotations
 import os
 import signal
 import tempfile
-from contextlib import contextmanager
+from collections.abc import Callable
+from contextlib import contextmanager, suppress
 from pathlib import Path
-from typing import BinaryIO, Callable
+from typing import BinaryIO
 
-from .cli import Interrupts, ToolError
+from irb140_dynamics.tools.cli import Interrupts, ToolError
 
 HELD = {signal.SIGINT, signal.SIGTERM}
 
@@ -37,7 +38,7 @@ class Outputs:
         self._staged: list[tuple[Path, Path, str]] = []  # (temporary, target, as typed)
         self._created: list[Path] = []  # folders made for the outputs, outermost first
 
-    def __enter__(self) -> "Outputs":
+    def __enter__(self) -> Outputs:
         return self
 
     def __exit__(self, kind, *_) -> None:
@@ -99,15 +100,11 @@ class Outputs:
     def discard(self) -> None:
         with signals_held():
             for temporary, _, _ in self._staged:
-                try:
+                with suppress(OSError):
                     temporary.unlink()
-                except OSError:
-                    pass
             for folder in reversed(self._created):
-                try:
+                with suppress(OSError):
                     folder.rmdir()
-                except OSError:
-                    pass
             self._staged, self._created = [], []
 
 
