@@ -134,4 +134,4 @@ def test_export_urdf_tool_prints_the_committed_file_and_refuses_bad_input_in_one
     code, output = run_to_exit(command)
     assert code == 0 and output == EXPORTED.read_text(), output[:500]
     code, output = run_to_exit(command + ["--ros-args", "-p", "joint_2.link.com:=[0.1, 0.0]"])
-    assert code == 1 and output.count("\n") == 1 and "export_urdf: joint_2.link.com" in output, output
+    assert code == 1 and output.count("\n") == 1 and "export_urdf: error: joint_2.link.com" in output, output
