@@ -14,3 +14,22 @@ import sys
 
 if "numpy" not in sys.modules and not {"OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"} & set(os.environ):
     os.environ["OPENBLAS_NUM_THREADS"] = "1"
+
+# A tool started as the program (python -m irb140_dynamics.tools.<name>, a console script, ros2
+# run) takes SIGINT and SIGTERM from here on, before its own module is even compiled: they are
+# noted in EARLY_SIGNALS (nothing raised), and its main() acts on them (record: a stop request;
+# the others: interrupted, exit 130). Imported by a test or a library, nothing is installed.
+TOOL_SCRIPTS = {"identify", "record", "excitation", "export_urdf"}
+EARLY_SIGNALS: list[int] = []
+
+
+def _started_as_a_tool() -> bool:
+    program = os.path.basename(sys.argv[0]) if sys.argv else ""
+    return program == "-m" or program in TOOL_SCRIPTS or program.startswith("irb140-")
+
+
+if _started_as_a_tool():
+    import signal
+
+    for _signal in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(_signal, lambda signum, _frame: EARLY_SIGNALS.append(signum))

@@ -196,9 +196,14 @@ def run(tool: str, body: Callable[[Interrupts], int]) -> int:
     """``body(interrupts)`` -> exit status. A ToolError or bad input becomes one line
     'tool: error: ...' and status 1; Ctrl-C (or SIGTERM) one line 'tool: interrupted' and
     130 (143); the body's ``Outputs`` leave nothing behind in both cases."""
+    from irb140_dynamics.tools import EARLY_SIGNALS
+
     interrupts = Interrupts()
     interrupts.install()
     try:
+        if EARLY_SIGNALS:  # Ctrl-C while the tool was starting: nothing done yet
+            interrupts.received = EARLY_SIGNALS[0]
+            raise KeyboardInterrupt
         return body(interrupts)
     except SystemExit as stop:  # argparse: --help (0), a bad argument (2, its line printed)
         interrupts.finished = True

@@ -29,7 +29,8 @@ from irb140_dynamics.tools.cli import Parser, ToolError, number, one_line, outpu
 
 DEFAULT_TOPIC = "/joint_states"  # as identification.recording's
 PROGRESS_PERIOD = 2.0  # s between progress lines when stderr is not a terminal (0.2 on one)
-DRAIN_TIME = 0.25  # s: after Ctrl-C, messages already received are still written for this long
+DRAIN_TIME = 1.0  # s: after Ctrl-C, messages already received are written, for at most this long
+DRAIN_QUIET = 0.05  # s: until none has come for this long
 
 
 def parser() -> Parser:
@@ -64,7 +65,9 @@ class Stop:
     SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
     def __init__(self):
-        self.signals: list[int] = []
+        from irb140_dynamics.tools import EARLY_SIGNALS
+
+        self.signals: list[int] = EARLY_SIGNALS  # those that came while the tool was starting
         for s in self.SIGNALS:
             signal.signal(s, self._on_signal)
 
@@ -156,8 +159,10 @@ def _loop(recorder, stop: Stop) -> str:
             executor.spin_once(timeout_sec=0.1)
             progress(recorder.progress())
         if stop and not recorder.finished:  # what is queued was received before the signal
-            deadline = time.monotonic() + DRAIN_TIME
-            while time.monotonic() < deadline and not recorder.failure and not recorder.check():
+            deadline, count, quiet = time.monotonic() + DRAIN_TIME, -1, time.monotonic()
+            while time.monotonic() < min(deadline, quiet + DRAIN_QUIET) and not recorder.failure:
+                if recorder.count != count:
+                    count, quiet = recorder.count, time.monotonic()
                 executor.spin_once(timeout_sec=0.01)
     finally:
         progress.end()
