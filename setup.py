@@ -31,6 +31,11 @@ setup(
             "identify = irb140_dynamics.tools.identify:main",
             "excitation = irb140_dynamics.tools.excitation:main",
             "record = irb140_dynamics.tools.record:main",
+            # the tools under names of their own, for an install without the ros2 CLI (pip)
+            "irb140-export-urdf = irb140_dynamics.tools.export_urdf:main",
+            "irb140-identify = irb140_dynamics.tools.identify:main",
+            "irb140-excitation = irb140_dynamics.tools.excitation:main",
+            "irb140-record = irb140_dynamics.tools.record:main",
         ],
     },
 )

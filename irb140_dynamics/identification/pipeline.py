@@ -107,7 +107,6 @@ def identify(
         raise ValueError(
             f"prior_weight must be > 0 and min_speed >= 0, got {settings.prior_weight}, {settings.min_speed}"
         )
-    base = find_base_parameters(prior)
     P = 13 * prior.n
     train, held_out = NormalEquations(prior.n, P), NormalEquations(prior.n, P)
     min_speed = settings.min_speed if settings.min_speed is not None else SLOW_SPEEDS * prior.smoothing_velocity
@@ -124,6 +123,7 @@ def identify(
     for tally, equations, use in ((tallies[0], train, "to fit"), (tallies[-1], held_out, "to validate")):
         if equations.rows.sum() == 0:
             raise RecordingError(tally.path, _nothing_usable(tally, use, min_speed))
+    base = find_base_parameters(prior)  # after the recordings are read: a bad one is refused at once
     estimate = weighted_least_squares(train, base, tallies[0].design.noise_correlation())
     fit = consistent_parameters(prior, base, estimate, settings.prior_weight)
     source = (

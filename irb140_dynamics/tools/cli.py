@@ -15,7 +15,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-LINE_LIMIT = 300  # characters: the longest error line a tool prints
+LINE_LIMIT = 299  # characters: an error line is shorter than 300 (the rest cut, marked with ...)
 INTERRUPTED = 130  # exit status after Ctrl-C (128 + SIGINT), 143 after SIGTERM
 open_line = [False]  # a progress bar's line on stderr is unfinished: end it before an error
 
@@ -60,8 +60,14 @@ def number(
     return parse
 
 
+def shown(path) -> str:
+    """A path as typed, its middle left out when it is long (an error line stays short)."""
+    text = str(path)
+    return text if len(text) <= 80 else f"{text[:38]}...{text[-39:]}"
+
+
 def _refuse(path: str, why: str) -> ToolError:
-    return ToolError(f"{path}: {why}")
+    return ToolError(f"{shown(path)}: {why}")
 
 
 def _why(error: OSError) -> str:
@@ -76,7 +82,7 @@ def _probe_directory(path: str, directory: Path) -> None:
     try:
         descriptor, name = tempfile.mkstemp(prefix=".irb140-probe-", dir=directory)
     except OSError as error:
-        raise _refuse(path, f"cannot write in {directory} ({_why(error)})") from None
+        raise _refuse(path, f"cannot write in {shown(directory)} ({_why(error)})") from None
     os.close(descriptor)
     os.unlink(name)
 
@@ -104,9 +110,9 @@ def output_file(path: str) -> Path:
             raise _refuse(path, "exists and is not a regular file")
     directory = target.parent
     if not directory.exists():
-        raise _refuse(path, f"no such directory {directory}")
+        raise _refuse(path, f"no such directory {shown(directory)}")
     if not directory.is_dir():
-        raise _refuse(path, f"{_nearest_file(directory)} is not a directory")
+        raise _refuse(path, f"{shown(_nearest_file(directory))} is not a directory")
     _name_fits(path, target, directory)
     _probe_directory(path, directory)
     return target
@@ -129,7 +135,7 @@ def output_directory(path: str, must_be_new: bool = False) -> Path:
     while not os.path.lexists(ancestor):
         ancestor = ancestor.parent
     if not ancestor.is_dir():
-        raise _refuse(path, f"{ancestor} is not a directory")
+        raise _refuse(path, f"{shown(ancestor)} is not a directory")
     _name_fits(path, target, target.parent if target.parent.exists() else ancestor)
     _probe_directory(path, ancestor)
     return target

@@ -68,8 +68,12 @@ class Stop:
         from irb140_dynamics.tools import EARLY_SIGNALS
 
         self.signals: list[int] = EARLY_SIGNALS  # those that came while the tool was starting
-        for s in self.SIGNALS:
-            signal.signal(s, self._on_signal)
+        self.previous = {s: signal.signal(s, self._on_signal) for s in self.SIGNALS}
+
+    def restore(self) -> None:
+        """The handlers from before (main() called in a process that goes on)."""
+        for s, handler in self.previous.items():
+            signal.signal(s, handler)
 
     def _on_signal(self, signum, _frame) -> None:
         self.signals.append(signum)
@@ -91,6 +95,8 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as error:  # noqa: BLE001  (a defect of ours: the bag is closed, then one line)
         _say(f"record: internal error: {type(error).__name__}: {error}")
         return 1
+    finally:
+        stop.restore()
 
 
 def _record(argv: list[str], stop: Stop) -> int:
