@@ -28,7 +28,8 @@ def _started_as_a_tool() -> bool:
     return program == "-m" or program in TOOL_SCRIPTS or program.startswith("irb140-")
 
 
-if _started_as_a_tool():
+AS_PROGRAM = _started_as_a_tool()  # then signals are ignored once main() is done (interpreter exit)
+if AS_PROGRAM:
     import signal
 
     for _signal in (signal.SIGINT, signal.SIGTERM):

@@ -8,6 +8,7 @@ handlers before the heavy imports, so that a Ctrl-C during them is handled too.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import signal
@@ -183,8 +184,12 @@ class Interrupts:
             self._previous[s] = signal.signal(s, self._on_signal)
 
     def restore(self) -> None:
+        """The handlers from before; when the tool is the program, SIG_IGN instead: Python
+        resets its handlers to the default as it exits, and a late Ctrl-C would kill it."""
+        from irb140_dynamics.tools import AS_PROGRAM
+
         for s, handler in self._previous.items():
-            signal.signal(s, handler)
+            signal.signal(s, signal.SIG_IGN if AS_PROGRAM else handler)
         self._previous = {}
 
     @property
@@ -214,28 +219,47 @@ def run(tool: str, body: Callable[[Interrupts], int]) -> int:
     except SystemExit as stop:  # argparse: --help (0), a bad argument (2, its line printed)
         interrupts.finished = True
         return stop.code if isinstance(stop.code, int) else 0
-    except KeyboardInterrupt:
+    except BaseException as error:  # noqa: BLE001  (sorted in _failed)
         interrupts.finished = True
-        interrupts.received = interrupts.received or signal.SIGINT
-        _say(f"{tool}: interrupted")
-        return interrupts.status
-    except ToolError as error:
-        interrupts.finished = True
-        _say(f"{tool}: error: {error}")
-        return 1
-    except (ValueError, OSError, ArithmeticError, MemoryError, RecursionError) as error:
-        interrupts.finished = True
-        _say(f"{tool}: error: {_describe(error)}")
-        return 1
-    except Exception as error:  # noqa: BLE001  (a defect of ours: still one line, not a traceback)
-        interrupts.finished = True
-        if os.environ.get("IRB140_TRACEBACK"):  # for the developers
-            raise
-        _say(f"{tool}: internal error: {type(error).__name__}: {error}")
-        return 1
+        return _failed(tool, error, interrupts)
     finally:
         interrupts.finished = True
         interrupts.restore()
+
+
+def _failed(tool: str, error: BaseException, interrupts: Interrupts) -> int:
+    """The one line and the exit status of a tool that ``error`` stopped."""
+    if isinstance(error, KeyboardInterrupt) or interrupts.received is not None:
+        # Ctrl-C, or what it became on its way up (NumPy's "initialization failed" ImportError)
+        interrupts.received = interrupts.received or signal.SIGINT
+        _say(f"{tool}: interrupted")
+        _exit_now_if_the_program(interrupts.status)
+        return interrupts.status
+    if isinstance(error, ToolError):
+        _say(f"{tool}: error: {error}")
+    elif isinstance(error, (ValueError, OSError, ArithmeticError, MemoryError, RecursionError)):
+        _say(f"{tool}: error: {_describe(error)}")
+    elif isinstance(error, Exception):  # a defect of ours: still one line, not a traceback
+        if os.environ.get("IRB140_TRACEBACK"):  # for the developers
+            raise error
+        _say(f"{tool}: internal error: {type(error).__name__}: {error}")
+    else:  # GeneratorExit and the like
+        raise error
+    return 1
+
+
+def _exit_now_if_the_program(status: int) -> None:
+    """Exit with ``status`` at once when the tool is the program. A KeyboardInterrupt that
+    passed through code run by PyRun_* (an extension module's start-up) leaves a flag by
+    which the interpreter, at its end, kills itself with SIGINT (status -2) however the
+    exception was handled; nothing is left to clean up here (the outputs are discarded)."""
+    from irb140_dynamics.tools import AS_PROGRAM
+
+    if AS_PROGRAM:
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(OSError, ValueError):
+                stream.flush()
+        os._exit(status)
 
 
 def _describe(error: BaseException) -> str:

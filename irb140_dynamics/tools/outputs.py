@@ -83,6 +83,9 @@ class Outputs:
         here on no longer interrupts: the tool has finished its work."""
         with signals_held():
             if self.interrupts is not None:
+                if self.interrupts.received is not None:  # a Ctrl-C that library code swallowed
+                    self.discard()
+                    raise KeyboardInterrupt
                 self.interrupts.finished = True
             written = []
             for temporary, target, typed in self._staged:

@@ -71,9 +71,12 @@ class Stop:
         self.previous = {s: signal.signal(s, self._on_signal) for s in self.SIGNALS}
 
     def restore(self) -> None:
-        """The handlers from before (main() called in a process that goes on)."""
+        """The handlers from before (main() called in a process that goes on); SIG_IGN when
+        the tool is the program (Python restores the default ones as it exits)."""
+        from irb140_dynamics.tools import AS_PROGRAM
+
         for s, handler in self.previous.items():
-            signal.signal(s, handler)
+            signal.signal(s, signal.SIG_IGN if AS_PROGRAM else handler)
 
     def _on_signal(self, signum, _frame) -> None:
         self.signals.append(signum)

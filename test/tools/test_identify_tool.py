@@ -285,3 +285,52 @@ def test_progress_bar_ends_at_100_percent_on_its_own_line():
     assert len(frames) == 2  # the first and the last: the others fall within the interval
     assert frames[0].startswith("reading run.mcap: [") and " 0 % 0/1,000 samples" in frames[0]
     assert "[" + "#" * 30 + "] 100 % 1,000/1,000 samples" in frames[1] and frames[1].endswith("\n")
+
+
+def test_plots_and_result_are_written_together_or_not_at_all(workflow, tmp_path, monkeypatch, capsys):
+    """A plot that cannot be written (here: the second fails) leaves neither the result nor
+    the first plot, nor a temporary file or the plots folder made for them."""
+    import irb140_dynamics.identification.plots as plots
+
+    real = plots.write_plots
+
+    def failing(result, save):
+        calls = []
+
+        def second_fails(name, write):
+            calls.append(name)
+            if len(calls) == 2:
+                raise OSError(28, "No space left on device")
+            save(name, write)
+
+        return real(result, second_fails)
+
+    monkeypatch.setattr(plots, "write_plots", failing)
+    out, folder = tmp_path / "o.yaml", tmp_path / "new" / "plots"
+    assert identify_tool.main([str(workflow["bag"]), "--out", str(out), "--plots", str(folder), "--quiet"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("identify: error: ") and "No space left" in err[0], err
+    assert list(tmp_path.iterdir()) == [], list(tmp_path.rglob("*"))
+
+
+def test_arguments_and_outputs_are_checked_before_the_recording_is_read(workflow, tmp_path, monkeypatch, capsys):
+    import irb140_dynamics.identification.pipeline as pipeline
+
+    monkeypatch.setattr(pipeline, "identify", lambda *a, **k: pytest.fail("the recording was read"))
+    afile = tmp_path / "afile"
+    afile.write_text("")
+    cases = [
+        (["--out", "/proc/o.yaml"], "identify: error: /proc/o.yaml: cannot write in /proc"),
+        (["--out", f"{afile}/o.yaml"], f"identify: error: {afile}/o.yaml: {afile} is not a directory"),
+        (["--out", str(tmp_path)], f"identify: error: {tmp_path}: is a directory"),
+        (["--out", f"{tmp_path}/o.yaml", "--plots", f"{afile}/p"], f"{afile}/p: {afile} is not a directory"),
+        (["--out", f"{tmp_path}/o.yaml", "--cutoff", "inf"], "argument --cutoff: must be a finite number, got 'inf'"),
+        (["--out", f"{tmp_path}/o.yaml", "--held-out", "1"], "--held-out: must be < 1, got 1"),
+        (["--out", f"{tmp_path}/o.yaml", "--prior-weight", "-1"], "argument --prior-weight: must be > 0, got -1"),
+        (["--out", f"{tmp_path}/o.yaml", "--min-speed", "nan"], "argument --min-speed: must be a finite number"),
+    ]
+    for args, problem in cases:
+        assert identify_tool.main([str(workflow["bag"]), *args, "--quiet"]) in (1, 2)
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and problem in err[0], (args, err)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
