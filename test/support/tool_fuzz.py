@@ -187,8 +187,9 @@ class ToolFuzzer:
 
 
 def snapshot(folder: Path) -> dict[str, float]:
-    """Every file and folder under ``folder`` (hidden ones too), with its modification time."""
-    return {str(p.relative_to(folder)): p.stat().st_mtime for p in folder.rglob("*")}
+    """Every file and folder under ``folder`` (hidden ones too), a file with its modification
+    time (a folder's changes when the tools try it for writing: a file made and removed)."""
+    return {str(p.relative_to(folder)): 0.0 if p.is_dir() else p.stat().st_mtime for p in folder.rglob("*")}
 
 
 def run_case(case: Case, folder: Path) -> tuple[int, str, str]:
