@@ -184,7 +184,7 @@ def _executor(node):
         from rclpy.experimental import EventsExecutor
 
         executor = EventsExecutor(context=node.context)
-    except ImportError:
+    except (ImportError, OSError, ValueError):  # (it enables faulthandler: a stderr without a file fails)
         from rclpy.executors import SingleThreadedExecutor
 
         executor = SingleThreadedExecutor(context=node.context)

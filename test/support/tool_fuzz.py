@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-NUMBERS_BAD = ["nan", "inf", "-inf", "-5", "1e300", "-1e-300", "abc", "", "0x10", "1e", "--", "1,5", "\u0661"]
+NUMBERS_BAD = ["nan", "inf", "-inf", "-5", "1e300", "-1e-300", "abc", "", "0x10", "1e", "--", "1,5"]
 INTEGERS_BAD = ["nan", "-5", "1.5", "1e9999", "", "abc", str(2**70), "0x10"]
 OUTPUTS_BAD = [
     "/proc/out.yaml",
@@ -173,7 +173,7 @@ class ToolFuzzer:
 
     def record(self, bad: bool) -> Case:  # always bad: a good one would wait for a publisher
         options = {
-            "--out": (["bag"], OUTPUTS_BAD + ["afile", "folder"]),
+            "--out": (["bag"], [x for x in OUTPUTS_BAD if not x.startswith("missing/")] + ["afile", "folder"]),
             "--topic": (["/joint_states"], TOPICS_BAD),
             "--duration": (["1"], NUMBERS_BAD),
             "--depth": (["10"], INTEGERS_BAD + ["0"]),
