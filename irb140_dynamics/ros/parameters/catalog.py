@@ -8,6 +8,8 @@ NODE_PARAMETER_NAMES = frozenset(
     {
         "acceleration.cutoff_frequency",
         "acceleration.mode",
+        "check.analysis_timeout",
+        "check.wait_timeout",
         "collision.observer_gain",
         "command_timeout",
         "diagnostics.period",
