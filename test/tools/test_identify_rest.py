@@ -16,6 +16,8 @@ from irb140_dynamics.tools import identify as identify_tool
 
 from ..support.synthetic_arm import NOISE, QUANTUM, Samples, true_arm, write_csv
 
+pytestmark = pytest.mark.slow  # the fixture simulates 25 s of an arm and identifies it
+
 RATE, PERIOD, PERIODS = 250.0, 4.0, 3
 BEFORE, AFTER = 5.0, 8.0  # s of rest: the last 20 % of the samples are all rest
 
