@@ -1,4 +1,4 @@
-"""Ctrl-C (or SIGTERM) at any moment of identify and excitation, as processes: one line
+"""Ctrl-C (or SIGTERM) at any moment of identify, excitation and export_urdf, as processes: one line
 ('<tool>: interrupted'), no traceback, exit 130 (143), and no output left behind (no
 result, no plot, no temporary file, no folder made for them); or, when the signal came
 after the tool finished its work, exit 0 with every output whole. Seeded moments from
@@ -121,4 +121,18 @@ def test_excitation_interrupted_at_any_moment(tmp_path, delay, signals):
         assert left == ["excitation.yaml"] and "wrote excitation.yaml" in output, output
         return
     assert code == 128 + signals[0] and output.count("excitation: interrupted") == 1, output
+    assert left == [], left
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("delay, signals", list(moments(9, 3, 3.0)))
+def test_export_urdf_interrupted_at_any_moment(tmp_path, delay, signals):
+    command = [sys.executable, "-m", "irb140_dynamics.tools.export_urdf", "--out", "arm.urdf"]
+    code, output = interrupted(command, tmp_path, delay, signals)
+    assert "Traceback" not in output, output
+    left = sorted(p.name for p in tmp_path.iterdir())
+    if code == 0:
+        assert left == ["arm.urdf"] and "wrote arm.urdf" in output, output
+        return
+    assert code == 128 + signals[0] and output.count("export_urdf: interrupted") == 1, output
     assert left == [], left
