@@ -23,6 +23,7 @@ step went without its command, none had two, and id_node's clock read each state
 
 import os
 import re
+import shlex
 import sys
 import time
 
@@ -50,7 +51,7 @@ PERIOD = round(1e9 / RATE)  # ns
 EXCITATION_PERIOD = 5.0  # s
 DEMO_PERIOD = 8.0  # s: demo_node's default motion
 TRACKED = 4.0  # s of it compared: out to its far end
-TAIL = 1.0  # s recorded after the excitation
+TAIL = 1.0  # s recorded after the excitation: record's default --tail
 ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 HOLD = 0.5  # s of simulated time the arm is held still after a reset: the reference arrives meanwhile
 SIM = [
@@ -79,6 +80,21 @@ CONTROLLER = [
 
 def tool(name: str, *args: str) -> list[str]:
     return [sys.executable, "-m", f"irb140_dynamics.tools.{name}", *args]
+
+
+def doc_commands() -> dict[str, list[str]]:
+    """The excitation, record and identify command lines of docs/sim.md's walkthrough, as
+    typed (after `ros2 run irb140_dynamics`): what this test runs."""
+    text = (ROOT / "docs" / "sim.md").read_text()
+    section = text.split("## Record, identify, track better")[1].split("\n## ")[0]
+    commands = {}
+    for line in re.sub(r"\\\n\s*", " ", section).splitlines():
+        found = re.match(r"\s*ros2 run irb140_dynamics (excitation|record|identify) (.*)", line.split(" #")[0])
+        if found:
+            commands[found[1]] = shlex.split(found[2])
+    assert sorted(commands) == ["excitation", "identify", "record"], commands
+    assert "--reference" in commands["record"] and "--ros-args" in commands["record"], commands["record"]
+    return commands
 
 
 def trajectory_message(path) -> JointTrajectory:
@@ -234,21 +250,15 @@ def processes():
 def test_identified_from_a_ros_recording_tracks_five_times_better(probe, processes, tmp_path):  # noqa: F811
     began = time.monotonic()
     excitation_file, bag, identified = tmp_path / "excitation.yaml", tmp_path / "run", tmp_path / "identified.yaml"
-    code, output = run_to_exit(
-        tool(
-            "excitation",
-            "--out",
-            str(excitation_file),
-            "--period",
-            str(EXCITATION_PERIOD),
-            "--rate",
-            "50",
-            "--iterations",
-            "0",
-            "--seed",
-            "2",
-        )
-    )
+    typed = doc_commands()  # the tools' command lines as docs/sim.md gives them, its file names ours
+    where = {
+        "excitation.yaml": str(excitation_file),
+        "run": str(bag),
+        "run/": f"{bag}/",
+        "identified.yaml": str(identified),
+    }
+    typed = {name: [where.get(arg, arg) for arg in args] for name, args in typed.items()}
+    code, output = run_to_exit(tool("excitation", *typed["excitation"]))
     assert code == 0, output
     excitation = trajectory_message(excitation_file)
     start_pose = list(excitation.points[0].positions)  # where the recording starts: no motion to get there
@@ -257,20 +267,7 @@ def test_identified_from_a_ros_recording_tracks_five_times_better(probe, process
     )
     controller = processes(module_command("irb140_dynamics.nodes.id_node.node", *CONTROLLER))
     # as docs/sim.md: record started before the motion, it stops by itself TAIL s after the motion's end
-    recorder = processes(
-        tool(
-            "record",
-            "--out",
-            str(bag),
-            "--reference",
-            "/id_node/reference",
-            "--tail",
-            str(TAIL),
-            "--ros-args",
-            "-p",
-            "use_sim_time:=true",
-        )
-    )
+    recorder = processes(tool("record", *typed["record"]))
     loop = Loop(probe)
     lines = []
     assert wait_for_line(recorder, "recording /joint_states", lines, TIMEOUT), "".join(lines)
@@ -280,7 +277,7 @@ def test_identified_from_a_ros_recording_tracks_five_times_better(probe, process
     output = "".join(lines) + output
     assert recorder.returncode == 0 and f"wrote {bag}" in output and "after the end of the motion" in output, output
     # one BLAS thread: OpenBLAS's threads spin for the cores the nodes need (4 s of CPU become 30)
-    identify = processes(tool("identify", str(bag), "--out", str(identified), "--quiet"), ONE_THREAD)
+    identify = processes(tool("identify", *typed["identify"]), ONE_THREAD)
 
     demo = reference_message(DEMO_PERIOD)
     before, checked_before = loop.check_lockstep(irb140(), demo, loop.move(demo, TRACKED))
