@@ -147,12 +147,16 @@ def _spin(argv: list[str], args, out, stop: Stop) -> int:
         try:
             why = _loop(recorder, stop)
         finally:  # whatever happened: the bag closed whole (signals only set flags meanwhile)
-            summary = recorder.close()
+            try:
+                summary = recorder.close()
+            except (OSError, ValueError) as error:  # a full disk
+                recorder.failure = recorder.failure or f"{args.out}: cannot close the bag ({error})"
             recorder.destroy_node()
     finally:
         rclpy.try_shutdown()
     print(f"stopped: {why}", file=sys.stderr, flush=True)
-    print(summary, flush=True)
+    if summary is not None:
+        print(summary, flush=True)
     if recorder.failure:
         _say(f"record: error: {recorder.failure}")
         return 1
