@@ -308,9 +308,9 @@ def _is_number(text: str) -> bool:
 
 
 def _scan(path: Path) -> int:
-    """A CSV file's lines, counted in blocks; a line over CSV_LINE_LIMIT bytes or a NUL byte
-    (binary data) refused before anything is parsed."""
-    lines, carry = 0, 0  # newlines so far, bytes of the line in progress
+    """A CSV file's non-blank lines, counted in blocks; a line over CSV_LINE_LIMIT bytes or a
+    NUL byte (binary data) refused before anything is parsed."""
+    lines, carry, pending = 0, 0, False  # non-blank lines ended, bytes and content of the open one
     try:
         with open(path, "rb") as stream:
             while block := stream.read(1 << 20):
@@ -323,8 +323,11 @@ def _scan(path: Path) -> int:
                             path,
                             f"line {lines + k + 1}: longer than {CSV_LINE_LIMIT} bytes: not a CSV file of joint states",
                         )
-                lines += len(parts) - 1
-                carry = len(parts[-1]) + (carry if len(parts) == 1 else 0)
+                if len(parts) > 1:
+                    lines += (pending or bool(parts[0].strip())) + sum(1 for x in parts[1:-1] if x.strip())
+                    carry, pending = len(parts[-1]), bool(parts[-1].strip())
+                else:
+                    carry, pending = carry + len(parts[0]), pending or bool(parts[0].strip())
     except OSError as error:
         raise RecordingError(path, f"cannot be read ({error.strerror})") from None
-    return lines + (1 if carry else 0)
+    return lines + pending
