@@ -24,8 +24,14 @@ EARLY_SIGNALS: list[int] = []
 
 
 def _started_as_a_tool() -> bool:
+    """Is one of TOOL_SCRIPTS the program: its console script, or ``python -m`` of its module?
+    (Other tools of the package handle Ctrl-C their own way: for them nothing is installed.)"""
     program = os.path.basename(sys.argv[0]) if sys.argv else ""
-    return program == "-m" or program in TOOL_SCRIPTS or program.startswith("irb140-")
+    if program == "-m":  # runpy is importing the package on its way to the module
+        original = list(getattr(sys, "orig_argv", []))
+        module = original[original.index("-m") + 1] if "-m" in original[:-1] else ""
+        return module in {f"{__name__}.{name}" for name in TOOL_SCRIPTS}
+    return program in TOOL_SCRIPTS or program in {f"irb140-{name.replace('_', '-')}" for name in TOOL_SCRIPTS}
 
 
 AS_PROGRAM = _started_as_a_tool()  # then signals are ignored once main() is done (interpreter exit)

@@ -192,8 +192,16 @@ def payload_family(model: RobotModel, payload: RigidBody) -> PayloadFamily:
 
     Built once per arm and shape (the last FAMILIES remembered): the two models validate
     the CoM and inertia (ModelError naming ``payload.com`` or ``payload.inertia``) and
-    compile their kernels then.
+    compile their kernels then. ValueError starting "UNPROVEN:" for an arm with a prismatic
+    joint: the worst-case proof (harmonic sums in the joint angles) does not cover them.
     """
+    sliding = [j.name for j in model.joints if j.prismatic]
+    if sliding:
+        more = f" (and {len(sliding) - 1} more)" if len(sliding) > 1 else ""
+        raise ValueError(
+            f"UNPROVEN: the payload check's worst-case proof covers revolute joints only; joint "
+            f"{sliding[0][:100]!r}{more} is prismatic"
+        )
     arm = tuple(getattr(model, f.name) for f in fields(model) if f.name != "payload")
     key = (arm, tuple(payload.com), tuple(payload.inertia))
     with _LOCK:

@@ -35,8 +35,10 @@ NODE_PARAMETER_NAMES = frozenset(
         "rated_payload.mass",
         "reference_timeout",
         "reset_hold",
+        "retime.grid",
         "substeps",
         "thread_priority",
+        "watch_topic",
     }
 )
 # per-joint parameters of a node: <joint><suffix>
