@@ -34,6 +34,11 @@ setup(
             "equations = irb140_dynamics.tools.equations:main",
             "retime = irb140_dynamics.tools.retime:main",
             "trajectory_check_node = irb140_dynamics.nodes.trajectory_check_node.node:main",
+            # the tools under names of their own, for an install without the ros2 CLI (pip)
+            "irb140-export-urdf = irb140_dynamics.tools.export_urdf:main",
+            "irb140-identify = irb140_dynamics.tools.identify:main",
+            "irb140-excitation = irb140_dynamics.tools.excitation:main",
+            "irb140-record = irb140_dynamics.tools.record:main",
         ],
     },
 )

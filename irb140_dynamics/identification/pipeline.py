@@ -1,23 +1,22 @@
-"""Identification of a recording, end to end: read, filter, accumulate, estimate, validate.
+"""Identification of a recording, end to end: read, filter, select, accumulate, estimate, validate.
 
-One pass over the recording, chunk by chunk. Fit points (``signals``) before the held-out
-part go into the training normal equations, the others into the held-out ones (the last
-``held_out`` fraction of the samples, or a second recording): any parameter vector's
-held-out RMS error then follows from those sums exactly, so nothing has to be read twice.
-A torque row is left out when its joint is too slow for the Coulomb model: |qd| below
-``min_speed`` (default 3 smoothing velocities, where tanh is 99.5 % of its level) anywhere
-in the filter window, judged by |qd| < min_speed + |qdd| half-window (min_speed 0: every row
-is used): there a joint may be
-stuck (stiction holds it at any torque within the Coulomb level), which the model does not
-describe; such rows would bias the friction and everything correlated with it.
+One pass over the recording, chunk by chunk, turns the samples into fit points
+(``signals``: filtered and decimated to about 4 cut-offs per second). A torque row is left
+out when its joint is too slow for the Coulomb model: |qd| below ``min_speed`` (default 3
+smoothing velocities, where tanh is 99.5 % of its level) anywhere in the filter window,
+judged by |qd| < min_speed + |qdd| half-window. Then ``selection`` trims the rest at both
+ends of the recording and holds out the last ``held_out`` fraction of the points that
+move (or uses a second recording, trimmed alike): the others go into the training normal
+equations, the held-out ones into theirs, so that any parameter vector's held-out RMS
+error follows from those sums exactly. Memory holds one chunk of samples, the fit points
+(``FitPoints``: (4 n + 2) doubles each, some 30 MB per hour of a 6-joint recording at the
+default cut-off), the sums and at most ``plot_points`` held-out points for the plots.
 
 The estimate's covariance is scaled by the measured correlation of its residuals
 (``correlation``: on a real arm, what the model lacks correlates them far more than the
 filter does), so that the pull toward the prior is weighed against what the data really
 tell. With ``offsets``, each joint's torque gets a constant offset (a torque sensor's
 bias), fitted and eliminated from the sums (``NormalEquations.centred``); off by default.
-Memory holds one chunk, the sums, at most ``plot_points`` held-out fit points for the plots
-and the first ``correlation_points`` training fit points.
 """
 
 from __future__ import annotations
@@ -40,6 +39,7 @@ from irb140_dynamics.identification.consistent import (
 from irb140_dynamics.identification.correlation import residual_correlation
 from irb140_dynamics.identification.least_squares import Estimate, NormalEquations, weighted_least_squares
 from irb140_dynamics.identification.recording import CHUNK_SIZE, DEFAULT_TOPIC, Recording, RecordingError
+from irb140_dynamics.identification.selection import Selection, rows_used, select
 from irb140_dynamics.identification.signals import DEFAULT_CUTOFF, Differentiator, FilterDesign, FitPoints, _joined
 
 SLOW_SPEEDS = 3.0  # min_speed in smoothing velocities
@@ -70,9 +70,15 @@ class SampleTally:
     invalid: int = 0  # a missing (effort, velocity) or non-finite value
     edges: int = 0  # within half a filter window of a gap or an end
     fit_points: int = 0
-    slow_rows: np.ndarray | None = None  # per joint
+    slow_rows: np.ndarray | None = None  # per joint, among the selected fit points
     design: FilterDesign | None = None
     has_velocity: bool = False
+    selection: Selection | None = None  # of the fit points: rest trimmed, held-out part
+    start: float = 0.0  # s: the first and last valid sample's times
+    end: float = 0.0
+    rest_start: float = 0.0  # s of rest trimmed before the first moving fit point
+    rest_end: float = 0.0  # and after the last
+    held_from: float = 0.0  # s from the start: where the held-out part begins (== span end: none)
 
     @property
     def used(self) -> int:
@@ -119,61 +125,65 @@ def identify(
         raise ValueError(
             f"prior_weight must be > 0 and min_speed >= 0, got {settings.prior_weight}, {settings.min_speed}"
         )
-    base = find_base_parameters(prior)
     P = 13 * prior.n
     train, held_out = NormalEquations(prior.n, P), NormalEquations(prior.n, P)
     min_speed = settings.min_speed if settings.min_speed is not None else SLOW_SPEEDS * prior.smoothing_velocity
-    keeper = _Keeper(settings.plot_points, settings.correlation_points)
     recordings = [Recording(path, prior.joint_names, settings.topic, settings.chunk_size)]
     if validate is not None:
         recordings.append(Recording(validate, prior.joint_names, settings.topic, settings.chunk_size))
-    tallies = []
+    tallies, held_points, training_points = [], None, None
     for k, recording in enumerate(recordings):
-        if validate is None:
-            if recording.total <= 0:
-                raise RecordingError(
-                    recording.path,
-                    "it does not tell how many messages it holds, so its last "
-                    f"{100 * settings.held_out:g} % cannot be held out: validate with --validate",
-                )
-            split = int(round(recording.total * (1.0 - settings.held_out)))
-        else:
-            split = np.iinfo(np.int64).max if k == 0 else 0
-        tallies.append(_accumulate(prior, recording, split, (train, held_out), min_speed, settings, keeper, progress))
+        tally, points = _read(prior, recording, settings, progress)
+        fraction = settings.held_out if validate is None else (0.0 if k == 0 else 1.0)
+        held, training = _accumulate(
+            prior, tally, points, fraction, min_speed, (train, held_out), settings.correlation_points
+        )
+        held_points = held if held is not None else held_points
+        training_points = training if k == 0 else training_points
+        tallies.append(tally)
     for tally, equations, use in ((tallies[0], train, "to fit"), (tallies[-1], held_out, "to validate")):
         if equations.rows.sum() == 0:
-            raise RecordingError(tally.path, _nothing_usable(tally, use))
+            raise RecordingError(tally.path, _nothing_usable(tally, use, min_speed))
+    base = find_base_parameters(prior)  # after the recordings are read: a bad one is refused at once
     filter_correlation = tallies[0].design.noise_correlation()
     estimate = weighted_least_squares(train.centred() if settings.offsets else train, base, filter_correlation)
     beta_offsets = (train.t - train.s[:, base.independent] @ estimate.beta) / np.maximum(train.rows, 1)
-    correlation, _ = residual_correlation(
-        prior, base, estimate.beta, *keeper.training(), beta_offsets if settings.offsets else None, filter_correlation
-    )
+    correlation = filter_correlation
+    if training_points is not None:
+        half_window = tallies[0].design.half / tallies[0].design.rate
+        use = rows_used(training_points.qd, training_points.qdd, min_speed, half_window)
+        correlation, _ = residual_correlation(
+            prior,
+            base,
+            estimate.beta,
+            training_points,
+            use,
+            beta_offsets if settings.offsets else None,
+            filter_correlation,
+        )
     estimate = replace(estimate, covariance=estimate.covariance * (correlation / filter_correlation))
     fit = consistent_parameters(prior, base, estimate, settings.prior_weight)
     offsets = train.offsets(fit.pi) if settings.offsets else None
     check = physical_check(prior, base, estimate, fit)
-    source = str(validate) if validate is not None else f"the last {100 * settings.held_out:g} % of the recording"
+    source = (
+        f"{validate} (rest trimmed)"
+        if validate is not None
+        else f"the last {100 * settings.held_out:g} % of the moving fit points of the recording"
+    )
+    plots = (
+        None
+        if held_points is None
+        else held_points.take(slice(None, None, _every(len(held_points), settings.plot_points)))
+    )
     return Result(
-        prior,
-        fit.model,
-        base,
-        estimate,
-        fit,
-        train,
-        held_out,
-        tallies,
-        keeper.points(),
-        source,
-        check,
-        correlation,
-        offsets,
+        prior, fit.model, base, estimate, fit, train, held_out, tallies, plots, source, check, correlation, offsets
     )
 
 
-def _accumulate(prior, recording, split, where, min_speed, settings, keeper, progress) -> SampleTally:
+def _read(prior, recording, settings, progress) -> tuple[SampleTally, FitPoints | None]:
+    """A recording's fit points (all of them, in order) and its tally."""
     tally = SampleTally(str(recording.path), recording.total, slow_rows=np.zeros(prior.n, dtype=np.int64))
-    differentiator, pending = None, []
+    differentiator, parts, times = None, [], []
     if progress:
         progress(tally.path, 0, tally.expected)
     for chunk in recording.chunks():
@@ -182,38 +192,73 @@ def _accumulate(prior, recording, split, where, min_speed, settings, keeper, pro
             design = FilterDesign.of(_rate(recording, chunk), settings.cutoff)
             tally.design, tally.has_velocity = design, bool(np.isfinite(chunk.velocity).all())
             differentiator = Differentiator(design, prior.n, tally.has_velocity)
-            keeper.expect(max(recording.total - min(split, recording.total), 0) / design.stride)
+        finite = chunk.time[np.isfinite(chunk.time)]
+        if len(finite):
+            times += [float(finite.min()), float(finite.max())]
         points = differentiator.push(chunk)
         if points is not None:
-            pending.append(points)
-            if sum(len(p) for p in pending) >= FIT_BATCH:
-                _add(prior, _joined(pending), split, where, min_speed, tally, keeper)
-                pending = []
+            parts.append(points)
         if progress:
             progress(tally.path, tally.read + sum(recording.skipped.values()), tally.expected)
-    if pending:
-        _add(prior, _joined(pending), split, where, min_speed, tally, keeper)
     if differentiator is not None:
         differentiator.finish()
         tally.invalid, tally.edges = differentiator.invalid_samples, differentiator.edge_samples
     tally.skipped = recording.skipped
-    return tally
+    if times:
+        tally.start, tally.end = min(times), max(times)
+    points = _joined(parts)
+    tally.fit_points = 0 if points is None else len(points)
+    return tally, points
 
 
-def _add(prior, points: FitPoints, split, where, min_speed, tally, keeper) -> None:
-    tally.fit_points += len(points)
-    Y = regressor_batch(prior, points.q, points.qd, points.qdd)
+def _accumulate(
+    prior,
+    tally: SampleTally,
+    points: FitPoints | None,
+    held_out: float,
+    min_speed: float,
+    where: tuple[NormalEquations, NormalEquations],
+    training_limit: int,
+) -> tuple[FitPoints | None, FitPoints | None]:
+    """Select ``points`` (rest trimmed, the last ``held_out`` fraction of the moving ones held
+    out), add them to the training and held-out sums ``where``; the held-out points, and the
+    first ``training_limit`` training points (for the residuals' correlation)."""
+    if points is None or len(points) == 0:
+        return None, None
     half_window = tally.design.half / tally.design.rate
-    use = np.abs(points.qd) >= min_speed + np.abs(points.qdd) * half_window if min_speed > 0 else np.isfinite(points.qd)
+    moves = rows_used(points.qd, points.qdd, min_speed, half_window).any(axis=1)
+    selection = tally.selection = select(moves, held_out)
+    if selection is None:
+        return None, None
+    tally.rest_start = float(points.time[selection.first] - tally.start)
+    tally.rest_end = float(tally.end - points.time[selection.end - 1])
+    tally.held_from = float(points.time[min(selection.split, selection.end - 1)] - tally.start)
+    for part, equations in ((selection.train, where[0]), (selection.held, where[1])):
+        for batch in range(part.start, part.stop, FIT_BATCH):
+            _add(
+                prior,
+                points.take(slice(batch, min(batch + FIT_BATCH, part.stop))),
+                min_speed,
+                half_window,
+                tally,
+                equations,
+            )
+    held = points.take(selection.held) if selection.split < selection.end else None
+    train = selection.train
+    first = slice(train.start, min(train.stop, train.start + training_limit))
+    return held, (points.take(first) if first.stop > first.start else None)
+
+
+def _add(prior, points: FitPoints, min_speed, half_window, tally, equations: NormalEquations) -> None:
+    Y = regressor_batch(prior, points.q, points.qd, points.qdd)
+    use = rows_used(points.qd, points.qdd, min_speed, half_window)
     tally.slow_rows += np.sum(~use, axis=0)
-    training = int(np.searchsorted(points.index, split))  # the points are in the recording's order
-    for part, equations in ((slice(0, training), where[0]), (slice(training, None), where[1])):
-        if len(points.index[part]):
-            equations.add(Y[part], points.tau[part], use[part])  # views, not copies
-    if training < len(points):
-        keeper.add(points.take(slice(training, None)))
-    if training > 0:
-        keeper.add_training(points.take(slice(0, training)), use[:training])
+    equations.add(Y, points.tau, use)
+
+
+def _every(count: int, limit: int) -> int:
+    """The step that keeps at most about ``limit`` of ``count`` points."""
+    return max(1, -(-count // max(limit, 1)))
 
 
 def _rate(recording: Recording, chunk) -> float:
@@ -224,44 +269,18 @@ def _rate(recording: Recording, chunk) -> float:
     return 1.0 / float(np.median(steps))
 
 
-def _nothing_usable(tally: SampleTally, use: str) -> str:
+def _nothing_usable(tally: SampleTally, use: str, min_speed: float) -> str:
     if tally.read == 0:
         reasons = ", ".join(f"{count} {kind.replace('_', ' ')}" for kind, count in tally.skipped.items())
         return f"no usable joint states of the model's joints ({reasons or 'no messages'})"
     if tally.invalid == tally.read:
         return "no sample has efforts (and positions) for every joint of the model"
+    if tally.fit_points and tally.selection is None:
+        return (
+            f"nothing moves: every joint is slower than {min_speed:.3g} rad/s throughout ({tally.read} samples); "
+            "record a motion (or lower --min-speed)"
+        )
     return (
         f"no torque rows left {use}: {tally.read} samples, {tally.invalid} without effort, {tally.edges} at "
         f"gaps and ends, the rest too slow; record a longer, faster motion"
     )
-
-
-class _Keeper:
-    """Every k-th held-out fit point, at most about ``limit`` of them; the first
-    ``training_limit`` training fit points and their used rows."""
-
-    def __init__(self, limit: int, training_limit: int):
-        self.limit, self.every, self.parts, self.seen = limit, 1, [], 0
-        self.training_limit, self.training_parts, self.training_use, self.training_count = training_limit, [], [], 0
-
-    def add_training(self, points: FitPoints, use: np.ndarray) -> None:
-        room = self.training_limit - self.training_count
-        if room > 0:
-            self.training_parts.append(points.take(slice(0, room)))
-            self.training_use.append(use[:room])
-            self.training_count += len(self.training_parts[-1])
-
-    def training(self) -> tuple[FitPoints, np.ndarray]:
-        return _joined(self.training_parts), np.concatenate(self.training_use)
-
-    def expect(self, count: float) -> None:
-        self.every = max(1, int(np.ceil(count / max(self.limit, 1))))
-
-    def add(self, points: FitPoints) -> None:
-        keep = (self.seen + np.arange(len(points))) % self.every == 0
-        self.seen += len(points)
-        if keep.any() and sum(len(p) for p in self.parts) < 2 * self.limit:
-            self.parts.append(points.take(keep))
-
-    def points(self) -> FitPoints | None:
-        return _joined(self.parts)

@@ -2,16 +2,21 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 
 from irb140_dynamics.core.regressor import inertial_parameters, regressor_batch
 from irb140_dynamics.identification.pipeline import Result
 
+Save = Callable[[str, Callable[[BinaryIO], None]], None]  # (file name, writer of its bytes)
 
-def write_plots(result: Result, directory) -> list[Path]:
-    """torques.png and residuals.png of the held-out fit points in ``directory``; their paths."""
+
+def write_plots(result: Result, directory) -> list[str]:
+    """torques.png and residuals.png of the held-out fit points, in ``directory`` or, when it
+    is a ``Save`` function, through it (the tools stage them: all outputs or none); their names."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -20,8 +25,16 @@ def write_plots(result: Result, directory) -> list[Path]:
     points = result.plot_points
     if points is None or len(points) == 0:
         return []
-    directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
+    if callable(directory):
+        save = directory
+    else:
+        folder = Path(directory)
+        folder.mkdir(parents=True, exist_ok=True)
+
+        def save(name, write):
+            with open(folder / name, "wb") as stream:
+                write(stream)
+
     order = np.argsort(points.time)
     time = points.time[order] - points.time[order][0]
     Y = regressor_batch(result.prior, points.q[order], points.qd[order], points.qdd[order])
@@ -29,7 +42,7 @@ def write_plots(result: Result, directory) -> list[Path]:
     predicted = {"prior": Y @ inertial_parameters(result.prior), "identified": Y @ result.fit.pi}
     names = result.prior.joint_names
     n = len(names)
-    paths = []
+    written = []
     for kind in ("torques", "residuals"):
         figure, axes = plt.subplots(n, 1, figsize=(11, 2.0 * n + 1), sharex=True, squeeze=False)
         for j, axis in enumerate(axes[:, 0]):
@@ -61,8 +74,9 @@ def write_plots(result: Result, directory) -> list[Path]:
         axes[0, 0].set_title(f"{kind.capitalize()} on held-out data: {result.held_out_source}")
         axes[-1, 0].set_xlabel("time [s] (held-out fit points)")
         figure.tight_layout()
-        path = directory / f"{kind}.png"
-        figure.savefig(path, dpi=110)
-        plt.close(figure)
-        paths.append(path)
-    return paths
+        try:
+            save(f"{kind}.png", lambda stream, figure=figure: figure.savefig(stream, format="png", dpi=110))
+        finally:
+            plt.close(figure)
+        written.append(f"{kind}.png")
+    return written

@@ -32,6 +32,7 @@ from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder
 JOINT_STATE = "sensor_msgs/msg/JointState"
 DEFAULT_TOPIC = "/joint_states"
 CHUNK_SIZE = 20_000
+CSV_LINE_LIMIT = 1 << 20  # bytes: a longer CSV line is refused (a joint-state row has a few hundred)
 BAG_SUFFIXES = (".mcap", ".db3")
 
 
@@ -234,11 +235,13 @@ class _CsvSource:
     def __init__(self, recording: Recording):
         self.recording = recording
         path = recording.path
+        if not path.is_file():
+            raise RecordingError(path, "not a regular file")
+        self.total = _scan(path) - 1
         try:
             with open(path, newline="") as stream:
                 header = next(csv.reader(stream), None)
-                self.total = sum(1 for line in stream if line.strip())
-        except (OSError, UnicodeDecodeError) as error:
+        except (OSError, UnicodeDecodeError, csv.Error) as error:
             raise RecordingError(path, f"cannot be read ({error})") from None
         if not header:
             raise RecordingError(path, "empty: expected a header row (time, position_<joint>, ..., effort_<joint>)")
@@ -255,6 +258,12 @@ class _CsvSource:
         self.width = len(header)
 
     def chunks(self) -> Iterator[RawChunk]:
+        try:
+            yield from self._chunks()
+        except (OSError, UnicodeDecodeError, csv.Error) as error:
+            raise RecordingError(self.recording.path, f"cannot be read ({error})") from None
+
+    def _chunks(self) -> Iterator[RawChunk]:
         recording, n = self.recording, self.recording.n
         first = 0
         with open(recording.path, newline="") as stream:
@@ -286,7 +295,10 @@ class _CsvSource:
             try:
                 rows.append([float(row[i]) if row[i].strip() else np.nan for i in self.columns])
             except ValueError:
-                raise RecordingError(self.recording.path, f"line {first_line + k}: not a number in {row}") from None
+                bad = next(row[i] for i in self.columns if not _is_number(row[i]))
+                raise RecordingError(
+                    self.recording.path, f"line {first_line + k}: not a number: {bad[:40]!r}"
+                ) from None
         return np.array(rows, dtype=float).reshape(-1, len(self.columns))
 
 
@@ -311,3 +323,37 @@ def _column(where: dict, field: str, joint) -> int | None:
             if name in where:
                 return where[name]
     return None
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text) if text.strip() else None
+        return True
+    except ValueError:
+        return False
+
+
+def _scan(path: Path) -> int:
+    """A CSV file's non-blank lines, counted in blocks; a line over CSV_LINE_LIMIT bytes or a
+    NUL byte (binary data) refused before anything is parsed."""
+    lines, carry, pending = 0, 0, False  # non-blank lines ended, bytes and content of the open one
+    try:
+        with open(path, "rb") as stream:
+            while block := stream.read(1 << 20):
+                if b"\0" in block:
+                    raise RecordingError(path, "binary data (a NUL byte): not a CSV file")
+                parts = block.split(b"\n")
+                for k, part in enumerate(parts):
+                    if len(part) + (carry if k == 0 else 0) > CSV_LINE_LIMIT:
+                        raise RecordingError(
+                            path,
+                            f"line {lines + k + 1}: longer than {CSV_LINE_LIMIT} bytes: not a CSV file of joint states",
+                        )
+                if len(parts) > 1:
+                    lines += (pending or bool(parts[0].strip())) + sum(1 for x in parts[1:-1] if x.strip())
+                    carry, pending = len(parts[-1]), bool(parts[-1].strip())
+                else:
+                    carry, pending = carry + len(parts[0]), pending or bool(parts[0].strip())
+    except OSError as error:
+        raise RecordingError(path, f"cannot be read ({error.strerror})") from None
+    return lines + pending

@@ -18,7 +18,10 @@ def _count(x: int) -> str:
 
 def _tally_lines(tally: SampleTally, names) -> list[str]:
     left_out = tally.read - tally.used
-    reasons = [f"{_count(tally.invalid)} without effort (or another value)", f"{_count(tally.edges)} at gaps and ends"]
+    reasons = [
+        f"{_count(tally.invalid)} invalid (a value missing, not finite or beyond 1e6)",
+        f"{_count(tally.edges)} at gaps and ends",
+    ]
     lines = [
         f"{tally.path}: {_count(tally.read)} samples read, {_count(tally.used)} used, {_count(left_out)} left out "
         f"({', '.join(reasons)})"
@@ -39,6 +42,19 @@ def _tally_lines(tally: SampleTally, names) -> list[str]:
             f"{name} {100.0 * k / max(tally.fit_points, 1):.1f} %" for name, k in zip(names, tally.slow_rows)
         )
         lines.append(f"  torque rows too slow for Coulomb friction, left out: {slow}")
+    selection = tally.selection
+    if selection is not None:
+        span = tally.end - tally.start
+        motion = f"{tally.rest_start:.2f} s to {span - tally.rest_end:.2f} s of {span:.2f} s"
+        lines.append(
+            f"  motion: {motion} (rest trimmed: {tally.rest_start:.2f} s at the start, "
+            f"{tally.rest_end:.2f} s at the end)"
+        )
+        if 0 < selection.held_moving < selection.moving:
+            lines.append(
+                f"  held out from {tally.held_from:.2f} s on: the last {_count(selection.held_moving)} of "
+                f"{_count(selection.moving)} moving fit points"
+            )
     return lines
 
 
@@ -53,7 +69,10 @@ def summary(result: Result) -> str:
         f"base parameters: {result.base.count} of {len(result.base.names)}; condition number of the "
         f"base regressor: {estimate.condition_number:.1f}"
     )
-    lines.append(f"held out: {result.held_out_source} ({_count(int(result.held_out.rows.max()))} points)")
+    lines.append(
+        f"held out: {result.held_out_source} ({_count(int(result.held_out.rows.max()))} torque rows); "
+        "a fit point moves when a joint is fast enough to use its torque row"
+    )
     lines.append("")
     lines.append(
         f"{'joint':<12} {'peak [N m]':>10}   {'prior RMS [N m]':>15} {'(% peak)':>9}   "

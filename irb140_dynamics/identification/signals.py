@@ -13,8 +13,8 @@ The filtered signals carry nothing above f_c: they are kept at every ``stride``-
 only (about 4 f_c), which is what makes hour-long recordings cheap to fit.
 
 Samples must be evenly spaced: a step more than 50 % off the recording's median step (a
-gap, a repeated or out-of-order stamp), or a sample with a missing or non-finite value,
-ends a segment; the first and last half window of every segment cannot be filtered and
+gap, a repeated or out-of-order stamp), or a sample with a missing, non-finite or absurd
+value (beyond ``LARGEST``: no arm's, and its square would overflow the sums), ends a segment; the first and last half window of every segment cannot be filtered and
 are left out (counted in ``edge_samples``). Works chunk by chunk with a bounded buffer:
 the results are those of filtering each segment whole.
 """
@@ -31,6 +31,7 @@ from scipy.linalg import lstsq
 POLYORDER = 4
 DEFAULT_CUTOFF = 10.0  # Hz
 POINTS_PER_CUTOFF = 4.0  # fit points per second per Hz of cut-off
+LARGEST = 1e6  # rad, rad/s, N m: a larger value (or NaN) makes its sample invalid
 
 
 @dataclass(frozen=True)
@@ -96,7 +97,7 @@ class Differentiator:
         self.smooth, self.d1, self.d2 = (design.coefficients(d) for d in (0, 1, 2))
         self.step = 1.0 / design.rate
         self.edge_samples = 0  # left out: within half a window of a segment's ends
-        self.invalid_samples = 0  # left out: a missing or non-finite value
+        self.invalid_samples = 0  # left out: a missing, non-finite or absurd value
         self._segment = None  # (index, time, values (B, channels)) of the open segment, trimmed
         self._length = 0  # samples in the open segment so far
         self._next = 0  # position in the buffer of the next fit point
@@ -105,7 +106,8 @@ class Differentiator:
     def push(self, chunk) -> FitPoints | None:
         signals = [chunk.position, chunk.effort] + ([chunk.velocity] if self.has_velocity else [])
         values = np.hstack(signals)
-        valid = np.isfinite(values).all(axis=1) & np.isfinite(chunk.time)
+        with np.errstate(invalid="ignore"):
+            valid = (np.abs(values) <= LARGEST).all(axis=1) & np.isfinite(chunk.time)
         self.invalid_samples += int(np.sum(~valid))
         index = chunk.first + np.flatnonzero(valid)
         time, values = chunk.time[valid], values[valid]

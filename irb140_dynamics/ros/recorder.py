@@ -6,6 +6,12 @@ node's clock (simulated time with use_sim_time, as `ros2 bag record --use-sim-ti
 message type comes from the graph: the recorder waits until the topic has a publisher.
 Its subscription offers what every publisher gives: reliable when all of them are
 reliable, else best effort (as rosbag2 adapts).
+
+It finishes by itself (``finished`` says why) ``duration`` s after the first message, or
+``tail`` s after the end of the motion last sent on a ``reference`` topic (a
+JointTrajectory, as id_node follows it: from its header stamp, or from its arrival when
+unstamped; a single point, a hold, is no motion). Nothing here stops the process: the
+tool's loop reads ``finished`` and closes the bag.
 """
 
 from __future__ import annotations
@@ -39,14 +45,31 @@ def open_bag(path: Path):
 
 
 class Recorder(Node):
-    """Records ``topic`` into a new bag at ``out``, for ``duration`` s of the node's clock
-    after the first message (0: until Ctrl-C)."""
+    """Records ``topic`` into a new bag at ``out`` until ``finished`` (see the module's docstring)."""
 
-    def __init__(self, topic: str, out: Path, duration: float = 0.0, depth: int = DEFAULT_DEPTH, **kwargs):
+    def __init__(
+        self,
+        topic: str,
+        out: Path,
+        duration: float = 0.0,
+        depth: int = DEFAULT_DEPTH,
+        reference: str | None = None,
+        tail: float = 1.0,
+        **kwargs,
+    ):
         super().__init__("record", **kwargs)
-        if not duration >= 0.0:
-            raise ValueError(f"--duration: must be >= 0, got {duration}")
+        if not duration >= 0.0 or not tail >= 0.0:
+            raise ValueError(f"--duration and --tail: must be >= 0, got {duration}, {tail}")
         self.topic, self.out, self.duration, self.depth = self.resolve_topic_name(topic), Path(out), duration, depth
+        self.tail = tail
+        self.finished: str | None = None  # why the recording is complete
+        self.failure: str | None = None  # why it cannot go on (one line)
+        self.reference_end: int | None = None  # ns, node clock: where the last motion ends
+        if reference is not None:
+            from trajectory_msgs.msg import JointTrajectory
+
+            self.reference = self.resolve_topic_name(reference)
+            self.create_subscription(JointTrajectory, self.reference, self._on_reference, 10)
         self._writer = open_bag(self.out)
         self._connection = None
         self.count, self.first, self.last = 0, None, None  # messages, receive times [ns]
@@ -58,36 +81,79 @@ class Recorder(Node):
 
     def _subscribe_when_published(self) -> None:
         publishers = self.get_publishers_info_by_topic(self.topic)
-        if not publishers:
+        if not publishers or self.failure:
             return
         self._waiting.cancel()
         type_name = publishers[0].topic_type
         from rosbags.typesys import Stores, get_typestore
 
-        self._connection = self._writer.add_connection(
-            self.topic, type_name, typestore=get_typestore(Stores.ROS2_JAZZY)
-        )
+        try:
+            message = message_class(type_name)
+            self._connection = self._writer.add_connection(
+                self.topic, type_name, typestore=get_typestore(Stores.ROS2_JAZZY)
+            )
+        except Exception as error:  # noqa: BLE001  (an unknown type: rosbags and importlib raise many kinds)
+            self.failure = f"{self.topic}: cannot record its type {type_name} ({type(error).__name__}: {error})"
+            return
         reliable = all(p.qos_profile.reliability == ReliabilityPolicy.RELIABLE for p in publishers)
         qos = QoSProfile(
             depth=self.depth, reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT
         )
-        self.create_subscription(message_class(type_name), self.topic, self._on_message, qos, raw=True)
+        self.create_subscription(message, self.topic, self._on_message, qos, raw=True)
         self.get_logger().info(
             f"recording {self.topic} ({type_name}, {'reliable' if reliable else 'best effort'}) to {self.out}"
         )
 
     def _on_message(self, raw: bytes) -> None:
+        if self.finished or self.failure:
+            return
         now = self.get_clock().now().nanoseconds
         if self.first is None:
             self.first = now
-        elif self.duration and now - self.first >= self.duration * 1e9:
-            self.context.try_shutdown()  # main() then closes the bag
+        elif self.check(now):
             return
-        self._writer.write(self._connection, now, raw)
+        try:
+            self._writer.write(self._connection, now, raw)
+        except (OSError, ValueError) as error:  # a full disk
+            self.failure = f"{self.out}: cannot write ({getattr(error, 'strerror', None) or error})"
+            return
         self.count, self.last = self.count + 1, now
 
+    def _on_reference(self, msg) -> None:
+        if not msg.points:
+            return
+        last = msg.points[-1].time_from_start
+        length = last.sec * 1_000_000_000 + last.nanosec
+        if length <= 0:  # a hold, not a motion
+            return
+        stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+        start = stamp if stamp > 0 else self.get_clock().now().nanoseconds
+        if self.reference_end is None:
+            self.get_logger().info(
+                f"following {self.reference}: stops {self.tail:g} s after its motion ends ({length * 1e-9:g} s long)"
+            )
+        self.reference_end = start + length
+
+    def check(self, now: int | None = None) -> bool:
+        """Is the recording complete at ``now`` (node clock, ns)? Sets ``finished``."""
+        if self.finished:
+            return True
+        now = self.get_clock().now().nanoseconds if now is None else now
+        if self.duration and self.first is not None and now - self.first >= self.duration * 1e9:
+            self.finished = f"{self.duration:g} s after the first message"
+        elif self.reference_end is not None and now >= self.reference_end + self.tail * 1e9:
+            self.finished = f"{self.tail:g} s after the end of the motion on {self.reference}"
+        return self.finished is not None
+
+    def progress(self) -> str:
+        """What is recorded so far, in a line."""
+        span = 0.0 if self.first is None else (self.last - self.first) * 1e-9
+        goal = f" of {self.duration:g} s" if self.duration else ""
+        return f"recording {self.topic}: {self.count:,} messages, {span:.1f} s{goal}"
+
     def close(self) -> str:
-        """Close the bag; what it holds, in a line."""
+        """Close the bag (call once, with signals held off: a bag half closed is unreadable);
+        what it holds, in a line."""
         self._writer.close()
         span = 0.0 if self.first is None else (self.last - self.first) * 1e-9
         return f"wrote {self.out}: {self.count} messages of {self.topic} over {span:.3f} s"

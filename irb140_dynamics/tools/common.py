@@ -1,4 +1,4 @@
-"""What the command-line tools share: the model's arguments, errors in one line, a progress bar."""
+"""What the command-line tools share: the model's arguments and a progress bar (see cli.py for the rest)."""
 
 from __future__ import annotations
 
@@ -7,12 +7,8 @@ import sys
 import time
 from pathlib import Path
 
-from irb140_dynamics.core.io.model_source import ToolModel, parse_override, tool_model
 from irb140_dynamics.package_files import default_config_path
-
-
-class ToolError(Exception):
-    """An error the tool reports in one line (exit status 1)."""
+from irb140_dynamics.tools.cli import ToolError, open_line  # noqa: F401 (ToolError: the tools import it from here too)
 
 
 def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model") -> None:
@@ -42,22 +38,12 @@ def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model"
     )
 
 
-def model_of(args: argparse.Namespace) -> ToolModel:
+def model_of(args: argparse.Namespace):
     """The model of the arguments that ``add_model_arguments`` declared (ValueError in one line)."""
+    from irb140_dynamics.core.io.model_source import parse_override, tool_model
+
     overrides = dict(parse_override(text) for text in args.overrides)
     return tool_model(args.params_file, args.urdf, args.base, args.tip, overrides, default_config_path())
-
-
-def run(tool: str, body) -> int:
-    """body() -> exit status; a ToolError or bad input becomes 'tool: error: ...' and status 1."""
-    try:
-        return body()
-    except (ToolError, ValueError, OSError) as error:
-        print(f"{tool}: error: {error}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt:
-        print(f"{tool}: interrupted", file=sys.stderr)
-        return 130
 
 
 class ProgressBar:
@@ -85,6 +71,7 @@ class ProgressBar:
             f"\rreading {Path(path).name}: [{bar:<{self.WIDTH}}] {100 * fraction:3.0f} % "
             f"{done:,}/{total:,} samples, {now - self.start:.0f} s"
         )
+        open_line[0] = not finished and self.stream is sys.stderr
         if finished:
             self.stream.write("\n")
         self.stream.flush()

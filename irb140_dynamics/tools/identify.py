@@ -1,63 +1,84 @@
 """identify: the arm's dynamic parameters from a recording of its joint states.
 
-    ros2 run irb140_dynamics identify BAG --out IDENTIFIED.yaml [--topic /joint_states]
+    irb140-identify BAG --out IDENTIFIED.yaml [--topic /joint_states]
         [--params-file PRIOR.yaml | --urdf PRIOR.urdf [--base LINK] [--tip LINK]] [-p NAME:=VALUE]
         [--urdf-out IDENTIFIED.urdf] [--plots DIR] [--validate BAG2] [--offsets]
+    (or: ros2 run irb140_dynamics identify ..., python -m irb140_dynamics.tools.identify ...)
 
 BAG: a ROS 2 bag (directory, .mcap or .db3) with sensor_msgs/JointState including effort,
-or a CSV file (see docs/identification.md). Prints a progress bar while reading (stderr),
-then the summary; writes IDENTIFIED.yaml, a parameter file the nodes load with
---params-file, and, when the prior is a URDF (or with --urdf-out), the identified arm as a
-URDF (IDENTIFIED.urdf beside it by default: the prior's kinematics and limits, the
-identified inertials and friction; armature has no place in URDF). Exit status 0, or 1
-with one line naming the file and the problem.
+or a CSV file (see docs/identification.md). Rest is trimmed at both ends by itself: the
+recording may start before the motion and stop after it. A fit point *moves* when at
+least one joint is fast enough to use its torque row (--min-speed); the last --held-out
+fraction of the moving fit points is held out for validation (or all of --validate BAG2),
+the rest fitted; the report says where the motion and the held-out part are.
+
+Every argument and output path is checked before the recording is read. Prints a progress
+bar while reading (stderr), then the summary; writes IDENTIFIED.yaml (a parameter file
+both nodes load with --params-file), when the prior is a URDF (or with --urdf-out) the
+identified arm as a URDF (IDENTIFIED.urdf beside it by default: the prior's kinematics and
+limits, the identified inertials and friction), and, with --plots, DIR/torques.png and
+DIR/residuals.png: all of them or none (each written to a temporary file beside it,
+renamed at the end). Exit status 0; 1 with one line naming the file and the problem; 2
+for a bad argument; 130 after Ctrl-C, nothing written.
 """
 
 from __future__ import annotations
 
 import argparse
-import shlex
 import sys
 from pathlib import Path
 
-from irb140_dynamics.core.io.atomic import write_text
-from irb140_dynamics.identification.pipeline import IdentificationSettings, identify
-from irb140_dynamics.identification.recording import DEFAULT_TOPIC
-from irb140_dynamics.identification.report import identified_file, identified_urdf, summary
-from irb140_dynamics.identification.signals import DEFAULT_CUTOFF
-from irb140_dynamics.tools.common import ProgressBar, add_model_arguments, model_of, run
+from irb140_dynamics.tools.cli import Parser, ToolError, input_path, number, output_directory, output_file, run
+from irb140_dynamics.tools.common import add_model_arguments
+
+DEFAULT_HELD_OUT = 0.2
 
 
-def parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="identify", description=__doc__.split("\n\n")[0].split(": ", 1)[1])
+def parser() -> Parser:
+    from irb140_dynamics.identification.recording import DEFAULT_TOPIC  # light: no NumPy work at import
+    from irb140_dynamics.identification.signals import DEFAULT_CUTOFF
+
+    p = Parser(
+        prog="identify",
+        description=__doc__.split("\n\n")[0].split(": ", 1)[1],
+        epilog="\n\n".join(__doc__.split("\n\n")[2:4]),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("recording", metavar="BAG", help="ROS 2 bag (directory, .mcap, .db3) or .csv file")
     p.add_argument("--out", required=True, metavar="IDENTIFIED.yaml", help="parameter file to write")
     p.add_argument("--topic", default=DEFAULT_TOPIC, help=f"JointState topic in the bag (default {DEFAULT_TOPIC})")
     p.add_argument("--plots", metavar="DIR", help="write torques.png and residuals.png of the held-out data here")
-    p.add_argument("--validate", metavar="BAG2", help="validate on this recording instead of the last 20 %% of BAG")
+    p.add_argument(
+        "--validate",
+        metavar="BAG2",
+        help="validate on this recording (rest trimmed) instead of the last --held-out of BAG's moving fit points",
+    )
     p.add_argument(
         "--cutoff",
-        type=float,
+        type=number(0.0, 1e6, above=True),
         default=DEFAULT_CUTOFF,
+        metavar="HZ",
         help=f"filter cut-off [Hz] for smoothing and differentiation (default {DEFAULT_CUTOFF:g})",
     )
     p.add_argument(
         "--min-speed",
-        type=float,
+        type=number(0.0, 1e3),
         metavar="RAD_S",
-        help="leave out torque rows of joints slower than this (default 3 smoothing velocities; 0: keep every row)",
+        help="a joint's torque row is used (and the point moves) from this speed on "
+        "(default 3 smoothing velocities of the prior; 0: keep every row)",
     )
     p.add_argument(
         "--held-out",
-        type=float,
-        default=0.2,
+        type=number(0.0, 1.0, above=True),
+        default=DEFAULT_HELD_OUT,
         metavar="FRACTION",
-        help="fraction at the end of BAG held out for validation (default 0.2)",
+        help=f"fraction of BAG's moving fit points, at its end, held out (default {DEFAULT_HELD_OUT:g})",
     )
     p.add_argument(
         "--prior-weight",
-        type=float,
+        type=number(0.0, 1e6, above=True),
         default=1.0,
+        metavar="W",
         help="strength of the pull toward the prior (default 1; see docs/identification.md)",
     )
     p.add_argument(
@@ -76,40 +97,65 @@ def parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    args = parser().parse_args(sys.argv[1:] if argv is None else argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    return run("identify", lambda interrupts: _identify(argv, interrupts))
 
-    def body() -> int:
-        source = model_of(args)
-        prior, prior_path = source.model, source.origin
-        settings = IdentificationSettings(
-            topic=args.topic,
-            cutoff=args.cutoff,
-            min_speed=args.min_speed,
-            held_out=args.held_out,
-            prior_weight=args.prior_weight,
-            offsets=args.offsets,
-        )
-        progress = None if args.quiet else ProgressBar()
+
+def _identify(argv: list[str], interrupts) -> int:
+    args = parser().parse_args(argv)
+    if not args.held_out < 1.0:
+        raise ToolError(f"--held-out: must be < 1, got {args.held_out:g}")
+    recording = input_path(args.recording)
+    validate = input_path(args.validate) if args.validate else None
+    params = input_path(args.params_file) if args.params_file else None
+    urdf = input_path(args.urdf) if args.urdf else None
+    out = output_file(args.out)
+    urdf_out = output_file(args.urdf_out) if args.urdf_out else None
+    plots = output_directory(args.plots) if args.plots else None
+    inputs = ((args.recording, recording), (args.validate, validate), (args.params_file, params), (args.urdf, urdf))
+    for given, path in inputs:
+        if path is not None and path in (out, urdf_out, plots):
+            raise ToolError(f"{given}: is an input and an output; give the output another name")
+
+    import shlex
+
+    from irb140_dynamics.identification.pipeline import IdentificationSettings, identify
+    from irb140_dynamics.identification.report import identified_file, identified_urdf, summary
+    from irb140_dynamics.tools.common import ProgressBar, model_of
+    from irb140_dynamics.tools.outputs import Outputs
+
+    source = model_of(args)
+    prior, prior_path = source.model, source.origin
+    if urdf_out is None and source.urdf is not None:
+        args.urdf_out = str(Path(args.out).with_suffix(".urdf"))
+        urdf_out = output_file(args.urdf_out)
+    settings = IdentificationSettings(
+        topic=args.topic,
+        cutoff=args.cutoff,
+        min_speed=args.min_speed,
+        held_out=args.held_out,
+        prior_weight=args.prior_weight,
+        offsets=args.offsets,
+    )
+    progress = None if args.quiet else ProgressBar()
+    with Outputs(interrupts) as outputs:
         result = identify(prior, args.recording, settings, validate=args.validate, progress=progress)
         print(f"prior: {prior_path}")
-        print(summary(result))
-        command = shlex.join(["identify", *(sys.argv[1:] if argv is None else argv)])
-        urdf_out = args.urdf_out or (Path(args.out).with_suffix(".urdf") if source.urdf is not None else None)
-        parameters = identified_file(result, command)
-        urdf = identified_urdf(result, source.urdf_text, command) if urdf_out else None
-        write_text(args.out, parameters)
-        print(f"wrote {args.out}")
-        if urdf is not None:
-            write_text(urdf_out, urdf)
-            print(f"wrote {urdf_out}")
-        if args.plots:
+        print(summary(result), flush=True)
+        command = shlex.join(["identify", *argv])
+        outputs.text(out, args.out, identified_file(result, command))
+        if urdf_out is not None:
+            outputs.text(urdf_out, args.urdf_out, identified_urdf(result, source.urdf_text, command))
+        if plots is not None:
             from irb140_dynamics.identification.plots import write_plots
 
-            for path in write_plots(result, args.plots):
-                print(f"wrote {path}")
-        return 0
-
-    return run("identify", body)
+            outputs.directory(plots, args.plots)
+            names = write_plots(result, lambda name, save: outputs.stage(plots / name, f"{args.plots}/{name}", save))
+            if not names:
+                print(f"no held-out points to plot: nothing written in {args.plots}")
+        for typed in outputs.commit():
+            print(f"wrote {typed}")
+    return 0
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 the topic, takes its type from the graph, adapts to a best-effort publisher, stops after
 --duration, and writes a bag that `identify` reads; an existing bag is refused in one line."""
 
+import os
 import sys
 import time
 
@@ -51,3 +52,43 @@ def test_record_writes_what_was_published_for_the_duration(probe, tmp_path):  # 
 
     code, output = run_to_exit(record_command(out))
     assert code == 1 and "exists already" in output and "Traceback" not in output, output
+
+
+def test_record_stops_by_itself_after_the_reference_motion_not_at_a_hold(probe, tmp_path):  # noqa: F811
+    from builtin_interfaces.msg import Duration
+    from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+
+    out = tmp_path / "run"
+    process = start(record_command(out, "--reference", "/ref", "--tail", "0.2"))
+    states = probe.create_publisher(JointState, "joint_states", 10)
+    reference = probe.create_publisher(JointTrajectory, "/ref", 10)
+    hold = JointTrajectory(joint_names=NAMES, points=[JointTrajectoryPoint(positions=[0.0] * 6)])
+    motion = JointTrajectory(
+        joint_names=NAMES,
+        points=[JointTrajectoryPoint(positions=[0.0] * 6), JointTrajectoryPoint(positions=[0.1] * 6)],
+    )
+    motion.points[1].time_from_start = Duration(sec=0, nanosec=300_000_000)
+    lines, k, held = [], 0, None
+    deadline = time.monotonic() + TIMEOUT
+    os.set_blocking(process.stdout.fileno(), False)
+    try:
+        while process.poll() is None:
+            while line := process.stdout.readline():
+                lines.append(line)
+            assert time.monotonic() < deadline, "record did not stop"
+            states.publish(JointState(name=NAMES, position=[0.0] * 6, effort=[float(k)] * 6))
+            k += 1
+            if reference.get_subscription_count() and held is None:
+                reference.publish(hold)  # a hold is no motion: record goes on
+                held = time.monotonic()
+            elif held is not None and time.monotonic() > held + 1.0 and not any("following" in x for x in lines):
+                reference.publish(motion)  # until record has it (unstamped: it starts at its last arrival)
+            time.sleep(1.0 / RATE)
+        output = "".join(lines) + (process.stdout.read() or "")
+    finally:
+        process.kill()
+    assert process.returncode == 0, output
+    assert "following /ref: stops 0.2 s after its motion ends (0.3 s long)" in output, output
+    assert "stopped: 0.2 s after the end of the motion on /ref" in output, output
+    effort = np.concatenate([chunk.effort for chunk in Recording(out, NAMES).chunks()])[:, 0]
+    assert f"wrote {out}: {len(effort)} messages" in output and np.all(np.diff(effort) == 1.0)

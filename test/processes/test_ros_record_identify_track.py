@@ -4,7 +4,9 @@ on simulated time; `excitation`, `record` and `identify` as the commands a user 
 
 1. `excitation` writes a short excitation trajectory to a file; sim_node starts at its start.
 2. id_node on the report's model drives the arm along it (published on ~/reference) while
-   `record` writes joint_states to a bag; `identify` fits the model to the bag.
+   `record --reference /id_node/reference` writes joint_states to a bag, started before the
+   motion and stopping by itself TAIL s (simulated) after it, as docs/sim.md says;
+   `identify` fits the model to the bag as it is (it trims the rest at both ends itself).
 3. The demo's motion (a different one) is tracked by id_node on the report's model, then,
    restarted with --params-file IDENTIFIED.yaml, on the identified one: the tracking error
    RMS falls at least 5x.
@@ -13,8 +15,7 @@ A motion starts alike each time: id_node holds the arm at its first point (a one
 ~/reference; its arrival is seen in ~/tracking_error, so the connection is up); for the
 demo's motion sim_node is reset there and held still for reset_hold, and the motion's
 ~/reference is stamped to start when the hold ends (the excitation starts from the hold,
-so that the recording holds nothing but physics; the recording is stopped with id_node
-paused, so that it ends TAIL after the motion). Lockstep makes what follows the same
+so that the recording holds nothing but physics). Lockstep makes what follows the same
 whatever the machine's load: each joint state k+1 is checked to carry (as effort) exactly
 the command computed from state k and the reference at state k's simulated time, so no
 step went without its command, none had two, and id_node's clock read each state's stamp.
@@ -22,7 +23,7 @@ step went without its command, none had two, and id_node's clock read each state
 
 import os
 import re
-import signal
+import shlex
 import sys
 import time
 
@@ -50,7 +51,7 @@ PERIOD = round(1e9 / RATE)  # ns
 EXCITATION_PERIOD = 5.0  # s
 DEMO_PERIOD = 8.0  # s: demo_node's default motion
 TRACKED = 4.0  # s of it compared: out to its far end
-TAIL = 1.0  # s recorded after the excitation
+TAIL = 1.0  # s recorded after the excitation: record's default --tail
 ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 HOLD = 0.5  # s of simulated time the arm is held still after a reset: the reference arrives meanwhile
 SIM = [
@@ -81,6 +82,21 @@ def tool(name: str, *args: str) -> list[str]:
     return [sys.executable, "-m", f"irb140_dynamics.tools.{name}", *args]
 
 
+def doc_commands() -> dict[str, list[str]]:
+    """The excitation, record and identify command lines of docs/sim.md's walkthrough, as
+    typed (after `ros2 run irb140_dynamics`): what this test runs."""
+    text = (ROOT / "docs" / "sim.md").read_text()
+    section = text.split("## Record, identify, track better")[1].split("\n## ")[0]
+    commands = {}
+    for line in re.sub(r"\\\n\s*", " ", section).splitlines():
+        found = re.match(r"\s*ros2 run irb140_dynamics (excitation|record|identify) (.*)", line.split(" #")[0])
+        if found:
+            commands[found[1]] = shlex.split(found[2])
+    assert sorted(commands) == ["excitation", "identify", "record"], commands
+    assert "--reference" in commands["record"] and "--ros-args" in commands["record"], commands["record"]
+    return commands
+
+
 def trajectory_message(path) -> JointTrajectory:
     """A JointTrajectory YAML file (as `ros2 topic pub --yaml-file` reads it) as a message."""
     data = yaml.safe_load(path.read_text())
@@ -94,6 +110,14 @@ def trajectory_message(path) -> JointTrajectory:
         for p in data["points"]
     ]
     return JointTrajectory(joint_names=data["joint_names"], points=points)
+
+
+def saw(process, lines: list[str], text: str) -> bool:
+    """Has ``process`` printed a line with ``text``? (reads what it printed so far, without waiting)"""
+    os.set_blocking(process.stdout.fileno(), False)
+    while line := process.stdout.readline():
+        lines.append(line)
+    return any(text in line for line in lines)
 
 
 def hold_message(names, positions) -> JointTrajectory:
@@ -152,7 +176,7 @@ class Loop:
             for s, e in list(self.errors.items())[-20:]
         )
 
-    def move(self, msg: JointTrajectory, duration: float, reset: bool = True) -> list[int]:
+    def move(self, msg: JointTrajectory, duration: float, reset: bool = True, also=lambda: True) -> list[int]:
         """Hold the arm at the first point of ``msg``; ``reset``: reset it there, held still
         HOLD s, and follow ``msg`` from the end of the hold (deterministic: the same state at
         the same time), else from HOLD s on; for ``duration`` s: the stamps of those states."""
@@ -164,7 +188,7 @@ class Loop:
         else:
             start = self.latest + round(HOLD * 1e9)
         msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(start, 1_000_000_000)
-        self.send_until(msg, lambda: any(s >= start for s in self.errors))
+        self.send_until(msg, lambda: any(s >= start for s in self.errors) and also())
         end = start + round(duration * 1e9)
         self.probe.spin_until(lambda: self.latest >= end, timeout=duration * 4 + TIMEOUT)
         stamps = [s for s in sorted(self.states) if start <= s < end]
@@ -226,21 +250,15 @@ def processes():
 def test_identified_from_a_ros_recording_tracks_five_times_better(probe, processes, tmp_path):  # noqa: F811
     began = time.monotonic()
     excitation_file, bag, identified = tmp_path / "excitation.yaml", tmp_path / "run", tmp_path / "identified.yaml"
-    code, output = run_to_exit(
-        tool(
-            "excitation",
-            "--out",
-            str(excitation_file),
-            "--period",
-            str(EXCITATION_PERIOD),
-            "--rate",
-            "50",
-            "--iterations",
-            "0",
-            "--seed",
-            "2",
-        )
-    )
+    typed = doc_commands()  # the tools' command lines as docs/sim.md gives them, its file names ours
+    where = {
+        "excitation.yaml": str(excitation_file),
+        "run": str(bag),
+        "run/": f"{bag}/",
+        "identified.yaml": str(identified),
+    }
+    typed = {name: [where.get(arg, arg) for arg in args] for name, args in typed.items()}
+    code, output = run_to_exit(tool("excitation", *typed["excitation"]))
     assert code == 0, output
     excitation = trajectory_message(excitation_file)
     start_pose = list(excitation.points[0].positions)  # where the recording starts: no motion to get there
@@ -248,19 +266,18 @@ def test_identified_from_a_ros_recording_tracks_five_times_better(probe, process
         module_command("irb140_dynamics.nodes.sim_node.node", *SIM, "-p", f"initial_positions:={start_pose}")
     )
     controller = processes(module_command("irb140_dynamics.nodes.id_node.node", *CONTROLLER))
-    recorder = processes(tool("record", "--out", str(bag), "--ros-args", "-p", "use_sim_time:=true"))
+    # as docs/sim.md: record started before the motion, it stops by itself TAIL s after the motion's end
+    recorder = processes(tool("record", *typed["record"]))
     loop = Loop(probe)
     lines = []
     assert wait_for_line(recorder, "recording /joint_states", lines, TIMEOUT), "".join(lines)
-    loop.move(excitation, EXCITATION_PERIOD + TAIL, reset=False)  # no reset: every state recorded is physical
-    os.kill(controller.pid, signal.SIGSTOP)  # the loop stands still (lockstep) while the recording stops:
-    try:  # it ends TAIL after the motion, however long the recorder takes to stop
-        code, output = interrupt(recorder, lines)
-    finally:
-        os.kill(controller.pid, signal.SIGCONT)
-    assert code == 0 and f"wrote {bag}" in output, output
+    # the excitation is sent until id_node follows it and record has seen it (its "following" line)
+    loop.move(excitation, EXCITATION_PERIOD + TAIL, reset=False, also=lambda: saw(recorder, lines, "following"))
+    output, _ = recorder.communicate(timeout=4 * TIMEOUT)
+    output = "".join(lines) + output
+    assert recorder.returncode == 0 and f"wrote {bag}" in output and "after the end of the motion" in output, output
     # one BLAS thread: OpenBLAS's threads spin for the cores the nodes need (4 s of CPU become 30)
-    identify = processes(tool("identify", str(bag), "--out", str(identified), "--quiet"), ONE_THREAD)
+    identify = processes(tool("identify", *typed["identify"]), ONE_THREAD)
 
     demo = reference_message(DEMO_PERIOD)
     before, checked_before = loop.check_lockstep(irb140(), demo, loop.move(demo, TRACKED))

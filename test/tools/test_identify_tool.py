@@ -146,14 +146,14 @@ def test_summary_reports_counts_errors_and_consistency(workflow):
     used, left_out, edges = (
         int(x.replace(",", ""))
         for x in re.search(
-            r"samples read, ([\d,]+) used, ([\d,]+) left out \(0 without effort \(or another value\), ([\d,]+) at gaps",
+            r"samples read, ([\d,]+) used, ([\d,]+) left out \(0 invalid \(a value missing, not finite or beyond 1e6\), ([\d,]+) at gaps",
             printed,
         ).groups()
     )
     assert used + left_out == 3001 and left_out == edges > 0
     assert "torque rows too slow for Coulomb friction, left out: joint_1 " in printed
     assert "base parameters: 52 of 78; condition number of the base regressor: " in printed
-    assert "held out: the last 20 % of the recording" in printed
+    assert "held out: the last 20 % of the moving fit points of the recording" in printed
     table = re.findall(r"^(joint_\d) +(\S+) +(\S+) +\((\S+) %\) +(\S+) +\((\S+) %\)$", printed, flags=re.M)
     assert [row[0] for row in table] == list(NAMES)
     for _name, peak, _prior, prior_percent, identified, identified_percent in table:
@@ -251,7 +251,10 @@ def test_validation_on_a_second_recording(workflow, tmp_path, capsys):
     [
         (["missing.mcap", "--out", "{tmp}/o.yaml"], "missing.mcap: no such file or directory"),
         (["{bag}", "--out", "{tmp}/o.yaml", "--topic", "/other"], "no topic /other"),
-        (["{bag}", "--out", "{tmp}/o.yaml", "--params-file", "{tmp}/none.yaml"], "none.yaml: no such parameter file"),
+        (
+            ["{bag}", "--out", "{tmp}/o.yaml", "--params-file", "{tmp}/none.yaml"],
+            "none.yaml: no such file or directory",
+        ),
         (["{bag}", "--out", "{tmp}/o.yaml", "--params-file", "{bad}"], "joint_2.link.mass: must be >= 0"),
     ],
 )
@@ -268,8 +271,8 @@ def test_identify_errors_are_one_line_and_write_nothing(workflow, tmp_path, caps
 
 
 def test_excitation_refuses_bad_options(tmp_path, capsys):
-    assert excitation_tool.main(["--out", str(tmp_path / "t.yaml"), "--rate", "0"]) == 1
-    assert "excitation: error: --rate must be > 0" in capsys.readouterr().err
+    assert excitation_tool.main(["--out", str(tmp_path / "t.yaml"), "--rate", "0"]) == 2
+    assert "excitation: error: argument --rate: must be > 0, got 0" in capsys.readouterr().err
     assert not (tmp_path / "t.yaml").exists()
 
 
@@ -284,3 +287,52 @@ def test_progress_bar_ends_at_100_percent_on_its_own_line():
     assert len(frames) == 2  # the first and the last: the others fall within the interval
     assert frames[0].startswith("reading run.mcap: [") and " 0 % 0/1,000 samples" in frames[0]
     assert "[" + "#" * 30 + "] 100 % 1,000/1,000 samples" in frames[1] and frames[1].endswith("\n")
+
+
+def test_plots_and_result_are_written_together_or_not_at_all(workflow, tmp_path, monkeypatch, capsys):
+    """A plot that cannot be written (here: the second fails) leaves neither the result nor
+    the first plot, nor a temporary file or the plots folder made for them."""
+    import irb140_dynamics.identification.plots as plots
+
+    real = plots.write_plots
+
+    def failing(result, save):
+        calls = []
+
+        def second_fails(name, write):
+            calls.append(name)
+            if len(calls) == 2:
+                raise OSError(28, "No space left on device")
+            save(name, write)
+
+        return real(result, second_fails)
+
+    monkeypatch.setattr(plots, "write_plots", failing)
+    out, folder = tmp_path / "o.yaml", tmp_path / "new" / "plots"
+    assert identify_tool.main([str(workflow["bag"]), "--out", str(out), "--plots", str(folder), "--quiet"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("identify: error: ") and "No space left" in err[0], err
+    assert list(tmp_path.iterdir()) == [], list(tmp_path.rglob("*"))
+
+
+def test_arguments_and_outputs_are_checked_before_the_recording_is_read(workflow, tmp_path, monkeypatch, capsys):
+    import irb140_dynamics.identification.pipeline as pipeline
+
+    monkeypatch.setattr(pipeline, "identify", lambda *a, **k: pytest.fail("the recording was read"))
+    afile = tmp_path / "afile"
+    afile.write_text("")
+    cases = [
+        (["--out", "/proc/o.yaml"], "identify: error: /proc/o.yaml: cannot write in /proc"),
+        (["--out", f"{afile}/o.yaml"], f"identify: error: {afile}/o.yaml: {afile} is not a directory"),
+        (["--out", str(tmp_path)], f"identify: error: {tmp_path}: is a directory"),
+        (["--out", f"{tmp_path}/o.yaml", "--plots", f"{afile}/p"], f"{afile}/p: {afile} is not a directory"),
+        (["--out", f"{tmp_path}/o.yaml", "--cutoff", "inf"], "argument --cutoff: must be a finite number, got 'inf'"),
+        (["--out", f"{tmp_path}/o.yaml", "--held-out", "1"], "--held-out: must be < 1, got 1"),
+        (["--out", f"{tmp_path}/o.yaml", "--prior-weight", "-1"], "argument --prior-weight: must be > 0, got -1"),
+        (["--out", f"{tmp_path}/o.yaml", "--min-speed", "nan"], "argument --min-speed: must be a finite number"),
+    ]
+    for args, problem in cases:
+        assert identify_tool.main([str(workflow["bag"]), *args, "--quiet"]) in (1, 2)
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and problem in err[0], (args, err)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]

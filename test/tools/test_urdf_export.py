@@ -134,4 +134,48 @@ def test_export_urdf_tool_prints_the_committed_file_and_refuses_bad_input_in_one
     code, output = run_to_exit(command)
     assert code == 0 and output == EXPORTED.read_text(), output[:500]
     code, output = run_to_exit(command + ["--ros-args", "-p", "joint_2.link.com:=[0.1, 0.0]"])
-    assert code == 1 and output.count("\n") == 1 and "export_urdf: joint_2.link.com" in output, output
+    assert code == 1 and output.count("\n") == 1 and "export_urdf: error: joint_2.link.com" in output, output
+
+
+def test_exported_limits_are_positive_and_come_from_their_sources():
+    """docs/urdf.md: the model's, else the data sheet's speeds and the derived torque limits,
+    else (a joint no static payload loads) the rated payload at the acceleration limit."""
+    import math
+
+    from irb140_dynamics.core import RATED_PAYLOAD, derive_torque_limits
+    from irb140_dynamics.tools.cli import ToolError
+    from irb140_dynamics.tools.export_urdf import DATA_SHEET_SPEEDS, POSES, limits
+
+    model = load_model(CONFIG)
+    effort, velocity, sources = limits(model)
+    derived = derive_torque_limits(model)
+    speeds = [math.radians(s) for s in DATA_SHEET_SPEEDS]
+    assert velocity == pytest.approx(speeds, rel=1e-15)  # config/irb140.yaml holds the data sheet's
+    loaded = model.with_payload(RATED_PAYLOAD)
+    rng_poses = {}
+    for k, (e, d) in enumerate(zip(effort, derived.values)):
+        assert e > 0 and math.isfinite(e)
+        if math.isfinite(d):
+            assert e == d and "static" in sources[k]
+        else:  # joints 1 and 6: no gravity torque; the inertia about the axis at its acceleration limit
+            lower, upper = np.array([j.position_limits for j in model.joints]).T
+            q = np.random.default_rng(k).uniform(lower, upper, size=(POSES, model.n))
+            M = np.array([mass_matrix(loaded, x)[k, k] for x in q])
+            rng_poses[k] = M
+            assert e == pytest.approx(M.max() * model.joints[k].acceleration_limit, rel=1e-9)
+    assert sorted(rng_poses) == [0, 5]
+    robot = ET.fromstring(urdf_of(model))
+    written = [robot.find(f"joint[@name='{j.name}']/limit") for j in model.joints]
+    assert [float(x.get("effort")) for x in written] == effort
+    assert [float(x.get("velocity")) for x in written] == velocity
+
+    no_speeds = dataclasses.replace(
+        model, joints=tuple(dataclasses.replace(j, velocity_limit=0.0, torque_limit=50.0) for j in model.joints)
+    )
+    effort, velocity, _ = limits(no_speeds)
+    assert effort == [50.0] * 6 and velocity == pytest.approx(speeds, rel=1e-15)
+    other = dataclasses.replace(
+        no_speeds, joints=tuple(dataclasses.replace(j, name=f"j{k}") for k, j in enumerate(no_speeds.joints))
+    )
+    with pytest.raises(ToolError, match="j0: no velocity_limit"):
+        limits(other)
