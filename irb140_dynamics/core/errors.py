@@ -1,8 +1,14 @@
-"""Errors as one line of text: what a log line, a service answer or a tool's error shows."""
+"""Errors as one line of text: what a log line, a service answer or a tool's error shows.
+
+One line, under 300 characters: the rest of a long message (a URDF element, a list of
+names) is cut and the cut marked with '...'."""
 
 from __future__ import annotations
 
+LINE_LIMIT = 299  # characters: an error line is shorter than 300
 
-def one_line(error: BaseException | str) -> str:
-    """The error's text with its line breaks made spaces."""
-    return str(error).replace("\n", " ")
+
+def one_line(error: BaseException | str, limit: int = LINE_LIMIT) -> str:
+    """The error's text on one line (white space runs made one space), cut to ``limit``."""
+    text = " ".join(str(error).split())
+    return text if len(text) <= limit else text[: limit - 3] + "..."

@@ -16,19 +16,14 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-LINE_LIMIT = 299  # characters: an error line is shorter than 300 (the rest cut, marked with ...)
+from irb140_dynamics.core.errors import LINE_LIMIT, one_line  # noqa: F401 (the tools import them from here)
+
 INTERRUPTED = 130  # exit status after Ctrl-C (128 + SIGINT), 143 after SIGTERM
 open_line = [False]  # a progress bar's line on stderr is unfinished: end it before an error
 
 
 class ToolError(Exception):
     """An error the tool reports in one line (exit status 1)."""
-
-
-def one_line(text: str, limit: int = LINE_LIMIT) -> str:
-    """``text`` on one line, cut to ``limit`` characters (the end marked with '...')."""
-    text = " ".join(str(text).split())
-    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 class Parser(argparse.ArgumentParser):

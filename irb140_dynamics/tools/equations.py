@@ -25,7 +25,7 @@ from ..core import RigidBody, load_model
 from ..core.equations import DEFAULT_QUANTITIES, FORMS, QUANTITIES, generate
 from ..core.errors import one_line
 from ..core.urdf import load_urdf
-from .common import ToolError, run
+from .cli import ToolError, run
 
 NAME = "equations"
 QUIET_SECONDS = 2.0  # a progress line on stderr once the work takes longer than this
@@ -59,7 +59,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    return run(NAME, lambda: _main(sys.argv[1:] if argv is None else argv))
+    return run(NAME, lambda interrupts: _main(sys.argv[1:] if argv is None else argv))
 
 
 def _main(argv: list[str]) -> int:

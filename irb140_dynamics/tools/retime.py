@@ -29,7 +29,7 @@ from ..core.io.atomic import write_files
 from ..core.io.model_source import tool_model
 from ..core.io.trajectory_file import joint_trajectory_yaml, read_joint_trajectory
 from ..core.trajectories import Trajectory, TrajectoryError, check_trajectory, retime, trajectory_limits
-from .common import ToolError, run
+from .cli import ToolError, run
 
 NAME = "retime"
 OVER_LIMIT = 3
@@ -135,7 +135,7 @@ def main(argv=None) -> int:
         )
         return 0
 
-    return run(NAME, body)
+    return run(NAME, lambda interrupts: body())
 
 
 def _torque_notes(model, limits) -> list[str]:
