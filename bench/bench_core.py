@@ -11,7 +11,7 @@ to bench/results/core.json. Sections:
 - batch: states per second of the ``*_batch`` functions on N random states against a
   Python loop of the Pinocchio call over the same states.
 - kernel generation: the one-off cost of tracing and compiling each kernel of a fresh model.
-- UR5 from its URDF: the UR5 read by our URDF loader (shared/urdf/ur5.urdf) against
+- UR5 from its URDF: the UR5 read by our URDF loader (test/data/urdf/ur5.urdf) against
   Pinocchio's URDF parser on the same file, per call.
 
 Every pair is checked to give the same numbers before it is timed.
@@ -23,7 +23,7 @@ import math
 import time
 
 import numpy as np
-
+import pinocchio as pin
 from common import (  # first: puts the checkout on sys.path
     REPO,
     Figure,
@@ -35,7 +35,6 @@ from common import (  # first: puts the checkout on sys.path
     write_results,
 )
 
-import pinocchio as pin
 from irb140_dynamics.core import (
     gravity,
     gravity_batch,
@@ -46,9 +45,11 @@ from irb140_dynamics.core import (
     rnea_batch,
 )
 from irb140_dynamics.core import kernels as kernel_cache  # noqa: E402
-from irb140_dynamics.core.rigid_body import RigidBody, inertia_matrix  # noqa: E402
-from irb140_dynamics.core.urdf import load_urdf  # noqa: E402
-from test.pinocchio_model import build as pinocchio_model, rot_x, rot_z  # noqa: E402
+from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.io.urdf import load_urdf  # noqa: E402
+from irb140_dynamics.core.model.rigid_body import RigidBody, inertia_matrix  # noqa: E402
+from test.support.pinocchio_model import build as pinocchio_model  # noqa: E402
+from test.support.pinocchio_model import rot_x, rot_z
 
 BATCH_STATES = 100_000
 BATCH_CHECKED = 1_000  # states of the batch compared with Pinocchio
@@ -57,7 +58,7 @@ FRESH_MODELS = 3  # kernel generation is timed on this many fresh models
 KERNELS = ("rnea", "rnea_wrench", "gravity_torques", "coriolis", "mass_matrix", "coriolis_matrix")
 TOLERANCE = dict(rtol=1e-9, atol=1e-9)
 SEED = 140
-UR5 = REPO.parent / "shared" / "urdf" / "ur5.urdf"  # the public description beside the repository
+UR5 = REPO / "test" / "data" / "urdf" / "ur5.urdf"  # the public description, copied with its licence
 
 
 # -- the baselines ----------------------------------------------------------------------
@@ -126,7 +127,7 @@ def single_state(model, pm, data) -> list[Row]:
     """Per-call cost of one state: public functions, raw kernels and the textbook RNEA."""
     q, qd, qdd = (x[0] for x in random_states(model, 1, np.random.default_rng(SEED)))
     lists = q.tolist(), qd.tolist(), qdd.tolist()
-    kernels = model.kernels
+    kernels = kernels_of(model)
     textbook = TextbookRnea(model)
 
     tau = rnea(model, q, qd, qdd)
@@ -145,11 +146,14 @@ def single_state(model, pm, data) -> list[Row]:
         ("rnea kernel (lists) vs pin.rnea", lambda: kernels.rnea.scalar(*lists), pin_rnea, None),
         ("rnea vs textbook NumPy RNEA", ours_rnea, lambda: textbook(q, qd, qdd), None),
         ("gravity vs computeGeneralizedGravity", lambda: gravity(model, q), pin_gravity, Target(8)),
-        ("gravity kernel (list) vs computeGeneralizedGravity",
-         lambda: kernels.gravity_torques.scalar(lists[0]), pin_gravity, None),
+        (
+            "gravity kernel (list) vs computeGeneralizedGravity",
+            lambda: kernels.gravity_torques.scalar(lists[0]),
+            pin_gravity,
+            None,
+        ),
         ("mass_matrix vs pin.crba", lambda: mass_matrix(model, q), pin_crba, Target(15)),
-        ("mass_matrix kernel (list) vs pin.crba",
-         lambda: kernels.mass_matrix.scalar(lists[0]), pin_crba, None),
+        ("mass_matrix kernel (list) vs pin.crba", lambda: kernels.mass_matrix.scalar(lists[0]), pin_crba, None),
     ]
     group = "single state, per call"
     return [
@@ -176,12 +180,30 @@ def batch(model, pm, data) -> list[Row]:
     vector, matrix = (model.n,), (model.n, model.n)
     unchanged = lambda x: x  # noqa: E731
     cases = [  # name, ours, baseline call on state i, its result shape, for the check, target
-        ("rnea_batch vs loop of pin.rnea", lambda: rnea_batch(model, Q, QD, QDD),
-         lambda i: pin.rnea(pm, data, Q[i], QD[i], QDD[i]), vector, unchanged, Target(2, at_least=True)),
-        ("gravity_batch vs loop of computeGeneralizedGravity", lambda: gravity_batch(model, Q),
-         lambda i: pin.computeGeneralizedGravity(pm, data, Q[i]), vector, unchanged, None),
-        ("mass_matrix_batch vs loop of pin.crba", lambda: mass_matrix_batch(model, Q),
-         lambda i: pin.crba(pm, data, Q[i]), matrix, symmetric_from_upper, None),
+        (
+            "rnea_batch vs loop of pin.rnea",
+            lambda: rnea_batch(model, Q, QD, QDD),
+            lambda i: pin.rnea(pm, data, Q[i], QD[i], QDD[i]),
+            vector,
+            unchanged,
+            Target(2, at_least=True),
+        ),
+        (
+            "gravity_batch vs loop of computeGeneralizedGravity",
+            lambda: gravity_batch(model, Q),
+            lambda i: pin.computeGeneralizedGravity(pm, data, Q[i]),
+            vector,
+            unchanged,
+            None,
+        ),
+        (
+            "mass_matrix_batch vs loop of pin.crba",
+            lambda: mass_matrix_batch(model, Q),
+            lambda i: pin.crba(pm, data, Q[i]),
+            matrix,
+            symmetric_from_upper,
+            None,
+        ),
     ]
     group = f"batch of {BATCH_STATES:,} states"
     rows = []
@@ -208,8 +230,12 @@ def ur5_from_urdf() -> list[Row]:
     check_same("UR5 mass_matrix", mass_matrix(model, q), symmetric_from_upper(pin.crba(pm, data, q)))
     cases = [
         ("UR5 rnea vs pin.rnea", lambda: rnea(model, q, qd, qdd), lambda: pin.rnea(pm, data, q, qd, qdd), Target(8)),
-        ("UR5 gravity vs computeGeneralizedGravity", lambda: gravity(model, q),
-         lambda: pin.computeGeneralizedGravity(pm, data, q), None),
+        (
+            "UR5 gravity vs computeGeneralizedGravity",
+            lambda: gravity(model, q),
+            lambda: pin.computeGeneralizedGravity(pm, data, q),
+            None,
+        ),
         ("UR5 mass_matrix vs pin.crba", lambda: mass_matrix(model, q), lambda: pin.crba(pm, data, q), None),
     ]
     group = "UR5 from its URDF (ours: load_urdf; Pinocchio: buildModelFromXML), per call"
@@ -226,7 +252,7 @@ def kernel_generation() -> tuple[list[Row], dict]:
     times = {name: [] for name in ("kernels setup", *KERNELS, "first rnea() call", payload_changed)}
     for k in range(FRESH_MODELS):
         kernel_cache._arm.cache_clear()  # compiled code is shared between models of the same arm
-        kernels = _timed(times["kernels setup"], lambda: irb140().kernels)
+        kernels = _timed(times["kernels setup"], lambda: kernels_of(irb140()))
         for name in KERNELS:
             _timed(times[name], lambda: getattr(kernels, name))
         kernel_cache._arm.cache_clear()

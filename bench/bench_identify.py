@@ -29,13 +29,12 @@ import time
 from pathlib import Path
 
 import numpy as np
-
+import pinocchio as pin
 from common import REPO, Figure, Row, Target, machine_info, print_table, seconds_per_call, write_results
 
-import pinocchio as pin
 from irb140_dynamics.core import irb140
 from irb140_dynamics.core.regressor import regressor_batch
-from test.pinocchio_model import build as pinocchio_model  # noqa: E402
+from test.support.pinocchio_model import build as pinocchio_model  # noqa: E402
 
 SEED = 140
 REGRESSOR_STATES = 20_000
@@ -52,11 +51,16 @@ def _peak():
             print("peak_kb", line.split()[1], file=sys.stderr)
 atexit.register(_peak)
 """
-IDENTIFY = PEAK_AT_EXIT + """
+IDENTIFY = (
+    PEAK_AT_EXIT
+    + """
 from irb140_dynamics.tools.identify import main
 sys.exit(main(sys.argv[1:]))
 """
-DESERIALISE_ONLY = PEAK_AT_EXIT + """
+)
+DESERIALISE_ONLY = (
+    PEAK_AT_EXIT
+    + """
 import sys
 from pathlib import Path
 from rosbags.highlevel import AnyReader
@@ -69,6 +73,7 @@ with AnyReader([Path(sys.argv[1])], default_typestore=get_typestore(Stores.ROS2_
         count += 1
 print(count, "messages")
 """
+)
 
 
 def regressor_rows() -> list[Row]:
@@ -88,10 +93,18 @@ def regressor_rows() -> list[Row]:
 
     ours = regressor_batch(model, Q, QD, QDD)
     np.testing.assert_allclose(ours[:1000, :, :60], loop(1000), rtol=1e-9, atol=1e-9)
-    rates = [Figure.rate(seconds_per_call(fn, blocks=REGRESSOR_REPEATS, number=1), REGRESSOR_STATES)
-             for fn in (lambda: regressor_batch(model, Q, QD, QDD), loop)]
-    return [Row(f"regressor, {REGRESSOR_STATES:,} states", "regressor_batch vs loop of computeJointTorqueRegressor",
-                *rates, Target(2, at_least=True))]
+    rates = [
+        Figure.rate(seconds_per_call(fn, blocks=REGRESSOR_REPEATS, number=1), REGRESSOR_STATES)
+        for fn in (lambda: regressor_batch(model, Q, QD, QDD), loop)
+    ]
+    return [
+        Row(
+            f"regressor, {REGRESSOR_STATES:,} states",
+            "regressor_batch vs loop of computeJointTorqueRegressor",
+            *rates,
+            Target(2, at_least=True),
+        )
+    ]
 
 
 def write_long_bag(path: Path, minutes: float, rate: float) -> None:
@@ -100,7 +113,7 @@ def write_long_bag(path: Path, minutes: float, rate: float) -> None:
     from rosbags.typesys import Stores, get_typestore
 
     from irb140_dynamics.identification.excitation import optimise_excitation
-    from test.synthetic_arm import drive, joint_state_messages, true_arm
+    from test.support.synthetic_arm import drive, joint_state_messages, true_arm
 
     typestore = get_typestore(Stores.ROS2_JAZZY)
     trajectory = optimise_excitation(irb140(), iterations=5, seed=SEED).trajectory
@@ -114,8 +127,12 @@ def write_long_bag(path: Path, minutes: float, rate: float) -> None:
             samples = drive(arm, trajectory, rate, duration, seed=block, start=block * BLOCK_SECONDS)
             for ns, raw in joint_state_messages(samples, names, with_velocity=True, typestore=typestore):
                 writer.write(connection, ns, raw)
-            print(f"\rwriting {path}: {block + 1}/{blocks} min, {time.perf_counter() - started:.0f} s", end="",
-                  file=sys.stderr, flush=True)
+            print(
+                f"\rwriting {path}: {block + 1}/{blocks} min, {time.perf_counter() - started:.0f} s",
+                end="",
+                file=sys.stderr,
+                flush=True,
+            )
     print(file=sys.stderr)
 
 
@@ -151,12 +168,26 @@ def recording_rows(bag: Path, minutes: float, rate: float, repeats: int) -> tupl
     group = f"recording: {messages:,} JointState messages ({minutes:g} min at {rate:g} Hz)"
     ours_mb, baseline_mb = max(run[2] for run in ours), max(run[2] for run in baseline)
     rows = [
-        Row(group, "identify vs rosbags deserialisation alone", Figure.cost([run[0] for run in ours], "s"),
-            Figure.cost([run[0] for run in baseline], "s"), Target(1.5)),
-        Row(group, "the same, CPU time (user + system)", Figure.cost([run[1] for run in ours], "s"),
-            Figure.cost([run[1] for run in baseline], "s")),
-        Row(group, "identify peak memory", Figure(ours_mb, ours_mb, "MB"), Figure(baseline_mb, baseline_mb, "MB"),
-            Target(1024, absolute=True)),
+        Row(
+            group,
+            "identify vs rosbags deserialisation alone",
+            Figure.cost([run[0] for run in ours], "s"),
+            Figure.cost([run[0] for run in baseline], "s"),
+            Target(1.5),
+        ),
+        Row(
+            group,
+            "the same, CPU time (user + system)",
+            Figure.cost([run[1] for run in ours], "s"),
+            Figure.cost([run[1] for run in baseline], "s"),
+        ),
+        Row(
+            group,
+            "identify peak memory",
+            Figure(ours_mb, ours_mb, "MB"),
+            Figure(baseline_mb, baseline_mb, "MB"),
+            Target(1024, absolute=True),
+        ),
     ]
     return rows, {"messages": messages, "identify_output": ours[-1][3]}
 
@@ -179,15 +210,23 @@ def main() -> None:
     print_table(rows, "irb140_dynamics identification (ratio = ours / baseline)")
     if details:
         print(details["identify_output"])
-    path = write_results("identify", {
-        "benchmark": "identify",
-        "machine": machine_info(("numpy", "scipy", "pinocchio", "rosbags")),
-        "settings": {"minutes": args.minutes, "rate": args.rate, "repeats": args.repeats,
-                     "regressor_states": REGRESSOR_STATES, "seed": SEED},
-        "rows": [row.as_dict() for row in rows],
-        "messages": details.get("messages"),
-        "runtime_s": time.perf_counter() - started,
-    })
+    path = write_results(
+        "identify",
+        {
+            "benchmark": "identify",
+            "machine": machine_info(("numpy", "scipy", "pinocchio", "rosbags")),
+            "settings": {
+                "minutes": args.minutes,
+                "rate": args.rate,
+                "repeats": args.repeats,
+                "regressor_states": REGRESSOR_STATES,
+                "seed": SEED,
+            },
+            "rows": [row.as_dict() for row in rows],
+            "messages": details.get("messages"),
+            "runtime_s": time.perf_counter() - started,
+        },
+    )
     print(f"raw figures: {path.relative_to(REPO)} ({time.perf_counter() - started:.0f} s)")
 
 

@@ -8,7 +8,7 @@
 Prints one table and writes the raw figures to bench/results/nodes.json. Sections:
 
 - end to end, per rate and executor (bench/stream.py): the node under test runs in its
-  own process (id_node as ``python -m irb140_dynamics.id_node``, or the baseline
+  own process (id_node as ``python -m irb140_dynamics.nodes.id_node.node``, or the baseline
   bench/relay_node.py, which republishes joint_states unchanged on feedforward_torques
   with the same QoS). This process publishes JointState at a fixed rate for a warm-up and
   then ``--duration`` seconds, and takes the torque messages as they arrive: their delay,
@@ -34,12 +34,13 @@ import os
 import time
 
 from common import REPO, machine_info, print_table, write_results  # first: puts the checkout on sys.path
-from irb140_dynamics.ros.spin import EXECUTORS  # noqa: E402  (events: what every node's main() uses)
 from machine_load import OTHERS_WARNING, STOLEN_WARNING
 from node_processes import QOS_DEPTH, isolated_domain
 from payload_section import payload_rows
 from soak import print_soak, soak
 from stream import CHANGE_RATE, RECEIVER_DEPTH, end_to_end
+
+from irb140_dynamics.ros.runtime.spin import EXECUTORS  # noqa: E402  (events: what every node's main() uses)
 
 RATES = (1000, 2000)  # Hz
 CHANGE_PERIOD = 0.1  # s between two parameter changes in the run at CHANGE_RATE
@@ -53,32 +54,62 @@ def parse_args(argv=None) -> argparse.Namespace:
     parser.add_argument("--duration", type=float, default=DURATION, help="measured seconds per run (default 10)")
     parser.add_argument("--warmup", type=float, default=WARMUP, help="seconds streamed before measuring (default 1)")
     parser.add_argument("--rates", type=float, nargs="+", default=list(RATES), help="Hz (default 1000 2000)")
-    parser.add_argument("--executor", nargs="+", choices=EXECUTORS, default=["events"],
-                        help="executor of both nodes: events (rclpy.experimental.EventsExecutor, as "
-                             "main() does; default) and/or single_threaded (rclpy.spin)")
-    parser.add_argument("--no-event-handlers", action="store_true",
-                        help="run both nodes without rclpy's default QoS event handlers "
-                             "(a bench-only variant through relay_node.py)")
+    parser.add_argument(
+        "--executor",
+        nargs="+",
+        choices=EXECUTORS,
+        default=["events"],
+        help="executor of both nodes: events (rclpy.experimental.EventsExecutor, as "
+        "main() does; default) and/or single_threaded (rclpy.spin)",
+    )
+    parser.add_argument(
+        "--no-event-handlers",
+        action="store_true",
+        help="run both nodes without rclpy's default QoS event handlers (a bench-only variant through relay_node.py)",
+    )
     parser.add_argument("--no-payload", action="store_true", help="skip the payload check section")
-    parser.add_argument("--change-period", type=float, default=CHANGE_PERIOD,
-                        help=f"s between two payload.mass changes in the run at {CHANGE_RATE} Hz with parameter "
-                             f"changes (default {CHANGE_PERIOD:g})")
+    parser.add_argument(
+        "--change-period",
+        type=float,
+        default=CHANGE_PERIOD,
+        help=f"s between two payload.mass changes in the run at {CHANGE_RATE} Hz with parameter "
+        f"changes (default {CHANGE_PERIOD:g})",
+    )
     parser.add_argument("--no-changes", action="store_true", help="skip the run with parameter changes")
-    parser.add_argument("--repeat", type=int, default=REPEAT,
-                        help=f"runs of each pair, relay and id_node in turn; the table shows medians and total "
-                             f"losses (default {REPEAT})")
-    parser.add_argument("--soak", type=float, metavar="MINUTES", default=None,
-                        help="only the soak: id_node and the relay side by side at 1 kHz for MINUTES "
-                             "(10 in the issue), their RSS growth (bench/results/soak.json)")
+    parser.add_argument(
+        "--repeat",
+        type=int,
+        default=REPEAT,
+        help=f"runs of each pair, relay and id_node in turn; the table shows medians and total "
+        f"losses (default {REPEAT})",
+    )
+    parser.add_argument(
+        "--soak",
+        type=float,
+        metavar="MINUTES",
+        default=None,
+        help="only the soak: id_node and the relay side by side at 1 kHz for MINUTES "
+        "(10 in the issue), their RSS growth (bench/results/soak.json)",
+    )
     parser.add_argument("--no-stream", action="store_true", help="skip the end-to-end section")
-    parser.add_argument("--depth", type=int, default=QOS_DEPTH,
-                        help=f"qos.depth of both nodes (default {QOS_DEPTH}, id_node's): their joint_states queue "
-                             "holds depth / rate seconds of a stall")
-    parser.add_argument("--effort", action="store_true",
-                        help="joint states carry efforts: id_node's momentum observer runs on every message")
-    parser.add_argument("--profile", action="store_true",
-                        help="sample each node with py-spy over the measured window "
-                             "(bench/results/profile_*.txt; perturbs the figures a little)")
+    parser.add_argument(
+        "--depth",
+        type=int,
+        default=QOS_DEPTH,
+        help=f"qos.depth of both nodes (default {QOS_DEPTH}, id_node's): their joint_states queue "
+        "holds depth / rate seconds of a stall",
+    )
+    parser.add_argument(
+        "--effort",
+        action="store_true",
+        help="joint states carry efforts: id_node's momentum observer runs on every message",
+    )
+    parser.add_argument(
+        "--profile",
+        action="store_true",
+        help="sample each node with py-spy over the measured window "
+        "(bench/results/profile_*.txt; perturbs the figures a little)",
+    )
     parser.add_argument("--domain-id", type=int, default=None, help="ROS_DOMAIN_ID (default: random in 50..99)")
     return parser.parse_args(argv)
 
@@ -90,16 +121,33 @@ def main(argv=None) -> None:
     if args.soak is not None:
         results = soak(args.soak, CHANGE_RATE, env)
         print_soak(results)
-        path = write_results("soak", {"benchmark": "soak", "machine": machine_info(("numpy", "rclpy")), **results,
-                                      "runtime_s": time.perf_counter() - started})
+        path = write_results(
+            "soak",
+            {
+                "benchmark": "soak",
+                "machine": machine_info(("numpy", "rclpy")),
+                **results,
+                "runtime_s": time.perf_counter() - started,
+            },
+        )
         print(f"raw figures: {path.relative_to(REPO)}")
         return
 
     rows, runs, payload = [], [], {}
     if not args.no_stream:
-        stream, runs = end_to_end(args.rates, args.executor, args.duration, args.warmup, env, args.profile,
-                                  args.no_event_handlers, None if args.no_changes else args.change_period,
-                                  effort=args.effort, repeat=args.repeat, depth=args.depth)
+        stream, runs = end_to_end(
+            args.rates,
+            args.executor,
+            args.duration,
+            args.warmup,
+            env,
+            args.profile,
+            args.no_event_handlers,
+            None if args.no_changes else args.change_period,
+            effort=args.effort,
+            repeat=args.repeat,
+            depth=args.depth,
+        )
         rows += stream
     if not args.no_payload:
         print("  payload check ...", flush=True)
@@ -110,12 +158,16 @@ def main(argv=None) -> None:
     busy = [r for r in runs if r["other_processes_cores"] > OTHERS_WARNING]
     if busy:
         worst = max(r["other_processes_cores"] for r in busy)
-        print(f"note: other processes used up to {worst:.2f} of {os.cpu_count()} cores during "
-              f"{len(busy)} of {len(runs)} runs: the delays and losses are not those of an idle machine")
+        print(
+            f"note: other processes used up to {worst:.2f} of {os.cpu_count()} cores during "
+            f"{len(busy)} of {len(runs)} runs: the delays and losses are not those of an idle machine"
+        )
     stolen = [r for r in runs if r["stolen_percent"] > STOLEN_WARNING]
     if stolen:
-        print(f"note: the hypervisor took up to {max(r['stolen_percent'] for r in stolen):.1f} % of the CPUs' time "
-              f"(steal) during {len(stolen)} of {len(runs)} runs: stalls of a shared host, not of these processes")
+        print(
+            f"note: the hypervisor took up to {max(r['stolen_percent'] for r in stolen):.1f} % of the CPUs' time "
+            f"(steal) during {len(stolen)} of {len(runs)} runs: stalls of a shared host, not of these processes"
+        )
     if args.profile:
         print("profiled (py-spy): figures perturbed; share of the node's samples, inclusive:")
         for r in runs:
@@ -132,8 +184,10 @@ def main(argv=None) -> None:
                 "warmup_s": args.warmup,
                 "rates_hz": args.rates,
                 "executors": args.executor,
-                "qos": {"joint_states": f"best_effort, depth {args.depth}",
-                        "feedforward_torques": f"reliable, depth {args.depth} (node) / {RECEIVER_DEPTH} (here)"},
+                "qos": {
+                    "joint_states": f"best_effort, depth {args.depth}",
+                    "feedforward_torques": f"reliable, depth {args.depth} (node) / {RECEIVER_DEPTH} (here)",
+                },
                 "rmw": os.environ.get("RMW_IMPLEMENTATION", "default (rmw_fastrtps_cpp)"),
                 "ros_domain_id": domain_id,
                 "profiled": args.profile,

@@ -29,7 +29,6 @@ import sys
 import time
 
 import numpy as np
-
 from common import REPO, Row, Target, Value, machine_info, print_table, write_results  # first: the checkout on sys.path
 from machine_load import OTHERS_WARNING, load_between, snapshot
 from node_processes import STARTUP_TIMEOUT, NodeProcess, isolated_domain, wait_for
@@ -62,27 +61,64 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
 
     namespace = f"/bench_sim_{os.getpid()}_{index}"
     ros_args = ["--ros-args", "-r", f"__ns:={namespace}"]
-    sim = NodeProcess([sys.executable, "-m", "irb140_dynamics.sim_node", *ros_args, "-p", f"rate:={rate}",
-                       "-p", f"initial_positions:={POSE}", "-p", f"thread_priority:={priority}"], env)
+    sim = NodeProcess(
+        [
+            sys.executable,
+            "-m",
+            "irb140_dynamics.nodes.sim_node.node",
+            *ros_args,
+            "-p",
+            f"rate:={rate}",
+            "-p",
+            f"initial_positions:={POSE}",
+            "-p",
+            f"thread_priority:={priority}",
+        ],
+        env,
+    )
     controller = None
     if loop:
-        controller = NodeProcess([sys.executable, "-m", "irb140_dynamics.id_node", *ros_args,
-                                  "-p", "effort_commands.enabled:=true", "-p", "effort_commands.source:=gravity"], env)
+        controller = NodeProcess(
+            [
+                sys.executable,
+                "-m",
+                "irb140_dynamics.nodes.id_node.node",
+                *ros_args,
+                "-p",
+                "effort_commands.enabled:=true",
+                "-p",
+                "effort_commands.source:=gravity",
+            ],
+            env,
+        )
     listener, taker = Node("bench_sim_listener"), Node("bench_sim_taker")
     executor = SingleThreadedExecutor()
     executor.add_node(listener)
     diagnostics, receiver = [], None
     hardware_id = f"{namespace}/sim_node"
     try:
-        listener.create_subscription(DiagnosticArray, "/diagnostics",
-                                     lambda msg: diagnostics.append((time.monotonic(), msg)), 100)
-        states = taker.create_subscription(JointState, f"{namespace}/joint_states", lambda msg: None,
-                                           QoSProfile(depth=QOS_DEPTH, reliability=ReliabilityPolicy.RELIABLE))
-        wait_for(lambda: taker.count_publishers(f"{namespace}/joint_states") > 0, STARTUP_TIMEOUT, sim,
-                 "sim_node's joint_states")
+        listener.create_subscription(
+            DiagnosticArray, "/diagnostics", lambda msg: diagnostics.append((time.monotonic(), msg)), 100
+        )
+        states = taker.create_subscription(
+            JointState,
+            f"{namespace}/joint_states",
+            lambda msg: None,
+            QoSProfile(depth=QOS_DEPTH, reliability=ReliabilityPolicy.RELIABLE),
+        )
+        wait_for(
+            lambda: taker.count_publishers(f"{namespace}/joint_states") > 0,
+            STARTUP_TIMEOUT,
+            sim,
+            "sim_node's joint_states",
+        )
         if controller is not None:
-            wait_for(lambda: listener.count_publishers(f"{namespace}/effort_commands") > 0, STARTUP_TIMEOUT,
-                     controller, "id_node's effort_commands")
+            wait_for(
+                lambda: listener.count_publishers(f"{namespace}/effort_commands") > 0,
+                STARTUP_TIMEOUT,
+                controller,
+                "id_node's effort_commands",
+            )
         receiver = Receiver(states, taker.context)
         receiver.start()
 
@@ -93,15 +129,23 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
 
         spin(warmup)
         first = len(diagnostics)
-        wait_for(lambda: spin(0.05) or any(counts_of(m, hardware_id) for _, m in diagnostics[first:]),
-                 5.0, sim, "sim_node's /diagnostics")
+        wait_for(
+            lambda: spin(0.05) or any(counts_of(m, hardware_id) for _, m in diagnostics[first:]),
+            5.0,
+            sim,
+            "sim_node's /diagnostics",
+        )
         start_at, start_msg = next((t, m) for t, m in diagnostics[first:] if counts_of(m, hardware_id))
         cpu0 = sim.cpu_seconds(), controller.cpu_seconds() if controller else 0.0
         load0 = snapshot()
         spin(duration - 0.5)
         later = len(diagnostics)
-        wait_for(lambda: spin(0.05) or any(counts_of(m, hardware_id) for _, m in diagnostics[later:]),
-                 5.0, sim, "sim_node's /diagnostics")
+        wait_for(
+            lambda: spin(0.05) or any(counts_of(m, hardware_id) for _, m in diagnostics[later:]),
+            5.0,
+            sim,
+            "sim_node's /diagnostics",
+        )
         end_at, end_msg = next((t, m) for t, m in diagnostics[later:] if counts_of(m, hardware_id))
         cpu1 = sim.cpu_seconds(), controller.cpu_seconds() if controller else 0.0
         load1 = snapshot()
@@ -152,21 +196,43 @@ def _ns(stamp) -> int:
 
 def rows_of(alone: dict, loop: dict) -> list[Row]:
     priority = f", thread_priority {loop['thread_priority']}" if loop["thread_priority"] else ""
-    group = (f"sim_node at {loop['rate_hz']:g} Hz for {loop['window_s']:.0f} s beside id_node{priority} "
-             "(baseline: sim_node alone)")
+    group = (
+        f"sim_node at {loop['rate_hz']:g} Hz for {loop['window_s']:.0f} s beside id_node{priority} "
+        "(baseline: sim_node alone)"
+    )
     rows = [
-        Row(group, f"late steps (of {loop['steps']})", Value.of(loop["late_percent"], "%"),
-            Value.of(alone["late_percent"], "%"), LATE_TARGET),
-        Row(group, "skipped steps", Value.of(loop["skipped_steps"], "msgs"), Value.of(alone["skipped_steps"], "msgs"),
-            SKIPPED_TARGET),
+        Row(
+            group,
+            f"late steps (of {loop['steps']})",
+            Value.of(loop["late_percent"], "%"),
+            Value.of(alone["late_percent"], "%"),
+            LATE_TARGET,
+        ),
+        Row(
+            group,
+            "skipped steps",
+            Value.of(loop["skipped_steps"], "msgs"),
+            Value.of(alone["skipped_steps"], "msgs"),
+            SKIPPED_TARGET,
+        ),
         Row(group, "steps per second", Value.of(loop["steps_per_s"], "Hz"), Value.of(alone["steps_per_s"], "Hz")),
     ]
     for stat in ("p50", "p99", "max"):
-        rows.append(Row(group, f"publish lateness {stat}", Value.of(loop["publish_lateness_us"][stat], "us"),
-                        Value.of(alone["publish_lateness_us"][stat], "us")))
+        rows.append(
+            Row(
+                group,
+                f"publish lateness {stat}",
+                Value.of(loop["publish_lateness_us"][stat], "us"),
+                Value.of(alone["publish_lateness_us"][stat], "us"),
+            )
+        )
     rows += [
-        Row(group, "sim_node CPU per step", Value.of(loop["sim_cpu_us_per_step"], "us"),
-            Value.of(alone["sim_cpu_us_per_step"], "us")),
+        Row(
+            group,
+            "sim_node CPU per step",
+            Value.of(loop["sim_cpu_us_per_step"], "us"),
+            Value.of(alone["sim_cpu_us_per_step"], "us"),
+        ),
         Row(group, "id_node CPU", Value.of(loop["id_node_cpu_percent"], "%")),
     ]
     return rows
@@ -177,8 +243,12 @@ def main(argv=None) -> None:
     parser.add_argument("--duration", type=float, default=DURATION, help="measured seconds per run (default 10)")
     parser.add_argument("--warmup", type=float, default=WARMUP, help="seconds before measuring (default 2)")
     parser.add_argument("--rate", type=float, default=RATE, help="sim_node's rate, Hz (default 1000)")
-    parser.add_argument("--priority", type=int, default=0,
-                        help="sim_node's thread_priority (SCHED_FIFO 1..99; default 0: ordinary scheduling)")
+    parser.add_argument(
+        "--priority",
+        type=int,
+        default=0,
+        help="sim_node's thread_priority (SCHED_FIFO 1..99; default 0: ordinary scheduling)",
+    )
     parser.add_argument("--domain-id", type=int, default=None, help="ROS_DOMAIN_ID (default: random in 50..99)")
     args = parser.parse_args(argv)
     started = time.perf_counter()
@@ -190,31 +260,46 @@ def main(argv=None) -> None:
     runs = []
     try:
         for index, loop in enumerate((False, True)):
-            print(f"  sim_node {'beside id_node' if loop else 'alone'} at {args.rate:g} Hz: "
-                  f"{args.warmup + args.duration:g} s ...", flush=True)
+            print(
+                f"  sim_node {'beside id_node' if loop else 'alone'} at {args.rate:g} Hz: "
+                f"{args.warmup + args.duration:g} s ...",
+                flush=True,
+            )
             runs.append(run(loop, args.rate, args.duration, args.warmup, env, index, args.priority))
             r = runs[-1]
-            print(f"    {r['late_steps']} of {r['steps']} steps late ({r['late_percent']:.3f} %), "
-                  f"{r['skipped_steps']} skipped, CPU {r['sim_cpu_us_per_step']:.0f} us/step", flush=True)
+            print(
+                f"    {r['late_steps']} of {r['steps']} steps late ({r['late_percent']:.3f} %), "
+                f"{r['skipped_steps']} skipped, CPU {r['sim_cpu_us_per_step']:.0f} us/step",
+                flush=True,
+            )
     finally:
         rclpy.try_shutdown()
     rows = rows_of(*runs)
     print_table(rows, "sim_node real time (ratio = beside id_node / alone)")
     worst = max(r["other_processes_cores"] for r in runs)
     if worst > OTHERS_WARNING:
-        print(f"note: other processes used up to {worst:.2f} of {os.cpu_count()} cores during the runs: "
-              "late steps are not those of an idle machine")
-    path = write_results("sim", {
-        "benchmark": "sim",
-        "machine": machine_info(("numpy", "rclpy", "mujoco")),
-        "settings": {"duration_s": args.duration, "warmup_s": args.warmup, "rate_hz": args.rate,
-                     "thread_priority": args.priority,
-                     "ros_domain_id": domain_id,
-                     "rmw": os.environ.get("RMW_IMPLEMENTATION", "default (rmw_fastrtps_cpp)")},
-        "rows": [row.as_dict() for row in rows],
-        "runs": runs,
-        "runtime_s": time.perf_counter() - started,
-    })
+        print(
+            f"note: other processes used up to {worst:.2f} of {os.cpu_count()} cores during the runs: "
+            "late steps are not those of an idle machine"
+        )
+    path = write_results(
+        "sim",
+        {
+            "benchmark": "sim",
+            "machine": machine_info(("numpy", "rclpy", "mujoco")),
+            "settings": {
+                "duration_s": args.duration,
+                "warmup_s": args.warmup,
+                "rate_hz": args.rate,
+                "thread_priority": args.priority,
+                "ros_domain_id": domain_id,
+                "rmw": os.environ.get("RMW_IMPLEMENTATION", "default (rmw_fastrtps_cpp)"),
+            },
+            "rows": [row.as_dict() for row in rows],
+            "runs": runs,
+            "runtime_s": time.perf_counter() - started,
+        },
+    )
     print(f"raw figures: {path.relative_to(REPO)} ({time.perf_counter() - started:.0f} s)")
 
 

@@ -15,11 +15,11 @@ import statistics
 import subprocess
 import sys
 import timeit
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
-from typing import Callable, Iterable, Sequence
 
 REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "bench" / "results"
@@ -58,13 +58,13 @@ class Figure:
     unit: str
 
     @classmethod
-    def cost(cls, samples: Sequence[float], unit: str = "us") -> "Figure":
+    def cost(cls, samples: Sequence[float], unit: str = "us") -> Figure:
         """Seconds per call (lower is better) as microseconds or milliseconds."""
         scale = {"us": 1e6, "ms": 1e3, "s": 1.0}[unit]
         return cls(min(samples) * scale, statistics.median(samples) * scale, unit)
 
     @classmethod
-    def rate(cls, samples: Sequence[float], items: int, unit: str = "states/s") -> "Figure":
+    def rate(cls, samples: Sequence[float], items: int, unit: str = "states/s") -> Figure:
         """Items per second (higher is better) of calls that each process ``items``."""
         return cls(items / min(samples), items / statistics.median(samples), unit)
 
@@ -137,7 +137,7 @@ class Value(Figure):
     """One measured number (best = median = it), printed alone."""
 
     @classmethod
-    def of(cls, x: float, unit: str) -> "Value":
+    def of(cls, x: float, unit: str) -> Value:
         return cls(float(x), float(x), unit)
 
     def __str__(self) -> str:
@@ -228,7 +228,7 @@ def machine_info(modules: Sequence[str] = ("numpy",)) -> dict:
     for module in modules:
         info[module] = _version(module)
     info["git_commit"] = _git_commit()
-    info["date"] = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    info["date"] = datetime.now(UTC).isoformat(timespec="seconds")
     return info
 
 

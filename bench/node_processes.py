@@ -13,7 +13,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from typing import Callable
+from collections.abc import Callable
 
 from common import REPO
 from machine_load import process_cpu_seconds
@@ -49,9 +49,10 @@ class NodeProcess:
 
     def __init__(self, command: list[str], env: dict):
         self.command = command
-        self.log = tempfile.TemporaryFile(mode="w+")
-        self.process = subprocess.Popen(command, env=env, stdout=self.log, stderr=subprocess.STDOUT, text=True,
-                                        preexec_fn=_die_with_parent)
+        self.log = tempfile.TemporaryFile(mode="w+")  # noqa: SIM115 (open for the process's life; closed in stop())
+        self.process = subprocess.Popen(
+            command, env=env, stdout=self.log, stderr=subprocess.STDOUT, text=True, preexec_fn=_die_with_parent
+        )
 
     def alive(self) -> bool:
         return self.process.poll() is None
@@ -94,15 +95,21 @@ def node_command(kind: str, executor: str, namespace: str, lean: bool = False, d
     """id_node as `ros2 run` starts it (its main(): the events executor), or through
     relay_node.py (the relay, or id_node under another executor or without QoS event
     handlers, ``lean``); both with id_node's default QoS given explicitly."""
-    ros_args = ["--ros-args", "-r", f"__ns:={namespace}",
-                "-p", "qos.reliability:=best_effort", "-p", f"qos.depth:={depth}"]
+    ros_args = [
+        "--ros-args",
+        "-r",
+        f"__ns:={namespace}",
+        "-p",
+        "qos.reliability:=best_effort",
+        "-p",
+        f"qos.depth:={depth}",
+    ]
     if kind == "id_node":
         ros_args += ["-p", "acceleration.mode:=differentiate"]
         if executor == "events" and not lean:
-            return [sys.executable, "-m", "irb140_dynamics.id_node", *ros_args]
+            return [sys.executable, "-m", "irb140_dynamics.nodes.id_node.node", *ros_args]
     lean_flag = ["--no-event-handlers"] if lean else []
-    return [sys.executable, str(REPO / "bench" / "relay_node.py"), kind, "--executor", executor, *lean_flag,
-            *ros_args]
+    return [sys.executable, str(REPO / "bench" / "relay_node.py"), kind, "--executor", executor, *lean_flag, *ros_args]
 
 
 def wait_for(condition: Callable[[], bool], timeout: float, process: NodeProcess, what: str) -> None:

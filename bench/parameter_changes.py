@@ -11,7 +11,6 @@ import threading
 import time
 
 import numpy as np
-
 from common import set_priority
 
 REPLY_TIMEOUT = 5.0  # s
@@ -21,8 +20,9 @@ SERVICES_TIMEOUT = 30.0  # s, for the node's parameter services to appear
 class ParameterChanger(threading.Thread):
     """Sets ``name`` on the node ``node_name`` (fully qualified) every ``period`` s once started."""
 
-    def __init__(self, node_name: str, period: float, name: str = "payload.mass", first: float = 1.0,
-                 step: float = 0.001):
+    def __init__(
+        self, node_name: str, period: float, name: str = "payload.mass", first: float = 1.0, step: float = 0.001
+    ):
         super().__init__(daemon=True)
         import rclpy
         from rclpy.context import Context
@@ -73,11 +73,20 @@ class ParameterChanger(threading.Thread):
         self.join(timeout=REPLY_TIMEOUT + 1)
         self.close()
         ms = np.array(self.replies) * 1e3
-        reply = {"p50": float(np.percentile(ms, 50)), "p99": float(np.percentile(ms, 99)), "max": float(ms.max())} \
-            if ms.size else {"p50": None, "p99": None, "max": None}
-        return {"parameter": self.name, "period_s": self.period, "accepted": len(self.replies),
-                "refused": len(self.refused), "first_refusal": self.refused[0] if self.refused else None,
-                "unanswered": self.unanswered, "reply_ms": reply}
+        reply = (
+            {"p50": float(np.percentile(ms, 50)), "p99": float(np.percentile(ms, 99)), "max": float(ms.max())}
+            if ms.size
+            else {"p50": None, "p99": None, "max": None}
+        )
+        return {
+            "parameter": self.name,
+            "period_s": self.period,
+            "accepted": len(self.replies),
+            "refused": len(self.refused),
+            "first_refusal": self.refused[0] if self.refused else None,
+            "unanswered": self.unanswered,
+            "reply_ms": reply,
+        }
 
     def close(self) -> None:
         import rclpy

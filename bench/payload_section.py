@@ -36,8 +36,14 @@ def payload_rows(env: dict) -> tuple[list[Row], dict]:
     def cold(payload: str) -> list[float]:
         seconds = []
         for _ in range(COLD_PROCESSES):
-            out = subprocess.run([sys.executable, "-c", COLD_SNIPPET.format(payload=payload)], env=env,
-                                 capture_output=True, text=True, timeout=120, check=True)
+            out = subprocess.run(
+                [sys.executable, "-c", COLD_SNIPPET.format(payload=payload)],
+                env=env,
+                capture_output=True,
+                text=True,
+                timeout=120,
+                check=True,
+            )
             seconds.append(float(out.stdout.split()[-1]))
         return seconds
 
@@ -46,12 +52,15 @@ def payload_rows(env: dict) -> tuple[list[Row], dict]:
     timed = {
         "check_payload, cold: first call in a fresh process": cold("6.0"),
         f"check_payload, cold, RigidBody({OFF_AXIS})": cold(OFF_AXIS),
-        "check_payload, warm": seconds_per_call(lambda: check_payload(model, payload, q=STRETCHED),
-                                                blocks=7, block_seconds=0.2),
-        "  derive_torque_limits alone": seconds_per_call(lambda: derive_torque_limits(model),
-                                                         blocks=7, block_seconds=0.2),
-        "  workspace_load (the sweep and its proof) alone": seconds_per_call(lambda: workspace_load(model, payload, limits),
-                                                               blocks=7, block_seconds=0.2),
+        "check_payload, warm": seconds_per_call(
+            lambda: check_payload(model, payload, q=STRETCHED), blocks=7, block_seconds=0.2
+        ),
+        "  derive_torque_limits alone": seconds_per_call(
+            lambda: derive_torque_limits(model), blocks=7, block_seconds=0.2
+        ),
+        "  workspace_load (the sweep and its proof) alone": seconds_per_call(
+            lambda: workspace_load(model, payload, limits), blocks=7, block_seconds=0.2
+        ),
     }
     rows = [Row(group, name, Figure.cost(samples, "ms")) for name, samples in timed.items()]
     service, raw = service_calls(env)
@@ -61,9 +70,11 @@ def payload_rows(env: dict) -> tuple[list[Row], dict]:
 
 def service_calls(env: dict) -> tuple[list[tuple[str, Figure]], dict]:
     """Round trips of ~/check on a payload_check_node process (see _time_service_calls)."""
-    names = ("~/check round trip, first call",
-             f"~/check round trip, next {SERVICE_CALLS} calls",
-             "~/check round trip, new participant at once")
+    names = (
+        "~/check round trip, first call",
+        f"~/check round trip, next {SERVICE_CALLS} calls",
+        "~/check round trip, new participant at once",
+    )
     if not (REPO / "irb140_dynamics" / "payload_check_node.py").is_file():
         reason = "payload_check_node missing"
         return [(name, NotMeasured(None, None, "ms", reason)) for name in names], {"service": reason}
@@ -93,8 +104,17 @@ def _time_service_calls(env: dict) -> tuple[float, list[float], float]:
     from std_srvs.srv import Trigger
 
     namespace = f"/bench_nodes_{os.getpid()}_payload"
-    process = NodeProcess([sys.executable, "-m", "irb140_dynamics.payload_check_node",
-                           "--ros-args", "-r", f"__ns:={namespace}"], env)
+    process = NodeProcess(
+        [
+            sys.executable,
+            "-m",
+            "irb140_dynamics.nodes.payload_check_node.node",
+            "--ros-args",
+            "-r",
+            f"__ns:={namespace}",
+        ],
+        env,
+    )
 
     def calls(settle: float, count: int) -> list[float]:
         """A client in a participant of its own: wait for the service, settle, call."""
@@ -132,4 +152,3 @@ def _time_service_calls(env: dict) -> tuple[float, list[float], float]:
         return settled[0], settled[1:], at_discovery[0]
     finally:
         process.stop()
-

@@ -39,8 +39,15 @@ class Receiver(threading.Thread):
                 now = time.time_ns()
                 msg, info = taken
                 stamp = msg.header.stamp
-                records.append((stamp.sec * 1_000_000_000 + stamp.nanosec, info["source_timestamp"],
-                                info["received_timestamp"], now, info["publication_sequence_number"] or 0))
+                records.append(
+                    (
+                        stamp.sec * 1_000_000_000 + stamp.nanosec,
+                        info["source_timestamp"],
+                        info["received_timestamp"],
+                        now,
+                        info["publication_sequence_number"] or 0,
+                    )
+                )
                 self.last_arrival = time.monotonic()
 
     def stop(self) -> None:

@@ -12,7 +12,7 @@ rclpy without computing anything.
 ``id_node``: irb140_dynamics' IdNode itself, for running it under an executor other than
 the one its main() uses (bench_nodes.py --executor single_threaded).
 
-``--executor``: as irb140_dynamics.ros.spin.run takes it; ``events`` (the default) is what
+``--executor``: as irb140_dynamics.ros.runtime.spin.run takes it; ``events`` (the default) is what
 every node's main() uses, ``single_threaded`` is rclpy.spin, for comparison.
 ``--no-event-handlers``: the node's publishers and subscriptions are created without
 rclpy's default QoS event handlers (the incompatible-QoS and incompatible-type warnings),
@@ -33,7 +33,7 @@ from rclpy.node import Node  # noqa: E402
 from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 
-from irb140_dynamics.ros.spin import EXECUTORS, run  # noqa: E402
+from irb140_dynamics.ros.runtime.spin import EXECUTORS, run  # noqa: E402
 
 RELIABILITIES = {"best_effort": ReliabilityPolicy.BEST_EFFORT, "reliable": ReliabilityPolicy.RELIABLE}
 
@@ -47,15 +47,16 @@ class RelayNode(Node):
         reliability = RELIABILITIES[self.declare_parameter("qos.reliability", "best_effort").value]
         self.declare_parameter("payload.mass", 0.0)  # set like id_node's in the benchmark; changes nothing here
         self._publisher = self.create_publisher(JointState, "feedforward_torques", depth)
-        self.create_subscription(JointState, "joint_states", self._publisher.publish,
-                                 QoSProfile(depth=depth, reliability=reliability))
+        self.create_subscription(
+            JointState, "joint_states", self._publisher.publish, QoSProfile(depth=depth, reliability=reliability)
+        )
         self.get_logger().info("ready: relaying joint_states to feedforward_torques")
 
 
 def make_node(kind: str):
     if kind == "relay":
         return RelayNode
-    from irb140_dynamics.id_node import IdNode
+    from irb140_dynamics.nodes.id_node.node import IdNode
 
     return IdNode
 
@@ -79,7 +80,7 @@ def without_event_handlers() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv if argv is None else argv
-    ours = argv[1:argv.index("--ros-args")] if "--ros-args" in argv else argv[1:]
+    ours = argv[1 : argv.index("--ros-args")] if "--ros-args" in argv else argv[1:]
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("node", choices=("relay", "id_node"))
     parser.add_argument("--executor", choices=EXECUTORS, default="events")
@@ -87,7 +88,7 @@ def main(argv: list[str] | None = None) -> int:
     options = parser.parse_args(ours)
     if options.no_event_handlers:
         without_event_handlers()
-    ros_args = argv[argv.index("--ros-args"):] if "--ros-args" in argv else []
+    ros_args = argv[argv.index("--ros-args") :] if "--ros-args" in argv else []
     return run(options.node, make_node(options.node), [argv[0], *ros_args], options.executor)
 
 

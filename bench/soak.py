@@ -21,13 +21,13 @@ by that until it has logged 1,000 messages, then stops; the relay logs nothing.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import threading
 import time
 
 import numpy as np
-
 from node_processes import QOS_DEPTH, STARTUP_TIMEOUT, NodeProcess, node_command, rss_kb, wait_for
 from parameter_changes import ParameterChanger
 
@@ -73,14 +73,21 @@ def slope_kb_per_min(t_s: np.ndarray, rss: np.ndarray) -> float | None:
     return float(np.polyfit(t_s / 60.0, rss, 1)[0])
 
 
-def soak(minutes: float, rate: float, env: dict, change_period: float = CHANGE_PERIOD,
-         sample_period: float = SAMPLE_PERIOD, warmup: float = WARMUP, odd: bool = True) -> dict:
+def soak(
+    minutes: float,
+    rate: float,
+    env: dict,
+    change_period: float = CHANGE_PERIOD,
+    sample_period: float = SAMPLE_PERIOD,
+    warmup: float = WARMUP,
+    odd: bool = True,
+) -> dict:
     """Run the soak; the raw figures (samples, slopes, messages) by node. ``odd``: with the
     1 % bad messages and 1 % of never-seen joint names."""
     import rclpy
+    from rcl_interfaces.msg import Log
     from rclpy.node import Node
     from rclpy.qos import QoSProfile, ReliabilityPolicy
-    from rcl_interfaces.msg import Log
     from sensor_msgs.msg import JointState
 
     rclpy.init()
@@ -103,14 +110,25 @@ def soak(minutes: float, rate: float, env: dict, change_period: float = CHANGE_P
                 command.append("--disable-rosout-logs")  # its log messages to the console only
             processes[kind] = NodeProcess(command, env)
             publishers[kind] = node.create_publisher(
-                JointState, f"{namespace}/joint_states",
-                QoSProfile(depth=QOS_DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT))
+                JointState,
+                f"{namespace}/joint_states",
+                QoSProfile(depth=QOS_DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT),
+            )
             subscription = node.create_subscription(
-                JointState, f"{namespace}/feedforward_torques", lambda msg: None,
-                QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE))
-            wait_for(lambda: publishers[kind].get_subscription_count() > 0
-                     and node.count_publishers(f"{namespace}/feedforward_torques") > 0,
-                     STARTUP_TIMEOUT, processes[kind], f"{kind} matched")
+                JointState,
+                f"{namespace}/feedforward_torques",
+                lambda msg: None,
+                QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE),
+            )
+            wait_for(
+                lambda: (
+                    publishers[kind].get_subscription_count() > 0
+                    and node.count_publishers(f"{namespace}/feedforward_torques") > 0
+                ),
+                STARTUP_TIMEOUT,
+                processes[kind],
+                f"{kind} matched",
+            )
             drains[kind] = Drain(subscription, node.context)
             drains[kind].start()
             changers[kind] = ParameterChanger(f"{namespace}/{kind.removesuffix('_quiet')}", change_period)
@@ -171,8 +189,13 @@ def soak(minutes: float, rate: float, env: dict, change_period: float = CHANGE_P
                 "log_messages": logs[kind],
             }
         results["sent"] = sent
-        results["settings"] = {"minutes": minutes, "rate_hz": rate, "warmup_s": warmup,
-                               "sample_period_s": sample_period, "change_period_s": change_period}
+        results["settings"] = {
+            "minutes": minutes,
+            "rate_hz": rate,
+            "warmup_s": warmup,
+            "sample_period_s": sample_period,
+            "change_period_s": change_period,
+        }
         return results
     finally:
         for changer in changers.values():
@@ -191,19 +214,21 @@ def _spin(node) -> None:
     import rclpy
     from rclpy.executors import ExternalShutdownException
 
-    try:
+    with contextlib.suppress(ExternalShutdownException, rclpy.executors.ShutdownException):
         rclpy.spin(node)
-    except (ExternalShutdownException, rclpy.executors.ShutdownException):
-        pass
 
 
 def print_soak(results: dict) -> bool:
     """The soak side by side; True if id_node grew no faster than the relay (second half)."""
     s = results["settings"]
-    print(f"\nsoak: {s['minutes']:g} min at {s['rate_hz']:g} Hz, {results['sent']} messages to each node, "
-          f"payload.mass set every {s['change_period_s']:g} s; RssAnon after a {s['warmup_s']:g} s warm-up\n")
-    print(f"{'node':<14}{'RssAnon start [MB]':>20}{'RssAnon end [MB]':>18}{'growth [kB]':>13}"
-          f"{'kB/min':>9}{'kB/min, 2nd half':>18}{'outputs':>10}{'logs':>7}")
+    print(
+        f"\nsoak: {s['minutes']:g} min at {s['rate_hz']:g} Hz, {results['sent']} messages to each node, "
+        f"payload.mass set every {s['change_period_s']:g} s; RssAnon after a {s['warmup_s']:g} s warm-up\n"
+    )
+    print(
+        f"{'node':<14}{'RssAnon start [MB]':>20}{'RssAnon end [MB]':>18}{'growth [kB]':>13}"
+        f"{'kB/min':>9}{'kB/min, 2nd half':>18}{'outputs':>10}{'logs':>7}"
+    )
 
     def fmt(x, spec):
         return "-" if x is None else format(x, spec)
@@ -212,16 +237,22 @@ def print_soak(results: dict) -> bool:
         r = results[kind]
         first = r["rss_anon_kb"][0][1] / 1024 if r["rss_anon_kb"] else None
         last = r["rss_anon_kb"][-1][1] / 1024 if r["rss_anon_kb"] else None
-        print(f"{kind:<14}{fmt(first, '.1f'):>20}{fmt(last, '.1f'):>18}{fmt(r['growth_kb'], '.0f'):>13}"
-              f"{fmt(r['slope_kb_per_min'], '.1f'):>9}{fmt(r['slope_second_half_kb_per_min'], '.1f'):>18}"
-              f"{r['outputs']:>10}{r.get('log_messages', 0):>7}")
-    print("logs: messages each node sent to /rosout; rcl keeps its last 1,000 (~0.5 kB each), so a node that "
-          "warns grows by that until it has sent 1,000")
+        print(
+            f"{kind:<14}{fmt(first, '.1f'):>20}{fmt(last, '.1f'):>18}{fmt(r['growth_kb'], '.0f'):>13}"
+            f"{fmt(r['slope_kb_per_min'], '.1f'):>9}{fmt(r['slope_second_half_kb_per_min'], '.1f'):>18}"
+            f"{r['outputs']:>10}{r.get('log_messages', 0):>7}"
+        )
+    print(
+        "logs: messages each node sent to /rosout; rcl keeps its last 1,000 (~0.5 kB each), so a node that "
+        "warns grows by that until it has sent 1,000"
+    )
     base = results["relay"]["slope_second_half_kb_per_min"]
     met = {}
     for kind in ("id_node", "id_node_quiet"):
         ours = results[kind]["slope_second_half_kb_per_min"]
         met[kind] = ours is not None and base is not None and ours <= base + TOLERANCE
-        print(f"target: {kind}'s growth (2nd half) <= the relay's + {TOLERANCE:g} kB/min: "
-              f"{'met' if met[kind] else 'MISSED'}")
+        print(
+            f"target: {kind}'s growth (2nd half) <= the relay's + {TOLERANCE:g} kB/min: "
+            f"{'met' if met[kind] else 'MISSED'}"
+        )
     return met["id_node"]

@@ -19,7 +19,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-
 from common import REPO, RESULTS, Row, set_priority  # first: puts the checkout on sys.path
 from machine_load import load_between, snapshot
 from node_processes import QOS_DEPTH, STARTUP_TIMEOUT, NodeProcess, node_command, wait_for
@@ -84,11 +83,21 @@ def joint_efforts(positions: list, velocities: list) -> list:
     return rnea_batch(irb140(), Q, np.array(velocities), np.zeros_like(Q)).tolist()
 
 
-
-
-def stream_run(node, kind: str, executor: str, rate: float, duration: float, warmup: float,
-               env: dict, index: int, profile: bool = False, lean: bool = False,
-               change_period: float | None = None, effort: bool = False, depth: int = QOS_DEPTH) -> dict:
+def stream_run(
+    node,
+    kind: str,
+    executor: str,
+    rate: float,
+    duration: float,
+    warmup: float,
+    env: dict,
+    index: int,
+    profile: bool = False,
+    lean: bool = False,
+    change_period: float | None = None,
+    effort: bool = False,
+    depth: int = QOS_DEPTH,
+) -> dict:
     """Start the node, stream joint states at ``rate`` through it, return the raw figures.
 
     ``effort``: every joint state carries efforts (id_node then runs its momentum observer
@@ -107,14 +116,24 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
     profile_path = RESULTS / f"profile_{kind}_{executor}_{rate:g}hz.txt"
     try:
         publisher = node.create_publisher(
-            JointState, f"{namespace}/joint_states",
-            QoSProfile(depth=QOS_DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT))
+            JointState,
+            f"{namespace}/joint_states",
+            QoSProfile(depth=QOS_DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT),
+        )
         subscription = node.create_subscription(
-            JointState, f"{namespace}/feedforward_torques", lambda msg: None,
-            QoSProfile(depth=RECEIVER_DEPTH, reliability=ReliabilityPolicy.RELIABLE))
-        wait_for(lambda: publisher.get_subscription_count() > 0
-                 and node.count_publishers(f"{namespace}/feedforward_torques") > 0,
-                 STARTUP_TIMEOUT, process, f"{kind} matched on joint_states and feedforward_torques")
+            JointState,
+            f"{namespace}/feedforward_torques",
+            lambda msg: None,
+            QoSProfile(depth=RECEIVER_DEPTH, reliability=ReliabilityPolicy.RELIABLE),
+        )
+        wait_for(
+            lambda: (
+                publisher.get_subscription_count() > 0 and node.count_publishers(f"{namespace}/feedforward_torques") > 0
+            ),
+            STARTUP_TIMEOUT,
+            process,
+            f"{kind} matched on joint_states and feedforward_torques",
+        )
         receiver = Receiver(subscription, node.context)
         receiver.start()
         if change_period is not None:
@@ -160,7 +179,9 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
             last = int(stamps[-1])
             drain_end = time.monotonic() + DRAIN_TIMEOUT
             while time.monotonic() < drain_end:  # until the last output is in, or the stream is quiet
-                if (receiver.records and receiver.records[-1][0] == last) or time.monotonic() - receiver.last_arrival > QUIET:
+                if (
+                    receiver.records and receiver.records[-1][0] == last
+                ) or time.monotonic() - receiver.last_arrival > QUIET:
                     break
                 time.sleep(0.005)
         cpu = process.cpu_seconds() - cpu0
@@ -184,8 +205,20 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
         if publisher is not None:
             node.destroy_publisher(publisher)
         process.stop()
-    run = summarize(kind, executor, rate, duration, stamps[~skipped], first - int(skipped[:first].sum()),
-                    lateness[~skipped], receiver.records, cpu, own, load, sent_s)
+    run = summarize(
+        kind,
+        executor,
+        rate,
+        duration,
+        stamps[~skipped],
+        first - int(skipped[:first].sum()),
+        lateness[~skipped],
+        receiver.records,
+        cpu,
+        own,
+        load,
+        sent_s,
+    )
     # ticks of the window the source was too late for (a stall of this process): not sent,
     # as a driver's fixed-rate loop that overran sends its current state, not the missed ones
     run["stale_ticks_not_sent"] = int(skipped[first:].sum())
@@ -199,9 +232,20 @@ def stream_run(node, kind: str, executor: str, rate: float, duration: float, war
     return run
 
 
-def end_to_end(rates, executors, duration, warmup, env, profile=False, lean=False,
-               change_period: float | None = None, change_rate: float = CHANGE_RATE,
-               effort: bool = False, repeat: int = 1, depth: int = QOS_DEPTH) -> tuple[list[Row], list[dict]]:
+def end_to_end(
+    rates,
+    executors,
+    duration,
+    warmup,
+    env,
+    profile=False,
+    lean=False,
+    change_period: float | None = None,
+    change_rate: float = CHANGE_RATE,
+    effort: bool = False,
+    repeat: int = 1,
+    depth: int = QOS_DEPTH,
+) -> tuple[list[Row], list[dict]]:
     """Per executor and rate: the relay, then id_node, each in a fresh process, ``repeat``
     times in turn; then, with ``change_period``, both again at ``change_rate`` with a
     parameter change every ``change_period`` s."""
@@ -219,19 +263,25 @@ def end_to_end(rates, executors, duration, warmup, env, profile=False, lean=Fals
             for kind in ("relay", "id_node") * repeat:
                 every = "" if changes is None else f", payload.mass set every {changes * 1e3:g} ms"
                 print(f"  {kind} at {rate:g} Hz, {executor}{every}: {warmup + duration:g} s ...", flush=True)
-                run = stream_run(node, kind, executor, rate, duration, warmup, env, len(runs), profile, lean,
-                                 changes, effort, depth)
+                run = stream_run(
+                    node, kind, executor, rate, duration, warmup, env, len(runs), profile, lean, changes, effort, depth
+                )
                 runs.append(run)
                 d = run["delay_us"]
-                print(f"    p50 {_opt(d['p50'])} us, p99 {_opt(d['p99'])} us, max {_opt(d['max'])} us, "
-                      f"lost {run['lost']} of {run['sent']}, node CPU {run['node_cpu_us_per_msg']:.1f} us/msg, "
-                      f"source late by up to {run['source_late_max_ms']:.1f} ms "
-                      f"({run['stale_ticks_not_sent']} stale ticks not sent)", flush=True)
+                print(
+                    f"    p50 {_opt(d['p50'])} us, p99 {_opt(d['p99'])} us, max {_opt(d['max'])} us, "
+                    f"lost {run['lost']} of {run['sent']}, node CPU {run['node_cpu_us_per_msg']:.1f} us/msg, "
+                    f"source late by up to {run['source_late_max_ms']:.1f} ms "
+                    f"({run['stale_ticks_not_sent']} stale ticks not sent)",
+                    flush=True,
+                )
                 if run["parameter_changes"] is not None:
                     c = run["parameter_changes"]
-                    print(f"    changes: {c['accepted']} accepted, {c['refused']} refused, {c['unanswered']} "
-                          f"unanswered; reply p50 {_opt(c['reply_ms']['p50'])} ms, p99 {_opt(c['reply_ms']['p99'])} ms",
-                          flush=True)
+                    print(
+                        f"    changes: {c['accepted']} accepted, {c['refused']} refused, {c['unanswered']} "
+                        f"unanswered; reply p50 {_opt(c['reply_ms']['p50'])} ms, p99 {_opt(c['reply_ms']['p99'])} ms",
+                        flush=True,
+                    )
     finally:
         node.destroy_node()
         rclpy.try_shutdown()
@@ -249,9 +299,25 @@ def start_profiler(process: NodeProcess, duration: float, path) -> subprocess.Po
         raise RuntimeError(f"--profile needs py-spy: {spy.parent}/pip install py-spy")
     RESULTS.mkdir(parents=True, exist_ok=True)
     return subprocess.Popen(
-        [str(spy), "record", "--pid", str(process.process.pid), "--duration", f"{duration:g}",
-         "--rate", "250", "--nonblocking", "--format", "raw", "--output", str(path)],
-        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, preexec_fn=lambda: set_priority(0))
+        [
+            str(spy),
+            "record",
+            "--pid",
+            str(process.process.pid),
+            "--duration",
+            f"{duration:g}",
+            "--rate",
+            "250",
+            "--nonblocking",
+            "--format",
+            "raw",
+            "--output",
+            str(path),
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        preexec_fn=lambda: set_priority(0),
+    )
 
 
 def profile_summary(path, top: int = 15) -> list[tuple[str, float]]:
@@ -272,4 +338,3 @@ def profile_summary(path, top: int = 15) -> list[tuple[str, float]]:
             inclusive[name] = inclusive.get(name, 0) + int(count)
     ranked = sorted(inclusive.items(), key=lambda item: -item[1])[:top]
     return [(name, round(100 * count / total, 1)) for name, count in ranked] if total else []
-

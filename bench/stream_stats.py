@@ -13,8 +13,7 @@ def percentiles(x_ns: np.ndarray) -> dict:
     return {"p50": float(np.percentile(us, 50)), "p99": float(np.percentile(us, 99)), "max": float(us.max())}
 
 
-def summarize(kind, executor, rate, duration, stamps, first, lateness, records, cpu, own, load: dict,
-              sent_s) -> dict:
+def summarize(kind, executor, rate, duration, stamps, first, lateness, records, cpu, own, load: dict, sent_s) -> dict:
     """``stamps``: of the messages sent, the measured window from index ``first``;
     ``records``: the Receiver's; ``cpu``, ``own``: the node's and this process's CPU seconds
     over the window; ``load``: machine_load.load_between over it."""

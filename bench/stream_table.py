@@ -32,21 +32,42 @@ def stream_rows(runs: list[dict]) -> list[Row]:
         repeats = f", {len(ours)} runs each, medians" if len(ours) > 1 else ""
         depth = ours[0].get("qos_depth", QOS_DEPTH)
         lean += "" if depth == QOS_DEPTH else f", qos.depth {depth}"
-        group = (f"id_node end to end, {rate:g} Hz for {ours[0]['duration_s']:g} s{changes}{repeats}, "
-                 f"executor {executor}{lean} (baseline: relay" + (", the same parameter calls)" if changes else ")"))
+        group = (
+            f"id_node end to end, {rate:g} Hz for {ours[0]['duration_s']:g} s{changes}{repeats}, "
+            f"executor {executor}{lean} (baseline: relay" + (", the same parameter calls)" if changes else ")")
+        )
         p99_target = P99_TARGET if change_period is None else None  # with changes the target is 0 lost (issue 8)
         for stat, target in (("p50", None), ("p99", p99_target), ("max", None)):
             rows.append(Row(group, f"delay {stat}", _delay(ours, stat), _delay(base, stat), target))
         sent = sum(run["sent"] for run in ours)
-        rows.append(Row(group, f"lost (of {sent} sent)", Value.of(sum(run["lost"] for run in ours), "msgs"),
-                        Value.of(sum(run["lost"] for run in base), "msgs"), LOST_TARGET))
-        rows.append(Row(group, "node CPU per message", _median(ours, "node_cpu_us_per_msg", "us/msg"),
-                        _median(base, "node_cpu_us_per_msg", "us/msg")))
+        rows.append(
+            Row(
+                group,
+                f"lost (of {sent} sent)",
+                Value.of(sum(run["lost"] for run in ours), "msgs"),
+                Value.of(sum(run["lost"] for run in base), "msgs"),
+                LOST_TARGET,
+            )
+        )
+        rows.append(
+            Row(
+                group,
+                "node CPU per message",
+                _median(ours, "node_cpu_us_per_msg", "us/msg"),
+                _median(base, "node_cpu_us_per_msg", "us/msg"),
+            )
+        )
         if change_period is not None:
             ours_c, base_c = [r["parameter_changes"] for r in ours], [r["parameter_changes"] for r in base]
             calls = sum(c["accepted"] + c["refused"] + c["unanswered"] for c in ours_c)
-            rows.append(Row(group, f"changes accepted (of {calls})", Value.of(sum(c["accepted"] for c in ours_c), "calls"),
-                            Value.of(sum(c["accepted"] for c in base_c), "calls")))
+            rows.append(
+                Row(
+                    group,
+                    f"changes accepted (of {calls})",
+                    Value.of(sum(c["accepted"] for c in ours_c), "calls"),
+                    Value.of(sum(c["accepted"] for c in base_c), "calls"),
+                )
+            )
             for stat in ("p50", "p99"):
                 rows.append(Row(group, f"SetParameters reply {stat}", _reply(ours_c, stat), _reply(base_c, stat)))
     return rows

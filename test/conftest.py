@@ -1,7 +1,10 @@
-"""Test session setup: DDS isolated to this machine and to this session's own domain."""
+"""Test session setup: DDS isolated to this machine and to this session's own domain, and
+the markers of the test folders: test/ros/ spins nodes (``ros``), test/processes/ starts
+executables (``process``)."""
 
 import os
 import random
+from pathlib import Path
 
 # Set before rclpy is imported anywhere: a domain of our own, discovery on localhost only.
 os.environ["ROS_DOMAIN_ID"] = str(random.SystemRandom().randint(1, 100))
@@ -11,14 +14,25 @@ os.environ.pop("ROS_STATIC_PEERS", None)
 
 import pytest  # noqa: E402
 
+TEST_ROOT = Path(__file__).resolve().parent
+FOLDER_MARKERS = {"ros": "ros", "processes": "process"}
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        folder = Path(str(item.fspath)).resolve().relative_to(TEST_ROOT).parts[0]
+        marker = FOLDER_MARKERS.get(folder)
+        if marker is not None:
+            item.add_marker(marker)
+
 
 @pytest.fixture
 def quick_proofs(monkeypatch):
     """A smaller budget for the proof of worst static torques: for tests of what is proven
     and reported, not of how far the proof gets. Proofs remembered are forgotten before and
     after, so that no other test sees one of these."""
-    from irb140_dynamics.core import certify
-    from irb140_dynamics.core.payload_family import forget_families
+    from irb140_dynamics.core.payload.family import forget_families
+    from irb140_dynamics.core.payload.proof import certify
 
     monkeypatch.setattr(certify, "EVALUATIONS", 10_000)
     forget_families()

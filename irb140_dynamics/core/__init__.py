@@ -1,11 +1,11 @@
 """The dynamics core: models, kinematics, dynamics and payloads. No ROS in here.
 
-    >>> from irb140_dynamics.core import irb140, gravity
-    >>> gravity(irb140(), [0, -1.5707963267948966, 1.5707963267948966, 0, 0, 0]).round(3)
-    array([  0.   , 243.382,  79.156,  -0.   ,   2.43 ,   0.   ])
+>>> from irb140_dynamics.core import irb140, gravity
+>>> gravity(irb140(), [0, -1.5707963267948966, 1.5707963267948966, 0, 0, 0]).round(3)
+array([  0.   , 243.382,  79.156,  -0.   ,   2.43 ,   0.   ])
 """
 
-from .dynamics import (
+from irb140_dynamics.core.dynamics import (
     coriolis,
     coriolis_batch,
     coriolis_matrix,
@@ -18,11 +18,13 @@ from .dynamics import (
     rnea,
     rnea_batch,
 )
-from .geometry import irb140
-from .kinematics import dh_transform, flange_jacobian, flange_pose, link_frames
-from .joints import DH, Friction, Joint, Placement
-from .model import RobotModel, load_model, read_parameter_file
-from .payload import (
+from irb140_dynamics.core.io.params_file import load_model, read_parameter_file
+from irb140_dynamics.core.kinematics import dh_transform, flange_jacobian, flange_pose, link_frames
+from irb140_dynamics.core.model.irb140 import irb140
+from irb140_dynamics.core.model.joints import DH, Friction, Joint, Placement
+from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.payload import (
     RATED_PAYLOAD,
     MaxPayload,
     PayloadCheck,
@@ -33,7 +35,6 @@ from .payload import (
     max_payload_at,
     workspace_load,
 )
-from .rigid_body import ModelError, RigidBody
 
 __all__ = [
     "DH",

@@ -17,14 +17,15 @@ sanity caps keep them finite.
 
 from __future__ import annotations
 
-from functools import lru_cache
+from collections.abc import Sequence
+from functools import cache
 from math import isfinite
-from typing import Sequence
 
 import numpy as np
 
-from .model import RobotModel
-from .states import finite_result, finite_results, state, states
+from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.model.states import finite_result, finite_results, state, states
 
 ArrayLike = Sequence[float] | np.ndarray
 
@@ -37,7 +38,7 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
     origin) that the environment exerts on the flange, in the flange frame. tau balances
     it: tau = ID(q, qd, qdd) - J(q)^T f_ext, with J the flange Jacobian in the flange frame.
     """
-    kernels = model.kernels
+    kernels = kernels_of(model)
     args = (state(q, model.n, "q"), state(qd, model.n, "qd"), state(qdd, model.n, "qdd"))
     tau = kernels.rnea.scalar(*args) if f_ext is None else kernels.rnea_wrench.scalar(*args, state(f_ext, 6, "f_ext"))
     if not isfinite(sum(tau)):  # inline: rnea is the hot path
@@ -49,31 +50,31 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
 
 def gravity(model: RobotModel, q: ArrayLike) -> np.ndarray:
     """Gravity torques g(q) [N m]: what holds the arm (and payload) still at q."""
-    return np.array(model.kernels.gravity_torques.scalar(state(q, model.n, "q")))
+    return np.array(kernels_of(model).gravity_torques.scalar(state(q, model.n, "q")))
 
 
 def coriolis(model: RobotModel, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
     """Coriolis and centrifugal torques C(q, qd) qd [N m]."""
-    c = model.kernels.coriolis.scalar(state(q, model.n, "q"), state(qd, model.n, "qd"))
+    c = kernels_of(model).coriolis.scalar(state(q, model.n, "q"), state(qd, model.n, "qd"))
     return np.array(finite_result(c, "coriolis", q=q, qd=qd))
 
 
 def coriolis_matrix(model: RobotModel, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
     """The Coriolis matrix C(q, qd) of the Christoffel symbols: Mdot - 2C is skew-symmetric."""
     n = model.n
-    flat = model.kernels.coriolis_matrix.scalar(state(q, n, "q"), state(qd, n, "qd"))
+    flat = kernels_of(model).coriolis_matrix.scalar(state(q, n, "q"), state(qd, n, "qd"))
     return np.array(finite_result(flat, "coriolis_matrix", q=q, qd=qd)).reshape(n, n)
 
 
 def mass_matrix(model: RobotModel, q: ArrayLike) -> np.ndarray:
     """The joint-space mass matrix M(q) [kg m^2], symmetric positive definite."""
     n = model.n
-    return _symmetric(np.array(model.kernels.mass_matrix.scalar(state(q, n, "q"))), n)
+    return _symmetric(np.array(kernels_of(model).mass_matrix.scalar(state(q, n, "q"))), n)
 
 
 def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext=None) -> np.ndarray:
     """Joint accelerations qdd = M(q)^-1 (tau - C(q, qd) qd - g(q) - tau_f(qd)) [rad/s^2]."""
-    n, kernels = model.n, model.kernels
+    n, kernels = model.n, kernels_of(model)
     args = (state(q, n, "q"), state(qd, n, "qd"), [0.0] * n)
     tau_in = state(tau, n, "tau")
     if f_ext is None:
@@ -95,31 +96,32 @@ def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayL
 def rnea_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
     """rnea for N states: Q, QD, QDD shaped (N, n) -> tau shaped (N, n)."""
     columns = states(model.n, Q=Q, QD=QD, QDD=QDD)
-    tau = _with_friction(model, _evaluate(model.kernels.rnea.array, *columns), columns[1])
+    tau = _with_friction(model, _evaluate(kernels_of(model).rnea.array, *columns), columns[1])
     return finite_results(tau, "rnea_batch", "Q", "QD", "QDD")
 
 
 def gravity_batch(model: RobotModel, Q) -> np.ndarray:
     """gravity for N states: Q shaped (N, n) -> g shaped (N, n)."""
-    return _evaluate(model.kernels.gravity_torques.array, *states(model.n, Q=Q))
+    return _evaluate(kernels_of(model).gravity_torques.array, *states(model.n, Q=Q))
 
 
 def coriolis_batch(model: RobotModel, Q, QD) -> np.ndarray:
     """coriolis for N states: (N, n) -> C(q, qd) qd shaped (N, n)."""
-    return finite_results(_evaluate(model.kernels.coriolis.array, *states(model.n, Q=Q, QD=QD)),
-                          "coriolis_batch", "Q", "QD")
+    return finite_results(
+        _evaluate(kernels_of(model).coriolis.array, *states(model.n, Q=Q, QD=QD)), "coriolis_batch", "Q", "QD"
+    )
 
 
 def mass_matrix_batch(model: RobotModel, Q) -> np.ndarray:
     """mass_matrix for N states: Q shaped (N, n) -> M shaped (N, n, n)."""
-    return _symmetric(_evaluate(model.kernels.mass_matrix.array, *states(model.n, Q=Q)), model.n)
+    return _symmetric(_evaluate(kernels_of(model).mass_matrix.array, *states(model.n, Q=Q)), model.n)
 
 
 def forward_dynamics_batch(model: RobotModel, Q, QD, TAU) -> np.ndarray:
     """forward_dynamics for N states: (N, n) arrays -> QDD shaped (N, n)."""
     q, qd, tau = states(model.n, Q=Q, QD=QD, TAU=TAU)
-    bias = _with_friction(model, _evaluate(model.kernels.rnea.array, q, qd, np.zeros_like(q)), qd)
-    M = _symmetric(_evaluate(model.kernels.mass_matrix.array, q), model.n)
+    bias = _with_friction(model, _evaluate(kernels_of(model).rnea.array, q, qd, np.zeros_like(q)), qd)
+    M = _symmetric(_evaluate(kernels_of(model).mass_matrix.array, q), model.n)
     with np.errstate(over="ignore", invalid="ignore"):
         QDD = np.linalg.solve(M, (tau.T - bias)[..., None])[..., 0]
     return finite_results(QDD, "forward_dynamics_batch", "Q", "QD", "TAU")
@@ -158,7 +160,7 @@ def _symmetric(upper: np.ndarray, n: int) -> np.ndarray:
     return upper[..., _upper_to_full(n)]
 
 
-@lru_cache(maxsize=None)
+@cache
 def _upper_to_full(n: int) -> np.ndarray:
     """For each entry of an n x n matrix, its index in the row-by-row upper triangle."""
     index = np.empty((n, n), dtype=np.intp)

@@ -10,8 +10,8 @@ import math
 
 import numpy as np
 
-from .model import DH, RobotModel
-from .states import state
+from irb140_dynamics.core.model.robot_model import DH, RobotModel
+from irb140_dynamics.core.model.states import state
 
 
 def dh_transform(dh: DH, q: float) -> np.ndarray:

@@ -18,77 +18,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from .algorithms import (
-    Link,
-    add,
-    cross,
-    dot,
-    forward_motion,
-    inertia_times,
-    rotate,
-    turns,
-)
-from .states import state, states
-from .joints import Friction
-from .model import RobotModel
-from .rigid_body import ModelError, RigidBody, inertia_matrix
+from irb140_dynamics.core.algorithms.regressor import rigid_body_regressor  # noqa: F401 (part of this module's interface)
+from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.model.joints import Friction
+from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, inertia_matrix
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.model.states import state, states
 
 _CHUNK = 4096  # states per pass of the kernel (its buffers then stay in the CPU caches)
 
 LINK_PARAMETERS = ("m", "mcx", "mcy", "mcz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
 JOINT_PARAMETERS = ("viscous", "coulomb", "armature")
-# Pinocchio's inertia order as entries (xx, yy, zz, xy, xz, yz) of our inertia 6-tuples
-_UNIT_INERTIAS = tuple(
-    tuple(1.0 if k == position else 0.0 for k in range(6)) for position in (0, 3, 1, 4, 5, 2)
-)
-_UNIT_VECTORS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-
-
-def rigid_body_regressor(links, cs, qd, qdd, gravity):
-    """The n x 10n rigid-body regressor (rows of columns), written on scalars like ``rnea``."""
-    rots = turns(links, cs)
-    motion = forward_motion(links, rots, qd, qdd, gravity, at_joints=True)
-    n = len(links)
-    Y = [[0.0] * (10 * n) for _ in range(n)]
-    for k in range(n):
-        w, dw, a = _in_joint_frame(links[k], *motion[k])
-        for column, (f, moment) in enumerate(_unit_wrenches(w, dw, a)):
-            for i in reversed(range(k + 1)):
-                if i < k:
-                    f, moment = _to_parent_joint_frame(links[i + 1], rots[i + 1], links[i], f, moment)
-                Y[i][10 * k + column] = dot(links[i].u, moment)
-    return Y
-
-
-def _in_joint_frame(link: Link, w, dw, a):
-    """Link motion (a at the joint origin o'_i) in frame i, in the joint frame."""
-    if link.R1 is None:
-        return w, dw, a
-    return rotate(link.R1, w), rotate(link.R1, dw), rotate(link.R1, a)
-
-
-def _unit_wrenches(w, dw, a):
-    """The wrench (about the joint origin) that each unit inertial parameter needs."""
-    yield a, (0.0, 0.0, 0.0)  # m
-    for e in _UNIT_VECTORS:  # m c
-        yield add(cross(dw, e), cross(w, cross(w, e))), cross(e, a)
-    for E in _UNIT_INERTIAS:
-        yield (0.0, 0.0, 0.0), add(inertia_times(E, dw), cross(w, inertia_times(E, w)))
-
-
-def _to_parent_joint_frame(child: Link, rot, parent: Link, f, n):
-    """A wrench about o'_child in its joint frame, as one about o'_parent in the parent's."""
-    f, n = rotate(rot, f), rotate(rot, n)
-    if child.R0 is not None:
-        f, n = rotate(child.R0, f), rotate(child.R0, n)
-    if child.p0 is not None:
-        n = add(n, cross(child.p0, f))
-    n = add(n, cross(parent.p, f))  # about o'_parent, parent link frame
-    if parent.R1 is not None:
-        f, n = rotate(parent.R1, f), rotate(parent.R1, n)
-    return f, n
-
-
 # -- public functions ---------------------------------------------------------------------
 
 
@@ -97,7 +37,7 @@ def regressor(model: RobotModel, q, qd, qdd) -> np.ndarray:
     n = model.n
     q, qd, qdd = state(q, n, "q"), state(qd, n, "qd"), state(qdd, n, "qdd")
     Y = np.zeros((n, 13 * n))
-    Y[:, : 10 * n] = np.reshape(model.kernels.regressor.scalar(q, qd, qdd), (10 * n, n)).T
+    Y[:, : 10 * n] = np.reshape(kernels_of(model).regressor.scalar(q, qd, qdd), (10 * n, n)).T
     _joint_columns(model, Y, np.array(qd), np.array(qdd))
     return Y
 
@@ -113,7 +53,7 @@ def regressor_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
     # Y[:, i, c]; the constant zeros (about half: link k moves no joint after k) are left
     # as they are, their pages never touched.
     rows = np.zeros((n * 13 * n, N))
-    kernel = model.kernels.regressor
+    kernel = kernels_of(model).regressor
     where = [(j, (j % n) * 13 * n + j // n) for j in kernel.written]
     out = [None] * (10 * n * n)
     for start in range(0, N, _CHUNK):

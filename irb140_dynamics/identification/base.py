@@ -24,8 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import qr
 
-from ..core.model import RobotModel
-from ..core.regressor import parameter_names, regressor_batch
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.regressor import parameter_names, regressor_batch
 
 RANK_TOLERANCE = 1e-8  # |R_ii| of unit-norm columns below this: dependent
 DEFAULT_STATES = 400
@@ -90,7 +90,11 @@ def random_states(model: RobotModel, count: int, rng) -> tuple[np.ndarray, np.nd
     speed = np.array([j.velocity_limit or 2.0 for j in model.joints])
     acceleration = np.array([j.acceleration_limit or 10.0 for j in model.joints])
     shape = (count, model.n)
-    return rng.uniform(lower, upper, shape), rng.uniform(-speed, speed, shape), rng.uniform(-acceleration, acceleration, shape)
+    return (
+        rng.uniform(lower, upper, shape),
+        rng.uniform(-speed, speed, shape),
+        rng.uniform(-acceleration, acceleration, shape),
+    )
 
 
 def find_base_parameters(model: RobotModel, states: int = DEFAULT_STATES, seed: int = 0) -> BaseParameters:

@@ -33,10 +33,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..core.model import RobotModel
-from ..core.regressor import inertial_parameters, with_inertial_parameters
-from .base import BaseParameters
-from .estimation import Estimate
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.regressor import inertial_parameters, with_inertial_parameters
+from irb140_dynamics.identification.base import BaseParameters
+from irb140_dynamics.identification.least_squares import Estimate
 
 PRIOR_SPREAD = 0.5
 FRICTION_SPREAD = (10.0, 10.0, 1.0)  # viscous N m s/rad, Coulomb N m, armature kg m^2
@@ -134,7 +134,10 @@ class ConsistentFit:
 
 
 def consistent_parameters(
-    prior: RobotModel, base: BaseParameters, estimate: Estimate, prior_weight: float = 1.0,
+    prior: RobotModel,
+    base: BaseParameters,
+    estimate: Estimate,
+    prior_weight: float = 1.0,
     max_evaluations: int = MAX_EVALUATIONS,
 ) -> ConsistentFit:
     """The physically consistent parameters of the module's docstring, as a model."""
@@ -169,14 +172,24 @@ def consistent_parameters(
     # pseudo-inertia's eigenvalues raised to a small floor, friction and armature to 0
     normal = data_map.T @ data_map + np.diag(regularisation**2)
     unconstrained = np.linalg.solve(normal, data_map.T @ data_target + regularisation**2 * pi_prior)
-    start = [log_cholesky_of(_positive(pseudo_inertia(unconstrained[10 * i : 10 * i + 10]), spread[10 * i : 10 * i + 10]))
-             for i in range(n)]
+    start = [
+        log_cholesky_of(_positive(pseudo_inertia(unconstrained[10 * i : 10 * i + 10]), spread[10 * i : 10 * i + 10]))
+        for i in range(n)
+    ]
     x0 = np.concatenate([*start, np.maximum(unconstrained[10 * n :], 0.0)])
     lower = np.concatenate([np.tile(THETA_LOWER, n), np.zeros(3 * n)])
     upper = np.concatenate([np.tile(THETA_UPPER, n), np.full(3 * n, np.inf)])
     x0 = np.clip(x0, lower, upper)
-    result = least_squares(residuals, x0, jac=jacobian, bounds=(lower, upper), method="trf", x_scale="jac",
-                           max_nfev=max_evaluations, ftol=1e-4)
+    result = least_squares(
+        residuals,
+        x0,
+        jac=jacobian,
+        bounds=(lower, upper),
+        method="trf",
+        x_scale="jac",
+        max_nfev=max_evaluations,
+        ftol=1e-4,
+    )
     pi, _ = evaluate(result.x)
     pi[10 * n :] = np.maximum(pi[10 * n :], 0.0)
     deviation = (K @ pi - estimate.beta) / estimate.std

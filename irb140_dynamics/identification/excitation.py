@@ -26,9 +26,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize
 
-from ..core.model import RobotModel
-from ..core.regressor import regressor_batch
-from .base import BaseParameters, find_base_parameters
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.regressor import regressor_batch
+from irb140_dynamics.identification.base import BaseParameters, find_base_parameters
 
 DEFAULT_PERIOD = 10.0  # s
 DEFAULT_HARMONICS = 5
@@ -78,7 +78,7 @@ class Limits:
     acceleration: np.ndarray
 
     @classmethod
-    def of(cls, model: RobotModel, margin: float = DEFAULT_MARGIN) -> "Limits":
+    def of(cls, model: RobotModel, margin: float = DEFAULT_MARGIN) -> Limits:
         lower, upper = np.array([j.position_limits for j in model.joints]).T
         room = margin * (upper - lower)
         speed = np.array([j.velocity_limit or DEFAULT_SPEED for j in model.joints])
@@ -97,8 +97,14 @@ def shaped(free: np.ndarray, n: int, harmonics: int, period: float, limits: Limi
     Q, QD, QDD = unit.evaluate(np.linspace(0.0, period, CHECK_POINTS_PER_HARMONIC * harmonics, endpoint=False))
     span = Q.max(axis=0) - Q.min(axis=0)
     with np.errstate(divide="ignore"):
-        scale = np.min([(limits.upper - limits.lower) / span, HEADROOM * limits.speed / np.abs(QD).max(axis=0),
-                        HEADROOM * limits.acceleration / np.abs(QDD).max(axis=0)], axis=0)
+        scale = np.min(
+            [
+                (limits.upper - limits.lower) / span,
+                HEADROOM * limits.speed / np.abs(QD).max(axis=0),
+                HEADROOM * limits.acceleration / np.abs(QDD).max(axis=0),
+            ],
+            axis=0,
+        )
     scale = np.where(np.isfinite(scale), scale, 0.0)
     q0 = (limits.upper + limits.lower) / 2.0 - scale * (Q.max(axis=0) + Q.min(axis=0)) / 2.0
     return FourierTrajectory(period, q0, a * scale[:, None], b * scale[:, None])

@@ -13,25 +13,25 @@ chunk, the sums and at most ``plot_points`` held-out fit points for the plots.
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
-from ..core.model import RobotModel
-from ..core.regressor import inertial_parameters, regressor_batch
-from .base import BaseParameters, find_base_parameters
-from .consistent import ConsistentFit, consistent_parameters
-from .estimation import Estimate, NormalEquations, weighted_least_squares
-from .recording import CHUNK_SIZE, DEFAULT_TOPIC, Recording, RecordingError
-from .signals import DEFAULT_CUTOFF, Differentiator, FilterDesign, FitPoints, _joined
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.regressor import inertial_parameters, regressor_batch
+from irb140_dynamics.identification.base import BaseParameters, find_base_parameters
+from irb140_dynamics.identification.consistent import ConsistentFit, consistent_parameters
+from irb140_dynamics.identification.least_squares import Estimate, NormalEquations, weighted_least_squares
+from irb140_dynamics.identification.recording import CHUNK_SIZE, DEFAULT_TOPIC, Recording, RecordingError
+from irb140_dynamics.identification.signals import DEFAULT_CUTOFF, Differentiator, FilterDesign, FitPoints, _joined
 
 SLOW_SPEEDS = 3.0  # min_speed in smoothing velocities
 FIT_BATCH = 8192  # fit points gathered before the regressor and the sums run: few, large array operations
 
 
 @dataclass(frozen=True)
-class Settings:
+class IdentificationSettings:
     topic: str = DEFAULT_TOPIC
     cutoff: float = DEFAULT_CUTOFF  # Hz
     min_speed: float | None = None  # rad/s; None: SLOW_SPEEDS smoothing velocities
@@ -42,7 +42,7 @@ class Settings:
 
 
 @dataclass
-class Tally:
+class SampleTally:
     """What became of a recording's samples."""
 
     path: str
@@ -70,7 +70,7 @@ class Result:
     fit: ConsistentFit
     train: NormalEquations
     held_out: NormalEquations
-    tallies: list[Tally]
+    tallies: list[SampleTally]
     plot_points: FitPoints | None
     held_out_source: str
 
@@ -83,13 +83,20 @@ class Result:
 Progress = Callable[[str, int, int], None]  # (path, samples done, samples expected)
 
 
-def identify(prior: RobotModel, path, settings: Settings = Settings(), validate=None,
-             progress: Progress | None = None) -> Result:
+def identify(
+    prior: RobotModel,
+    path,
+    settings: IdentificationSettings = IdentificationSettings(),
+    validate=None,
+    progress: Progress | None = None,
+) -> Result:
     """Identify ``prior``'s parameters from the recording at ``path`` (see the module's docstring)."""
     if not 0.0 < settings.held_out < 1.0 and validate is None:
         raise ValueError(f"held_out: must be within (0, 1), got {settings.held_out}")
     if not settings.prior_weight > 0.0 or not (settings.min_speed is None or settings.min_speed >= 0.0):
-        raise ValueError(f"prior_weight must be > 0 and min_speed >= 0, got {settings.prior_weight}, {settings.min_speed}")
+        raise ValueError(
+            f"prior_weight must be > 0 and min_speed >= 0, got {settings.prior_weight}, {settings.min_speed}"
+        )
     base = find_base_parameters(prior)
     P = 13 * prior.n
     train, held_out = NormalEquations(prior.n, P), NormalEquations(prior.n, P)
@@ -102,8 +109,11 @@ def identify(prior: RobotModel, path, settings: Settings = Settings(), validate=
     for k, recording in enumerate(recordings):
         if validate is None:
             if recording.total <= 0:
-                raise RecordingError(recording.path, "it does not tell how many messages it holds, so its last "
-                                     f"{100 * settings.held_out:g} % cannot be held out: validate with --validate")
+                raise RecordingError(
+                    recording.path,
+                    "it does not tell how many messages it holds, so its last "
+                    f"{100 * settings.held_out:g} % cannot be held out: validate with --validate",
+                )
             split = int(round(recording.total * (1.0 - settings.held_out)))
         else:
             split = np.iinfo(np.int64).max if k == 0 else 0
@@ -117,8 +127,8 @@ def identify(prior: RobotModel, path, settings: Settings = Settings(), validate=
     return Result(prior, fit.model, base, estimate, fit, train, held_out, tallies, keeper.points(), source)
 
 
-def _accumulate(prior, recording, split, where, min_speed, settings, keeper, progress) -> Tally:
-    tally = Tally(str(recording.path), recording.total, slow_rows=np.zeros(prior.n, dtype=np.int64))
+def _accumulate(prior, recording, split, where, min_speed, settings, keeper, progress) -> SampleTally:
+    tally = SampleTally(str(recording.path), recording.total, slow_rows=np.zeros(prior.n, dtype=np.int64))
     differentiator, pending = None, []
     if progress:
         progress(tally.path, 0, tally.expected)
@@ -168,14 +178,16 @@ def _rate(recording: Recording, chunk) -> float:
     return 1.0 / float(np.median(steps))
 
 
-def _nothing_usable(tally: Tally, use: str) -> str:
+def _nothing_usable(tally: SampleTally, use: str) -> str:
     if tally.read == 0:
         reasons = ", ".join(f"{count} {kind.replace('_', ' ')}" for kind, count in tally.skipped.items())
         return f"no usable joint states of the model's joints ({reasons or 'no messages'})"
     if tally.invalid == tally.read:
         return "no sample has efforts (and positions) for every joint of the model"
-    return (f"no torque rows left {use}: {tally.read} samples, {tally.invalid} without effort, {tally.edges} at "
-            f"gaps and ends, the rest too slow; record a longer, faster motion")
+    return (
+        f"no torque rows left {use}: {tally.read} samples, {tally.invalid} without effort, {tally.edges} at "
+        f"gaps and ends, the rest too slow; record a longer, faster motion"
+    )
 
 
 class _PlotKeeper:

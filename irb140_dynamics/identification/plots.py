@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.regressor import inertial_parameters, regressor_batch
-from .pipeline import Result
+from irb140_dynamics.core.regressor import inertial_parameters, regressor_batch
+from irb140_dynamics.identification.pipeline import Result
 
 
 def write_plots(result: Result, directory) -> list[Path]:
@@ -38,10 +38,22 @@ def write_plots(result: Result, directory) -> list[Path]:
                 axis.plot(time, predicted["prior"][:, j], color="tab:orange", linewidth=0.8, label="prior model")
                 axis.plot(time, predicted["identified"][:, j], color="tab:blue", linewidth=0.8, label="identified")
             else:
-                axis.plot(time, measured[:, j] - predicted["prior"][:, j], ".", color="tab:orange", markersize=1.5,
-                          label="measured - prior")
-                axis.plot(time, measured[:, j] - predicted["identified"][:, j], ".", color="tab:blue", markersize=1.5,
-                          label="measured - identified")
+                axis.plot(
+                    time,
+                    measured[:, j] - predicted["prior"][:, j],
+                    ".",
+                    color="tab:orange",
+                    markersize=1.5,
+                    label="measured - prior",
+                )
+                axis.plot(
+                    time,
+                    measured[:, j] - predicted["identified"][:, j],
+                    ".",
+                    color="tab:blue",
+                    markersize=1.5,
+                    label="measured - identified",
+                )
                 axis.axhline(0.0, color="k", linewidth=0.5)
             axis.set_ylabel(f"{names[j]}\n[N m]")
             axis.grid(True, linewidth=0.3)

@@ -17,14 +17,15 @@ from __future__ import annotations
 
 import csv
 from collections import Counter
+from collections.abc import Iterator
 from dataclasses import dataclass
 from itertools import islice
 from pathlib import Path
-from typing import Iterator
 
 import numpy as np
 
-from ..core.joint_order import BadMessage, JointOrder
+from irb140_dynamics.core.io.stamps import seconds
+from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
 DEFAULT_TOPIC = "/joint_states"
@@ -118,14 +119,18 @@ class _BagChunker:
             return
         # each array has ``length`` float64 values in the machine's byte order (rosbags swaps
         # the others), so the buffers hold the values row by row
-        values = [np.frombuffer(x, np.float64).reshape(count, self.length).copy()
-                  for x in (self.positions, self.velocities, self.efforts)]
+        values = [
+            np.frombuffer(x, np.float64).reshape(count, self.length).copy()
+            for x in (self.positions, self.velocities, self.efforts)
+        ]
         if self.index is not None:
             values = [v[:, self.index] for v in values]
         # the integers through int64 arrays: half the time of the lists to float64 directly
-        sec, nanosec, received = (np.fromiter(x, np.int64, count).astype(np.float64)
-                                  for x in (self.seconds, self.nanoseconds, self.receive_times))
-        time = np.where((sec != 0.0) | (nanosec != 0.0), sec + nanosec * 1e-9, received * 1e-9)
+        sec, nanosec, received = (
+            np.fromiter(x, np.int64, count).astype(np.float64)
+            for x in (self.seconds, self.nanoseconds, self.receive_times)
+        )
+        time = np.where((sec != 0.0) | (nanosec != 0.0), seconds(sec, nanosec), received * 1e-9)
         for x in (self.positions, self.velocities, self.efforts, self.seconds, self.nanoseconds, self.receive_times):
             x.clear()
         self.parts.append((time, *values))
@@ -161,7 +166,11 @@ class _BagSource:
         chunker, chunk_size = _BagChunker(recording), recording.chunk_size
         received = chunker.receive_times
         # the loop's hot calls, bound once
-        add_position, add_velocity, add_effort = chunker.positions.__iadd__, chunker.velocities.__iadd__, chunker.efforts.__iadd__
+        add_position, add_velocity, add_effort = (
+            chunker.positions.__iadd__,
+            chunker.velocities.__iadd__,
+            chunker.efforts.__iadd__,
+        )
         add_seconds, add_nanoseconds, add_time = chunker.seconds.append, chunker.nanoseconds.append, received.append
         names_seen, length, room = None, -1, chunk_size
         try:
@@ -169,7 +178,9 @@ class _BagSource:
                 try:
                     msg = deserialize(raw, JOINT_STATE)
                 except Exception as error:
-                    raise RecordingError(recording.path, f"a {recording.topic} message cannot be read ({error})") from None
+                    raise RecordingError(
+                        recording.path, f"a {recording.topic} message cannot be read ({error})"
+                    ) from None
                 names, position, velocity, effort = msg.name, msg.position, msg.velocity, msg.effort
                 if names != names_seen or not names:
                     names_seen = names
@@ -266,7 +277,9 @@ class _CsvSource:
         rows = []
         for k, row in enumerate(csv.reader(lines)):
             if len(row) != self.width:
-                raise RecordingError(self.recording.path, f"line {first_line + k}: {len(row)} cells, the header has {self.width}")
+                raise RecordingError(
+                    self.recording.path, f"line {first_line + k}: {len(row)} cells, the header has {self.width}"
+                )
             try:
                 rows.append([float(row[i]) if row[i].strip() else np.nan for i in self.columns])
             except ValueError:

@@ -41,7 +41,7 @@ class FilterDesign:
     stride: int  # samples between fit points
 
     @classmethod
-    def of(cls, rate: float, cutoff: float = DEFAULT_CUTOFF) -> "FilterDesign":
+    def of(cls, rate: float, cutoff: float = DEFAULT_CUTOFF) -> FilterDesign:
         if not cutoff > 0.0:
             raise ValueError(f"cutoff: must be > 0 Hz, got {cutoff}")
         nyquist_fraction = min(cutoff / (rate / 2.0), 1.0)
@@ -84,7 +84,7 @@ class FitPoints:
     def __len__(self) -> int:
         return len(self.index)
 
-    def take(self, keep) -> "FitPoints":
+    def take(self, keep) -> FitPoints:
         return FitPoints(*(x[keep] for x in (self.index, self.time, self.q, self.qd, self.qdd, self.tau)))
 
 
@@ -136,7 +136,11 @@ class Differentiator:
             self._segment, self._next, self._length = (index, time, values), self.design.half, 0
         else:
             old = self._segment
-            self._segment = (np.concatenate([old[0], index]), np.concatenate([old[1], time]), np.vstack([old[2], values]))
+            self._segment = (
+                np.concatenate([old[0], index]),
+                np.concatenate([old[1], time]),
+                np.vstack([old[2], values]),
+            )
         self._length += len(index)
 
     def _emit(self) -> FitPoints | None:
@@ -170,4 +174,6 @@ def _joined(parts: list[FitPoints]) -> FitPoints | None:
         return None
     if len(parts) == 1:
         return parts[0]
-    return FitPoints(*(np.concatenate([getattr(p, f) for p in parts]) for f in ("index", "time", "q", "qd", "qdd", "tau")))
+    return FitPoints(
+        *(np.concatenate([getattr(p, f) for p in parts]) for f in ("index", "time", "q", "qd", "qdd", "tau"))
+    )

@@ -51,8 +51,9 @@ class Recorder(Node):
         self._connection = None
         self.count, self.first, self.last = 0, None, None  # messages, receive times [ns]
         # on the steady clock: with use_sim_time, simulated time may stand still until then
-        self._waiting = self.create_timer(POLL_PERIOD, self._subscribe_when_published,
-                                          clock=Clock(clock_type=ClockType.STEADY_TIME))
+        self._waiting = self.create_timer(
+            POLL_PERIOD, self._subscribe_when_published, clock=Clock(clock_type=ClockType.STEADY_TIME)
+        )
         self.get_logger().info(f"ready: waiting for a publisher of {self.topic}")
 
     def _subscribe_when_published(self) -> None:
@@ -63,14 +64,17 @@ class Recorder(Node):
         type_name = publishers[0].topic_type
         from rosbags.typesys import Stores, get_typestore
 
-        self._connection = self._writer.add_connection(self.topic, type_name,
-                                                       typestore=get_typestore(Stores.ROS2_JAZZY))
+        self._connection = self._writer.add_connection(
+            self.topic, type_name, typestore=get_typestore(Stores.ROS2_JAZZY)
+        )
         reliable = all(p.qos_profile.reliability == ReliabilityPolicy.RELIABLE for p in publishers)
-        qos = QoSProfile(depth=self.depth,
-                         reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT)
+        qos = QoSProfile(
+            depth=self.depth, reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT
+        )
         self.create_subscription(message_class(type_name), self.topic, self._on_message, qos, raw=True)
-        self.get_logger().info(f"recording {self.topic} ({type_name}, {'reliable' if reliable else 'best effort'}) "
-                               f"to {self.out}")
+        self.get_logger().info(
+            f"recording {self.topic} ({type_name}, {'reliable' if reliable else 'best effort'}) to {self.out}"
+        )
 
     def _on_message(self, raw: bytes) -> None:
         now = self.get_clock().now().nanoseconds

@@ -15,12 +15,11 @@ import math
 import mujoco
 import numpy as np
 
-from ..core.model import RobotModel
-from .mjcf import mujoco_model
-
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.sim.mjcf import mujoco_model
 
 # 4th order: at 1 kHz a 0.5 s free fall of the IRB-140 through 2.7 rad stays within 1e-8 rad of
-# the exact motion, where implicitfast (first order) is 2e-2 rad off; a step costs ~20 us.
+# the exact motion, where implicitfast (first order) is 2e-2 rad off (step costs: docs/benchmarks.md).
 DEFAULT_INTEGRATOR = "RK4"
 
 
@@ -31,8 +30,9 @@ class SimulationError(RuntimeError):
 class SimulatedArm:
     """One arm in MuJoCo: reset, apply torques, step, read q, qd and the applied torques."""
 
-    def __init__(self, model: RobotModel, period: float = 0.001, substeps: int = 1,
-                 integrator: str = DEFAULT_INTEGRATOR):
+    def __init__(
+        self, model: RobotModel, period: float = 0.001, substeps: int = 1, integrator: str = DEFAULT_INTEGRATOR
+    ):
         if not (math.isfinite(period) and period > 0.0):
             raise ValueError(f"period: must be > 0, got {period}")
         if int(substeps) != substeps or substeps < 1:
@@ -76,7 +76,7 @@ class SimulatedArm:
         self._set(q, qd, 0.0)
         self._reset_state = (q, qd)
 
-    def take_state_of(self, other: "SimulatedArm") -> None:
+    def take_state_of(self, other: SimulatedArm) -> None:
         """Continue from another arm's state (a model change while running)."""
         self._set(other.data.qpos, other.data.qvel, other.data.time)
         self.applied = other.applied.copy()

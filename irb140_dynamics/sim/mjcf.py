@@ -29,8 +29,8 @@ from xml.sax.saxutils import quoteattr
 import mujoco
 import numpy as np
 
-from ..core.model import RobotModel
-from ..core.rigid_body import RigidBody
+from irb140_dynamics.core.model.rigid_body import RigidBody
+from irb140_dynamics.core.model.robot_model import RobotModel
 
 MINIMAL_INERTIA = 1e-12  # kg and kg m^2: lower bound of each body's mass and principal moments
 FRICTION_IMPEDANCE = (0.999, 0.9999, 0.001, 0.5, 2.0)  # solimpfriction: dry friction nearly hard
@@ -119,5 +119,3 @@ def _number(x: float) -> str:
 
 def _numbers(xs) -> str:
     return " ".join(_number(x) for x in xs)
-
-

@@ -16,9 +16,8 @@ import os
 import sys
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
-
 
 SWITCH_INTERVAL = 1e-4  # s: Python's GIL switch interval while a loop runs
 
@@ -61,12 +60,16 @@ class StepSchedule:
 
 class RealTimeLoop:
     """Calls ``step(k, t)`` for each step k as it falls due (t: its due time, monotonic), in a
-    thread of its own that sleeps between steps: lighter than an executor's timer (a bare
-    1 kHz rclpy timer costs ~80 us of CPU per tick under the EventsExecutor, ~280 us under
-    rclpy.spin). An exception from ``step`` goes to ``on_error`` and the loop goes on."""
+    thread of its own that sleeps between steps: lighter than an executor's timer, whose
+    every tick costs CPU in rclpy (docs/benchmarks.md, sim_node). An exception from ``step`` goes to ``on_error`` and the loop goes on."""
 
-    def __init__(self, period: float, step: Callable[[int, float], None],
-                 on_error: Callable[[Exception], None], max_lag: float = 0.05):
+    def __init__(
+        self,
+        period: float,
+        step: Callable[[int, float], None],
+        on_error: Callable[[Exception], None],
+        max_lag: float = 0.05,
+    ):
         self.schedule = StepSchedule(period, max_lag)
         self._step, self._on_error = step, on_error
         self._stopping = threading.Event()
@@ -77,10 +80,10 @@ class RealTimeLoop:
         SCHED_FIFO at that priority (1..99; Linux), as ros2_control's controller manager runs
         its loop. Returns why the priority was refused (no CAP_SYS_NICE or rtprio limit), None
         when granted or not asked."""
-        # a thread that wants the GIL gets it within this (default 5 ms: a batch of late steps)
+        # a thread that wants the GIL gets it within this (Python's default is a batch of late steps)
         sys.setswitchinterval(min(sys.getswitchinterval(), SWITCH_INTERVAL))
         # the objects alive now (modules, models, the node) are never scanned again: a full
-        # garbage collection of a sim_node process then takes microseconds instead of 20-60 ms
+        # garbage collection of a sim_node process then scans only what came after startup
         gc.freeze()
         self._thread.start()
         if priority <= 0:

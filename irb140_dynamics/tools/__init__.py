@@ -1,4 +1,6 @@
-"""Command-line tools (``ros2 run irb140_dynamics <tool>``): thin wrappers of ``identification``.
+"""Command-line tools (``ros2 run irb140_dynamics <tool>``): thin wrappers of ``identification``
+and ``core``: parse, call, print. May import every floor below (``ros`` only where ROS I/O is
+the point: ``record``); never ``nodes``.
 
 Their linear algebra is on small matrices (a few hundred columns at most), where OpenBLAS's
 threads cost more than they give: they spin while they wait, and on a busy machine

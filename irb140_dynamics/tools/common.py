@@ -6,8 +6,9 @@ import sys
 import time
 from pathlib import Path
 
-from ..core.model import RobotModel, load_model
-from ..package_files import default_config_path
+from irb140_dynamics.core.io.params_file import load_model
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.package_files import default_config_path
 
 
 class ToolError(Exception):
@@ -58,8 +59,10 @@ class ProgressBar:
         self.last = now
         fraction = min(done / total, 1.0) if total > 0 else 0.0
         bar = "#" * int(self.WIDTH * fraction)
-        self.stream.write(f"\rreading {Path(path).name}: [{bar:<{self.WIDTH}}] {100 * fraction:3.0f} % "
-                          f"{done:,}/{total:,} samples, {now - self.start:.0f} s")
+        self.stream.write(
+            f"\rreading {Path(path).name}: [{bar:<{self.WIDTH}}] {100 * fraction:3.0f} % "
+            f"{done:,}/{total:,} samples, {now - self.start:.0f} s"
+        )
         if finished:
             self.stream.write("\n")
         self.stream.flush()

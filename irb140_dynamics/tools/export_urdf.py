@@ -13,11 +13,11 @@ from __future__ import annotations
 
 import sys
 
-from ..core import RobotModel, irb140
-from ..core.geometry import IRB140_SHAPES
-from ..core.urdf import export_urdf
-from ..ros.model_source import model_from_arguments
-from ..ros.spin import tool_arguments
+from irb140_dynamics.core import RobotModel, irb140
+from irb140_dynamics.core.io.urdf import export_urdf
+from irb140_dynamics.core.model.irb140 import IRB140_SHAPES
+from irb140_dynamics.ros.parameters.model_source import model_from_arguments
+from irb140_dynamics.ros.runtime.spin import tool_arguments
 
 NAME = "export_urdf"
 
@@ -35,8 +35,10 @@ def main(args: list[str] | None = None) -> int:
         extra = tool_arguments(args)
         if extra:
             help_asked = extra[0] in ("-h", "--help")
-            print(__doc__ if help_asked else f"{NAME}: unknown arguments {extra}; see --help",
-                  file=sys.stdout if help_asked else sys.stderr)
+            print(
+                __doc__ if help_asked else f"{NAME}: unknown arguments {extra}; see --help",
+                file=sys.stdout if help_asked else sys.stderr,
+            )
             return 0 if help_asked else 2
         text = urdf_of(model_from_arguments(args, NAME))
     except ValueError as error:

@@ -16,17 +16,22 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..identification.recording import DEFAULT_TOPIC
-from ..ros.recorder import DEFAULT_DEPTH, Recorder
-from ..ros.spin import run, tool_arguments
+from irb140_dynamics.identification.recording import DEFAULT_TOPIC
+from irb140_dynamics.ros.recorder import DEFAULT_DEPTH, Recorder
+from irb140_dynamics.ros.runtime.spin import run, tool_arguments
 
 
 def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="record", description=__doc__.split("\n\n")[0].split(": ", 1)[1])
     p.add_argument("--out", required=True, metavar="DIR", help="the bag directory to write (must not exist)")
     p.add_argument("--topic", default=DEFAULT_TOPIC, help=f"the topic (default {DEFAULT_TOPIC})")
-    p.add_argument("--duration", type=float, default=0.0, metavar="S",
-                   help="stop this long after the first message, node clock (default 0: at Ctrl-C)")
+    p.add_argument(
+        "--duration",
+        type=float,
+        default=0.0,
+        metavar="S",
+        help="stop this long after the first message, node clock (default 0: at Ctrl-C)",
+    )
     p.add_argument("--depth", type=int, default=DEFAULT_DEPTH, help=f"queue depth (default {DEFAULT_DEPTH})")
     return p
 

@@ -1,0 +1,78 @@
+"""The generalized momentum p = M(q) qd and dT/dq = C(q, qd)^T qd on scalars, O(n), for the
+momentum observer (``core.monitoring.observer``); ``energy_gradient`` is their definition.
+"""
+
+from __future__ import annotations
+
+from irb140_dynamics.core.algorithms.recursions import (
+    add,
+    cross,
+    dot,
+    inertia_times,
+    scale,
+    to_child,
+    to_parent_wrench,
+    turns,
+)
+from irb140_dynamics.core.model.rigid_body import ZERO3
+from irb140_dynamics.core.scalars.dual import dual_angles, partial
+
+
+def kinetic_energy(links, cs, qd):
+    """T = sum over links of 1/2 m v.v + v.(w x h) + 1/2 w.(I w), v the velocity of o_i."""
+    rots = turns(links, cs)
+    w, v = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    energy = 0.0
+    for link, rot, qd_i in zip(links, rots, qd):
+        if link.p0 is not None:
+            v = add(v, cross(w, link.p0))
+        w_parent = to_child(link, rot, w)
+        w = add(w_parent, scale(qd_i, link.b))
+        v = add(to_child(link, rot, v), cross(w, link.p))
+        energy = energy + 0.5 * (link.m * dot(v, v) + dot(w, inertia_times(link.I, w))) + dot(v, cross(w, link.h))
+    return energy
+
+
+def energy_gradient(links, cs, qd):
+    """dT/dq = C(q, qd)^T qd, exact: T on dual numbers carrying d/dq_k."""
+    T = kinetic_energy(links, dual_angles(cs), qd)
+    return [partial(T, k) for k in range(len(links))]
+
+
+def momentum_terms(links, cs, qd):
+    """[p, dT/dq]: the generalized momentum M qd and C^T qd, O(n).
+
+    With h_i the spatial momentum of link i, H_k the sum over the subtree k..n and v_k the
+    spatial velocity of link k: turning joint k at fixed qd turns the subtree about S_k,
+    dv_i/dq_k = S_k x (v_i - v_k) and dI_i/dq_k = S_k x* I_i - I_i S_k x, which leaves
+    (Featherstone's notation, x* the force cross product)
+
+        p_k = S_k . H_k,    dT/dq_k = -S_k . (v_k x* H_k).
+
+    Forward: each link's velocity (w; u at the joint origin o'_i, v at o_i). Backward: H
+    (linear L, angular A about o'_k) gathered like RNEA's wrenches; S_k . (v_k x* H_k) is
+    b . (w x A + u x L).
+    """
+    rots = turns(links, cs)
+    w, v = ZERO3, ZERO3
+    frames = []
+    for link, rot, qd_i in zip(links, rots, qd):  # velocities, as forward_motion's
+        if link.p0 is not None:
+            v = add(v, cross(w, link.p0))
+        w = add(to_child(link, rot, w), scale(qd_i, link.b))
+        u = to_child(link, rot, v)  # the joint origin's velocity, in frame i
+        v = add(u, cross(w, link.p))
+        frames.append((w, u, v))
+    n_links = len(links)
+    p, gradient = [0.0] * n_links, [0.0] * n_links
+    L, A = ZERO3, ZERO3  # the subtree's momentum
+    for i in reversed(range(n_links)):
+        link, (w, u, v) = links[i], frames[i]
+        if i + 1 < n_links:
+            L, A = to_parent_wrench(links[i + 1], rots[i + 1], L, A)
+        L_i = add(scale(link.m, v), cross(w, link.h))
+        L = add(L, L_i)
+        A = add(A, inertia_times(link.I, w), cross(link.h, v), cross(link.p, L))  # about o'_i
+        p[i] = dot(link.b, A) + link.armature * qd[i]
+        gradient[i] = -dot(link.b, add(cross(w, A), cross(u, L)))
+    return p + gradient

@@ -1,0 +1,292 @@
+"""The dynamics algorithms, written once on scalar components.
+
+Notation follows the report (Luh-Walker-Paul recursive Newton-Euler), everything of link i
+expressed in its own frame i. Joint i moves link i by T_i = pre Rot(u, theta_i) post (see
+``joints``); its axis passes through the joint origin o'_i = o_{i-1} + p0 (in frame i-1).
+
+    q, qd, qdd   joint positions, velocities, accelerations
+    w, dw, a     angular velocity, angular acceleration, linear acceleration of origin o_i
+    b            joint i's axis, in frame i
+    p0           o_{i-1} -> o'_i, in frame i-1 (zero for DH rows)
+    p            o'_i -> o_i, in frame i (for DH rows o_{i-1} -> o_i)
+    m, h, I      link mass, first moment m*c, inertia about o_i
+    f, n         force and moment (about o'_i) that link i-1 exerts on link i
+    tau          joint torques, tau_i = b . n_i (+ armature_i qdd_i)
+
+Vectors are 3-tuples, rotations 3x3 tuples of rows. A scalar may be a float, a NumPy array
+(many states at once) or a symbol of ``codegen`` (which turns these functions into
+straight-line code). So only ``+ - *`` are used, the joint angles enter as (cos, sin) pairs
+computed by the caller, and products with the constants 0 and +-1 are left out: for a DH
+row the generated code is the same as that of a hand-written DH recursion.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from irb140_dynamics.core.model.joints import snap
+from irb140_dynamics.core.model.rigid_body import ZERO3, Inertia6, Vector3, shift_inertia
+from irb140_dynamics.core.scalars.dual import Dual, dual_angles, partial  # noqa: F401 (Dual: part of this module's interface)
+
+Rotation = tuple[tuple[float, float, float], ...]
+
+
+@dataclass(frozen=True)
+class Link:
+    """Constants of link i for the recursions."""
+
+    theta_offset: float
+    R0: Rotation | None  # pre rotation (None: identity)
+    p0: Vector3 | None  # pre translation, in frame i-1 (None: zero)
+    u: Vector3  # the axis in the joint frame
+    R1: Rotation | None  # post rotation (None: identity)
+    p: Vector3  # post translation, in frame i
+    b: Vector3  # the axis in frame i
+    m: float
+    h: Vector3
+    I: Inertia6
+    armature: float = 0.0
+
+
+def chain(model) -> tuple[Link, ...]:
+    """The per-link constants of a RobotModel (payload merged into the last link)."""
+    return tuple(
+        Link(*_joint_constants(joint), *body.about_origin(), joint.armature)
+        for joint, body in zip(model.joints, model.bodies)
+    )
+
+
+@lru_cache(maxsize=256)  # a model rebuilt with another payload recomputes no joint's
+def _joint_constants(joint) -> tuple:
+    """(theta_offset, R0, p0, u, R1, p, b) of a Link."""
+    pre, post = joint.pre, joint.post
+    R1 = post.rotation()
+    return (
+        joint.offset,
+        None if pre.rpy == ZERO3 else _rows(pre.rotation()),
+        None if pre.xyz == ZERO3 else pre.xyz,
+        joint.turning_axis,
+        None if post.rpy == ZERO3 else _rows(R1),
+        tuple(R1.T @ np.array(post.xyz)) if post.rpy != ZERO3 else post.xyz,
+        tuple(snap(R1.T @ np.array(joint.turning_axis))),
+    )
+
+
+def flange_wrench(model, f_ext, n_ext):
+    """A wrench on the flange (force, moment about the flange origin, flange frame) as one
+    on the last link (moment about its origin, in its frame)."""
+    if model.flange.is_identity:
+        return f_ext, n_ext
+    R = _rows(model.flange.rotation())
+    f = rotate(R, f_ext)
+    return f, add(rotate(R, n_ext), cross(model.flange.xyz, f))
+
+
+def _rows(R) -> Rotation:
+    return tuple(tuple(float(x) for x in row) for row in R)
+
+
+# -- 3-vector algebra ---------------------------------------------------------------
+
+
+def add(*vectors):
+    return tuple(sum(components[1:], components[0]) for components in zip(*vectors))
+
+
+def scale(k, v):
+    return (k * v[0], k * v[1], k * v[2])
+
+
+def dot(u, v):
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+
+
+def cross(u, v):
+    return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+
+
+def inertia_times(inertia, v):
+    xx, yy, zz, xy, xz, yz = inertia
+    return (
+        xx * v[0] + xy * v[1] + xz * v[2],
+        xy * v[0] + yy * v[1] + yz * v[2],
+        xz * v[0] + yz * v[1] + zz * v[2],
+    )
+
+
+def _combination(terms):
+    """sum of coef * x, with the constant coefficients 0 and +-1 left out."""
+    total = None
+    for coef, x in terms:
+        if isinstance(coef, float):
+            if coef == 0.0:
+                continue
+            term = x if coef == 1.0 else -x if coef == -1.0 else coef * x
+        else:
+            term = coef * x
+        total = term if total is None else total + term
+    return 0.0 if total is None else total
+
+
+def rotate(R, v):
+    """R v."""
+    return tuple(_combination(zip(R[j], v)) for j in range(3))
+
+
+def rotate_back(R, v):
+    """R^T v."""
+    return tuple(_combination((R[k][j], v[k]) for k in range(3)) for j in range(3))
+
+
+def turn(u, c, s) -> Rotation:
+    """Rot(u, theta) = c (1 - u u^T) + s [u]x + u u^T, given c, s of theta."""
+    skew = ((0.0, -u[2], u[1]), (u[2], 0.0, -u[0]), (-u[1], u[0], 0.0))
+    rows = []
+    for j in range(3):
+        row = []
+        for k in range(3):
+            outer = u[j] * u[k]
+            entry = _combination((((1.0 if j == k else 0.0) - outer, c), (skew[j][k], s)))
+            row.append(entry + outer if outer else entry)
+        rows.append(tuple(row))
+    return tuple(rows)
+
+
+def to_child(link: Link, rot, v):
+    """R_i^T v: a vector of frame i-1 expressed in frame i (R_i = R0 Rot R1, rot = Rot)."""
+    if link.R0 is not None:
+        v = rotate_back(link.R0, v)
+    v = rotate_back(rot, v)
+    return v if link.R1 is None else rotate_back(link.R1, v)
+
+
+def to_parent(link: Link, rot, v):
+    """R_i v: a vector of frame i expressed in frame i-1."""
+    if link.R1 is not None:
+        v = rotate(link.R1, v)
+    v = rotate(rot, v)
+    return v if link.R0 is None else rotate(link.R0, v)
+
+
+def turns(links, cs):
+    return [turn(link.u, c, s) for link, (c, s) in zip(links, cs)]
+
+
+# -- algorithms ---------------------------------------------------------------------
+
+
+def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3):
+    """Joint torques tau(q, qd, qdd) by the recursive Newton-Euler algorithm.
+
+    ``cs`` holds (cos, sin) of each joint angle theta_i = q_i + theta_offset_i.
+    (f_ext, n_ext) is the wrench the environment exerts on the last link, in its frame, the
+    moment taken about its origin (see ``flange_wrench``); tau balances it (a load pressing
+    on the flange raises tau like a weight would). Friction is not included.
+    """
+    rots = turns(links, cs)
+    motion = forward_motion(links, rots, qd, qdd, gravity)
+    tau = [0.0] * len(links)
+    f, n = scale(-1.0, f_ext), scale(-1.0, n_ext)
+    for i in reversed(range(len(links))):
+        link, (w, dw, a) = links[i], motion[i]
+        if i + 1 < len(links):
+            f, n = to_parent_wrench(links[i + 1], rots[i + 1], f, n)
+        force = add(scale(link.m, a), cross(dw, link.h), cross(w, cross(w, link.h)))
+        moment = add(inertia_times(link.I, dw), cross(w, inertia_times(link.I, w)), cross(link.h, a))
+        f = add(force, f)
+        n = add(moment, n, cross(link.p, f))
+        tau[i] = dot(link.b, n) + link.armature * qdd[i]
+    return tau
+
+
+def forward_motion(links, rots, qd, qdd, gravity, at_joints=False):
+    """(w, dw, a) of each link, in its frame, a at its origin (``at_joints``: at its joint
+    origin o'_i); gravity as a base acceleration."""
+    w, dw, a = ZERO3, ZERO3, scale(-1.0, gravity)
+    motion = []
+    for link, rot, qd_i, qdd_i in zip(links, rots, qd, qdd):
+        if link.p0 is not None:  # the joint origin's acceleration, in frame i-1
+            a = add(a, cross(dw, link.p0), cross(w, cross(w, link.p0)))
+        w_parent = to_child(link, rot, w)
+        w = add(w_parent, scale(qd_i, link.b))
+        dw = add(to_child(link, rot, dw), scale(qdd_i, link.b), cross(w_parent, scale(qd_i, link.b)))
+        a_joint = to_child(link, rot, a)
+        a = add(a_joint, cross(dw, link.p), cross(w, cross(w, link.p)))
+        motion.append((w, dw, a_joint if at_joints else a))
+    return motion
+
+
+def to_parent_wrench(child: Link, rot, f, n):
+    """A wrench about o'_child in the child's frame, as one about o_parent in the parent's."""
+    f, n = to_parent(child, rot, f), to_parent(child, rot, n)
+    if child.p0 is not None:
+        n = add(n, cross(child.p0, f))
+    return f, n
+
+
+def crba(links, cs):
+    """Joint-space mass matrix M(q) by the composite rigid body algorithm (armature on the
+    diagonal).
+
+    Column j is the torque that a unit qdd_j needs with no velocity and no gravity: the
+    composite body j..n turns about joint j's axis, links before j stand still.
+    """
+    rots = turns(links, cs)
+    n_links = len(links)
+    composite = [None] * n_links
+    for i in reversed(range(n_links)):
+        m, h, inertia = links[i].m, links[i].h, links[i].I
+        if i + 1 < n_links:
+            child, rot = links[i + 1], rots[i + 1]
+            m_c, h_c, inertia_c = composite[i + 1]
+            r = to_parent(child, rot, child.p)  # o_i -> o_(i+1), in frame i
+            if child.p0 is not None:
+                r = add(r, child.p0)
+            m_c, h_c, inertia_c = shift_inertia(
+                m_c, to_parent(child, rot, h_c), _rotate_inertia(child, rot, inertia_c), r
+            )
+            m, h, inertia = m + m_c, add(h, h_c), tuple(x + y for x, y in zip(inertia, inertia_c))
+        composite[i] = (m, h, inertia)
+
+    M = [[0.0] * n_links for _ in range(n_links)]
+    for j in range(n_links):
+        link, (m, h, inertia) = links[j], composite[j]
+        a = cross(link.b, link.p)  # acceleration of o_j
+        f = add(scale(m, a), cross(link.b, h))
+        n = add(inertia_times(inertia, link.b), cross(h, a), cross(link.p, f))
+        M[j][j] = dot(link.b, n) + link.armature
+        for i in reversed(range(j)):
+            f, n = to_parent_wrench(links[i + 1], rots[i + 1], f, n)
+            n = add(n, cross(links[i].p, f))
+            M[i][j] = M[j][i] = dot(links[i].b, n)
+    return M
+
+
+def _rotate_inertia(link, rot, inertia):
+    """R I R^T for the joint rotation R_i: columns of R I, then R (R I)^T."""
+    xx, yy, zz, xy, xz, yz = inertia
+    columns = [to_parent(link, rot, col) for col in ((xx, xy, xz), (xy, yy, yz), (xz, yz, zz))]
+    rows_of_ri = list(zip(*columns))
+    col0 = to_parent(link, rot, rows_of_ri[0])
+    col1 = to_parent(link, rot, rows_of_ri[1])
+    col2 = to_parent(link, rot, rows_of_ri[2])
+    return (col0[0], col1[1], col2[2], col1[0], col2[0], col2[1])
+
+
+def christoffel_coriolis(links, cs, qd):
+    """The Coriolis matrix C(q, qd) from the Christoffel symbols of M(q).
+
+    C_ij = sum_k 1/2 (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) qd_k, so that C qd is the
+    Coriolis/centrifugal torque and Mdot - 2C is skew-symmetric. The partial derivatives
+    of M are exact: crba runs on dual numbers carrying d/dq of each scalar.
+    """
+    n = len(links)
+    M = crba(links, dual_angles(cs))
+    dM = [[[partial(M[i][j], k) for k in range(n)] for j in range(n)] for i in range(n)]
+    return [
+        [sum(0.5 * (dM[i][j][k] + dM[i][k][j] - dM[j][k][i]) * qd[k] for k in range(n)) for j in range(n)]
+        for i in range(n)
+    ]

@@ -1,0 +1,257 @@
+"""The robot model: a serial chain of revolute joints (see ``joints``: DH rows or URDF form).
+
+Units (SI throughout): m, rad, kg, kg m^2, m/s^2, N m.
+
+Link i is the body moved by joint i. The flange, where the payload sits, is the last link's
+frame placed by ``flange`` (identity for DH models: frame n). Gravity is given in the base
+frame 0.
+
+A model is immutable. Its flat parameter form (``to_params`` / ``from_params``) uses the
+same names as the ROS parameters of the nodes, so that a validation error names the
+parameter to fix:
+
+    joint_names                 [name, ...]
+    gravity                     [gx, gy, gz]
+    payload.mass / .com / .inertia
+    friction.smoothing_velocity rad/s, of the Coulomb friction's tanh
+    flange                      [x, y, z, roll, pitch, yaw] in the last link (identity if absent)
+    <joint>.dh                  [a, alpha, d, theta_offset], or in URDF form:
+    <joint>.origin, .axis       [x, y, z, roll, pitch, yaw] in the parent link; [x, y, z]
+    <joint>.link.mass / .com / .inertia
+    <joint>.position_limits     [lower, upper]
+    <joint>.torque_limit        N m, 0 = none given
+    <joint>.velocity_limit      rad/s, 0 = none given
+    <joint>.acceleration_limit  rad/s^2, 0 = none given
+    <joint>.friction.viscous    N m s/rad
+    <joint>.friction.coulomb    N m
+    <joint>.armature            kg m^2
+
+Besides being finite, masses, lengths, inertias and gravity are within sanity caps (see
+``rigid_body``) that keep every number the algorithms derive from them finite.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import Any
+
+from irb140_dynamics.core.model.friction import JointFriction
+from irb140_dynamics.core.model.joints import DH, Friction, Joint, Placement, validated_joint
+from irb140_dynamics.core.model.rigid_body import (
+    MAX_GRAVITY,
+    ZERO3,
+    ModelError,
+    RigidBody,
+    capped,
+    combine,
+    finite_number,
+    finite_numbers,
+    placed,
+)
+
+_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+DEFAULT_SMOOTHING_VELOCITY = 0.01  # rad/s: Coulomb friction reaches 76 % of its level at 0.01 rad/s
+__all__ = ["DH", "Friction", "Joint", "ModelError", "Placement", "RobotModel"]
+
+
+@dataclass(frozen=True)
+class RobotModel:
+    """A validated serial-chain model; raises ModelError naming the bad field."""
+
+    joints: tuple[Joint, ...]
+    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
+    payload: RigidBody = field(default_factory=RigidBody)
+    flange: Placement = Placement()  # the payload's frame in the last link's frame
+    smoothing_velocity: float = DEFAULT_SMOOTHING_VELOCITY  # rad/s, Coulomb friction's tanh
+
+    def __post_init__(self):
+        object.__setattr__(self, "joints", tuple(validated_joint(j) for j in self.joints))
+        object.__setattr__(self, "gravity", finite_numbers("gravity", self.gravity, 3))
+        capped("gravity", "|g|", math.hypot(*self.gravity), MAX_GRAVITY, "m/s^2")
+        object.__setattr__(self, "payload", RigidBody.checked("payload", self.payload))
+        object.__setattr__(self, "flange", Placement.validated("flange", self.flange))
+        smoothing = finite_number("friction.smoothing_velocity", self.smoothing_velocity)
+        if not smoothing > 0.0:
+            raise ModelError("friction.smoothing_velocity", f"must be > 0, got {smoothing}")
+        object.__setattr__(self, "smoothing_velocity", smoothing)
+        check_joint_names(self.joint_names)
+
+    @property
+    def n(self) -> int:
+        return len(self.joints)
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        return tuple(j.name for j in self.joints)
+
+    @property
+    def torque_limits(self) -> tuple[float, ...]:
+        return tuple(j.torque_limit for j in self.joints)
+
+    @property
+    def bodies(self) -> tuple[RigidBody, ...]:
+        """The moving bodies, the payload merged into the last link."""
+        bodies = [j.link for j in self.joints]
+        payload = self.payload
+        if not self.flange.is_identity:
+            payload = placed(payload, self.flange.rotation(), self.flange.xyz)
+        bodies[-1] = combine(bodies[-1], payload)
+        return tuple(bodies)
+
+    @cached_property
+    def friction(self):
+        """The joints' friction (see ``friction``), or None when all of it is zero."""
+        if not any(j.friction.viscous or j.friction.coulomb for j in self.joints):
+            return None
+        return JointFriction.of(self)
+
+    def with_payload(self, payload: RigidBody) -> RobotModel:
+        return replace(self, payload=payload)
+
+    def with_gravity(self, gravity) -> RobotModel:
+        return replace(self, gravity=tuple(gravity))
+
+    # -- flat parameter form --------------------------------------------------------
+
+    def to_params(self) -> dict[str, Any]:
+        params: dict[str, Any] = {
+            "joint_names": list(self.joint_names),
+            "gravity": list(self.gravity),
+            "friction.smoothing_velocity": self.smoothing_velocity,
+        }
+        if not self.flange.is_identity:
+            params["flange"] = self.flange.flat()
+        params.update(_body_params("payload", self.payload))
+        for j in self.joints:
+            if j.dh is not None:
+                params[f"{j.name}.dh"] = [j.dh.a, j.dh.alpha, j.dh.d, j.dh.theta_offset]
+            else:
+                params[f"{j.name}.origin"] = j.origin.flat()
+                params[f"{j.name}.axis"] = list(j.axis)
+            params.update(_body_params(f"{j.name}.link", j.link))
+            params[f"{j.name}.position_limits"] = list(j.position_limits)
+            params[f"{j.name}.torque_limit"] = j.torque_limit
+            params[f"{j.name}.velocity_limit"] = j.velocity_limit
+            params[f"{j.name}.acceleration_limit"] = j.acceleration_limit
+            params[f"{j.name}.friction.viscous"] = j.friction.viscous
+            params[f"{j.name}.friction.coulomb"] = j.friction.coulomb
+            params[f"{j.name}.armature"] = j.armature
+        return params
+
+    @classmethod
+    def from_params(cls, params: Mapping[str, Any]) -> RobotModel:
+        """Build from flat parameter names (as in ``to_params``); unknown names are ignored."""
+
+        def get(name, default=None):
+            if name in params and params[name] is not None:
+                return params[name]
+            if default is not None:
+                return default
+            raise ModelError(name, "missing")
+
+        names = check_joint_names(get("joint_names"))
+        joints = tuple(_joint_from_params(name, params, get) for name in names)
+        payload = _body_from_params("payload", get, optional=True)
+        return cls(
+            joints,
+            finite_numbers("gravity", get("gravity"), 3),
+            payload,
+            Placement.validated("flange", get("flange", (0.0,) * 6)),
+            get("friction.smoothing_velocity", DEFAULT_SMOOTHING_VELOCITY),
+        )
+
+
+JOINT_FIELDS = (
+    "dh",
+    "origin",
+    "axis",
+    "link.mass",
+    "link.com",
+    "link.inertia",
+    "position_limits",
+    "torque_limit",
+    "velocity_limit",
+    "acceleration_limit",
+    "friction.viscous",
+    "friction.coulomb",
+    "armature",
+)
+JOINTS_KEPT = 256  # joints remembered by their parameter values
+_joints_by_values: dict[tuple, Joint] = {}
+
+
+def _joint_from_params(name: str, params: Mapping[str, Any], get) -> Joint:
+    """The validated joint ``name``, validated once for the same values: a change of other
+    parameters (the payload's) re-validates no joint. The values are told apart by their
+    repr, exact for the numbers a valid joint has (and True, 1 and 1.0 differ, as 0.0 and -0.0)."""
+    key = name, repr([params.get(f"{name}.{field}") for field in JOINT_FIELDS])
+    joint = _joints_by_values.get(key)
+    if joint is None:
+        joint = validated_joint(_raw_joint(name, params, get))
+        if len(_joints_by_values) >= JOINTS_KEPT:
+            _joints_by_values.clear()
+        _joints_by_values[key] = joint
+    return joint
+
+
+def _raw_joint(name: str, params: Mapping[str, Any], get) -> Joint:
+    if params.get(f"{name}.dh") is None and params.get(f"{name}.origin") is not None:
+        kinematics = dict(
+            origin=Placement.validated(f"{name}.origin", get(f"{name}.origin")),
+            axis=finite_numbers(f"{name}.axis", get(f"{name}.axis"), 3),
+        )
+    else:
+        kinematics = dict(dh=DH(*finite_numbers(f"{name}.dh", get(f"{name}.dh"), 4)))
+    return Joint(
+        name,
+        link=_body_from_params(f"{name}.link", get),
+        position_limits=finite_numbers(
+            f"{name}.position_limits", get(f"{name}.position_limits", (-math.pi, math.pi)), 2
+        ),
+        torque_limit=get(f"{name}.torque_limit", 0.0),
+        velocity_limit=get(f"{name}.velocity_limit", 0.0),
+        acceleration_limit=get(f"{name}.acceleration_limit", 0.0),
+        friction=Friction(get(f"{name}.friction.viscous", 0.0), get(f"{name}.friction.coulomb", 0.0)),
+        armature=get(f"{name}.armature", 0.0),
+        **kinematics,
+    )
+
+
+def check_joint_names(names) -> list[str]:
+    """The names as a list, or ModelError: at least one, unique, each usable as a parameter prefix."""
+    if not isinstance(names, (list, tuple)) or not all(isinstance(x, str) for x in names):
+        raise ModelError("joint_names", f"expected a list of names, got {names!r}")
+    names = list(names)
+    if not names:
+        raise ModelError("joint_names", "at least one joint is needed")
+    for name in names:
+        if not _NAME.match(name):
+            raise ModelError(
+                "joint_names",
+                f"{name!r} is not a valid joint name (letters, digits, '_'; starts with a letter)",
+            )
+    if len(set(names)) != len(names):
+        raise ModelError("joint_names", f"names must be unique, got {names}")
+    return names
+
+
+def _body_params(prefix: str, body: RigidBody) -> dict[str, Any]:
+    return {
+        f"{prefix}.mass": body.mass,
+        f"{prefix}.com": list(body.com),
+        f"{prefix}.inertia": list(body.inertia),
+    }
+
+
+def _body_from_params(prefix: str, get, optional=False) -> RigidBody:
+    zeros = (0.0,) * 6 if optional else None
+    return RigidBody.validated(
+        prefix,
+        get(f"{prefix}.mass", 0.0 if optional else None),
+        get(f"{prefix}.com", ZERO3 if optional else None),
+        get(f"{prefix}.inertia", zeros),
+    )

@@ -1,0 +1,42 @@
+"""The payload room: what the arm can carry, and what it carries now.
+
+- ``limits``: joint torque limits (given, or derived from the rated payload), the largest
+  payload at a pose and the worst static load over the workspace;
+- ``check``: a payload against those limits, now and in its proven worst pose;
+- ``family``: a payload's torques as affine in its mass, and their proven extremes;
+- ``workspace``: the joint ranges and the sampled search for the worst pose;
+- ``mass_com_estimation``: the payload's mass and centre of mass from efforts at rest;
+- ``proof/``: the rigorous bounds (harmonic sums, interval boxes, branch and bound).
+
+May import: ``core.model``, ``core.scalars``, ``core.algorithms``, ``core.codegen``, the
+verbs in ``core.dynamics`` and ``core.kinematics``. Nothing of ROS.
+"""
+
+from irb140_dynamics.core.payload.check import PayloadCheck, check_payload
+from irb140_dynamics.core.payload.limits import (
+    RATED_PAYLOAD,
+    RTOL,
+    MaxPayload,
+    TorqueLimits,
+    WorkspaceLoad,
+    derive_torque_limits,
+    loads,
+    max_payload_at,
+    payload_family,
+    workspace_load,
+)
+
+__all__ = [
+    "RATED_PAYLOAD",
+    "RTOL",
+    "MaxPayload",
+    "PayloadCheck",
+    "TorqueLimits",
+    "WorkspaceLoad",
+    "check_payload",
+    "derive_torque_limits",
+    "loads",
+    "max_payload_at",
+    "payload_family",
+    "workspace_load",
+]

@@ -1,0 +1,258 @@
+"""A payload's shape at any mass: torques affine in the mass, and their proven worst values.
+
+Units: kg, m, rad, N m. A payload is a RigidBody on the flange (frame n); it replaces the
+model's own payload. For a fixed CoM and inertia the torques are affine in the payload
+mass m,
+
+    tau(m) = tau0 + m dtau,
+
+so at one state each joint allows an interval of masses (|tau_j(m)| <= L_j), exactly.
+
+The worst static torques over the joint ranges come in two halves: the search of
+``workspace`` (sampling and exact coordinate ascent) finds poses and their torques, the
+branch and bound of ``certify`` proves how far above them the true maxima can be (the
+gap; CERTIFY_RTOL of the torque when it closes, always within the budget of
+``certify.EVALUATIONS`` box bounds per proof). Models beyond harmonic.MAX_JOINTS joints
+get plain interval bounds within the budget of ``certify.interval_maxima``. Proofs are
+remembered per payload mass and joint ranges, families per arm and payload shape.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections import OrderedDict
+from dataclasses import dataclass, fields, replace
+from functools import cached_property
+
+import numpy as np
+
+from irb140_dynamics.core.algorithms import recursions as algorithms
+from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.dynamics import gravity_batch, rnea
+from irb140_dynamics.core.model.rigid_body import RigidBody
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.payload.proof import certify
+from irb140_dynamics.core.payload.proof.certify import Objective, certify_maxima, interval_maxima
+from irb140_dynamics.core.payload.proof.harmonic import StaticForms
+from irb140_dynamics.core.payload.workspace import JointRanges
+from irb140_dynamics.core.scalars.interval import Interval, bounds_of
+
+RTOL = 1e-9  # a torque within RTOL of its limit is within it
+CERTIFY_RTOL = 5e-10  # the gap the proof aims at, relative to the torque (half of RTOL)
+
+
+@dataclass(frozen=True, eq=False)
+class Extremes:
+    """max tau_j (row j) and max -tau_j (row n + j) over the joint ranges: the best value
+    found at a pose (a real torque there), the pose, and a proven upper bound."""
+
+    values: np.ndarray  # (2n,)
+    poses: np.ndarray  # (2n, n) rad
+    bounds: np.ndarray  # (2n,), >= values
+
+    def largest(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per joint the signed torque of largest magnitude found, its pose, and a proven
+        bound of the magnitude over the ranges: (n,), (n, n), (n,)."""
+        n = self.values.size // 2
+        values, bounds = self.values, self.bounds
+        positive = values[:n] >= values[n:] - RTOL * np.max(np.abs(values))  # a tie goes to +tau_j
+        torque = np.where(positive, values[:n], -values[n:])
+        pose = np.where(positive[:, None], self.poses[:n], self.poses[n:])
+        return torque, pose, np.maximum(np.maximum(bounds[:n], bounds[n:]), np.abs(torque))
+
+
+@dataclass(frozen=True, eq=False)
+class PayloadFamily:
+    """The model carrying one payload (CoM, inertia) at any mass m: tau(m) = tau0 + m dtau."""
+
+    empty: RobotModel  # the payload at 0 kg
+    unit: RobotModel  # the payload at 1 kg
+
+    def torques(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
+        """(tau0, dtau) [N m, N m/kg] that hold the motion (q, qd) with qdd = 0."""
+        qdd = np.zeros(self.empty.n)
+        tau0 = rnea(self.empty, q, qd, qdd)
+        return tau0, rnea(self.unit, q, qd, qdd) - tau0
+
+    def static_torques(self, Q) -> tuple[np.ndarray, np.ndarray]:
+        """(G0, dG): the gravity torques at poses Q (N, n), as tau0 and dtau."""
+        G0 = gravity_batch(self.empty, Q)
+        return G0, gravity_batch(self.unit, Q) - G0
+
+    def static_torque(self, m: float):
+        """Q -> the gravity torques at poses Q with the payload at m kg."""
+
+        def torque(Q):
+            G0, dG = self.static_torques(Q)
+            return G0 + m * dG
+
+        return torque
+
+    def search(self, m: float, ranges: JointRanges, sample_torques=None, warm=None):
+        """The search alone: max +-tau_j at m kg, (values (2n,), poses (2n, n))."""
+        n = self.empty.n
+        return ranges.maximize(self.static_torque(m), np.vstack([np.eye(n), -np.eye(n)]), sample_torques, warm)
+
+    def extremes(
+        self, m: float, ranges: JointRanges, sample_torques=None, warm=None, rows=None, share: float = 1.0, found=None
+    ) -> Extremes:
+        """The worst static torques at m kg, searched and proven (remembered per m and
+        ranges): all 2n of them, or only ``rows`` proven (the others' bounds inf), within
+        ``share`` of the proof's budget; ``found``: (values, poses) of a search at m done."""
+        rows = np.arange(2 * self.empty.n) if rows is None else np.asarray(rows, dtype=int)
+        key = (float(m), ranges.lower.tobytes(), ranges.upper.tobytes(), rows.tobytes())
+        if key not in self._proven:
+            values, poses = self.search(m, ranges, sample_torques, warm) if found is None else found
+            if len(self._proven) >= 8:
+                self._proven.pop(next(iter(self._proven)))
+            self._proven[key] = self._prove(m, ranges, values, poses, rows, share)
+        return self._proven[key]
+
+    @cached_property
+    def _proven(self) -> dict:
+        return {}
+
+    @cached_property
+    def forms(self) -> tuple[StaticForms, StaticForms] | None:
+        """The harmonic forms of the payload at 0 and 1 kg (None for too many joints)."""
+        empty = StaticForms.of(self.empty)
+        return None if empty is None else (empty, StaticForms.of(self.unit))
+
+    def _prove(self, m, ranges, values, poses, rows, share) -> Extremes:
+        n, torque = self.empty.n, self.static_torque(m)
+        bounds = np.full(2 * n, np.inf)
+        weights = np.vstack([np.eye(n), -np.eye(n)])
+        offsets = np.array(kernels_of(self.empty).angles)
+        scale = max(1.0, float(np.max(np.abs(values))))
+        tol = CERTIFY_RTOL * np.maximum(np.abs(values), 1e-3 * scale)
+        lower, upper = ranges.lower + offsets, ranges.upper + offsets
+        joints, signs = rows % n, np.where(rows < n, 1.0, -1.0)
+        if self.forms is None:
+            bounds[rows] = interval_maxima(
+                self._interval_torques(m, offsets), joints, signs, ranges.lower, ranges.upper, values[rows], tol[rows]
+            )
+            return Extremes(values, poses, bounds)
+        forms = self.forms[0].affine(self.forms[1], m)
+        objectives = [
+            Objective((forms.torque[j] * sign).reduced(merge=True), forms.omega[j].reduced(), forms.gravity_norm)
+            for j, sign in zip(joints, signs)
+        ]
+        boxes = [objective.value.box(lower, upper) for objective in objectives]
+
+        def angles(k, theta):  # the joint angles of objective k's box (parallel joints merged)
+            return np.array([objectives[i].value.angles(t, lower, upper)[0] for i, t in zip(k, theta)])
+
+        def polish(k, theta):
+            found, pose = ranges.climb(torque, weights[rows[k]], angles(k, theta) - offsets)
+            return found, np.array([objectives[i].value.fold(t)[0] for i, t in zip(k, pose + offsets)])
+
+        proof = certify_maxima(
+            objectives,
+            np.array([b[0] for b in boxes]),
+            np.array([b[1] for b in boxes]),
+            values[rows],
+            tol[rows],
+            polish,
+            int(share * certify.EVALUATIONS),
+        )
+        bounds[rows] = proof.bound
+        values, poses = values.copy(), poses.copy()
+        better = np.flatnonzero(proof.value > values[rows])
+        found = rows[better]
+        if found.size:  # the search missed these maxima: take the real poses' torques
+            pose = angles(better, proof.theta[better]) - offsets
+            value = np.einsum("kn,kn->k", torque(pose), weights[found])
+            higher = value > values[found]
+            values[found[higher]], poses[found[higher]] = value[higher], pose[higher]
+        return Extremes(values, poses, np.maximum(bounds, values))
+
+    def _interval_torques(self, m, offsets):
+        """(lo, hi) per joint (n, B) of the static torques at m kg over boxes of q (B, n)."""
+        model = self.empty.with_payload(RigidBody(m, self.empty.payload.com, self.empty.payload.inertia))
+        links, gravity, n = kernels_of(model).links, kernels_of(model).gravity, model.n
+
+        def evaluate(lo, hi):
+            theta = [Interval(lo[:, k], hi[:, k]) + offsets[k] for k in range(n)]
+            tau = algorithms.rnea(links, [(t.cos(), t.sin()) for t in theta], [0.0] * n, [0.0] * n, gravity)
+            pairs = [bounds_of(t, len(lo)) for t in tau]
+            return np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
+
+        return evaluate
+
+
+def payload_family(model: RobotModel, payload: RigidBody) -> PayloadFamily:
+    """``payload``'s shape at any mass on ``model`` (whatever payload ``model`` carries; its
+    flange and everything else kept).
+
+    Built once per arm and shape (the last FAMILIES remembered): the two models validate
+    the CoM and inertia (ModelError naming ``payload.com`` or ``payload.inertia``) and
+    compile their kernels then.
+    """
+    arm = tuple(getattr(model, f.name) for f in fields(model) if f.name != "payload")
+    key = (arm, tuple(payload.com), tuple(payload.inertia))
+    with _LOCK:
+        family = _FAMILIES.get(key)
+    if family is None:
+
+        def carrying(mass):
+            return replace(model, payload=RigidBody(mass, payload.com, payload.inertia))
+
+        family = PayloadFamily(carrying(0.0), carrying(1.0))
+        with _LOCK:
+            family = _FAMILIES.setdefault(key, family)
+            while len(_FAMILIES) > FAMILIES:
+                _FAMILIES.popitem(last=False)
+    return family
+
+
+def forget_families() -> None:
+    """Forget the families built (and so their proofs)."""
+    with _LOCK:
+        _FAMILIES.clear()
+
+
+FAMILIES = 16
+_FAMILIES: OrderedDict = OrderedDict()
+_LOCK = threading.Lock()
+
+
+def mass_bounds(tau0, dtau, limits) -> tuple[np.ndarray, np.ndarray]:
+    """Per joint, the payload masses m with |tau0 + m dtau| <= L: (lower, upper) [kg].
+
+    Works on (..., n) arrays; L = inf is no limit. An empty interval has lower > upper.
+    A dtau_j below 1e-12 of the largest is rounding noise: the payload does not load joint j.
+    """
+    tau0, dtau, L = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (tau0, dtau, limits)))
+    dtau = np.where(np.abs(dtau) <= 1e-12 * np.max(np.abs(dtau), axis=-1, keepdims=True), 0.0, dtau)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a, b = (-L - tau0) / dtau, (L - tau0) / dtau
+    fits = np.abs(tau0) <= L
+    lower = np.where(dtau == 0, np.where(fits, -np.inf, np.inf), np.minimum(a, b))
+    upper = np.where(dtau == 0, np.where(fits, np.inf, -np.inf), np.maximum(a, b))
+    return lower, upper
+
+
+def max_mass(tau0, dtau, limits) -> tuple[np.ndarray, np.ndarray]:
+    """The largest payload mass m >= 0 keeping every joint within its limit, and the joint
+    that bounds it (index; the first if several do), for torques (..., n).
+
+    nan if no m >= 0 fits (the joint is then one that fails); inf if no joint bounds it.
+    """
+    lower, upper = mass_bounds(tau0, dtau, limits)
+    m = np.min(upper, axis=-1)
+    joint = np.argmax(at_most(upper, m[..., None]), axis=-1)
+    fits = np.maximum(0.0, np.max(lower, axis=-1)) <= m
+    return np.where(fits, m, np.nan), joint
+
+
+def loads(torque) -> np.ndarray:
+    """Per joint: is the (worst) static torque more than rounding noise, i.e. does the load
+    reach the joint at all? Noise: RTOL of the largest, or of 1 N m."""
+    worst = np.abs(torque)
+    return worst > RTOL * max(worst.max(), 1.0)
+
+
+def at_most(x, m):
+    """x <= m, a value within RTOL of m counting as equal to it."""
+    with np.errstate(invalid="ignore"):
+        return (x <= m) | (x <= m + RTOL * np.abs(m))

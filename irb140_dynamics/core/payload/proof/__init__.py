@@ -1,0 +1,8 @@
+"""The payload proof: certified maxima of static joint torques over boxes of joint angles.
+
+``harmonic`` writes the static torques as finite harmonic sums with rigorous (interval)
+coefficients, ``bounds`` bounds such sums over a box, ``certify`` runs branch and bound on
+them. A maximum from here is proven, never sampled.
+
+May import: ``core.scalars``, ``core.algorithms``, ``core.codegen``, ``core.model``.
+"""

@@ -1,0 +1,168 @@
+"""Rigorous upper bounds of harmonic sums (see ``harmonic``) over boxes of angles.
+
+Units: rad. A box has centre m and half-widths r per joint; with t = theta - m each factor
+is re-expanded about m:
+
+    cos(theta) = cos m (1 - v) - sin m s,   sin(theta) = sin m (1 - v) + cos m s,
+    s = sin t in [-sin r, sin r],           v = 1 - cos t in [0, 1 - cos r],
+
+and the sum becomes one over products of 1, v and s (``expand``). Counting v as degree 2,
+the terms of degree >= 3 are bounded by their size (a product of v alone has the sign of
+its coefficient); the rest is a quadratic model g . s + s^T Q s / 2 (``model``): b v <= b
+s^2 / 2 for b < 0 (v >= s^2 / 2), b v <= b s^2 / (1 + cos r) for b >= 0. Its maximum
+over the box is bounded by ``quadratic_max``, exact where the model is concave with its
+top inside the box, so a box's bound is off by O(r^3) near a maximum.
+
+Floating-point rounding: each term of an expansion passes d stages of two operations on
+factors of size <= 1, and a row of the expansion adds up to at most 2.25 in size, so the
+bounds computed are within ``rounding(d)`` times the sum of the coefficients' sizes of
+the exact ones; ``certify`` adds that.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cache
+
+import numpy as np
+
+U = np.finfo(float).eps / 2  # unit roundoff
+_WIDE = 3.0  # rad: a half-width past which 1 - cos t is bounded by its size alone
+
+
+def rounding(d: int) -> float:
+    """The rounding error of a bound over d joints, relative to the coefficients' sizes."""
+    return (4 * d + 16) * U * 2.25**d
+
+
+def expand(coefficients, centre):
+    """The sums (B, 3^d) re-expanded about the centres (B, d): factors 1, v, s per joint."""
+    B, d = centre.shape
+    c, s = np.cos(centre), np.sin(centre)
+    M = np.zeros((B, d, 3, 3))  # row: 1, cos theta, sin theta; column: 1, v, s
+    M[:, :, 0, 0] = 1.0
+    M[:, :, 1, 0], M[:, :, 1, 1], M[:, :, 1, 2] = c, -c, -s
+    M[:, :, 2, 0], M[:, :, 2, 1], M[:, :, 2, 2] = s, -s, c
+    D = coefficients
+    for k in range(d - 1, -1, -1):  # the last joint first; each pass turns the axes once
+        D = np.matmul(D.reshape(B, -1, 3), M[:, k]).transpose(0, 2, 1).reshape(B, -1)
+    return D
+
+
+def sizes(radius):
+    """The largest size of each product of factors 1, v, s over the boxes (B, 3^d)."""
+    B, d = radius.shape
+    factor = np.stack([np.ones((B, d)), 1 - np.cos(np.minimum(radius, math.pi)), sizes_of_s(radius)], axis=2)
+    W = np.ones((B, 1))
+    for k in range(d):
+        W = (W[:, :, None] * factor[:, k, None, :]).reshape(B, -1)
+    return W
+
+
+def sizes_of_s(radius):
+    """max |sin t| for |t| <= radius."""
+    return np.where(radius < math.pi / 2, np.sin(np.minimum(radius, math.pi / 2)), 1.0)
+
+
+def model(D, W, radius):
+    """A re-expanded sum, its constant term left out, as g . s + s^T Q s / 2 plus at most
+    ``high`` over the boxes; and the size of each term (B, 3^d), for choosing a split."""
+    B, d = radius.shape
+    where = layout(d)
+    terms = np.where(where.signed, np.maximum(D, 0.0), np.abs(D)) * W
+    g, b = D[:, where.single_s], D[:, where.single_v]
+    wide = radius > _WIDE
+    curvature = np.where(b < 0, b, np.where(wide, 0.0, 2 * b / (1 + np.cos(np.minimum(radius, _WIDE)))))
+    high = terms[:, where.high].sum(axis=1) + np.where(wide & (b >= 0), terms[:, where.single_v], 0.0).sum(axis=1)
+    Q = np.zeros((B, d, d))
+    k, l = np.triu_indices(d, 1)
+    Q[:, k, l] = Q[:, l, k] = D[:, where.pair]
+    Q[:, np.arange(d), np.arange(d)] = curvature
+    return g, Q, high, terms
+
+
+def quadratic_max(g, Q, sigma, enough=None):
+    """An upper bound of g . s + s^T Q s / 2 over |s_k| <= sigma_k (B boxes): the smaller
+    of (1) each term maximised on its own, the products s_k s_l by size, and (2) the
+    Lagrangian dual sum mu_k sigma_k^2 + g^T S^-1 g / 2, S = 2 diag(mu) - Q positive
+    definite, valid for any mu >= 0 and exact when Q is concave with its top in the box:
+    mu by two sweeps of exact coordinate descent from a diagonally dominant start, the
+    value from an eigendecomposition, enlarged by its possible rounding error. The dual
+    only where (1) is above ``enough`` (B,), if given."""
+    B, d = g.shape
+    if d == 0:
+        return np.zeros(B)
+    absQ = np.abs(Q)
+    diagonal = np.diagonal(Q, axis1=1, axis2=2)
+    off = absQ.sum(axis=2) - np.abs(diagonal)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vertex = (diagonal < 0) & (np.abs(g) <= -diagonal * sigma)
+        alone = np.where(
+            vertex, g * g / np.where(diagonal < 0, -2 * diagonal, 1.0), np.abs(g) * sigma + 0.5 * diagonal * sigma**2
+        )
+    cross = np.einsum("bkl,bk,bl->b", absQ, sigma, sigma) - (np.abs(diagonal) * sigma**2).sum(axis=1)
+    bound = alone.sum(axis=1) + 0.5 * cross
+    rows = np.arange(B) if enough is None else np.flatnonzero(bound > enough)
+    if rows.size:
+        dual = _dual(g[rows], Q[rows], np.maximum(sigma[rows], 1e-9), diagonal[rows], off[rows])  # wider: still a bound
+        bound[rows] = np.minimum(bound[rows], dual)
+    return bound
+
+
+def _dual(g, Q, sigma, diagonal, off):
+    B, d = g.shape
+    size = np.abs(Q).max(axis=(1, 2)) + (np.abs(g) / sigma).max(axis=1) + 1e-300
+    mu = 0.5 * np.maximum(0.0, diagonal + off) + np.abs(g) / (2 * sigma) + 1e-9 * size[:, None]
+    rows = np.arange(d)
+    S = -Q.copy()
+    S[:, rows, rows] += 2 * mu
+    inverse = np.linalg.inv(S)
+    x = np.einsum("bkl,bl->bk", inverse, g)
+    for _ in range(2):
+        for k in range(d):  # the best mu_k for the others (Sherman-Morrison), S kept definite
+            h = inverse[:, k, k]
+            step = np.maximum((np.maximum(np.abs(x[:, k]) / sigma[:, k], 0.01) - 1) / (2 * h), -mu[:, k])
+            scale = 2 * step / (1 + 2 * step * h)
+            column = inverse[:, :, k].copy()
+            x -= (scale * x[:, k])[:, None] * column
+            inverse -= scale[:, None, None] * column[:, :, None] * column[:, None, :]
+            mu[:, k] += step
+    S = -Q.copy()
+    S[:, rows, rows] += 2 * np.maximum(mu, 0.0)
+    lam, V = np.linalg.eigh(S)
+    # the computed eigenpairs are exact for S + E, |E| <= 16 d U |S|: S >= (1 - eta)(S + E)
+    eta = 16 * d * U * np.sqrt((S**2).sum(axis=(1, 2))) / np.where(lam[:, 0] > 0, lam[:, 0], 1.0)
+    trusted = (lam[:, 0] > 0) & (eta < 0.5)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        projected = np.einsum("bkj,bk->bj", V, g)
+        value = (np.maximum(mu, 0.0) * sigma**2).sum(axis=1) + 0.5 * (projected**2 / lam).sum(axis=1) / (1 - eta)
+    return np.where(trusted, value * (1 + 16 * d * U), np.inf)
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where the terms of a sum over d joints are (the first joint slowest)."""
+
+    involves: np.ndarray  # (3^d, d): 1 where the term has a factor of joint k
+    signed: np.ndarray  # terms without an s factor: their sign is their coefficient's
+    high: np.ndarray  # terms of degree >= 3
+    single_s: np.ndarray  # the term s_k alone, per k
+    single_v: np.ndarray  # v_k alone
+    pair: np.ndarray  # s_k s_l, k < l
+
+
+@cache
+def layout(d: int) -> Layout:
+    digits = np.indices((3,) * d, dtype=int).reshape(d, -1).T if d else np.zeros((1, 0), int)
+    degree = np.where(digits == 1, 2, np.where(digits == 2, 1, 0)).sum(axis=1)
+    place = 3 ** np.arange(d - 1, -1, -1)
+    k, l = np.triu_indices(d, 1)
+    return Layout(
+        involves=(digits != 0).astype(float),
+        signed=~(digits == 2).any(axis=1),
+        high=degree >= 3,
+        single_s=2 * place,
+        single_v=place,
+        pair=2 * place[k] + 2 * place[l],
+    )

@@ -1,0 +1,299 @@
+"""Certified maxima of static torques over a box of joint angles: branch and bound.
+
+Units: rad, N m. The search in ``workspace`` finds poses and their torques: lower bounds
+of the maxima. Here each maximum also gets an upper bound that is proven: the box is cut
+into smaller boxes, each gets a rigorous upper bound of the objective over it, boxes whose
+bound is below the best value known are dropped, the others are split (the joint that
+weighs most in the bound, at its middle) until every bound is within ``tol`` of the best
+value known, or the budget of box bounds is spent. The bound then is the largest bound of
+a box kept; the gap, bound - best value, is what remains unproven. A box's centre that
+beats the best value by more than tol shows a maximum the search missed: it is climbed
+from (``polish``), and the real pose found serves as the best value from then on.
+
+An objective is +-tau_j written as a harmonic sum (see ``harmonic``: joints it does not
+depend on dropped, parallel joints before j merged into one angle). A box gets the smaller
+of two bounds: the sum's own, a second-order expansion about the box's centre (see
+``bounds``: off by O(r^3) near a maximum), and |tau_j| <= |g| |omega_j(theta after j)|
+(Cauchy-Schwarz), which holds whatever the joints before j do: it closes the boxes along
+the curves of poses that share a maximum (a wrist turning about its own axis, joints that
+only turn gravity), where no expansion gets tight.
+
+Rigour: the sums' coefficients are enclosures (Interval arithmetic); their widths and the
+terms of the joints dropped are the sums' ``error``, and ``bounds.rounding`` covers the
+floating-point rounding of a bound: both are added to each bound. The result is an upper
+bound of the exact maxima of the model's static torques.
+
+Cost: at most EVALUATIONS box bounds per call, each counted in units of a sum of TERMS
+terms (a box over a sum of d joints costs O(d 3^d)), in batches of at most BATCH boxes:
+the budget bounds the time whatever the model; for the IRB-140 and its rated payload the
+proof closes long before it is spent.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from irb140_dynamics.core.payload.proof.bounds import (
+    U,
+    expand,
+    layout,
+    model,
+    quadratic_max,
+    rounding,
+    sizes,
+    sizes_of_s,
+)
+from irb140_dynamics.core.payload.proof.harmonic import Reduced
+
+EVALUATIONS = 50_000  # box bounds per call, shared by the groups of objectives, counted in
+TERMS = 200  # bounds of sums of this many terms (the IRB-140's): a box over more terms counts more
+BATCH = 1024  # boxes bounded at once (the most promising first)
+SLICE = 2048  # box bounds per turn of a group
+
+
+@dataclass(frozen=True, eq=False)
+class Objective:
+    """Maximise ``value`` over the box; |value| <= gravity_norm |norm| holds too (norm: 3 sums)."""
+
+    value: Reduced
+    norm: Reduced
+    gravity_norm: float
+
+
+@dataclass(frozen=True, eq=False)
+class Maxima:
+    """Per objective: a proven upper bound of its maximum, and the best value the boxes'
+    centres (or the climbs from them) reached, with its angles theta (-inf and nan where
+    none beat the incumbent); and the number of box bounds spent."""
+
+    bound: np.ndarray
+    value: np.ndarray
+    theta: np.ndarray
+    evaluations: int
+
+
+def certify_maxima(objectives, lower, upper, incumbent, tol, polish=None, evaluations: int | None = None) -> Maxima:
+    """Upper bounds of the objectives' maxima over theta in [lower, upper] ((n,), or (K, n):
+    a box per objective), proven to
+    within ``tol`` (K,) of the best value known (``incumbent`` (K,), values at real poses)
+    unless the budget of ``evaluations`` box bounds runs out first. Objectives over the same
+    joints are searched together; after a first bound of the whole box each, the groups
+    take turns of at most SLICE box bounds, so that a hard one cannot starve the others.
+
+    Where a box's centre beats the best value known by more than tol, the search missed a
+    maximum there: ``polish(indices, theta)`` (objectives (P,), angles (P, n)) -> (values,
+    theta) climbs from it to the real poses' values, which then serve as the best known.
+    """
+    evaluations = EVALUATIONS if evaluations is None else evaluations
+    K = len(objectives)
+    lower = np.broadcast_to(np.asarray(lower, dtype=float), (K, np.shape(lower)[-1]))
+    upper = np.broadcast_to(np.asarray(upper, dtype=float), lower.shape)
+    incumbent, tol = np.asarray(incumbent, dtype=float), np.asarray(tol, dtype=float)
+    n = lower.shape[1]
+    members: dict[tuple, list[int]] = {}
+    for k, objective in enumerate(objectives):
+        members.setdefault((objective.value.dims, objective.norm.dims), []).append(k)
+    groups = []
+    for ks in members.values():
+        ks = np.array(ks)
+        climb = None if polish is None else (lambda local, theta, ks=ks: polish(ks[local], theta))
+        groups.append((ks, _Group([objectives[k] for k in ks], lower[ks], upper[ks], incumbent[ks], tol[ks], climb)))
+    spent = sum(group.advance(group.boxes) * group.cost for _, group in groups)  # the whole box, whatever the budget
+    while spent < evaluations:
+        open_groups = [group for _, group in groups if group.boxes]
+        if not open_groups:
+            break
+        share = max(1.0, min(SLICE, (evaluations - spent) / len(open_groups)))
+        for group in open_groups:
+            spent += group.advance(max(1, int(share / group.cost))) * group.cost
+    bound, value, theta = np.full(K, -np.inf), np.full(K, -np.inf), np.full((K, n), np.nan)
+    for ks, group in groups:
+        bound[ks], value[ks], theta[ks] = group.result()
+    return Maxima(bound, value, theta, int(spent))
+
+
+class _Group:
+    """Objectives over the same joints, searched together: boxes of theta, each with its
+    objective (``owner``) and its parent's bound, best first."""
+
+    def __init__(self, objectives, lower, upper, incumbent, tol, polish):
+        first = objectives[0]
+        self.value_dims, self.norm_dims = list(first.value.dims), list(first.norm.dims)
+        self.values = np.array([o.value.coefficients for o in objectives])  # (K, 3^d)
+        self.norms = np.array([o.norm.coefficients for o in objectives])  # (K, 3, 3^d')
+        g = np.array([o.gravity_norm for o in objectives])
+        size = np.abs(self.values).sum(axis=1)
+        self.value_slack = np.array([o.value.error for o in objectives]) + rounding(len(self.value_dims)) * size
+        norm_size = np.abs(self.norms).sum(axis=(1, 2))
+        norm_error = np.array([np.sum(o.norm.error) for o in objectives])
+        self.norm_slack = g * (norm_error + rounding(len(self.norm_dims)) * norm_size)
+        self.gravity = g * (1 + 8 * U)
+        self.cost = max(1.0, (3 ** len(self.value_dims) + 3 ** (len(self.norm_dims) + 1)) / TERMS)
+        K, n = lower.shape
+        upper = np.minimum(upper, lower + 2 * math.pi)  # the sums repeat every turn
+        self.tol = np.maximum(tol, 4 * (self.value_slack + self.norm_slack))  # rounding is not to be closed
+        self.polish = polish
+        self.lo, self.hi, self.owner = lower.copy(), upper.copy(), np.arange(K)
+        self.inherited = np.full(K, np.inf)
+        self.best, self.closed = incumbent.copy(), np.full(K, -np.inf)
+        self.best_value, self.best_theta = np.full(K, -np.inf), np.full((K, n), np.nan)
+
+    @property
+    def boxes(self) -> int:
+        return self.owner.size
+
+    def result(self):
+        """(bounds, best values the search found, their angles) per objective."""
+        bound = np.maximum(self.best, self.closed)
+        np.maximum.at(bound, self.owner, self.inherited)
+        return bound, self.best_value, self.best_theta
+
+    def advance(self, evaluations: int) -> int:
+        """Bound, drop, close or split up to ``evaluations`` boxes, best first; the number done."""
+        spent = 0
+        while self.owner.size and spent < evaluations:
+            lo, hi, owner, inherited, best, tol = self.lo, self.hi, self.owner, self.inherited, self.best, self.tol
+            take = min(owner.size, BATCH, evaluations - spent)
+            order = np.argsort(-inherited, kind="stable")
+            now, later = order[:take], order[take:]
+            centre, radius = 0.5 * (lo[now] + hi[now]), 0.5 * (hi[now] - lo[now])
+            k = owner[now]
+            bound, value, weight = self._bound(k, centre, radius, best[k] + tol[k])
+            spent += take
+            self._improve(k, value, centre, best, tol, self.polish, self.best_value, self.best_theta)
+            weight = np.where(hi[now] > lo[now], weight, -1.0)  # a joint whose range is a point cannot split
+            kept = bound >= best[k]
+            done = kept & ((bound <= best[k] + tol[k]) | (weight.max(axis=1) <= 0))  # (nothing to split: as is)
+            np.maximum.at(self.closed, k[done], bound[done])
+            split = now[kept & ~done]
+            axis = np.argmax(weight[kept & ~done], axis=1)
+            middle = 0.5 * (lo[split, axis] + hi[split, axis])
+            left_hi, right_lo = hi[split].copy(), lo[split].copy()
+            rows = np.arange(split.size)
+            left_hi[rows, axis], right_lo[rows, axis] = middle, middle
+            parent = bound[kept & ~done]
+            self.lo = np.concatenate([lo[later], lo[split], right_lo])
+            self.hi = np.concatenate([hi[later], left_hi, hi[split]])
+            self.owner = np.concatenate([owner[later], owner[split], owner[split]])
+            self.inherited = np.concatenate([inherited[later], parent, parent])
+        return spent
+
+    @staticmethod
+    def _improve(k, value, centre, best, tol, polish, best_value, best_theta):
+        """Take the boxes' centres (objectives k) that beat the best values: climbed from by
+        ``polish`` where they beat them by more than tol."""
+        order = np.argsort(value)  # ascending: per objective the best centre comes last
+        top = np.zeros(len(best), dtype=int) - 1
+        top[k[order]] = order
+        found = np.flatnonzero((top >= 0) & (value[np.maximum(top, 0)] > best))
+        if not found.size:
+            return
+        values, thetas = value[top[found]], centre[top[found]]
+        missed = values > best[found] + tol[found]
+        if polish is not None and missed.any():
+            climbed, climbed_theta = polish(found[missed], thetas[missed])
+            higher = climbed > values[missed]
+            values[np.flatnonzero(missed)[higher]] = climbed[higher]
+            thetas[np.flatnonzero(missed)[higher]] = climbed_theta[higher]
+        best[found] = np.maximum(best[found], values)
+        best_value[found], best_theta[found] = values, thetas
+
+    def _bound(self, owner, centre, radius, target):
+        """Upper bounds over the boxes, a value at each centre (rounded down; -inf where not
+        needed) and each joint's weight in the bound (where to split: the norm bound's
+        joints only where it could come down to ``target``, the best value known plus tol).
+        The bound over fewer joints first, the other only where the first is above target."""
+        B, n = centre.shape
+        value = np.full(B, -np.inf)
+        by_value, by_norm, floor = np.full(B, np.inf), np.full(B, np.inf), np.full(B, np.inf)
+        value_weight, norm_weight = np.zeros((B, n)), np.zeros((B, n))
+        norm_first = len(self.norm_dims) < len(self.value_dims)
+        for part in ("norm", "value") if norm_first else ("value", "norm"):
+            rows = np.flatnonzero(np.minimum(by_value, by_norm) > target)
+            if not rows.size:
+                break
+            args = owner[rows], centre[rows], radius[rows], target[rows]
+            if part == "value":
+                by_value[rows], value[rows], value_weight[rows] = self._value_bound(*args)
+            else:
+                by_norm[rows], floor[rows], norm_weight[rows] = self._norm_bound(*args)
+        use_norm = (by_norm < by_value) & (floor <= target)
+        return np.minimum(by_value, by_norm), value, np.where(use_norm[:, None], norm_weight, value_weight)
+
+    def _value_bound(self, owner, centre, radius, target):
+        """The value's own bound over the boxes, its value at the centres (rounded down),
+        and the joints' weights in it."""
+        B, n = centre.shape
+        d = self.value_dims
+        D = expand(self.values[owner], centre[:, d])
+        g, Q, high, terms = model(D, sizes(radius[:, d]), radius[:, d])
+        base = D[:, 0] + high + self.value_slack[owner]
+        bound = base + quadratic_max(g, Q, sizes_of_s(radius[:, d]), enough=target - base)
+        weight = np.zeros((B, n))
+        weight[:, d] = terms @ layout(len(d)).involves
+        return bound, D[:, 0] - self.value_slack[owner], weight
+
+    def _norm_bound(self, owner, centre, radius, target):
+        """|tau_j| <= |g| |omega_j| over the boxes, |g| |omega_j| at the centres, and the
+        joints' weights in it.
+
+        |omega|^2 = |omega(c)|^2 + 2 omega(c) . delta + |delta|^2, delta = omega - omega(c)
+        = A s + rest: the first two terms as a quadratic model, |delta|^2 <= |A s|^2 +
+        2 |A s| |rest| + |rest|^2 by the sizes of the terms."""
+        B, n = centre.shape
+        e = self.norm_dims
+        N = expand(self.norms[owner].reshape(B * 3, -1), np.repeat(centre[:, e], 3, axis=0)).reshape(B, 3, -1)
+        W, sigma, where = sizes(radius[:, e]), sizes_of_s(radius[:, e]), layout(len(e))
+        at_centre = N[:, :, 0]
+        along = np.einsum("bc,bca->ba", at_centre, N)
+        along[:, 0] = 0.0
+        g, Q, high, along_terms = model(along, W, radius[:, e])
+        A = N[:, :, where.single_s]  # (B, 3, d')
+        rest = np.abs(N) * W[:, None]
+        rest[:, :, 0] = 0.0
+        rest[:, :, where.single_s] = 0.0
+        rest = np.sqrt((rest.sum(axis=2) ** 2).sum(axis=1))
+        linear = (np.sqrt((A**2).sum(axis=1)) * sigma).sum(axis=1)
+        base = (at_centre**2).sum(axis=1) + 2 * high + 2 * linear * rest + rest**2
+        gravity, slack = self.gravity[owner], self.norm_slack[owner]
+        enough = ((target - slack) / gravity) ** 2 - base  # |omega|^2 that would do
+        squared = base + quadratic_max(2 * g, 2 * Q + 2 * np.einsum("bck,bcl->bkl", A, A), sigma, enough)
+        bound = gravity * np.sqrt(np.maximum(squared, 0.0)) * (1 + 4 * U) + slack
+        weight = np.zeros((B, n))
+        weight[:, e] = (along_terms + (np.abs(N) * W[:, None]).sum(axis=1)) @ where.involves
+        return bound, gravity * np.sqrt((at_centre**2).sum(axis=1)), weight
+
+
+INTERVAL_WORK = 20_000  # box x joint evaluations of plain interval bounds (beyond harmonic.MAX_JOINTS)
+
+
+def interval_maxima(evaluate, joints, signs, lower, upper, incumbent, tol, work: int = INTERVAL_WORK):
+    """Upper bounds of sign_k tau[joint_k] over q in [lower, upper] (n,), from plain
+    interval evaluations ``evaluate(lo, hi)`` -> (lo, hi) of the torques (n, B) over boxes
+    (B, n), bisecting the widest joint range while ``work`` lasts: loose, but proven."""
+    K, n = len(joints), len(lower)
+    lo, hi, owner = np.tile(lower, (K, 1)), np.tile(upper, (K, 1)), np.arange(K)
+    inherited, closed, spent = np.full(K, np.inf), np.full(K, -np.inf), 0
+    while owner.size and spent + owner.size * n <= work:
+        low, high = evaluate(lo, hi)
+        box = np.arange(owner.size)
+        bound = np.where(signs[owner] > 0, high[joints[owner], box], -low[joints[owner], box])
+        spent += owner.size * n
+        kept = bound >= incumbent[owner]
+        done = kept & (bound <= incumbent[owner] + tol[owner])
+        np.maximum.at(closed, owner[done], bound[done])
+        split = kept & ~done
+        lo, hi, owner, inherited = lo[split], hi[split], owner[split], bound[split]
+        axis = np.argmax(hi - lo, axis=1)
+        rows = np.arange(owner.size)
+        middle = 0.5 * (lo[rows, axis] + hi[rows, axis])
+        left_hi, right_lo = hi.copy(), lo.copy()
+        left_hi[rows, axis], right_lo[rows, axis] = middle, middle
+        lo, hi = np.concatenate([lo, right_lo]), np.concatenate([left_hi, hi])
+        owner, inherited = np.concatenate([owner, owner]), np.concatenate([inherited, inherited])
+    result = np.maximum(np.asarray(incumbent, dtype=float), closed)
+    np.maximum.at(result, owner, inherited)
+    return result

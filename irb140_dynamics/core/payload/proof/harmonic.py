@@ -1,0 +1,229 @@
+"""Static torques as finite harmonic sums with rigorous coefficients: what ``certify`` bounds.
+
+Units: rad, N m. With qd = qdd = 0 a torque is, in each joint angle theta_k = q_k +
+offset_k, A + B cos(theta_k) + C sin(theta_k) (see ``workspace``), so over all the angles
+
+    tau_j(theta) = sum over alpha in {0, 1, 2}^n of c_alpha prod_k phi[alpha_k](theta_k),
+    phi = (1, cos, sin).
+
+The 3^n coefficients follow from the torques at theta_k in {0, pi/2, pi}, where (cos, sin)
+= (1, 0), (0, 1), (-1, 0) exactly: A = (f(0) + f(pi)) / 2, B = (f(0) - f(pi)) / 2,
+C = f(pi/2) - A, one angle after the other. ``algorithms.rnea`` evaluates those torques on
+Interval numbers, so each coefficient comes as an enclosure of its exact value; the sum is
+exact: no cancellation is lost (cos^2 + sin^2 = 1 has been used up by the fit), which is
+what makes the bounds tight.
+
+Besides tau_j, ``certify`` uses omega_j: joint j's torque per unit of gravity along each
+axis of frame j (the frame joint j turns in), a sum over the joints after j. Static torques
+are linear in gravity, so tau_j = g_j . omega_j with g_j the gravity in frame j, and
+|tau_j| <= |g| |omega_j|; turning joint j turns omega_j about its axis, so |omega_j| does
+not depend on theta_j, which is set to 0 (the subchain from link j, by rnea too).
+
+Cost: 3^n torques for tau and about 3^n / 2 for the omegas, each one rnea pass on Interval
+arrays (3^6 = 729 states for six joints). Beyond MAX_JOINTS joints the sums grow too large
+and ``certify`` falls back to plain interval bounds.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from irb140_dynamics.core.algorithms import recursions as algorithms
+from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.scalars.interval import Interval, bounds_of
+
+MAX_JOINTS = 8  # 3^8 = 6561 coefficients per sum
+NOISE = 1e-14  # a joint whose terms weigh less than this fraction of a sum is dropped from it
+_COS, _SIN = np.array([1.0, 0.0, -1.0]), np.array([0.0, 1.0, 0.0])  # theta = 0, pi/2, pi
+
+
+@dataclass(frozen=True, eq=False)
+class HarmonicSum:
+    """sum_alpha c_alpha prod_k phi[alpha_k](theta[dims[k]]) for c_alpha within ``coefficients``
+    (an Interval of shape (..., 3^len(dims)); leading axes for several sums at once)."""
+
+    dims: tuple[int, ...]
+    coefficients: Interval
+
+    def __add__(self, other: HarmonicSum) -> HarmonicSum:
+        assert self.dims == other.dims
+        return HarmonicSum(self.dims, self.coefficients + other.coefficients)
+
+    def __sub__(self, other: HarmonicSum) -> HarmonicSum:
+        return self + other * -1.0
+
+    def __mul__(self, k: float) -> HarmonicSum:
+        return HarmonicSum(self.dims, self.coefficients * float(k))
+
+    def __getitem__(self, index) -> HarmonicSum:
+        c = self.coefficients
+        return HarmonicSum(self.dims, Interval(c.lo[index], c.hi[index]))
+
+    def reduced(self, merge: bool = False) -> Reduced:
+        """Midpoint coefficients and an error bound, without the joints it hardly depends on
+        (whose terms then count in the error: |phi| <= 1); with ``merge`` (a single sum),
+        joints it depends on only through theta_a +- theta_b become one (``merge_parallel``)."""
+        c, d = self.coefficients, len(self.dims)
+        lead = c.lo.shape[:-1]
+        mid = c.mid.reshape(lead + (3,) * d)
+        error = c.rad.reshape(lead + (-1,)).sum(axis=-1)
+        weight = np.abs(mid).reshape((-1,) + (3,) * d).sum(axis=0)
+        total = weight.sum()
+        dims = list(self.dims)
+        for axis in reversed(range(d)):
+            if np.take(weight, [1, 2], axis=axis).sum() <= NOISE * total:
+                dropped = np.take(mid, [1, 2], axis=len(lead) + axis)
+                error = error + np.abs(dropped).reshape(lead + (-1,)).sum(axis=-1)
+                mid, weight = np.take(mid, 0, axis=len(lead) + axis), np.take(weight, 0, axis=axis)
+                del dims[axis]
+        merges: list[tuple[int, int, float]] = []
+        if merge and not lead:
+            mid, residual = merge_parallel(mid, dims, merges, NOISE * total)
+            error = error + residual
+        return Reduced(tuple(dims), mid.reshape(lead + (-1,)), np.asarray(error, dtype=float), tuple(merges))
+
+    def __call__(self, theta: np.ndarray) -> np.ndarray:
+        """The midpoint sum at angles theta (N, n): (N, ...); for tests."""
+        theta = np.atleast_2d(theta)[:, list(self.dims)]
+        basis = np.ones((len(theta), 1))
+        for k in range(theta.shape[1]):
+            phi = np.stack([np.ones(len(theta)), np.cos(theta[:, k]), np.sin(theta[:, k])], axis=1)
+            basis = (basis[:, :, None] * phi[:, None, :]).reshape(len(theta), -1)
+        return np.einsum("pa,...a->p...", basis, self.coefficients.mid)
+
+
+@dataclass(frozen=True, eq=False)
+class Reduced:
+    """A harmonic sum with point coefficients (..., 3^len(dims)) and a bound on its error;
+    ``merges`` (a, b, sign) in order: theta_b folded into theta_a as theta_a + sign theta_b."""
+
+    dims: tuple[int, ...]
+    coefficients: np.ndarray
+    error: np.ndarray
+    merges: tuple[tuple[int, int, float], ...] = ()
+
+    def box(self, lower, upper) -> tuple[np.ndarray, np.ndarray]:
+        """The box of angles this sum is over, from the joints' (n,): a merged joint a
+        ranges over theta_a + sign theta_b, theta_b is 0."""
+        lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
+        for a, b, sign in self.merges:
+            lo[a], hi[a] = (lo[a] + lo[b], hi[a] + hi[b]) if sign > 0 else (lo[a] - hi[b], hi[a] - lo[b])
+            lo[b] = hi[b] = 0.0
+        return lo, hi
+
+    def fold(self, theta) -> np.ndarray:
+        """Joint angles (K, n) as a point of ``box``: the inverse of ``angles``."""
+        theta = np.array(theta, dtype=float, ndmin=2)
+        for a, b, sign in self.merges:
+            theta[:, a] += sign * theta[:, b]
+            theta[:, b] = 0.0
+        return theta
+
+    def angles(self, theta, lower, upper) -> np.ndarray:
+        """Joint angles (K, n) within [lower, upper] with the same sum as theta (K, n) from
+        ``box``: each merged sum split back, theta_b near the middle of its range."""
+        theta = np.array(theta, dtype=float, ndmin=2)
+        lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
+        before = []
+        for a, b, sign in self.merges:
+            before.append((lo[a], hi[a]))
+            lo[a], hi[a] = (lo[a] + lower[b], hi[a] + upper[b]) if sign > 0 else (lo[a] - upper[b], hi[a] - lower[b])
+        for (a, b, sign), (lo_a, hi_a) in zip(reversed(self.merges), reversed(before)):
+            total, middle = theta[:, a].copy(), 0.5 * (lower[b] + upper[b])
+            theta[:, a] = np.clip(total - sign * middle, lo_a, hi_a)
+            theta[:, b] = np.clip(sign * (total - theta[:, a]), lower[b], upper[b])
+        return theta
+
+
+@dataclass(frozen=True, eq=False)
+class StaticForms:
+    """A model's static torques tau_j (one sum per joint, over all joints) and omega_j
+    (three sums per joint, over the joints after it), and |g| rounded up."""
+
+    torque: HarmonicSum
+    omega: tuple[HarmonicSum, ...]
+    gravity_norm: float
+
+    @classmethod
+    def of(cls, model) -> StaticForms | None:
+        """The forms of ``model`` (None beyond MAX_JOINTS joints)."""
+        if model.n > MAX_JOINTS:
+            return None
+        kernels = kernels_of(model)
+        return _forms(kernels.links, tuple(kernels.gravity))
+
+    def affine(self, other: StaticForms, k: float) -> StaticForms:
+        """self + k (other - self): the forms of a payload at k kg from those at 0 and 1 kg."""
+        torque = self.torque + (other.torque - self.torque) * k
+        omega = tuple(a + (b - a) * k for a, b in zip(self.omega, other.omega))
+        return StaticForms(torque, omega, self.gravity_norm)
+
+
+def _forms(links, gravity) -> StaticForms:
+    n = len(links)
+    zeros = [0.0] * n
+    values = algorithms.rnea(links, _circle_points(n), zeros, zeros, gravity)
+    torque = _fit(_stack(values, 3**n), n)
+    omega = []
+    for j in range(n):
+        rest = n - j - 1
+        cs = [(1.0, 0.0)] + _circle_points(rest, copies=3)
+        unit_gravity = tuple(Interval(np.repeat(np.eye(3)[axis], 3**rest)) for axis in range(3))
+        per_axis = algorithms.rnea(links[j:], cs, zeros[j:], zeros[j:], unit_gravity)[0]
+        lo, hi = bounds_of(per_axis, 3 * 3**rest)
+        omega.append(_fit(Interval(lo.reshape(3, -1), hi.reshape(3, -1)), rest, first=j + 1))
+    norm = math.hypot(*gravity)
+    return StaticForms(torque, tuple(omega), float(np.nextafter(norm * (1 + 4e-16), np.inf)))
+
+
+def _circle_points(d: int, copies: int = 1) -> list:
+    """(cos, sin) pairs for d joints over the 3^d combinations of theta in {0, pi/2, pi},
+    the first joint slowest; ``copies`` times over."""
+    digits = np.tile(np.array(list(itertools.product(range(3), repeat=d)), dtype=int), (copies, 1))
+    return [(Interval(_COS[column]), Interval(_SIN[column])) for column in digits.T]
+
+
+def _stack(values, size: int) -> Interval:
+    bounds = [bounds_of(v, size) for v in values]
+    return Interval(np.array([b[0] for b in bounds]), np.array([b[1] for b in bounds]))
+
+
+def _fit(values: Interval, d: int, first: int = 0) -> HarmonicSum:
+    """Coefficients from the values (..., 3^d) at theta in {0, pi/2, pi}^d."""
+    lead = values.lo.shape[:-1]
+    shape = lead + (3,) * d
+    c = Interval(values.lo.reshape(shape), values.hi.reshape(shape))
+    for axis in range(len(lead), len(shape)):
+        f0, f1, f2 = (Interval(np.take(c.lo, i, axis), np.take(c.hi, i, axis)) for i in range(3))
+        A, B = (f0 + f2) * 0.5, (f0 - f2) * 0.5
+        C = f1 - A
+        c = Interval(np.stack([A.lo, B.lo, C.lo], axis), np.stack([A.hi, B.hi, C.hi], axis))
+    flat = lead + (3**d,)
+    return HarmonicSum(tuple(range(first, first + d)), Interval(c.lo.reshape(flat), c.hi.reshape(flat)))
+
+
+def merge_parallel(T, dims: list, merges: list, noise: float):
+    """T (3,)*d without pairs of neighbouring joints it depends on only through theta_a +-
+    theta_b (parallel joints before the one whose torque it is: they only turn gravity),
+    each pair folded into joint a (theta_b = 0; dims and merges updated); and the size of
+    the terms that did not fit that form, for the error bound."""
+    residual, p = 0.0, 0
+    while p + 1 < len(dims):
+        X = np.moveaxis(T, (p, p + 1), (0, 1))
+        for sign in (1.0, -1.0):  # cos(a +- b) = ca cb -+ sa sb, sin(a +- b) = sa cb +- ca sb
+            B, C = 0.5 * (X[1, 1] - sign * X[2, 2]), 0.5 * (X[2, 1] + sign * X[1, 2])
+            fit = np.zeros_like(X)
+            fit[0, 0], fit[1, 1], fit[2, 2], fit[2, 1], fit[1, 2] = X[0, 0], B, -sign * B, C, sign * C
+            off = np.abs(X - fit).sum()
+            if off <= noise:
+                T = np.moveaxis(np.stack([X[0, 0], B, C]), 0, p)
+                residual += off
+                merges.append((dims[p], dims.pop(p + 1), sign))
+                break
+        else:
+            p += 1
+    return T, residual

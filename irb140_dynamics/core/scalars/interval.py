@@ -1,0 +1,122 @@
+"""Interval numbers: rigorous enclosures of real values through floating-point arithmetic.
+
+An Interval holds lower and upper bounds ``lo`` <= ``hi`` (floats or NumPy arrays: many
+intervals at once). Each + - * rounds outward (np.nextafter, one ulp each way), so the
+exact real result of the same operations on any values within the operands lies within
+the computed interval. Exact cases stay exact: a product with the constant 0 is 0, with
++-1 the operand; a float constant is an exact point. cos and sin enclose the range of
+the function over the interval (rounded outward by a few ulps).
+
+The algorithms (``algorithms.rnea`` and the others) use only + - * on their scalars and
+take (cos, sin) pairs, so they run on Intervals unchanged: that is how the static torques
+get rigorous bounds (see ``harmonic`` and ``certify``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+_DOWN, _UP = -np.inf, np.inf
+_TRIG_SLACK = 4 * np.finfo(float).eps  # relative widening of a computed cos or sin
+_TINY = 1e-300
+
+
+class Interval:
+    """[lo, hi], elementwise; see the module docstring."""
+
+    __slots__ = ("lo", "hi")
+    __array_priority__ = 1000  # ndarray * Interval goes to Interval.__rmul__
+
+    def __init__(self, lo, hi=None):
+        self.lo = lo
+        self.hi = lo if hi is None else hi
+
+    @property
+    def mid(self):
+        return 0.5 * (self.lo + self.hi)
+
+    @property
+    def rad(self):
+        """A radius r with [lo, hi] within mid +- r (rounded up)."""
+        mid = self.mid
+        return np.nextafter(np.maximum(self.hi - mid, mid - self.lo), _UP)
+
+    def __repr__(self) -> str:
+        return f"Interval({self.lo!r}, {self.hi!r})"
+
+    def __neg__(self) -> Interval:
+        return Interval(-self.hi, -self.lo)
+
+    def __add__(self, other):
+        if isinstance(other, Interval):
+            lo, hi = self.lo + other.lo, self.hi + other.hi
+        elif _is_zero(other):
+            return self
+        else:
+            lo, hi = self.lo + other, self.hi + other
+        return Interval(np.nextafter(lo, _DOWN), np.nextafter(hi, _UP))
+
+    __radd__ = __add__
+
+    def __sub__(self, other):
+        return self + (-other)
+
+    def __rsub__(self, other):
+        return (-self) + other
+
+    def __mul__(self, other):
+        if isinstance(other, Interval):
+            products = (self.lo * other.lo, self.lo * other.hi, self.hi * other.lo, self.hi * other.hi)
+            lo = np.minimum(np.minimum(products[0], products[1]), np.minimum(products[2], products[3]))
+            hi = np.maximum(np.maximum(products[0], products[1]), np.maximum(products[2], products[3]))
+        elif np.ndim(other) == 0:
+            if other == 0:
+                return 0.0
+            if other == 1:
+                return self
+            if other == -1:
+                return -self
+            lo, hi = (self.lo * other, self.hi * other) if other > 0 else (self.hi * other, self.lo * other)
+        else:
+            a, b = self.lo * other, self.hi * other
+            lo, hi = np.minimum(a, b), np.maximum(a, b)
+        return Interval(np.nextafter(lo, _DOWN), np.nextafter(hi, _UP))
+
+    __rmul__ = __mul__
+
+    def cos(self) -> Interval:
+        """An enclosure of cos over [lo, hi]."""
+        return _trig(np.cos, self.lo, self.hi, 0.0)
+
+    def sin(self) -> Interval:
+        """An enclosure of sin over [lo, hi] (cos shifted by pi/2)."""
+        return _trig(np.sin, self.lo, self.hi, math.pi / 2)
+
+
+def _is_zero(x) -> bool:
+    return np.ndim(x) == 0 and x == 0
+
+
+def _trig(fn, lo, hi, peak):
+    """The range of fn (cos or sin) over [lo, hi]: the ends, and +1 / -1 where the
+    interval holds a peak (peak + 2 k pi) or trough (peak + pi + 2 k pi)."""
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    a, b = fn(lo), fn(hi)
+    low, high = np.minimum(a, b), np.maximum(a, b)
+    turns = 2 * math.pi
+    has_peak = np.floor((hi - peak) / turns) >= np.ceil((lo - peak) / turns)
+    has_trough = np.floor((hi - peak - math.pi) / turns) >= np.ceil((lo - peak - math.pi) / turns)
+    whole = hi - lo >= turns
+    high = np.where(has_peak | whole, 1.0, high + _TRIG_SLACK * np.abs(high) + _TINY)
+    low = np.where(has_trough | whole, -1.0, low - _TRIG_SLACK * np.abs(low) - _TINY)
+    return Interval(np.maximum(low, -1.0), np.minimum(high, 1.0))
+
+
+def bounds_of(x, shape) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi) arrays of ``shape`` for an Interval or a plain number (an exact point)."""
+    if isinstance(x, Interval):
+        return np.broadcast_to(x.lo, shape), np.broadcast_to(x.hi, shape)
+    value = np.broadcast_to(np.asarray(x, dtype=float), shape)
+    return value, value

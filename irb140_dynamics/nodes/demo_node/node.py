@@ -1,0 +1,163 @@
+"""demo_node: a first look at the closed loop. Sends id_node a reference motion and prints
+how well the simulated arm (sim_node) follows it under computed-torque control.
+
+Publishes    /id_node/reference         trajectory_msgs/JointTrajectory: one period of a
+                                        smooth motion of every joint, sent again each period
+Subscribes   joint_states, /id_node/tracking_error (sensor_msgs/JointState)
+Prints       the tracking error RMS per joint [mrad] over the last second, every second;
+             at the end (Ctrl-C, or after ``duration``) a plot of reference and actual
+             positions per joint is written to ``plot_file`` (PNG)
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+
+import numpy as np
+from builtin_interfaces.msg import Duration
+from rclpy.node import Node
+from sensor_msgs.msg import JointState
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+
+from irb140_dynamics.core.io.stamps import nanoseconds, sec_nanosec
+from irb140_dynamics.ros.runtime.spin import run
+
+NAMES = [f"joint_{i}" for i in range(1, 7)]
+CENTRE = [0.0, -0.6, 1.0, 0.0, 0.5, 0.0]  # rad: where the motion starts and ends (sim_node's initial_positions)
+AMPLITUDE = [0.8, 0.5, 0.5, 1.0, 0.6, 1.5]  # rad
+POINTS_PER_SECOND = 50
+PARAMETER_NAMES = ("period", "plot_file", "duration")  # declared below; known to the other nodes' warnings
+
+
+def motion(t: np.ndarray, period: float):
+    """q, qd, qdd of c + a (1 - cos(w t)) / 2: from rest at CENTRE and back in one period."""
+    w = 2 * math.pi / period
+    c, a, t = np.array(CENTRE), np.array(AMPLITUDE), np.asarray(t)[:, None]
+    return c + a * (1 - np.cos(w * t)) / 2, a * w * np.sin(w * t) / 2, a * w**2 * np.cos(w * t) / 2
+
+
+def reference_message(period: float) -> JointTrajectory:
+    """One period of the motion, POINTS_PER_SECOND points a second, as id_node's ~/reference."""
+    t = np.arange(int(period * POINTS_PER_SECOND) + 1) / POINTS_PER_SECOND
+    Q, QD, QDD = motion(t, period)
+    msg = JointTrajectory(joint_names=NAMES)
+    for ti, q, qd, qdd in zip(t, Q, QD, QDD):
+        sec, nanosec = sec_nanosec(ti)
+        msg.points.append(
+            JointTrajectoryPoint(
+                positions=q.tolist(),
+                velocities=qd.tolist(),
+                accelerations=qdd.tolist(),
+                time_from_start=Duration(sec=sec, nanosec=nanosec),
+            )
+        )
+    return msg
+
+
+class DemoNode(Node):
+    def __init__(self, **kwargs):
+        super().__init__("demo_node", **kwargs)
+        self.period = self.declare_parameter("period", 8.0).value  # s
+        self.plot_file = self.declare_parameter("plot_file", "demo_tracking.png").value
+        duration = self.declare_parameter("duration", 0.0).value  # s, 0 = until Ctrl-C
+        self._reference_pub = self.create_publisher(JointTrajectory, "/id_node/reference", 10)
+        self._positions = {}  # stamp [ns] -> q, of the latest joint states
+        self._stamps = deque(maxlen=2000)
+        self._recent = deque(maxlen=5000)  # (time [s], error) of the last seconds
+        self._history = []  # (time [s], q_ref, q) for the plot, every 10th sample
+        self.create_subscription(JointState, "joint_states", self._on_joint_state, 10)
+        self.create_subscription(JointState, "/id_node/tracking_error", self._on_error, 10)
+        self._start = self.get_clock().now()
+        self._sender = self.create_timer(0.1, self._start_when_heard)
+        self.create_timer(1.0, self._print)
+        if duration > 0.0:
+            self.create_timer(duration, self._finish)
+        self.get_logger().info(f"ready: a {self.period} s reference motion for id_node, sent every period")
+
+    def _start_when_heard(self) -> None:
+        """Send the first reference once id_node listens, then one every period."""
+        if self._reference_pub.get_subscription_count() == 0:
+            return
+        self._sender.cancel()
+        self._send_reference()
+        self.create_timer(self.period, self._send_reference)
+
+    def _elapsed(self) -> float:
+        return (self.get_clock().now() - self._start).nanoseconds * 1e-9
+
+    def _send_reference(self) -> None:
+        self._reference_pub.publish(reference_message(self.period))
+
+    @staticmethod
+    def _ns(msg) -> int:
+        return nanoseconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
+
+    def _on_joint_state(self, msg: JointState) -> None:
+        stamp = self._ns(msg)
+        if len(self._stamps) == self._stamps.maxlen:
+            self._positions.pop(self._stamps[0], None)
+        self._stamps.append(stamp)
+        self._positions[stamp] = np.array(msg.position)
+
+    def _on_error(self, msg: JointState) -> None:
+        t, error = self._elapsed(), np.array(msg.position)
+        self._recent.append((t, error))
+        q = self._positions.get(self._ns(msg))
+        if q is not None and len(self._recent) % 10 == 0:
+            self._history.append((t, q + error, q))
+
+    def _print(self) -> None:
+        t = self._elapsed()
+        errors = [e for s, e in self._recent if s > t - 1.0]
+        if not errors:
+            print(f"t={t:6.1f} s  waiting for sim_node and id_node ...", flush=True)
+            return
+        rms = np.sqrt(np.mean(np.square(errors), axis=0)) * 1e3
+        print(f"t={t:6.1f} s  tracking error RMS [mrad] " + " ".join(f"{x:7.3f}" for x in rms), flush=True)
+
+    def _finish(self) -> None:
+        self.context.try_shutdown()  # main() then destroys the node, which writes the plot
+
+    def write_plot(self) -> str | None:
+        """Reference and actual positions per joint, as a PNG; its path, or None without data."""
+        if not self._history:
+            return None
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        t = np.array([h[0] for h in self._history])
+        reference, actual = np.array([h[1] for h in self._history]), np.array([h[2] for h in self._history])
+        figure, axes = plt.subplots(3, 2, figsize=(11, 8), sharex=True)
+        for j, axis in enumerate(axes.flat):
+            axis.plot(t, reference[:, j], label="reference")
+            axis.plot(t, actual[:, j], "--", label="actual")
+            axis.set_title(
+                f"{NAMES[j]}: error RMS {np.sqrt(np.mean((reference[:, j] - actual[:, j]) ** 2)) * 1e3:.2f} mrad"
+            )
+            axis.set_ylabel("q [rad]")
+        axes.flat[0].legend()
+        for axis in axes[-1]:
+            axis.set_xlabel("t [s]")
+        figure.tight_layout()
+        figure.savefig(self.plot_file)
+        plt.close(figure)
+        print(f"plot written: {self.plot_file}", flush=True)
+        return self.plot_file
+
+    def destroy_node(self):
+        try:
+            self.write_plot()
+        except Exception as error:  # a plot that fails must not hide the shutdown
+            self.get_logger().error(f"no plot: {error}")
+        return super().destroy_node()
+
+
+def main(args=None):
+    raise SystemExit(run("demo_node", DemoNode, args))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,1 @@
+"""id_node: live inverse dynamics, gravity compensation, computed torque, collisions."""

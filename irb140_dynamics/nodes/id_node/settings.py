@@ -1,0 +1,110 @@
+"""id_node's parameters and the settings it runs on, validated whole (see ros.live)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from irb140_dynamics.core import RobotModel
+from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.nodes.id_node.collision import (
+    COLLISION_PARAMETERS,
+    CollisionSettings,
+    build_collision_settings,
+    collision_threshold_specs,
+)
+from irb140_dynamics.nodes.id_node.tracking import Gains, build_gains, gain_specs
+from irb140_dynamics.ros.parameters.specs import QOS_PARAMETERS, Spec, check_choice, check_number, check_qos
+
+ACCELERATION_MODES = ("zero", "differentiate")
+EFFORT_SOURCES = ("feedforward", "gravity", "computed_torque")
+MAX_CUTOFF_FREQUENCY = 1e6  # Hz
+MAX_TIMEOUT = 1e6  # s
+
+NODE_PARAMETERS = [
+    Spec(
+        "acceleration.mode",
+        "zero",
+        "qdd when no ~/reference gives it: 'zero', or 'differentiate' the measured velocities (low-pass "
+        "filtered; for monitoring: as a command it would feed the measured acceleration back, "
+        "so effort_commands never use it)",
+    ),
+    Spec(
+        "acceleration.cutoff_frequency",
+        20.0,
+        "cut-off of the velocity differentiation filter",
+        "Hz",
+        minimum=1e-3,
+        maximum=MAX_CUTOFF_FREQUENCY,
+    ),
+    Spec(
+        "reference_timeout",
+        0.5,
+        "a ~/reference is let go this long after its last point (node clock); 0 = never",
+        "s",
+        minimum=0.0,
+        maximum=MAX_TIMEOUT,
+    ),
+    Spec(
+        "effort_commands.enabled", False, "also publish torques on effort_commands (Float64MultiArray)", read_only=True
+    ),
+    Spec(
+        "effort_commands.source",
+        "feedforward",
+        "which torques go to effort_commands: 'feedforward', 'gravity' or 'computed_torque'",
+    ),
+    *COLLISION_PARAMETERS,
+    *QOS_PARAMETERS,
+]
+
+
+def PER_JOINT_PARAMETERS(joint_names) -> list[Spec]:
+    return collision_threshold_specs(joint_names) + gain_specs(joint_names)
+
+
+@dataclass(frozen=True)
+class IdNodeSettings:
+    """What the node runs on, built and validated from all of its parameters at once."""
+
+    model: RobotModel
+    acceleration_mode: str
+    cutoff_frequency: float
+    reference_timeout: float
+    effort_source: str
+    collision: CollisionSettings
+    gains: Gains
+
+
+def check_settings(values: dict) -> IdNodeSettings:
+    """Validate every parameter (quick, within the parameter call); kernels not compiled yet."""
+    model = RobotModel.from_params(values)
+    check_choice("acceleration.mode", values["acceleration.mode"], ACCELERATION_MODES)
+    check_choice("effort_commands.source", values["effort_commands.source"], EFFORT_SOURCES)
+    check_qos(values)
+    return IdNodeSettings(
+        model,
+        values["acceleration.mode"],
+        check_number(
+            "acceleration.cutoff_frequency", values["acceleration.cutoff_frequency"], 1e-3, MAX_CUTOFF_FREQUENCY, "Hz"
+        ),
+        check_number("reference_timeout", values["reference_timeout"], 0.0, MAX_TIMEOUT, "s"),
+        values["effort_commands.source"],
+        build_collision_settings(values, model.joint_names),
+        build_gains(values, model.joint_names),
+    )
+
+
+KERNELS = ("rnea", "gravity_torques", "momentum", "monitor")  # what a message uses (the last two: the observer)
+
+
+def finish_settings(settings: IdNodeSettings, previous: IdNodeSettings | None) -> IdNodeSettings:
+    """Compile the kernels the messages use, here and not on a message (off the executor
+    unless they exist already: a payload or gravity change shares the arm's code)."""
+    if previous is not None and previous.model == settings.model:
+        return replace(settings, model=previous.model)
+    for name in KERNELS:
+        getattr(kernels_of(settings.model), name)  # compiles it
+    return settings
+
+
+def compiled(settings: IdNodeSettings, previous: IdNodeSettings | None) -> bool:
+    return kernels_of(settings.model).compiled(*KERNELS)

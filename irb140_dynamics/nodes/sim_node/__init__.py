@@ -1,0 +1,1 @@
+"""sim_node: the arm simulated in MuJoCo (``sim``), behind ROS topics."""

@@ -1,0 +1,176 @@
+"""sensor_msgs/JointState as the bytes DDS carries (CDR), for id_node's path per message.
+
+rclpy turns every message taken into a Python object field by field, and every message
+published back into C. id_node reads its joint states from the serialized bytes with
+``struct`` instead (strings read as rclpy reads them), and publishes its torque messages as
+bytes: the message written once, then only the stamp and the efforts written into a copy.
+bench/bench_nodes.py measures what that saves (docs/benchmarks.md).
+
+The layout is XCDR1 (what rmw_fastrtps and rmw_cyclonedds send for ROS 2 types): a
+4-byte encapsulation header, then the fields in order, each primitive aligned to its size
+counted from the end of the header; a string is a uint32 length (NUL included) and its
+bytes, a sequence a uint32 count and its elements. Anything but little-endian plain CDR
+(encapsulation 0x0001) goes to rclpy's deserializer, so every valid message is read.
+"""
+
+from __future__ import annotations
+
+import struct
+from typing import NamedTuple
+
+from rclpy.serialization import deserialize_message
+from sensor_msgs.msg import JointState
+
+from irb140_dynamics.core.model.joint_order import BadMessage
+
+PLAIN_CDR_LE = b"\x00\x01"  # the encapsulation kind this module reads itself
+HEADER = 4  # bytes of the encapsulation header; alignment counts from its end
+_UINT32 = struct.Struct("<I")
+_STAMP = struct.Struct("<iI")
+_FRAME_ID = HEADER + _STAMP.size  # where the frame_id starts
+_names_seen: tuple[bytes, str, tuple] | None = None  # the bytes of the last frame_id and names read, and them
+
+
+class Time(NamedTuple):
+    sec: int
+    nanosec: int
+
+
+class Header(NamedTuple):
+    stamp: Time
+    frame_id: str
+
+
+class JointStateView(NamedTuple):
+    """The fields of a JointState read from its bytes, as a JointState has them."""
+
+    header: Header
+    name: tuple
+    position: tuple
+    velocity: tuple
+    effort: tuple
+
+
+def read_joint_state_cdr(raw: bytes) -> JointStateView | JointState:
+    """The JointState ``raw`` serializes (BadMessage ``malformed`` if it does not)."""
+    if raw[:2] != PLAIN_CDR_LE:
+        try:
+            return deserialize_message(raw, JointState)
+        except Exception as error:  # noqa: BLE001  (rclpy raises its own kinds for bad bytes)
+            raise BadMessage("malformed", f"undecodable joint state: {error}") from None
+    try:
+        return _read_plain_le(raw)
+    except (struct.error, ValueError) as error:
+        raise BadMessage("malformed", f"undecodable joint state: {error}") from None
+
+
+def _read_plain_le(raw: bytes) -> JointStateView:
+    global _names_seen
+    end = len(raw)
+    sec, nanosec = _STAMP.unpack_from(raw, HEADER)
+    seen = _names_seen
+    if seen is not None and raw.startswith(seen[0], _FRAME_ID):  # a stream repeats them: decoded once
+        block, frame_id, names = seen
+        at = _FRAME_ID + len(block)
+    else:
+        frame_id, at = _string(raw, _FRAME_ID)
+        count, at = _count(raw, at, end, 5)  # a name takes 5 bytes at least (length, NUL)
+        listed = []
+        for _ in range(count):
+            name, at = _string(raw, at)
+            listed.append(name)
+        names = tuple(listed)
+        _names_seen = (raw[_FRAME_ID:at], frame_id, names)
+    position, at = _doubles(raw, at, end)
+    velocity, at = _doubles(raw, at, end)
+    effort, at = _doubles(raw, at, end)
+    return JointStateView(Header(Time(sec, nanosec), frame_id), names, position, velocity, effort)
+
+
+def _aligned(at: int, size: int) -> int:
+    return at + (-(at - HEADER) % size)
+
+
+def _count(raw: bytes, at: int, end: int, element_size: int) -> tuple[int, int]:
+    """A sequence's count and where its elements start; ValueError if they cannot fit."""
+    at = _aligned(at, 4)
+    (count,) = _UINT32.unpack_from(raw, at)
+    if count * element_size > end - at - 4:
+        raise ValueError(f"a sequence of {count} does not fit in {end} bytes")
+    return count, at + 4
+
+
+def _string(raw: bytes, at: int) -> tuple[str, int]:
+    """A string as rclpy reads it: up to its first NUL, undecodable UTF-8 replaced."""
+    at = _aligned(at, 4)
+    (length,) = _UINT32.unpack_from(raw, at)
+    start, stop = at + 4, at + 4 + length
+    if stop > len(raw):
+        raise ValueError(f"a string of {length} bytes does not fit in {len(raw)}")
+    text = raw[start:stop]
+    nul = text.find(0)
+    return (text if nul < 0 else text[:nul]).decode("utf-8", "replace"), stop
+
+
+_DOUBLES: dict[int, struct.Struct] = {}
+
+
+def _doubles(raw: bytes, at: int, end: int) -> tuple[tuple, int]:
+    count, at = _count(raw, at, end, 8)
+    if count == 0:
+        return (), at
+    at = _aligned(at, 8)
+    layout = _DOUBLES.get(count)
+    if layout is None:
+        layout = struct.Struct(f"<{count}d")
+        if len(_DOUBLES) < 64:  # counts seen: a few joint counts, bounded against odd senders
+            _DOUBLES[count] = layout
+    return layout.unpack_from(raw, at), at + 8 * count
+
+
+class EffortMessage:
+    """JointState bytes with fixed names, empty positions and velocities, and efforts: written
+    once; ``serialize`` writes a stamp and the efforts into a copy."""
+
+    def __init__(self, names):
+        self.names = list(names)
+        self._efforts = struct.Struct(f"<{len(self.names)}d")
+        self._template = _plain_le(self.names, len(self.names))
+        self._at = len(self._template) - self._efforts.size  # effort is the last field
+
+    def serialize(self, stamp, effort) -> bytes:
+        """The message with ``stamp`` (anything with sec, nanosec) and ``effort`` (one per name)."""
+        buffer = bytearray(self._template)
+        _STAMP.pack_into(buffer, HEADER, stamp.sec, stamp.nanosec)
+        self._efforts.pack_into(buffer, self._at, *effort)
+        return bytes(buffer)
+
+
+def _plain_le(names, efforts: int) -> bytes:
+    """A JointState with ``names``, ``efforts`` zero efforts and nothing else (stamp 0)."""
+    out = bytearray(PLAIN_CDR_LE + b"\0\0")
+
+    def align(size: int) -> None:
+        out.extend(bytes(-(len(out) - HEADER) % size))
+
+    def count(value: int) -> None:
+        align(4)
+        out.extend(_UINT32.pack(value))
+
+    def string(text: str) -> None:
+        encoded = text.encode() + b"\0"
+        count(len(encoded))
+        out.extend(encoded)
+
+    out.extend(bytes(_STAMP.size))
+    string("")  # frame_id
+    count(len(names))
+    for name in names:
+        string(name)
+    count(0)  # position
+    count(0)  # velocity
+    count(efforts)
+    if efforts:
+        align(8)
+        out.extend(bytes(8 * efforts))
+    return bytes(out)

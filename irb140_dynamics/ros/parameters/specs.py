@@ -1,0 +1,219 @@
+"""Parameters of the nodes: declared with descriptors, validated whole, applied off the executor.
+
+A node lists its parameters as ``Spec``s and gives two functions: ``check`` turns all of
+their values into a draft of the configuration it runs on (a RobotModel, options),
+raising ValueError naming the parameter when something is wrong, quickly; ``finish``
+does the slow rest (compiling kernels, the workspace analysis); a draft may be None while
+an input from elsewhere, a URDF, has yet to come. ``LiveParameters`` (see ``live``)
+declares the parameters, builds the first configuration (a failure stops startup), and
+from then on checks every change whole before it is accepted (a refused change keeps the
+old configuration), then finishes it off the executor and swaps it in: a change stalls no
+message. Parameters given that no node of the package knows are warned about by name,
+with the nearest known name.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+from irb140_dynamics.core.io.params_file import read_parameter_file
+from irb140_dynamics.core.model.robot_model import check_joint_names
+from irb140_dynamics.package_files import CONFIG_NAME, PACKAGE, default_config_path  # noqa: F401 (PACKAGE, CONFIG_NAME: re-exported)
+from irb140_dynamics.ros.parameters.live import LiveParameters
+from irb140_dynamics.ros.parameters.spec import Spec, declare
+
+_declare = declare  # the name model_source imports
+
+
+MAX_QOS_DEPTH = 10_000  # messages: 10 s at 1 kHz; DDS may reserve memory for the whole depth
+RELIABILITIES = {"best_effort": ReliabilityPolicy.BEST_EFFORT, "reliable": ReliabilityPolicy.RELIABLE}
+QOS_PARAMETERS = [
+    Spec(
+        "qos.reliability",
+        "best_effort",
+        "joint_states subscription reliability: 'best_effort' (takes reliable and best-effort publishers) "
+        "or 'reliable'",
+        read_only=True,
+    ),
+    Spec(
+        "qos.depth",
+        10,
+        "queue depth of joint_states, ~/reference and the torque topics",
+        read_only=True,
+        minimum=1,
+        maximum=MAX_QOS_DEPTH,
+    ),
+]
+
+
+def check_choice(name: str, value, choices) -> None:
+    if value not in choices:
+        raise ValueError(f"{name}: must be one of {', '.join(choices)}; got {value!r}")
+
+
+def check_qos(values: dict) -> None:
+    check_choice("qos.reliability", values["qos.reliability"], RELIABILITIES)
+    check_qos_depth(values["qos.depth"])
+
+
+def check_qos_depth(depth) -> None:
+    if not (isinstance(depth, int) and 1 <= depth <= MAX_QOS_DEPTH):
+        raise ValueError(f"qos.depth: must be between 1 and {MAX_QOS_DEPTH}, got {depth}")
+
+
+def joint_states_qos(node: Node) -> QoSProfile:
+    """The joint_states subscription's QoS from the node's qos.* parameters."""
+    reliability = RELIABILITIES[node.get_parameter("qos.reliability").value]
+    return QoSProfile(depth=node.get_parameter("qos.depth").value, reliability=reliability)
+
+
+def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
+    """The model's parameters for these joints; defaults from the default model's file.
+
+    The per-joint defaults apply only when the joints are the default model's own: a
+    params file naming other joints must give every value (nothing is silently borrowed).
+    """
+    own = list(defaults.get("joint_names", [])) == list(joint_names)
+
+    def default(name, kind):
+        return defaults[name] if own and name in defaults else kind
+
+    specs = [
+        Spec("gravity", defaults.get("gravity", [0.0, 0.0, -9.81]), "gravity in the base frame", "m/s^2"),
+        Spec(
+            "friction.smoothing_velocity",
+            defaults.get("friction.smoothing_velocity", 0.01),
+            "Coulomb friction is coulomb * tanh(qd / this)",
+            "rad/s",
+            minimum=1e-9,
+        ),
+        *_body_specs(
+            "payload", "the payload on the flange", "flange frame", lambda name, kind: defaults.get(name, kind)
+        ),
+    ]
+    for joint in joint_names:
+        specs += [
+            Spec(
+                f"{joint}.dh",
+                default(f"{joint}.dh", Parameter.Type.DOUBLE_ARRAY),
+                "standard DH row [a, alpha, d, theta_offset]",
+                "m, rad, m, rad",
+            ),
+            *_body_specs(f"{joint}.link", f"the link {joint} moves", "its DH frame", default),
+            Spec(
+                f"{joint}.position_limits",
+                default(f"{joint}.position_limits", [-math.pi, math.pi]),
+                "[lower, upper] joint position",
+                "rad",
+            ),
+            Spec(
+                f"{joint}.torque_limit",
+                default(f"{joint}.torque_limit", 0.0),
+                "joint torque limit, 0 = none given",
+                "N m",
+                minimum=0.0,
+            ),
+            Spec(
+                f"{joint}.velocity_limit",
+                default(f"{joint}.velocity_limit", 0.0),
+                "joint speed limit, 0 = none given",
+                "rad/s",
+                minimum=0.0,
+            ),
+            Spec(
+                f"{joint}.acceleration_limit",
+                default(f"{joint}.acceleration_limit", 0.0),
+                "joint acceleration limit, 0 = none given",
+                "rad/s^2",
+                minimum=0.0,
+            ),
+            Spec(
+                f"{joint}.friction.viscous",
+                default(f"{joint}.friction.viscous", 0.0),
+                "viscous friction coefficient",
+                "N m s/rad",
+                minimum=0.0,
+            ),
+            Spec(
+                f"{joint}.friction.coulomb",
+                default(f"{joint}.friction.coulomb", 0.0),
+                "Coulomb friction level (smoothed, see friction.smoothing_velocity)",
+                "N m",
+                minimum=0.0,
+            ),
+            Spec(
+                f"{joint}.armature",
+                default(f"{joint}.armature", 0.0),
+                "rotor inertia reflected through the gear, added to M's diagonal",
+                "kg m^2",
+                minimum=0.0,
+            ),
+        ]
+    return specs
+
+
+def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
+    zeros3, zeros6 = [0.0] * 3, [0.0] * 6
+    optional = prefix == "payload"
+    return [
+        Spec(
+            f"{prefix}.mass",
+            default(f"{prefix}.mass", 0.0 if optional else Parameter.Type.DOUBLE),
+            f"mass of {what}",
+            "kg",
+            minimum=0.0,
+        ),
+        Spec(
+            f"{prefix}.com",
+            default(f"{prefix}.com", zeros3 if optional else Parameter.Type.DOUBLE_ARRAY),
+            f"centre of mass of {what}, in {frame}",
+            "m",
+        ),
+        Spec(
+            f"{prefix}.inertia",
+            default(f"{prefix}.inertia", zeros6 if optional else Parameter.Type.DOUBLE_ARRAY),
+            f"inertia of {what} about its centre of mass, [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]",
+            "kg m^2",
+        ),
+    ]
+
+
+def declare_model(
+    node: Node,
+    extra: list[Spec],
+    check: Callable[[dict], Any],
+    per_joint: Callable[[list[str]], list[Spec]] = None,
+    finish: Callable[[Any, Any], Any] | None = None,
+    startup_wait: float | None = None,
+    quick: Callable[[Any, Any], bool] | None = None,
+) -> LiveParameters:
+    """Declare the robot model's parameters and a node's own (``extra``, and ``per_joint``
+    specs made for the model's joint names), with the default model's defaults (see
+    LiveParameters for ``check``, ``finish``, ``startup_wait`` and ``quick``)."""
+    path = default_config_path()
+    if not path.is_file():
+        raise ValueError(f"default model: no {path}; is the package installed? (or give --params-file)")
+    defaults = read_parameter_file(path)
+    node.get_logger().info(f"default model: {path}")
+    names = declare(
+        node,
+        Spec("joint_names", defaults["joint_names"], "the model's joints, base to flange", read_only=True),
+    )
+    names = check_joint_names(names)  # they become parameter prefixes: check them first
+    own = per_joint(names) if per_joint else []
+    specs = [*model_specs(names, defaults), *extra, *own]
+    return LiveParameters(node, specs, check, finish, declared=["joint_names"], startup_wait=startup_wait, quick=quick)
+
+
+def check_number(name: str, value, minimum: float, maximum: float, unit: str = "") -> float:
+    """A finite number within [minimum, maximum], or ValueError naming the parameter."""
+    unit = f" {unit}" if unit else ""
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and minimum <= value <= maximum):
+        raise ValueError(f"{name}: must be between {minimum:g} and {maximum:g}{unit}, got {value}")
+    return float(value)

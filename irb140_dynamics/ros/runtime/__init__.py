@@ -1,0 +1,3 @@
+"""What every node needs to run: main() and spinning (``spin``), callbacks that never
+raise (``guard``), slow work off the executor (``builder``), /diagnostics statuses
+(``diagnostics``), publishers that know their subscribers (``listened``)."""

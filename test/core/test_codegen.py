@@ -1,0 +1,128 @@
+"""Generated kernels: bit for bit the algorithms run on floats, and no folded-away terms left."""
+
+import ast
+import math
+
+import numpy as np
+import pytest
+
+from irb140_dynamics.core import coriolis, coriolis_matrix, gravity, irb140, mass_matrix, rnea
+from irb140_dynamics.core.algorithms import recursions as algorithms
+from irb140_dynamics.core.codegen.kernels import kernels_of
+
+from ..support.common import loaded_irb140, model_makers, random_states
+
+MODELS = model_makers(seed=300, sizes=(2, 7))
+
+
+@pytest.fixture(scope="module", params=list(MODELS), ids=list(MODELS))
+def robot(request):
+    return MODELS[request.param]()
+
+
+@pytest.fixture
+def states(robot):
+    Q, QD, QDD = random_states(np.random.default_rng(31), robot.n, 200)
+    return [(q.tolist(), qd.tolist(), qdd.tolist()) for q, qd, qdd in zip(Q, QD, QDD)]
+
+
+def angles(robot, q):
+    """(cos, sin) of q_i + theta_offset_i, computed with math on Python floats."""
+    return [(math.cos(q_i + j.offset), math.sin(q_i + j.offset)) for q_i, j in zip(q, robot.joints)]
+
+
+def test_rnea_kernels_are_the_algorithm_bit_for_bit(robot, states):
+    links, zeros = algorithms.chain(robot), [0.0] * robot.n
+    rng = np.random.default_rng(32)
+    for q, qd, qdd in states:
+        cs = angles(robot, q)
+        assert rnea(robot, q, qd, qdd).tolist() == algorithms.rnea(links, cs, qd, qdd, robot.gravity)
+        assert gravity(robot, q).tolist() == algorithms.rnea(links, cs, zeros, zeros, robot.gravity)
+        assert coriolis(robot, q, qd).tolist() == algorithms.rnea(links, cs, qd, zeros, (0.0, 0.0, 0.0))
+        wrench = rng.normal(0.0, 20.0, 6).tolist()
+        direct = algorithms.rnea(links, cs, qd, qdd, robot.gravity, wrench[:3], wrench[3:])
+        assert rnea(robot, q, qd, qdd, wrench).tolist() == direct
+
+
+def test_mass_matrix_kernel_is_crba_bit_for_bit(robot, states):
+    links = algorithms.chain(robot)
+    for q, _, _ in states:
+        assert mass_matrix(robot, q).tolist() == algorithms.crba(links, angles(robot, q))
+
+
+def test_coriolis_matrix_kernel_is_the_algorithm_bit_for_bit(robot, states):
+    links = algorithms.chain(robot)
+    for q, qd, _ in states[:50]:
+        assert coriolis_matrix(robot, q, qd).tolist() == algorithms.christoffel_coriolis(links, angles(robot, q), qd)
+
+
+KERNEL_INPUTS = {  # the argument groups after q, by kernel
+    "rnea": ("qd", "qdd"),
+    "rnea_wrench": ("qd", "qdd", "wrench"),
+    "gravity_torques": (),
+    "coriolis": ("qd",),
+    "mass_matrix": (),
+    "coriolis_matrix": ("qd",),
+    "regressor": ("qd", "qdd"),
+    "momentum": ("qd",),
+}
+
+
+@pytest.mark.parametrize("name", list(KERNEL_INPUTS))
+def test_writing_array_form_is_the_array_form_bit_for_bit(robot, name):
+    kernel = getattr(kernels_of(robot), name)
+    rng = np.random.default_rng(33)
+    Q, QD, QDD = random_states(rng, robot.n, 64)
+    groups = [
+        Q.T,
+        *({"qd": QD.T, "qdd": QDD.T, "wrench": rng.normal(0.0, 20.0, (6, 64))}[g] for g in KERNEL_INPUTS[name]),
+    ]
+    expected = kernel.array(*groups)
+    out = [np.full(64, np.nan) for _ in expected]
+    kernel.into(out, *groups)
+    for j in kernel.written:
+        assert np.array_equal(out[j], np.broadcast_to(expected[j], 64)), f"output {j}"
+    folded = set(range(len(expected))) - set(kernel.written)
+    assert all(isinstance(expected[j], float) and np.isnan(out[j]).all() for j in folded)  # left to the caller
+
+
+def trivial_operations(source: str) -> list[str]:
+    """Multiplications by 0 or +-1 and additions or subtractions of 0 in generated code."""
+
+    def literal(node):
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub):
+            value = literal(node.operand)
+            return None if value is None else -value
+        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)):
+            return node.value
+        return None
+
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.BinOp):
+            operands = [literal(node.left), literal(node.right)]
+            if isinstance(node.op, ast.Mult) and any(v in (0, 1, -1) for v in operands if v is not None):
+                found.append(ast.unparse(node))
+            if isinstance(node.op, (ast.Add, ast.Sub)) and 0 in [v for v in operands if v is not None]:
+                found.append(ast.unparse(node))
+    return found
+
+
+def test_trivial_operation_finder_finds_them():
+    assert trivial_operations("def f(x):\n    return (x * 1.0, 0.0 * x, x * (-1.0), x + 0.0, x * 2.0)\n") == [
+        "x * 1.0",
+        "0.0 * x",
+        "x * -1.0",
+        "x + 0.0",
+    ]
+
+
+def test_irb140_gravity_kernel_has_no_trivial_operations():
+    source = kernels_of(irb140()).gravity_torques.source
+    assert "cos(q1 + 1.5707963267948966)" in source  # theta offset folded into the angle
+    assert trivial_operations(source) == []
+
+
+@pytest.mark.parametrize("kernel", ["rnea", "rnea_wrench", "coriolis", "mass_matrix", "coriolis_matrix"])
+def test_other_irb140_kernels_have_no_trivial_operations(kernel):
+    assert trivial_operations(getattr(kernels_of(loaded_irb140()), kernel).source) == []

@@ -1,0 +1,137 @@
+"""The house's rules on imports (docs/architecture.md): the floors and rooms of .importlinter
+kept, no import cycle at all (imports inside functions count, ``if TYPE_CHECKING:`` ones do
+not), no module of the package loaded by name, and the checks themselves able to fail."""
+
+import ast
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import grimp
+import pytest
+
+from ..support.paths import ROOT
+
+PACKAGE = "irb140_dynamics"
+# importlib used on purpose, and what it loads: never a module of this package.
+IMPORTLIB_ALLOWED = {
+    "irb140_dynamics/ros/recorder.py": "message classes of a recorded topic's type (sensor_msgs.msg, ...)",
+}
+
+
+def lint_imports(root: Path) -> subprocess.CompletedProcess:
+    command = [
+        sys.executable,
+        "-c",
+        "import sys; from importlinter.cli import lint_imports_command as c; c()",
+        "--config",
+        str(root / ".importlinter"),
+        "--no-cache",
+        "--no-logo",
+    ]
+    return subprocess.run(command, cwd=root, capture_output=True, text=True, timeout=120)
+
+
+def import_cycles(root: Path) -> list[list[str]]:
+    """The strongly connected components of more than one module (Tarjan, iterative)."""
+    sys.path.insert(0, str(root))
+    try:
+        graph = grimp.build_graph(PACKAGE, exclude_type_checking_imports=True, cache_dir=None)
+    finally:
+        sys.path.remove(str(root))
+    modules = sorted(graph.modules)
+    edges = {m: sorted(graph.find_modules_directly_imported_by(m)) for m in modules}
+    index, low, on_stack, stack, cycles, counter = {}, {}, set(), [], [], [0]
+    for start in modules:
+        if start in index:
+            continue
+        work = [(start, iter(edges[start]))]
+        index[start] = low[start] = counter[0]
+        counter[0] += 1
+        stack.append(start)
+        on_stack.add(start)
+        while work:
+            node, children = work[-1]
+            child = next(children, None)
+            if child is not None:
+                if child not in index:
+                    index[child] = low[child] = counter[0]
+                    counter[0] += 1
+                    stack.append(child)
+                    on_stack.add(child)
+                    work.append((child, iter(edges[child])))
+                elif child in on_stack:
+                    low[node] = min(low[node], index[child])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[node])
+            if low[node] == index[node]:
+                component = []
+                while True:
+                    member = stack.pop()
+                    on_stack.discard(member)
+                    component.append(member)
+                    if member == node:
+                        break
+                if len(component) > 1:
+                    cycles.append(sorted(component))
+    return cycles
+
+
+def test_the_floors_and_rooms_of_importlinter_are_kept():
+    result = lint_imports(ROOT)
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_no_import_cycles():
+    assert import_cycles(ROOT) == []
+
+
+def test_no_module_of_the_package_is_loaded_by_name():
+    users = {}
+    for path in sorted((ROOT / PACKAGE).rglob("*.py")):
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            named = isinstance(node, ast.Name) and node.id in ("importlib", "__import__")
+            imported = (
+                isinstance(node, (ast.Import, ast.ImportFrom))
+                and any(alias.name.startswith("importlib") for alias in node.names)
+                or isinstance(node, ast.ImportFrom)
+                and (node.module or "").startswith("importlib")
+            )
+            if named or imported:
+                users.setdefault(str(path.relative_to(ROOT)), node.lineno)
+    assert set(users) <= set(IMPORTLIB_ALLOWED), users
+
+
+@pytest.fixture
+def package_copy(tmp_path):
+    shutil.copytree(ROOT / PACKAGE, tmp_path / PACKAGE, ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copy(ROOT / ".importlinter", tmp_path)
+    return tmp_path
+
+
+def test_an_upward_import_breaks_the_floors(package_copy):
+    dynamics = package_copy / PACKAGE / "core" / "dynamics.py"
+    dynamics.write_text(dynamics.read_text() + "\nfrom irb140_dynamics.ros.runtime import spin  # noqa\n")
+    result = lint_imports(package_copy)
+    assert result.returncode != 0
+    assert "BROKEN" in result.stdout
+
+
+def test_a_node_importing_another_node_breaks_the_rules(package_copy):
+    node = package_copy / PACKAGE / "nodes" / "demo_node" / "node.py"
+    node.write_text(
+        node.read_text() + "\n\ndef _upward():\n    from irb140_dynamics.nodes.id_node import settings  # noqa\n"
+    )
+    result = lint_imports(package_copy)
+    assert result.returncode != 0
+    assert "No node imports another node" in result.stdout
+
+
+def test_a_cycle_inside_a_function_is_found(package_copy):
+    model = package_copy / PACKAGE / "core" / "model" / "robot_model.py"
+    model.write_text(model.read_text() + "\n\ndef _late():\n    from irb140_dynamics.core import dynamics  # noqa\n")
+    assert any("irb140_dynamics.core.model.robot_model" in cycle for cycle in import_cycles(package_copy))

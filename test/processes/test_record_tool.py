@@ -1,0 +1,53 @@
+"""record, the bag recorder for installs without rosbag2, as its own process: it waits for
+the topic, takes its type from the graph, adapts to a best-effort publisher, stops after
+--duration, and writes a bag that `identify` reads; an existing bag is refused in one line."""
+
+import sys
+import time
+
+import numpy as np
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import JointState
+
+from irb140_dynamics.identification.recording import Recording
+
+from ..support.node_process import TIMEOUT, run_to_exit, start
+
+NAMES = [f"joint_{i}" for i in range(1, 7)]
+RATE = 200.0  # Hz
+
+
+def record_command(out, *options):
+    return [sys.executable, "-m", "irb140_dynamics.tools.record", "--out", str(out), *options]
+
+
+def test_record_writes_what_was_published_for_the_duration(probe, tmp_path):  # noqa: F811
+    out = tmp_path / "run"
+    process = start(record_command(out, "--duration", "0.5"))
+    best_effort = QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT)
+    publisher = probe.create_publisher(JointState, "joint_states", best_effort)
+    deadline, k = time.monotonic() + TIMEOUT, 0
+    try:
+        while process.poll() is None:
+            assert time.monotonic() < deadline, "record did not stop"
+            msg = JointState(name=NAMES, position=[k * 1e-3] * 6, velocity=[1.0] * 6, effort=[float(k)] * 6)
+            msg.header.stamp.sec, msg.header.stamp.nanosec = 1000 + k // 200, (k % 200) * 5_000_000
+            publisher.publish(msg)
+            k += 1
+            time.sleep(1.0 / RATE)
+        output = process.stdout.read()
+    finally:
+        process.kill()
+    assert process.returncode == 0, output
+    assert "recording /joint_states (sensor_msgs/msg/JointState, best effort)" in output, output
+    chunks = list(Recording(out, NAMES).chunks())
+    effort = np.concatenate([chunk.effort for chunk in chunks])[:, 0]
+    time_ = np.concatenate([chunk.time for chunk in chunks])
+    assert f"wrote {out}: {len(effort)} messages of /joint_states" in output
+    assert 10 < len(effort) < 0.5 * RATE * 1.2  # 0.5 s of a 200 Hz stream (slower when the machine is busy)
+    assert np.all(np.diff(effort) == 1.0)  # every message, in order, none lost
+    np.testing.assert_allclose(np.diff(time_), 0.005, atol=1e-9)  # the header stamps
+    np.testing.assert_allclose(np.concatenate([c.position for c in chunks])[:, 0], effort * 1e-3)
+
+    code, output = run_to_exit(record_command(out))
+    assert code == 1 and "exists already" in output and "Traceback" not in output, output

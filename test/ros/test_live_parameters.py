@@ -1,0 +1,202 @@
+"""Parameter changes: checked whole within the call, built off the executor, the message flow
+never waiting for a build (issue 8, item 2); undeclared names refused by name (item 5)."""
+
+import threading
+
+import numpy as np
+import pytest
+from rcl_interfaces.msg import Parameter as ParameterMsg
+from rcl_interfaces.msg import ParameterValue
+from rcl_interfaces.srv import SetParameters, SetParametersAtomically
+from rclpy.parameter import Parameter
+from sensor_msgs.msg import JointState
+from std_srvs.srv import Trigger
+
+from irb140_dynamics.core import RigidBody, gravity, irb140
+from irb140_dynamics.nodes.id_node import node as id_module
+from irb140_dynamics.nodes.id_node.node import IdNode
+from irb140_dynamics.nodes.payload_check_node import node as payload_module
+from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
+
+from ..support.ros_harness import TIMEOUT, running
+
+NAMES = [f"joint_{i}" for i in range(1, 7)]
+Q = [0.1, -0.8, 1.0, 0.2, 0.5, 0.0]
+
+
+class Gate:
+    """Wraps a function so that, once closed, calls wait until the gate opens again."""
+
+    def __init__(self, function):
+        self.function, self.calls = function, 0
+        self._open = threading.Event()
+        self._open.set()
+
+    def close(self):
+        self._open.clear()
+
+    def open(self):
+        self._open.set()
+
+    def __call__(self, *args, **kwargs):
+        self.calls += 1
+        assert self._open.wait(TIMEOUT), "the gate stayed closed"
+        return self.function(*args, **kwargs)
+
+
+def unsettled_set(harness, params):
+    """SetParameters through the service, not waiting for the change to be in force."""
+    client = harness.parameter_client()
+    return harness.call(lambda: client.set_parameters(params)).results
+
+
+@pytest.fixture
+def gated_id_node(monkeypatch):
+    """id_node whose builds wait at a gate, and are never quick (always off the executor)."""
+    gate = Gate(id_module.finish_settings)
+    monkeypatch.setattr(id_module, "finish_settings", gate)
+    monkeypatch.setattr(id_module, "compiled", lambda *args: False)
+    with running(IdNode) as harness:
+        harness.gate = gate
+        harness.gravity = harness.listen(JointState, "gravity_torques")
+        harness.joint_states = harness.publisher(JointState, "joint_states")
+        yield harness
+        gate.open()
+
+
+def gravity_now(harness):
+    count = len(harness.gravity)
+    harness.joint_states.publish(JointState(name=NAMES, position=Q))
+    assert harness.spin_until(lambda: len(harness.gravity) > count)
+    return harness.gravity[-1].effort
+
+
+def test_messages_flow_while_a_change_is_built(gated_id_node):
+    node = gated_id_node
+    node.gate.close()
+    assert [r.successful for r in unsettled_set(node, [Parameter("payload.mass", value=5.0)])] == [True]
+    assert node.node.parameters.status().startswith("new parameters being applied")
+    for _ in range(3):  # answered meanwhile, by the model before the change
+        np.testing.assert_allclose(gravity_now(node), gravity(irb140(), Q), rtol=1e-12, atol=1e-12)
+    node.gate.open()
+    node.settle()
+    assert node.node.parameters.status() is None
+    np.testing.assert_allclose(gravity_now(node), gravity(irb140(payload=RigidBody(5.0)), Q), rtol=1e-12, atol=1e-12)
+
+
+def test_changes_faster_than_builds_end_with_the_newest(gated_id_node):
+    node = gated_id_node
+    node.gate.close()
+    calls = node.gate.calls
+    for mass in (1.0, 2.0, 3.0, 4.0, 5.0):
+        assert node.node.set_parameters([Parameter("payload.mass", value=mass)])[0].successful
+    node.gate.open()
+    node.settle()
+    assert node.node.settings.model.payload.mass == 5.0
+    assert node.gate.calls - calls <= 2  # the one under way, then the newest
+    np.testing.assert_allclose(gravity_now(node), gravity(irb140(payload=RigidBody(5.0)), Q), rtol=1e-12, atol=1e-12)
+
+
+def test_a_payload_or_gravity_change_is_in_force_when_the_call_returns():
+    """The kernels take the payload and gravity as an argument: nothing to compile."""
+    with running(IdNode) as harness:
+        node = harness.node
+        for change in ([Parameter("payload.mass", value=3.0)], [Parameter("gravity", value=[0.0, 0.0, -9.80665])]):
+            assert node.set_parameters(change)[0].successful
+            assert node.parameters.pending_since is None
+        expected = irb140(payload=RigidBody(3.0)).with_gravity((0.0, 0.0, -9.80665))
+        assert node.settings.model == expected
+
+
+@pytest.fixture
+def gated_payload_node(monkeypatch):
+    gate = Gate(payload_module.workspace_load)
+    monkeypatch.setattr(payload_module, "workspace_load", gate)
+    overrides = [Parameter("diagnostics.period", value=0.0)]
+    with running(PayloadCheckNode, parameter_overrides=overrides) as harness:
+        harness.gate = gate
+        harness.client = harness.probe.create_client(Trigger, "/payload_check_node/check")
+        assert harness.client.wait_for_service(timeout_sec=TIMEOUT)
+        yield harness
+        gate.open()
+
+
+def check(harness):
+    return harness.call(lambda: harness.client.call_async(Trigger.Request()))
+
+
+def test_check_answers_pending_at_once_while_the_analysis_runs(gated_payload_node):
+    node = gated_payload_node
+    node.gate.close()
+    assert [r.successful for r in unsettled_set(node, [Parameter("payload.mass", value=7.0)])] == [True]
+    reply = check(node)
+    assert not reply.success
+    assert reply.message.startswith("pending: the limits and workspace analysis of the new parameters are running")
+    node.gate.open()
+    node.settle()
+    reply = check(node)
+    assert not reply.success and reply.message.startswith("payload 7.000 kg at (0.000, 0.000, 0.000) m: OVER THE LIMIT")
+
+
+def test_a_payload_change_reuses_the_limits_and_a_warn_use_change_the_analysis(gated_payload_node, monkeypatch):
+    node = gated_payload_node
+    derived = Gate(payload_module.derive_torque_limits)
+    monkeypatch.setattr(payload_module, "derive_torque_limits", derived)
+    limits = node.node.settings.limits
+    assert [r.successful for r in node.set_parameters([Parameter("payload.mass", value=2.0)])] == [True]
+    assert derived.calls == 0 and node.node.settings.limits is limits
+    sweeps, workspace = node.gate.calls, node.node.settings.workspace
+    assert node.node.set_parameters([Parameter("diagnostics.warn_use", value=50.0)])[0].successful
+    assert node.node.parameters.pending_since is None  # in force at once: nothing to analyse
+    assert node.node.settings.warn_use == 50.0 and node.node.settings.workspace is workspace
+    assert node.gate.calls == sweeps
+
+
+def test_a_slow_first_analysis_does_not_hold_up_startup(monkeypatch):
+    gate = Gate(payload_module.workspace_load)
+    gate.close()
+    monkeypatch.setattr(payload_module, "workspace_load", gate)
+    monkeypatch.setattr(payload_module, "STARTUP_WAIT", 0.2)
+    overrides = [Parameter("diagnostics.period", value=0.0)]
+    with running(PayloadCheckNode, parameter_overrides=overrides) as harness:
+        try:
+            assert harness.node.settings is None
+            client = harness.probe.create_client(Trigger, "/payload_check_node/check")
+            assert client.wait_for_service(timeout_sec=TIMEOUT)
+            reply = harness.call(lambda: client.call_async(Trigger.Request()))
+            assert not reply.success and reply.message.startswith("pending:")
+        finally:
+            gate.open()
+        harness.settle()
+        assert harness.call(lambda: client.call_async(Trigger.Request())).success
+
+
+@pytest.mark.parametrize("make_node", [IdNode, PayloadCheckNode])
+def test_undeclared_and_empty_names_are_refused_by_name(make_node):
+    with running(make_node) as harness:
+        for name in ("", "payload.mas"):
+            [result] = harness.set_parameters([Parameter(name, value=1.0)])
+            assert not result.successful and repr(name) in result.reason, result.reason
+        result = harness.set_parameters_atomically([Parameter("payload.mass", value=1.0), Parameter("", value=1.0)])
+        assert not result.successful and "['']" in result.reason
+        client = harness.parameter_client()
+        names = harness.call(lambda: client.list_parameters([], 0)).result.names
+        assert "" not in names and "payload.mas" not in names
+        assert harness.node.get_parameter("payload.mass").value == 0.0
+
+
+def test_a_parameter_of_no_known_type_is_refused_and_the_node_goes_on():
+    """rclpy itself raises on it inside the service callback, which would end the node."""
+    with running(IdNode) as harness:
+        bad = ParameterMsg(name="payload.mass", value=ParameterValue(type=99))
+        good = Parameter("payload.mass", value=2.0).to_parameter_msg()
+        client = harness.probe.create_client(SetParameters, "/id_node/set_parameters")
+        atomic = harness.probe.create_client(SetParametersAtomically, "/id_node/set_parameters_atomically")
+        assert client.wait_for_service(TIMEOUT) and atomic.wait_for_service(TIMEOUT)
+        results = harness.call(lambda: client.call_async(SetParameters.Request(parameters=[bad, good]))).results
+        assert [r.successful for r in results] == [False, True]
+        assert results[0].reason == "'payload.mass': 99 is not a parameter type"
+        result = harness.call(lambda: atomic.call_async(SetParametersAtomically.Request(parameters=[good, bad]))).result
+        assert not result.successful
+        harness.settle()
+        assert harness.node.settings.model.payload.mass == 2.0

@@ -1,0 +1,230 @@
+"""sim_node in-process with real rclpy and DDS: commands in, states out, hold and timeout,
+reset, noise, bad commands, parameters."""
+
+import time
+
+import numpy as np
+import pytest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from rclpy.parameter import Parameter
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Trigger
+
+from irb140_dynamics.core import RigidBody, gravity, irb140
+from irb140_dynamics.nodes.sim_node import node as sim_node
+from irb140_dynamics.nodes.sim_node.node import SimNode
+
+from ..support.ros_harness import running
+
+NAMES = [f"joint_{i}" for i in range(1, 7)]
+POSE = [0.0, -0.5, 0.5, 0.0, 0.5, 0.0]  # rad: without torques the arm falls from here
+COMMAND = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]  # N m
+
+
+def make(**parameters):
+    overrides = {"initial_positions": POSE, "command_timeout": 0.0, **parameters}
+    return [Parameter(name, value=value) for name, value in overrides.items()]
+
+
+@pytest.fixture
+def sim(request):
+    with running(SimNode, parameter_overrides=make(**getattr(request, "param", {}))) as harness:
+        harness.states = harness.listen(JointState, "joint_states", 1000)
+        harness.commands = harness.publisher(Float64MultiArray, "effort_commands")
+        yield harness
+
+
+def command(sim, tau):
+    sim.commands.publish(Float64MultiArray(data=[float(x) for x in tau]))
+
+
+def states_after(sim, count: int):
+    """The next ``count`` joint states."""
+    start = len(sim.states)
+    assert sim.spin_until(lambda: len(sim.states) >= start + count), "joint_states stopped"
+    return sim.states[start : start + count]
+
+
+def wait_for_effort(sim, tau, timeout=10.0):
+    assert sim.spin_until(lambda: sim.states and np.array_equal(sim.states[-1].effort, tau), timeout), (
+        f"effort never became {list(tau)}"
+    )
+
+
+def stamp(msg) -> int:
+    """ns"""
+    return msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+
+
+def states_after_reset(sim, count: int):
+    """Reset the arm, and the first ``count`` joint states after it."""
+    sim.node.reset()
+    reset_at = sim.node.reset_stamp
+    assert sim.spin_until(lambda: sum(stamp(msg) > reset_at for msg in sim.states[-count:]) == count)
+    return sim.states[-count:]
+
+
+def test_states_are_named_stamped_every_period_and_the_arm_falls_without_torque(sim):
+    states = states_after(sim, 300)
+    assert all(msg.name == NAMES for msg in states)
+    steps = np.diff([stamp(msg) for msg in states]) / 1_000_000  # ms: the probe may miss some under load
+    assert steps.min() >= 1 and np.abs(steps - np.round(steps)).max() < 1e-6  # 1 kHz in stamps
+    assert all(not np.any(msg.effort) for msg in states)
+    position = np.array([msg.position for msg in states])
+    assert abs(position[-1, 1] - position[0, 1]) > 1e-3  # joint 2 falls
+
+
+def test_a_gravity_command_is_applied_and_held(sim):
+    g = gravity(irb140(), POSE)
+    command(sim, g)
+    wait_for_effort(sim, g)
+    states = states_after_reset(sim, 500)
+    position = np.array([msg.position for msg in states])
+    assert np.abs(position - POSE).max() < 1e-6  # held exactly: the engine's gravity is ours
+    assert all(np.array_equal(msg.effort, g) for msg in states)  # one command, held
+
+
+@pytest.mark.parametrize("sim", [{"command_timeout": 0.2}], indirect=True)
+def test_a_command_older_than_the_timeout_gives_zero_torque(sim):
+    command(sim, COMMAND)
+    wait_for_effort(sim, COMMAND)
+    applied = [msg for msg in sim.states if np.array_equal(msg.effort, COMMAND)]
+    wait_for_effort(sim, np.zeros(6), timeout=3.0)
+    held = stamp(sim.states[-1]) - stamp(applied[0])
+    assert 0.15e9 < held < 1e9
+    assert sim.node.counts["command_timeouts"] == 1
+    command(sim, COMMAND)  # a fresh command applies again
+    wait_for_effort(sim, COMMAND)
+
+
+def test_bad_commands_are_dropped_counted_and_never_applied(sim):
+    diagnostics = sim.listen(DiagnosticArray, "/diagnostics")
+    command(sim, COMMAND)
+    wait_for_effort(sim, COMMAND)
+    for bad in (COMMAND[:5], COMMAND + [7.0], [np.nan] + COMMAND[1:], COMMAND[:5] + [np.inf]):
+        command(sim, bad)
+    assert sim.spin_until(lambda: sim.node.counts["effort_commands.dropped"] == 4)
+    assert all(np.array_equal(msg.effort, COMMAND) for msg in states_after(sim, 100))
+    counts = sim.node.counts
+    assert counts["effort_commands.dropped_length_mismatch"] == 2 and counts["effort_commands.dropped_not_finite"] == 2
+    assert sim.spin_until(
+        lambda: any(
+            s.level == DiagnosticStatus.WARN and "dropped" in s.message for msg in diagnostics for s in msg.status
+        ),
+        timeout=3.0,
+    )
+
+
+def test_no_exception_leaves_a_callback(sim, monkeypatch):
+    """A defect of ours in a callback (here: made to raise) is counted per topic and warned
+    about; the node goes on, and a service answers that it failed."""
+    diagnostics = sim.listen(DiagnosticArray, "/diagnostics")
+
+    def broken(msg, n):
+        raise RuntimeError("a defect")
+
+    monkeypatch.setattr(sim_node, "read_command", broken)
+    command(sim, COMMAND)
+    assert sim.spin_until(lambda: sim.node.counts["effort_commands.errors"] >= 1)
+    monkeypatch.undo()
+    command(sim, COMMAND)
+    wait_for_effort(sim, COMMAND)  # commands apply again
+    monkeypatch.setattr(sim.node, "reset", lambda: 1 / 0)
+    client = sim.probe.create_client(Trigger, "/sim_node/reset")
+    assert client.wait_for_service(timeout_sec=10.0)
+    reply = sim.call(lambda: client.call_async(Trigger.Request()))
+    assert not reply.success and reply.message == "reset failed: division by zero"
+    assert sim.node.counts["reset.errors"] == 1
+    assert sim.spin_until(
+        lambda: any(
+            s.level == DiagnosticStatus.WARN and "callbacks failed" in s.message
+            for msg in diagnostics
+            for s in msg.status
+        ),
+        timeout=3.0,
+    )
+    states_after(sim, 50)  # still stepping
+
+
+def test_diagnostics_warn_when_real_time_is_lost(sim):
+    diagnostics = sim.listen(DiagnosticArray, "/diagnostics")
+    with sim.node._lock:  # the stepping thread waits: its steps fall behind
+        time.sleep(0.2)
+    assert sim.spin_until(
+        lambda: any(
+            s.level == DiagnosticStatus.WARN and "cannot keep real time" in s.message
+            for msg in diagnostics
+            for s in msg.status
+        ),
+        timeout=3.0,
+    )
+    assert sim.node.schedule.skipped > 0
+
+
+def test_a_blow_up_resets_the_arm_and_the_node_goes_on(sim):
+    command(sim, [0.0, 0.0, 0.0, 0.0, 0.0, 1e14])
+    assert sim.spin_until(lambda: sim.node.counts["diverged"] > 0)
+    command(sim, np.zeros(6))
+    states_after(sim, 50)
+    assert np.isfinite(sim.states[-1].position).all()
+
+
+@pytest.mark.parametrize("sim", [{"reset_hold": 0.3}], indirect=True)
+def test_reset_puts_the_arm_back_and_holds_it(sim):
+    states_after(sim, 400)  # after the first hold, the arm has fallen
+    assert abs(sim.states[-1].position[1] - POSE[1]) > 1e-3
+    client = sim.probe.create_client(Trigger, "/sim_node/reset")
+    assert client.wait_for_service(timeout_sec=10.0)
+    reply = sim.call(lambda: client.call_async(Trigger.Request()))
+    assert reply.success and "reset" in reply.message
+    held = states_after(sim, 150)
+    held = held[next(i for i, msg in enumerate(held) if msg.position.tolist() == POSE) :]  # from the reset on
+    assert len(held) > 50
+    assert all(msg.position.tolist() == POSE and not np.any(msg.velocity) and not np.any(msg.effort) for msg in held)
+    assert sim.spin_until(lambda: sim.states[-1].position[1] < POSE[1] - 1e-3, timeout=3.0)  # released
+
+
+@pytest.mark.parametrize("sim", [{"reset_hold": 100.0, "noise.position": 0.01, "noise.effort": 2.0}], indirect=True)
+def test_noise_on_positions_and_efforts(sim):
+    states = states_after(sim, 400)
+    position = np.array([msg.position for msg in states]) - POSE
+    effort = np.array([msg.effort for msg in states])
+    assert 0.008 < position.std() < 0.012 and abs(position.mean()) < 0.002
+    assert 1.6 < effort.std() < 2.4
+    assert sim.node.arm.q.tolist() == POSE  # the noise is on the messages, not the arm
+    assert not np.any(np.array([msg.velocity for msg in states]))
+
+
+def test_runtime_changes_apply_and_bad_ones_are_refused(sim):
+    g = gravity(irb140(payload=RigidBody(5.0)), POSE)
+    results = sim.set_parameters([Parameter("payload.mass", value=5.0)])
+    assert [r.successful for r in results] == [True]
+    assert sim.node.arm.model.payload.mass == 5.0
+    command(sim, g)
+    wait_for_effort(sim, g)
+    position = np.array([msg.position for msg in states_after_reset(sim, 200)])
+    assert np.abs(position - POSE).max() < 1e-6  # the new payload is simulated
+    for name, value, reason in [
+        ("initial_positions", [0.0] * 5, "expected 6 values"),
+        ("initial_positions", [0.0, -3.0, 0.0, 0.0, 0.0, 0.0], "joint_2 at -3.0 rad is outside"),
+        ("payload.mass", -1.0, "payload.mass"),
+        ("rate", 10.0, "read-only"),
+    ]:
+        result = sim.set_parameters([Parameter(name, value=value)])[0]
+        assert not result.successful and reason in result.reason, (name, result.reason)
+    assert sim.node.arm.model.payload.mass == 5.0
+
+
+@pytest.mark.parametrize(
+    "overrides, field",
+    [
+        ({"initial_positions": [0.0] * 3}, "initial_positions"),
+        ({"integrator": "leapfrog"}, "integrator"),
+        ({"substeps": 0}, "substeps"),
+        ({"thread_priority": 100}, "thread_priority"),
+    ],
+)
+def test_a_bad_start_is_one_clear_error(overrides, field):
+    with pytest.raises(ValueError, match=field), running(SimNode, parameter_overrides=make(**overrides)):
+        pass

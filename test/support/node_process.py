@@ -1,0 +1,81 @@
+"""Run a node as its own process, the way `ros2 run` would, with a time limit."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+from .paths import ROOT
+
+TIMEOUT = 30.0  # s, a process start included
+
+
+def start(command: list[str], env: dict | None = None) -> subprocess.Popen:
+    environment = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONUNBUFFERED": "1", **(env or {})}
+    return subprocess.Popen(command, env=environment, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+
+def module_command(module: str, *ros_args: str) -> list[str]:
+    command = [sys.executable, "-m", module]
+    return command + ["--ros-args", *ros_args] if ros_args else command
+
+
+def run_to_exit(command: list[str], env: dict | None = None, timeout: float = 60.0) -> tuple[int, str]:
+    """(exit code, output) of a node that is expected to stop by itself."""
+    process = start(command, env)
+    try:
+        output, _ = process.communicate(timeout=timeout)
+    finally:
+        process.kill()
+    return process.returncode, output
+
+
+def wait_for_line(process: subprocess.Popen, text: str, lines: list[str], timeout: float = 60.0) -> bool:
+    """Read the process's output into ``lines`` until a line with ``text`` (True), or the
+    process ends or ``timeout`` passes (False)."""
+    deadline = time.monotonic() + timeout
+    os.set_blocking(process.stdout.fileno(), False)
+    while time.monotonic() < deadline:
+        line = process.stdout.readline()
+        if line:
+            lines.append(line)
+            if text in line:
+                return True
+        elif process.poll() is not None:
+            return False
+        else:
+            time.sleep(0.05)
+    return False
+
+
+def interrupt(process: subprocess.Popen, lines: list[str] | None = None, timeout: float = 20.0) -> tuple[int, str]:
+    """Stop a process with Ctrl-C: (exit code, its output, after ``lines`` read before)."""
+    try:
+        process.send_signal(signal.SIGINT)
+        rest, _ = process.communicate(timeout=timeout)
+    finally:
+        process.kill()
+    return process.returncode, "".join(lines or []) + (rest or "")
+
+
+def run_until_ready(command: list[str], env: dict | None = None, timeout: float = 60.0) -> tuple[int, str]:
+    """Start a node, wait for its 'ready' line, stop it with Ctrl-C: (exit code, output)."""
+    process = start(command, env)
+    lines = []
+    try:
+        wait_for_line(process, "ready", lines, timeout)
+    finally:
+        code, output = interrupt(process, lines)
+    return code, output
+
+
+def one_fatal_line(code: int, output: str) -> str:
+    """The one [FATAL] line of a node that refused to start (exit 1, no traceback)."""
+    assert code == 1, output
+    assert "Traceback" not in output, output
+    fatal = [line for line in output.splitlines() if "[FATAL]" in line]
+    assert len(fatal) == 1, output
+    return fatal[0]

@@ -1,0 +1,284 @@
+"""The whole workflow on a synthetic arm: excitation, a recorded bag, identify, the nodes load it.
+
+The 'true' arm (``synthetic_arm``) follows the trajectory the `excitation` command wrote;
+its torques, with 1 % noise and 1e-5 rad position quantisation, are recorded as an .mcap
+bag; `identify` must give a held-out RMS torque error of at most 2 % of each joint's peak,
+every base parameter within 3 sigma of the truth, a physically consistent arm, and a
+parameter file id_node and payload_check_node start on.
+"""
+
+import contextlib
+import io
+import re
+
+import numpy as np
+import pytest
+import yaml
+from rosbags.typesys import Stores, get_typestore
+
+from irb140_dynamics.core import RobotModel, irb140, rnea, rnea_batch
+from irb140_dynamics.core.io.params_file import read_parameter_file
+from irb140_dynamics.core.regressor import inertial_parameters
+from irb140_dynamics.identification.base import find_base_parameters
+from irb140_dynamics.identification.consistent import is_consistent
+from irb140_dynamics.tools import excitation as excitation_tool
+from irb140_dynamics.tools import identify as identify_tool
+
+from ..support.synthetic_arm import Samples, joint_state_messages, true_arm, write_bag, write_csv
+
+RATE, PERIOD, PERIODS = 250.0, 4.0, 3  # 12 s of data, 3000 messages
+NAMES = irb140().joint_names
+
+
+def load_trajectory(path):
+    document = yaml.load(path.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    points = document["points"]
+    t = np.array([p["time_from_start"]["sec"] + 1e-9 * p["time_from_start"]["nanosec"] for p in points])
+    return (
+        document,
+        t,
+        *(np.array([p[field] for p in points]) for field in ("positions", "velocities", "accelerations")),
+    )
+
+
+@pytest.fixture(scope="module")
+def workflow(tmp_path_factory):
+    """excitation -> the true arm along it -> .mcap bag -> identify, run as the commands."""
+    work = tmp_path_factory.mktemp("identify")
+    trajectory_file = work / "excitation.yaml"
+    assert (
+        excitation_tool.main(
+            [
+                "--out",
+                str(trajectory_file),
+                "--period",
+                str(PERIOD),
+                "--harmonics",
+                "4",
+                "--periods",
+                str(PERIODS),
+                "--rate",
+                str(RATE),
+                "--iterations",
+                "3",
+                "--seed",
+                "2",
+            ]
+        )
+        == 0
+    )
+    document, t, Q, QD, QDD = load_trajectory(trajectory_file)
+    arm = true_arm(3)
+    tau = rnea_batch(arm, Q, QD, QDD)
+    peak = np.abs(tau).max(axis=0)
+    # With 52 base parameters, about 1 noise draw in 8 puts one beyond 3 sigma however honest
+    # the sigmas (1 - 0.9973^52); this seed's draw is a typical one (rms z ~ 1, max 2.6).
+    measured = tau + np.random.default_rng(5).normal(size=tau.shape) * 0.01 * peak
+    samples = Samples(t, np.round(Q / 1e-5) * 1e-5, QD, measured, tau)
+    typestore = get_typestore(Stores.ROS2_JAZZY)
+    bag = write_bag(work / "bag", joint_state_messages(samples, NAMES, with_velocity=False, typestore=typestore))
+    out, plots = work / "identified.yaml", work / "plots"
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        status = identify_tool.main([str(bag), "--out", str(out), "--plots", str(plots), "--quiet"])
+    return dict(
+        work=work,
+        trajectory=trajectory_file,
+        document=document,
+        samples=samples,
+        arm=arm,
+        QDD=QDD,
+        bag=bag,
+        out=out,
+        plots=plots,
+        status=status,
+        printed=printed.getvalue(),
+    )
+
+
+@pytest.fixture(scope="module")
+def identified(workflow):
+    assert workflow["status"] == 0
+    return RobotModel.from_params(read_parameter_file(workflow["out"]))
+
+
+def held_out(workflow):
+    """The last 20 % of the samples."""
+    samples = workflow["samples"]
+    k = int(0.8 * len(samples.time))
+    return samples.position[k:], samples.velocity[k:], workflow["QDD"][k:], samples.effort[k:], samples.true_effort[k:]
+
+
+def test_the_excitation_file_is_a_trajectory_within_the_limits(workflow):
+    text = workflow["trajectory"].read_text()
+    condition = float(re.search(r"# condition number of the base regressor: ([\d.]+)", text).group(1))
+    assert 1.0 < condition < 1000.0
+    document = workflow["document"]
+    assert document["joint_names"] == list(NAMES) and len(document["points"]) == RATE * PERIOD * PERIODS + 1
+    _, t, Q, QD, QDD = load_trajectory(workflow["trajectory"])
+    for j, joint in enumerate(irb140().joints):
+        lower, upper = joint.position_limits
+        assert lower <= Q[:, j].min() and Q[:, j].max() <= upper
+        assert np.abs(QD[:, j]).max() <= joint.velocity_limit and np.abs(QDD[:, j]).max() <= joint.acceleration_limit
+    np.testing.assert_allclose(QD[0], 0.0, atol=1e-12)  # starts at rest
+    np.testing.assert_allclose(Q[-1], Q[0], atol=1e-9)  # and comes back
+
+
+def test_identified_torques_within_2_percent_of_peak_on_held_out_data(workflow, identified):
+    q, qd, qdd, measured, true = held_out(workflow)
+    peak = np.abs(measured).max(axis=0)
+    for model, bound in ((identified, 0.02), (workflow["arm"], 0.02)):
+        error = np.sqrt(np.mean((rnea_batch(model, q, qd, qdd) - measured) ** 2, axis=0)) / peak
+        assert np.all(error <= bound), error
+    # against the noise-free torques: the model's own error, well below the noise
+    assert np.all(np.sqrt(np.mean((rnea_batch(identified, q, qd, qdd) - true) ** 2, axis=0)) / peak < 0.006)
+    # the report's model on the same data: 8 % to 70 % of peak
+    prior_error = np.sqrt(np.mean((rnea_batch(irb140(), q, qd, qdd) - measured) ** 2, axis=0)) / peak
+    assert np.all(prior_error > 0.05), prior_error
+
+
+def test_summary_reports_counts_errors_and_consistency(workflow):
+    printed = workflow["printed"]
+    assert workflow["status"] == 0, printed
+    assert f"{workflow['bag']}: 3,001 samples read, " in printed
+    used, left_out, edges = (
+        int(x.replace(",", ""))
+        for x in re.search(
+            r"samples read, ([\d,]+) used, ([\d,]+) left out \(0 without effort \(or another value\), ([\d,]+) at gaps",
+            printed,
+        ).groups()
+    )
+    assert used + left_out == 3001 and left_out == edges > 0
+    assert "torque rows too slow for Coulomb friction, left out: joint_1 " in printed
+    assert "base parameters: 52 of 78; condition number of the base regressor: " in printed
+    assert "held out: the last 20 % of the recording" in printed
+    table = re.findall(r"^(joint_\d) +(\S+) +(\S+) +\((\S+) %\) +(\S+) +\((\S+) %\)$", printed, flags=re.M)
+    assert [row[0] for row in table] == list(NAMES)
+    for _name, peak, _prior, prior_percent, identified, identified_percent in table:
+        assert float(identified_percent) <= 2.0 and float(prior_percent) > 5.0
+        assert float(identified) == pytest.approx(float(identified_percent) / 100 * float(peak), rel=0.01, abs=1e-3)
+    assert "physically consistent: yes" in printed and "the data agree with a physical arm" in printed
+    assert f"wrote {workflow['out']}" in printed
+
+
+def test_base_parameters_within_3_sigma_of_the_truth(workflow):
+    text = workflow["out"].read_text()
+    rows = re.findall(r"^# b(\d+) = +(\S+) \+- (\S+): ", text, flags=re.M)
+    base = find_base_parameters(irb140())
+    assert [int(r[0]) for r in rows] == list(range(1, base.count + 1))
+    estimate, std = np.array([[float(r[1]), float(r[2])] for r in rows]).T
+    z = (estimate - base.of(inertial_parameters(workflow["arm"]))) / std
+    assert np.abs(z).max() <= 3.0, dict(zip(base.labels(), z.round(2)))
+    assert 0.6 < np.sqrt(np.mean(z**2)) < 1.5  # the standard deviations are honest, not inflated
+
+
+def test_identified_model_is_physically_consistent(workflow, identified):
+    assert is_consistent(inertial_parameters(identified), identified.n)
+    assert "# physically consistent: yes" in workflow["out"].read_text()
+    prior = irb140()
+    for mine, theirs in zip(identified.joints, prior.joints):  # kinematics and limits are the prior's
+        assert (mine.dh, mine.position_limits, mine.velocity_limit) == (
+            theirs.dh,
+            theirs.position_limits,
+            theirs.velocity_limit,
+        )
+
+
+def test_plots_are_written(workflow):
+    for name in ("torques.png", "residuals.png"):
+        assert (workflow["plots"] / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.ros
+def test_id_node_publishes_the_identified_torques(workflow, identified):
+    from sensor_msgs.msg import JointState
+
+    from irb140_dynamics.nodes.id_node.node import IdNode
+
+    from ..support.ros_harness import running
+
+    args = ["--ros-args", "--params-file", str(workflow["out"])]
+    with running(IdNode, cli_args=args) as harness:
+        feedforward = harness.listen(JointState, "feedforward_torques")
+        publisher = harness.publisher(JointState, "joint_states")
+        samples = workflow["samples"]
+        for k in (2500, 2700, 2900):
+            q, qd = samples.position[k], samples.velocity[k]
+            publisher.publish(JointState(name=list(NAMES), position=q.tolist(), velocity=qd.tolist()))
+            assert harness.spin_until(lambda: len(feedforward) > 0)
+            torque = np.array(feedforward.pop().effort)
+            np.testing.assert_allclose(torque, rnea(identified, q, qd, np.zeros(6)), rtol=1e-9, atol=1e-9)
+            truth = rnea(workflow["arm"], q, qd, np.zeros(6))
+            assert np.all(np.abs(torque - truth) <= 0.02 * np.abs(samples.true_effort).max(axis=0))
+
+
+@pytest.mark.ros
+def test_payload_check_node_starts_on_the_identified_file(workflow, identified):
+    from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
+
+    from ..support.ros_harness import running
+
+    with running(PayloadCheckNode, cli_args=["--ros-args", "--params-file", str(workflow["out"])]) as harness:
+        for name in ("joint_2.link.mass", "joint_4.friction.coulomb", "joint_6.armature"):
+            assert harness.node.get_parameter(name).value == identified.to_params()[name]
+
+
+def test_validation_on_a_second_recording(workflow, tmp_path, capsys):
+    samples = workflow["samples"]
+    half = slice(len(samples.time) // 2, None)  # another recording: a CSV of the second half, with velocities
+    second = Samples(
+        samples.time[half],
+        samples.position[half],
+        samples.velocity[half],
+        samples.effort[half],
+        samples.true_effort[half],
+    )
+    csv = write_csv(tmp_path / "second.csv", second, NAMES, with_velocity=True)
+    status = identify_tool.main(
+        [str(workflow["bag"]), "--validate", str(csv), "--out", str(tmp_path / "o.yaml"), "--quiet"]
+    )
+    out = capsys.readouterr().out
+    assert status == 0, out
+    assert f"held out: {csv}" in out and "qd from measured velocities" in out
+    table = re.findall(r"^joint_\d +\S+ +\S+ +\((\S+) %\) +\S+ +\((\S+) %\)$", out, flags=re.M)
+    assert len(table) == 6 and all(float(identified) <= 2.0 < float(prior) for prior, identified in table), out
+
+
+@pytest.mark.parametrize(
+    "args, problem",
+    [
+        (["missing.mcap", "--out", "{tmp}/o.yaml"], "missing.mcap: no such file or directory"),
+        (["{bag}", "--out", "{tmp}/o.yaml", "--topic", "/other"], "no topic /other"),
+        (["{bag}", "--out", "{tmp}/o.yaml", "--params-file", "{tmp}/none.yaml"], "none.yaml: no such parameter file"),
+        (["{bag}", "--out", "{tmp}/o.yaml", "--params-file", "{bad}"], "joint_2.link.mass: must be >= 0"),
+    ],
+)
+def test_identify_errors_are_one_line_and_write_nothing(workflow, tmp_path, capsys, args, problem):
+    bad = tmp_path / "bad.yaml"
+    text = workflow["out"].read_text()
+    mass = re.search(r"    joint_2:\n(?:.*\n)*?        mass: (\S+)\n", text).group(1)  # joint_2's link mass
+    bad.write_text(text.replace(f"mass: {mass}", "mass: -1.0", 1))
+    args = [a.format(tmp=tmp_path, bag=workflow["bag"], bad=bad) for a in args]
+    assert identify_tool.main(args + ["--quiet"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("identify: error: ") and problem in err[0], err
+    assert not (tmp_path / "o.yaml").exists()
+
+
+def test_excitation_refuses_bad_options(tmp_path, capsys):
+    assert excitation_tool.main(["--out", str(tmp_path / "t.yaml"), "--rate", "0"]) == 1
+    assert "excitation: error: --rate must be > 0" in capsys.readouterr().err
+    assert not (tmp_path / "t.yaml").exists()
+
+
+def test_progress_bar_ends_at_100_percent_on_its_own_line():
+    from irb140_dynamics.tools.common import ProgressBar
+
+    stream = io.StringIO()
+    bar = ProgressBar(stream, interval=3600.0)
+    for done in (0, 400, 700, 1000):
+        bar("/data/run.mcap", done, 1000)
+    frames = stream.getvalue().split("\r")[1:]
+    assert len(frames) == 2  # the first and the last: the others fall within the interval
+    assert frames[0].startswith("reading run.mcap: [") and " 0 % 0/1,000 samples" in frames[0]
+    assert "[" + "#" * 30 + "] 100 % 1,000/1,000 samples" in frames[1] and frames[1].endswith("\n")
