@@ -7,12 +7,13 @@ Launch arguments (all with defaults):
   payload_com     m, in the flange frame (default [0.0, 0.0, 0.0])
 """
 
-from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
 from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
 from launch_ros.actions import Node
 from launch_ros.parameter_descriptions import ParameterValue
 from launch_ros.substitutions import FindPackageShare
+
+from launch import LaunchDescription
 
 PACKAGE = "irb140_dynamics"
 

@@ -11,12 +11,13 @@ Launch arguments (all with defaults):
   duration        s, demo_node stops after this long; 0 = until Ctrl-C (default 0.0)
 """
 
-from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
 from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
 from launch_ros.actions import Node
 from launch_ros.parameter_descriptions import ParameterValue
 from launch_ros.substitutions import FindPackageShare
+
+from launch import LaunchDescription
 
 PACKAGE = "irb140_dynamics"
 START = [0.0, -0.6, 1.0, 0.0, 0.5, 0.0]  # rad: where demo_node's motion starts and ends

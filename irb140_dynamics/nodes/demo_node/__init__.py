@@ -1,1 +1,8 @@
 """demo_node: a first look at the closed loop (a reference motion, the tracking error)."""
+
+from irb140_dynamics.nodes import start
+
+
+def main() -> None:
+    """The console script ``demo_node`` (``ros2 run irb140_dynamics demo_node``)."""
+    start("irb140_dynamics.nodes.demo_node.node")

@@ -42,6 +42,7 @@ class LoadedUrdf:
     base_link: str
     tip_link: str
     held_joints: tuple[str, ...]  # moving joints off the chain, held at zero, bodies lumped
+    robot_name: str = ""  # <robot name="...">: the hardware_id of the nodes' /diagnostics
 
 
 def load_urdf(text: str, base_link: str | None = None, tip_link: str | None = None) -> LoadedUrdf:
@@ -85,7 +86,7 @@ def load_urdf(text: str, base_link: str | None = None, tip_link: str | None = No
         model = RobotModel(tuple(joints), flange=since_last)
     except ModelError as error:
         raise UrdfError("chain", str(error)) from None
-    return LoadedUrdf(model, base, tip, tuple(held))
+    return LoadedUrdf(model, base, tip, tuple(held), tree.name)
 
 
 def compose(a: Placement, b: Placement) -> Placement:

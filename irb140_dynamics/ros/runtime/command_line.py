@@ -11,9 +11,13 @@ default in force without a word: it is refused, with the line to type instead.
 from __future__ import annotations
 
 import math
+import os
+import stat
 import textwrap
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any, Iterable
+from pathlib import Path
+from typing import Any
 
 ROS_ARGS = "--ros-args"
 HELP = ("-h", "--help")
@@ -37,7 +41,7 @@ class Usage:
             f"usage: {self.name} [-h] [--ros-args [--params-file FILE] [-p NAME:=VALUE] ...]",
             f"       ros2 run irb140_dynamics {self.name} --ros-args -p NAME:=VALUE",
             "",
-            *textwrap.wrap(self.summary, 92),
+            self.summary.strip(),
             "",
             "Parameters are given after --ros-args: -p NAME:=VALUE, or --params-file FILE (YAML, as",
             "config/irb140.yaml); most can be changed while running (ros2 param set), each change",
@@ -53,20 +57,21 @@ class Usage:
 
 
 def describe_spec(spec) -> list[str]:
-    """Two or more lines for one parameter: name (type, default, range), then its description."""
+    """Two or more lines for one parameter: name (type, default, range, unit), then its description."""
+    unit = f" {spec.unit}" if spec.unit else ""
     facts = [type_name(spec.default)]
     default = default_text(spec.default)
     if default is not None:
-        facts.append(f"default {default}")
+        facts.append(f"default {default}{unit}")
     bounds = range_text(spec)
     if bounds:
-        facts.append(bounds)
+        facts.append(f"{bounds}{unit}")
+    elif unit and default is None:
+        facts.append(unit.strip())
     if spec.read_only:
         facts.append("read-only: set at startup")
-    unit = f" [{spec.unit}]" if spec.unit else ""
-    head = f"  {spec.name} ({', '.join(facts)})"
-    body = textwrap.wrap(spec.description + unit, 88, initial_indent="      ", subsequent_indent="      ")
-    return [head, *body]
+    body = textwrap.wrap(spec.description, 88, initial_indent="      ", subsequent_indent="      ")
+    return [f"  {spec.name} ({', '.join(facts)})", *body]
 
 
 def type_name(default: Any) -> str:
@@ -105,10 +110,9 @@ def range_text(spec) -> str:
     low, high = getattr(spec, "minimum", None), getattr(spec, "maximum", None)
     if low is None and high is None:
         return ""
-    unit = f" {spec.unit}" if spec.unit else ""
     low = "-inf" if low is None or math.isinf(low) else f"{low:g}"
     high = "inf" if high is None or math.isinf(high) else f"{high:g}"
-    return f"{low} to {high}{unit}"
+    return f"{low} to {high}"
 
 
 def own_arguments(argv: Iterable[str]) -> list[str]:
@@ -133,45 +137,70 @@ def refusal(name: str, argv: list[str]) -> str | None:
     first = own[0]
     if first in ROS_FLAGS or ":=" in first or first.startswith("__"):
         rest = " ".join(own)
-        return (f"{name}: '{rest}' is a ROS argument and would be ignored: add --ros-args before it, "
+        return (f"cannot start: '{rest}' is a ROS argument and would be ignored: add --ros-args before it, "
                 f"e.g. {name} --ros-args {rest}")
-    return f"{name}: unknown argument '{first}': a node takes only ROS arguments, after --ros-args (see {name} --help)"
+    return f"cannot start: unknown argument '{first}': {name} takes only ROS arguments, after --ros-args (see --help)"
 
 
 def wants_help(argv: list[str]) -> bool:
     return any(a in HELP for a in own_arguments(argv))
 
 
-def model_sections(per_joint_title: str = "Per joint (NAME.x for each NAME of joint_names)") -> list[tuple[str, list]]:
-    """The model's parameters (every node's): source, whole-arm, per joint, URDF source."""
-    from ..package_files import default_config_path
-    from .model_source import DESCRIPTION_PARAMETERS, SOURCE
-    from .params import model_specs
+MAX_PARAMS_FILE = 16 * 2**20  # bytes: a params file larger than this is refused before rcl reads it
+_given: list[str] = []  # the params files of the node's command line (set by ``before_start``)
 
-    path = default_config_path()
-    defaults = {}
+
+def params_files(argv: list[str]) -> list[str]:
+    """The files of every ``--params-file`` inside ``--ros-args``, in order."""
+    files, inside, arguments = [], False, list(argv)[1:]
+    for i, argument in enumerate(arguments):
+        if argument == ROS_ARGS:
+            inside = True
+        elif inside and argument == "--":
+            inside = False
+        elif inside and argument == "--params-file" and i + 1 < len(arguments):
+            files.append(arguments[i + 1])
+    return files
+
+
+def params_files_given() -> list[str]:
+    """The params files the running node was started with (empty in-process)."""
+    return list(_given)
+
+
+def params_file_problem(path: str) -> str | None:
+    """Why rcl should not be given this params file (one line naming it), or None."""
+    file = Path(path)
     try:
-        from ..core.model import read_parameter_file
-
-        defaults = read_parameter_file(path)
-    except Exception:  # noqa: BLE001  (help without the file: no defaults shown)
-        pass
-    names = list(defaults.get("joint_names", []))
-    from .params import Spec
-
-    joint_names = Spec("joint_names", names or ["joint_1"], "the model's joints, base to flange", read_only=True)
-    specs = model_specs(["NAME"], {})
-    whole = [spec for spec in specs if not spec.name.startswith("NAME.")]
-    whole = [_with_default(spec, defaults) for spec in whole]
-    per_joint = [spec for spec in specs if spec.name.startswith("NAME.")]
-    return [
-        ("Model (defaults: the built-in IRB-140 model, config/irb140.yaml)", [SOURCE, joint_names, *whole]),
-        (f"{per_joint_title}; the built-in model gives every one of its joints", per_joint),
-        ("Model from a URDF (model.source: robot_description)", list(DESCRIPTION_PARAMETERS)),
-    ]
+        info = file.stat()
+    except FileNotFoundError:
+        return f"{path}: no such file (relative paths are read from {Path.cwd()})"
+    except OSError as error:
+        return f"{path}: cannot read: {error.strerror}"
+    if stat.S_ISDIR(info.st_mode):
+        return f"{path}: a directory, not a params file"
+    if not stat.S_ISREG(info.st_mode):
+        return f"{path}: not a regular file (a device or a pipe): a params file is a YAML file"
+    if info.st_size > MAX_PARAMS_FILE:
+        return f"{path}: {info.st_size} bytes, over the limit of {MAX_PARAMS_FILE} for a params file"
+    if not os.access(path, os.R_OK):
+        return f"{path}: cannot read: permission denied"
+    return None
 
 
-def _with_default(spec, defaults: dict):
-    from dataclasses import replace
-
-    return replace(spec, default=defaults[spec.name]) if spec.name in defaults else spec
+def before_start(name: str, argv: list[str], usage) -> tuple[int, str] | None:
+    """What to do before ROS starts: (exit code, text to print) for --help (0, the usage),
+    a ROS argument outside --ros-args (2) or a params file rcl should not read (1, the
+    reason); None to start. ``usage()``: the node's Usage."""
+    if wants_help(argv):
+        return 0, usage().text() if usage is not None else f"usage: {name} [-h] [--ros-args ...]\n"
+    refused = refusal(name, argv)
+    if refused:
+        return 2, refused
+    files = params_files(argv)
+    for path in files:
+        problem = params_file_problem(path)
+        if problem:
+            return 1, f"cannot start: {problem}"
+    _given[:] = files
+    return None

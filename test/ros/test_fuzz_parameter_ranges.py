@@ -19,8 +19,8 @@ import pytest
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 
-from .fuzz_ranges import NODES, SEED, bounds, candidates, numeric_parameters, try_value
-from .ros_harness import running
+from ..support.fuzz_ranges import NODES, SEED, bounds, candidates, numeric_parameters, try_value
+from ..support.ros_harness import running
 
 pytestmark = pytest.mark.ros
 
@@ -69,6 +69,8 @@ def test_read_only_numeric_parameters_refuse_bad_values_at_startup(name):
         for value in (math.inf, math.nan, high * 10 + 1 if descriptor.type == 3 else int(high) + 1):
             kind = Parameter.Type.INTEGER if descriptor.type == 2 and not isinstance(value, float) else None
             override = Parameter(parameter, kind or Parameter.Type.DOUBLE, value)
-            with pytest.raises(ValueError, match=parameter.replace(".", r"\.")):
-                with running(NODES[name], parameter_overrides=[override]):
-                    pass
+            with (
+                pytest.raises(ValueError, match=parameter.replace(".", r"\.")),
+                running(NODES[name], parameter_overrides=[override]),
+            ):
+                pass

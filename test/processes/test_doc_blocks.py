@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from .doc_blocks import (
+from ..support.doc_blocks import (
     Block,
     console_scripts,
     first_word,
@@ -19,8 +19,8 @@ from .doc_blocks import (
     read_blocks,
     synopsis_options,
 )
-from .node_process import interrupt, wait_for_line
-from .paths import ROOT
+from ..support.node_process import interrupt, wait_for_line
+from ..support.paths import ROOT
 
 pytestmark = [pytest.mark.process, pytest.mark.slow]
 
