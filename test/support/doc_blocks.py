@@ -74,7 +74,7 @@ def read_blocks(path: Path, commands: set[str]) -> list[Block]:
             end = i + 1
             while end < len(lines) and not lines[end].startswith("```"):
                 end += 1
-            text = "\n".join(lines[i + 1:end])
+            text = "\n".join(lines[i + 1 : end])
             if language == "python":
                 kind = "python"
             elif language in SHELL_LANGUAGES:
@@ -88,8 +88,10 @@ def read_blocks(path: Path, commands: set[str]) -> list[Block]:
             continue
         if line.startswith("    ") and line.strip() and (i == 0 or not lines[i - 1].strip()) and not _in_list(lines, i):
             end = i
-            while end < len(lines) and (lines[end].startswith("    ") or (
-                    not lines[end].strip() and end + 1 < len(lines) and lines[end + 1].startswith("    "))):
+            while end < len(lines) and (
+                lines[end].startswith("    ")
+                or (not lines[end].strip() and end + 1 < len(lines) and lines[end + 1].startswith("    "))
+            ):
                 end += 1
             text = "\n".join(x[4:] for x in lines[i:end])
             kind = "shell" if is_command(text, commands) else "output"
@@ -181,11 +183,11 @@ sys.stderr.write("ros2 " + " ".join(args[:2]) + ": needs the ros2 CLI, which thi
 sys.exit(127)
 '''
 
-CONSOLE_SCRIPT = '''#!{python}
+CONSOLE_SCRIPT = """#!{python}
 import sys
 from {module} import {function}
 sys.exit({function}())
-'''
+"""
 
 
 def make_bin(directory: Path, python: str, scripts: dict[str, str]) -> Path:

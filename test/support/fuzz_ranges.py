@@ -22,8 +22,11 @@ def numeric_parameters(node) -> dict:
     """name -> descriptor of each integer or double parameter of the node."""
     names = node.list_parameters([], 0).names
     described = node.describe_parameters(names)
-    return {name: d for name, d in zip(names, described)
-            if d.type in (ParameterType.PARAMETER_INTEGER, ParameterType.PARAMETER_DOUBLE)}
+    return {
+        name: d
+        for name, d in zip(names, described)
+        if d.type in (ParameterType.PARAMETER_INTEGER, ParameterType.PARAMETER_DOUBLE)
+    }
 
 
 def bounds(descriptor) -> tuple[float, float]:
