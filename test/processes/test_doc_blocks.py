@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -12,6 +13,7 @@ import pytest
 from ..support.doc_blocks import (
     Block,
     console_scripts,
+    doc_files,
     first_word,
     is_synopsis,
     logical_lines,
@@ -62,8 +64,14 @@ def node_of(line: str) -> str | None:
 
 def run_shell(script: str, cwd: Path, env: dict, timeout: float = LINE_TIMEOUT) -> tuple[int, str]:
     try:
-        done = subprocess.run(["bash", "-e", "-o", "pipefail", "-c", script], cwd=cwd, env=env, capture_output=True,
-                              text=True, timeout=timeout)
+        done = subprocess.run(
+            ["bash", "-e", "-o", "pipefail", "-c", script],
+            cwd=cwd,
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+        )
     except subprocess.TimeoutExpired as error:
         return -1, f"still running after {timeout:g} s: {error.output or ''}"
     return done.returncode, done.stdout + done.stderr
@@ -71,23 +79,22 @@ def run_shell(script: str, cwd: Path, env: dict, timeout: float = LINE_TIMEOUT) 
 
 def check_synopsis(line: str, cwd: Path, env: dict) -> str | None:
     """A usage synopsis: its executable's --help exits 0 and names every option it shows."""
-    words = line.split()
-    if words[:2] == ["ros2", "run"]:
-        words = words[3:]
-    code, output = run_shell(f"{words[0]} --help", cwd, env, timeout=HELP_TIMEOUT)
+    program = line.split(" [", 1)[0].strip()  # what comes before the first optional part
+    code, output = run_shell(f"{program} --help", cwd, env, timeout=HELP_TIMEOUT)
     if code != 0 or "Traceback" in output:
-        return f"`{words[0]} --help` exited {code}:\n{output}"
+        return f"`{program} --help` exited {code}:\n{output}"
     missing = [option for option in synopsis_options(line) if option not in output and option not in ("-h",)]
     if missing:
-        return f"`{words[0]} --help` does not mention {missing} of the synopsis `{line}`"
+        return f"`{program} --help` does not mention {missing} of the synopsis `{line}`"
     return None
 
 
 def run_block(block: Block, cwd: Path, env: dict) -> str | None:
     """None when the block ran as the doc says, else what went wrong."""
     if block.kind == "python":
-        done = subprocess.run([sys.executable, "-c", block.text], cwd=cwd, env=env, capture_output=True, text=True,
-                              timeout=LINE_TIMEOUT)
+        done = subprocess.run(
+            [sys.executable, "-c", block.text], cwd=cwd, env=env, capture_output=True, text=True, timeout=LINE_TIMEOUT
+        )
         return None if done.returncode == 0 else f"exit {done.returncode}:\n{done.stdout}{done.stderr}"
     nodes, pending = [], []
     try:
@@ -105,8 +112,14 @@ def run_block(block: Block, cwd: Path, env: dict) -> str | None:
                 if code != 0:
                     return f"exit {code} of:\n{chr(10).join(pending)}\n{output}"
                 pending = []
-            process = subprocess.Popen(["bash", "-c", f"exec {line}"], cwd=cwd, env=env, stdout=subprocess.PIPE,
-                                       stderr=subprocess.STDOUT, text=True)
+            process = subprocess.Popen(
+                ["bash", "-c", f"exec {line}"],
+                cwd=cwd,
+                env=env,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.STDOUT,
+                text=True,
+            )
             lines: list[str] = []
             nodes.append((line, process, lines))
             if not wait_for_line(process, "ready", lines, READY_TIMEOUT):
@@ -138,6 +151,8 @@ def clone_view(directory: Path) -> Path:
 def test_every_command_block_runs_as_typed(doc, environment, tmp_path):
     failures, ran = [], 0
     clone_view(tmp_path)
+    for name in doc_files(doc):
+        shutil.copy(ROOT / name, tmp_path / Path(name).name)
     for block in runnable(doc):
         if block.skip:
             continue

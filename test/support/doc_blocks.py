@@ -13,6 +13,9 @@ What it is:
 An HTML comment on the line(s) just before a block steers it:
 ``<!-- doc-test: skip (REASON) -->`` leaves it out, the reason required and shown;
 ``<!-- doc-test: output -->`` marks a block that looks like a command as output.
+``<!-- doc-test: files PATH ... -->`` anywhere in a doc: files of the repository (e.g. a
+URDF of test/data) the doc's blocks use, copied into its directory first, as the user has
+them in theirs.
 
 A shell block is run in a directory of its doc's own (the doc's blocks in order, so that a
 walkthrough's files carry over), with the package's executables on PATH as console
@@ -49,6 +52,14 @@ class Block:
     @property
     def where(self) -> str:
         return f"{self.path.name}:{self.line}"
+
+
+FILES = re.compile(r"<!--\s*doc-test:\s*files\s+(?P<paths>[^>]*?)\s*-->")
+
+
+def doc_files(path: Path) -> list[str]:
+    """The repository files a doc's blocks use (its ``doc-test: files`` comments)."""
+    return [name for found in FILES.finditer(path.read_text()) for name in found["paths"].split()]
 
 
 def console_scripts(setup_py: Path) -> dict[str, str]:
@@ -153,6 +164,9 @@ def logical_lines(text: str) -> list[str]:
         if line.rstrip().endswith("\\"):
             current += line.rstrip()[:-1] + " "
             continue
+        if line.startswith((" ", "\t")) and line.strip().startswith("[") and joined and not current:
+            joined[-1] += " " + line.strip()  # a synopsis continued on an indented line
+            continue
         current += line
         if current.strip() and not current.strip().startswith("#"):
             joined.append(current.strip())
@@ -173,11 +187,17 @@ def synopsis_options(line: str) -> list[str]:
 
 
 ROS2_STANDIN = '''#!{python}
-"""ros2, as far as the doc-test harness has it: `ros2 run irb140_dynamics X ARGS` runs X ARGS."""
+"""ros2, as far as the doc-test harness has it: `ros2 run irb140_dynamics X ARGS` runs X
+ARGS; `ros2 param set|get NODE NAME [VALUE]` and `ros2 service call SERVICE
+std_srvs/srv/Trigger` through rclpy, as ros2cli does them."""
 import os, sys
 args = sys.argv[1:]
 if len(args) >= 3 and args[0] == "run" and args[1] == "irb140_dynamics":
     os.execvp(args[2], args[2:])
+if args[:2] in (["param", "set"], ["param", "get"], ["service", "call"]):
+    sys.path.insert(0, {root!r})
+    from test.support.ros2_calls import main
+    sys.exit(main(args))
 sys.stderr.write("ros2 " + " ".join(args[:2]) + ": needs the ros2 CLI, which this environment has not; "
                  "give the block a <!-- doc-test: skip (REASON) --> comment\\n")
 sys.exit(127)
@@ -196,7 +216,7 @@ def make_bin(directory: Path, python: str, scripts: dict[str, str]) -> Path:
     for name, target in scripts.items():
         module, function = target.split(":")
         _executable(directory / name, CONSOLE_SCRIPT.format(python=python, module=module, function=function))
-    _executable(directory / "ros2", ROS2_STANDIN.format(python=python))
+    _executable(directory / "ros2", ROS2_STANDIN.format(python=python, root=str(Path(__file__).resolve().parents[2])))
     return directory
 
 

@@ -61,6 +61,11 @@ def as_parameter(name: str, value) -> Parameter:
 def try_value(node, name: str, descriptor, value) -> str | None:
     """Set one value the way `ros2 param set` does; None when the node answered as it must,
     else what was wrong."""
+    return answer(node, name, descriptor, value)[1]
+
+
+def answer(node, name: str, descriptor, value) -> tuple[bool, str | None]:
+    """(accepted, what was wrong or None) for one value set the way `ros2 param set` does."""
     before = node.get_parameter(name).value
     result = node.set_parameters([as_parameter(name, value)])[0]
     after = node.get_parameter(name).value
@@ -70,16 +75,16 @@ def try_value(node, name: str, descriptor, value) -> str | None:
     inside = fits_type and math.isfinite(value) and low <= value <= high
     if not result.successful:
         if not result.reason:
-            return f"{name} := {value!r}: refused without a reason"
+            return False, f"{name} := {value!r}: refused without a reason"
         if not (before == after or (before != before and after != after)):
-            return f"{name} := {value!r}: refused, yet the value changed from {before!r} to {after!r}"
+            return False, f"{name} := {value!r}: refused, yet the value changed from {before!r} to {after!r}"
         if inside and not descriptor.read_only and "out of range" in result.reason:
-            return f"{name} := {value!r}: within [{low}, {high}] yet refused as out of range: {result.reason}"
-        return None
+            return False, f"{name} := {value!r}: within [{low}, {high}] yet refused as out of range: {result.reason}"
+        return False, None
     if descriptor.read_only:
-        return f"{name} := {value!r}: accepted though read-only"
+        return True, f"{name} := {value!r}: accepted though read-only"
     if not inside:
-        return f"{name} := {value!r}: accepted though outside [{low}, {high}] (or not finite)"
+        return True, f"{name} := {value!r}: accepted though outside [{low}, {high}] (or not finite)"
     if not (isinstance(after, (int, float)) and math.isfinite(after) and after == value):
-        return f"{name} := {value!r}: accepted, yet the parameter holds {after!r}"
-    return None
+        return True, f"{name} := {value!r}: accepted, yet the parameter holds {after!r}"
+    return True, None
