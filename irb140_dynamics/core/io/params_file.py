@@ -7,32 +7,68 @@ the parameters, doubles written as doubles (see ``yaml_numbers``).
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
+from functools import lru_cache
 from typing import Any
 
+from irb140_dynamics.core.io.text_files import read_text_file
 from irb140_dynamics.core.io.yaml_numbers import yaml_value
 from irb140_dynamics.core.model.robot_model import RobotModel
 
 
 def read_parameter_file(path, node_name: str | None = None) -> dict[str, Any]:
-    """The flat parameters of a ROS 2 parameter file (``/**`` merged with ``node_name``)."""
+    """The flat parameters of a ROS 2 parameter file (``/**`` merged with ``node_name``).
+
+    The file is checked before it is parsed (``text_files``); YAML anchors and aliases,
+    which no parameter file needs, are refused (a few lines of them can stand for gigabytes).
+    A ValueError of one line names the file and what is wrong."""
     import yaml
 
-    with open(path) as stream:
-        document = yaml.safe_load(stream) or {}
+    text = read_text_file(path, "parameter file")
+    try:
+        document = yaml.load(text, Loader=_no_alias_loader()) or {}
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        where = f" (line {mark.line + 1})" if mark is not None else ""
+        raise ValueError(f"{path}: not valid YAML{where}: {getattr(error, 'problem', None) or error}") from None
+    except RecursionError:
+        raise ValueError(f"{path}: nested too deeply to be a parameter file") from None
+    if not isinstance(document, Mapping):
+        raise ValueError(f"{path}: not a parameter file (expected a mapping of node names)")
     params: dict[str, Any] = {}
     for key in ("/**", node_name, f"/{node_name}" if node_name else None):
         if key and key in document:
-            _flatten(document[key].get("ros__parameters", {}), "", params)
+            section = document[key]
+            if not isinstance(section, Mapping) or not isinstance(section.get("ros__parameters", {}), Mapping):
+                raise ValueError(f"{path}: {key}: expected 'ros__parameters:' and a mapping of parameters")
+            _flatten(section.get("ros__parameters", {}), params)
     return params
 
 
-def _flatten(tree: Mapping[str, Any], prefix: str, out: dict[str, Any]) -> None:
-    for key, value in tree.items():
-        name = f"{prefix}{key}"
-        if isinstance(value, Mapping):
-            _flatten(value, f"{name}.", out)
-        else:
-            out[name] = value
+def _flatten(tree: Mapping[str, Any], out: dict[str, Any]) -> None:
+    """Nested groups as dotted names, without recursion."""
+    pending = [("", tree)]
+    while pending:
+        prefix, node = pending.pop()
+        for key, value in node.items():
+            name = f"{prefix}{key}"
+            if isinstance(value, Mapping):
+                pending.append((f"{name}.", value))
+            else:
+                out[name] = value
+
+
+@lru_cache(maxsize=1)
+def _no_alias_loader():
+    import yaml
+
+    class NoAliasLoader(yaml.SafeLoader):
+        def compose_node(self, parent, index):
+            if self.check_event(yaml.AliasEvent):
+                event = self.peek_event()
+                raise yaml.composer.ComposerError(None, None, "YAML aliases are not accepted", event.start_mark)
+            return super().compose_node(parent, index)
+
+    return NoAliasLoader
 
 
 def load_model(path, node_name: str | None = None) -> RobotModel:
