@@ -86,8 +86,8 @@ def test_the_log_names_the_params_file(tmp_path):
 @pytest.mark.parametrize(
     "make_path, reason",
     [
-        (lambda tmp: str(tmp / "missing.yaml"), "no such file"),
-        (lambda tmp: str(tmp), "a directory"),
+        (lambda tmp: str(tmp / "missing.yaml"), "no such params file"),
+        (lambda tmp: str(tmp), "a folder"),
         (lambda tmp: "/dev/zero", "not a regular file"),
         (lambda tmp: "/dev/urandom", "not a regular file"),
     ],

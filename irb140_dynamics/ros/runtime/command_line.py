@@ -11,20 +11,34 @@ default in force without a word: it is refused, with the line to type instead.
 from __future__ import annotations
 
 import math
-import os
-import stat
 import textwrap
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from irb140_dynamics.core.io.text_files import InputFileError, read_text_file
+
 ROS_ARGS = "--ros-args"
 HELP = ("-h", "--help")
 # the flags rcl reads after --ros-args (design.ros2.org "ROS command line arguments")
-ROS_FLAGS = ("-p", "--param", "--params-file", "-r", "--remap", "-e", "--enclave", "--log-level",
-             "--log-config-file", "--enable-rosout-logs", "--disable-rosout-logs", "--enable-stdout-logs",
-             "--disable-stdout-logs", "--enable-external-lib-logs", "--disable-external-lib-logs")
+ROS_FLAGS = (
+    "-p",
+    "--param",
+    "--params-file",
+    "-r",
+    "--remap",
+    "-e",
+    "--enclave",
+    "--log-level",
+    "--log-config-file",
+    "--enable-rosout-logs",
+    "--disable-rosout-logs",
+    "--enable-stdout-logs",
+    "--disable-stdout-logs",
+    "--enable-external-lib-logs",
+    "--disable-external-lib-logs",
+)
 
 
 @dataclass
@@ -77,8 +91,12 @@ def describe_spec(spec) -> list[str]:
 def type_name(default: Any) -> str:
     """The ROS parameter type of a Spec's default (a value, or a Parameter.Type)."""
     if hasattr(default, "name") and not isinstance(default, (str, bool, int, float, list, tuple)):
-        return {"DOUBLE_ARRAY": "double[]", "INTEGER_ARRAY": "integer[]", "STRING_ARRAY": "string[]",
-                "BOOL_ARRAY": "bool[]"}.get(default.name, default.name.lower())
+        return {
+            "DOUBLE_ARRAY": "double[]",
+            "INTEGER_ARRAY": "integer[]",
+            "STRING_ARRAY": "string[]",
+            "BOOL_ARRAY": "bool[]",
+        }.get(default.name, default.name.lower())
     if isinstance(default, bool):
         return "bool"
     if isinstance(default, int):
@@ -137,8 +155,10 @@ def refusal(name: str, argv: list[str]) -> str | None:
     first = own[0]
     if first in ROS_FLAGS or ":=" in first or first.startswith("__"):
         rest = " ".join(own)
-        return (f"cannot start: '{rest}' is a ROS argument and would be ignored: add --ros-args before it, "
-                f"e.g. {name} --ros-args {rest}")
+        return (
+            f"cannot start: '{rest}' is a ROS argument and would be ignored: add --ros-args before it, "
+            f"e.g. {name} --ros-args {rest}"
+        )
     return f"cannot start: unknown argument '{first}': {name} takes only ROS arguments, after --ros-args (see --help)"
 
 
@@ -146,7 +166,6 @@ def wants_help(argv: list[str]) -> bool:
     return any(a in HELP for a in own_arguments(argv))
 
 
-MAX_PARAMS_FILE = 16 * 2**20  # bytes: a params file larger than this is refused before rcl reads it
 _given: list[str] = []  # the params files of the node's command line (set by ``before_start``)
 
 
@@ -169,22 +188,13 @@ def params_files_given() -> list[str]:
 
 
 def params_file_problem(path: str) -> str | None:
-    """Why rcl should not be given this params file (one line naming it), or None."""
-    file = Path(path)
+    """Why rcl should not be given this params file (one line naming it), or None: missing,
+    not a regular file (a device, /dev/zero), too large, not text (core.io.text_files)."""
     try:
-        info = file.stat()
-    except FileNotFoundError:
-        return f"{path}: no such file (relative paths are read from {Path.cwd()})"
-    except OSError as error:
-        return f"{path}: cannot read: {error.strerror}"
-    if stat.S_ISDIR(info.st_mode):
-        return f"{path}: a directory, not a params file"
-    if not stat.S_ISREG(info.st_mode):
-        return f"{path}: not a regular file (a device or a pipe): a params file is a YAML file"
-    if info.st_size > MAX_PARAMS_FILE:
-        return f"{path}: {info.st_size} bytes, over the limit of {MAX_PARAMS_FILE} for a params file"
-    if not os.access(path, os.R_OK):
-        return f"{path}: cannot read: permission denied"
+        read_text_file(path, "params file")
+    except InputFileError as error:
+        where = f" (relative paths are read from {Path.cwd()})" if not Path(path).is_absolute() else ""
+        return f"{error}{where}"
     return None
 
 
