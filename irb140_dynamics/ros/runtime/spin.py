@@ -105,6 +105,9 @@ def _start(make_node: Callable[[], Node], args: list[str], logger) -> tuple[Node
         try:
             with quiet_rcl():
                 rclpy.init(args=args)
+        except rclpy_implementation.UnknownROSArgsError as error:
+            logger.fatal(f"cannot start: rcl does not know the ROS arguments {error} (see --help)")
+            return None, 1
         except rclpy_implementation.RCLError as error:
             logger.fatal(f"cannot start: {init_error(error)}")
             return None, 1
