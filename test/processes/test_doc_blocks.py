@@ -59,6 +59,8 @@ def node_of(line: str) -> str | None:
     words = line.split()
     if words[:2] == ["ros2", "run"] and len(words) > 3:
         words = words[3:]
+    if "--help" in words or "-h" in words:
+        return None  # usage, not a node
     return words[0] if words and words[0] in NODES else None
 
 
@@ -136,7 +138,7 @@ def run_block(block: Block, cwd: Path, env: dict) -> str | None:
     return None
 
 
-CLONE = (".venv", "config", "urdf", "bench", "test")  # what a block may name as in the clone (linked)
+CLONE = (".venv", "config", "urdf", "bench", "test", "scripts")  # what a block may name as in the clone (linked)
 
 
 def clone_view(directory: Path) -> Path:
