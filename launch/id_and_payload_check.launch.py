@@ -26,14 +26,26 @@ def generate_launch_description():
             "payload.com": LaunchConfiguration("payload_com"),
         },
     ]
-    return LaunchDescription([
-        DeclareLaunchArgument(
-            "params_file", default_value=PathJoinSubstitution([FindPackageShare(PACKAGE), "config", "irb140.yaml"]),
-            description="the model's parameters (YAML, as config/irb140.yaml)"),
-        DeclareLaunchArgument("payload_mass", default_value="0.0", description="payload mass [kg]"),
-        DeclareLaunchArgument("payload_com", default_value="[0.0, 0.0, 0.0]",
-                              description="payload centre of mass in the flange frame [m]"),
-        Node(package=PACKAGE, executable="id_node", name="id_node", output="screen", parameters=shared),
-        Node(package=PACKAGE, executable="payload_check_node", name="payload_check_node", output="screen",
-             parameters=shared),
-    ])
+    return LaunchDescription(
+        [
+            DeclareLaunchArgument(
+                "params_file",
+                default_value=PathJoinSubstitution([FindPackageShare(PACKAGE), "config", "irb140.yaml"]),
+                description="the model's parameters (YAML, as config/irb140.yaml)",
+            ),
+            DeclareLaunchArgument("payload_mass", default_value="0.0", description="payload mass [kg]"),
+            DeclareLaunchArgument(
+                "payload_com",
+                default_value="[0.0, 0.0, 0.0]",
+                description="payload centre of mass in the flange frame [m]",
+            ),
+            Node(package=PACKAGE, executable="id_node", name="id_node", output="screen", parameters=shared),
+            Node(
+                package=PACKAGE,
+                executable="payload_check_node",
+                name="payload_check_node",
+                output="screen",
+                parameters=shared,
+            ),
+        ]
+    )

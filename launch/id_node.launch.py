@@ -18,21 +18,31 @@ PACKAGE = "irb140_dynamics"
 
 
 def generate_launch_description():
-    return LaunchDescription([
-        DeclareLaunchArgument(
-            "params_file", default_value=PathJoinSubstitution([FindPackageShare(PACKAGE), "config", "irb140.yaml"]),
-            description="the model's parameters (YAML, as config/irb140.yaml)"),
-        DeclareLaunchArgument("payload_mass", default_value="0.0", description="payload mass [kg]"),
-        DeclareLaunchArgument("payload_com", default_value="[0.0, 0.0, 0.0]",
-                              description="payload centre of mass in the flange frame [m]"),
-        Node(
-            package=PACKAGE, executable="id_node", name="id_node", output="screen",
-            parameters=[
-                LaunchConfiguration("params_file"),
-                {
-                    "payload.mass": ParameterValue(LaunchConfiguration("payload_mass"), value_type=float),
-                    "payload.com": LaunchConfiguration("payload_com"),
-                },
-            ],
-        ),
-    ])
+    return LaunchDescription(
+        [
+            DeclareLaunchArgument(
+                "params_file",
+                default_value=PathJoinSubstitution([FindPackageShare(PACKAGE), "config", "irb140.yaml"]),
+                description="the model's parameters (YAML, as config/irb140.yaml)",
+            ),
+            DeclareLaunchArgument("payload_mass", default_value="0.0", description="payload mass [kg]"),
+            DeclareLaunchArgument(
+                "payload_com",
+                default_value="[0.0, 0.0, 0.0]",
+                description="payload centre of mass in the flange frame [m]",
+            ),
+            Node(
+                package=PACKAGE,
+                executable="id_node",
+                name="id_node",
+                output="screen",
+                parameters=[
+                    LaunchConfiguration("params_file"),
+                    {
+                        "payload.mass": ParameterValue(LaunchConfiguration("payload_mass"), value_type=float),
+                        "payload.com": LaunchConfiguration("payload_com"),
+                    },
+                ],
+            ),
+        ]
+    )

@@ -25,20 +25,50 @@ START = [0.0, -0.6, 1.0, 0.0, 0.5, 0.0]  # rad: where demo_node's motion starts 
 
 def generate_launch_description():
     share = FindPackageShare(PACKAGE)
-    return LaunchDescription([
-        DeclareLaunchArgument("true_arm_file", default_value=PathJoinSubstitution([share, "config", "true_arm.yaml"]),
-                              description="the simulated arm's parameters"),
-        DeclareLaunchArgument("params_file", default_value=PathJoinSubstitution([share, "config", "irb140.yaml"]),
-                              description="id_node's model"),
-        DeclareLaunchArgument("plot_file", default_value="demo_tracking.png",
-                              description="demo_node's plot, written at the end"),
-        DeclareLaunchArgument("duration", default_value="0.0", description="s; 0 = until Ctrl-C"),
-        Node(package=PACKAGE, executable="sim_node", name="sim_node", output="screen",
-             parameters=[LaunchConfiguration("true_arm_file"), {"initial_positions": START, "reset_hold": 1.0}]),
-        Node(package=PACKAGE, executable="id_node", name="id_node", output="screen",
-             parameters=[LaunchConfiguration("params_file"),
-                         {"effort_commands.enabled": True, "effort_commands.source": "computed_torque"}]),
-        Node(package=PACKAGE, executable="demo_node", name="demo_node", output="screen",
-             parameters=[{"plot_file": LaunchConfiguration("plot_file"),
-                          "duration": ParameterValue(LaunchConfiguration("duration"), value_type=float)}]),
-    ])
+    return LaunchDescription(
+        [
+            DeclareLaunchArgument(
+                "true_arm_file",
+                default_value=PathJoinSubstitution([share, "config", "true_arm.yaml"]),
+                description="the simulated arm's parameters",
+            ),
+            DeclareLaunchArgument(
+                "params_file",
+                default_value=PathJoinSubstitution([share, "config", "irb140.yaml"]),
+                description="id_node's model",
+            ),
+            DeclareLaunchArgument(
+                "plot_file", default_value="demo_tracking.png", description="demo_node's plot, written at the end"
+            ),
+            DeclareLaunchArgument("duration", default_value="0.0", description="s; 0 = until Ctrl-C"),
+            Node(
+                package=PACKAGE,
+                executable="sim_node",
+                name="sim_node",
+                output="screen",
+                parameters=[LaunchConfiguration("true_arm_file"), {"initial_positions": START, "reset_hold": 1.0}],
+            ),
+            Node(
+                package=PACKAGE,
+                executable="id_node",
+                name="id_node",
+                output="screen",
+                parameters=[
+                    LaunchConfiguration("params_file"),
+                    {"effort_commands.enabled": True, "effort_commands.source": "computed_torque"},
+                ],
+            ),
+            Node(
+                package=PACKAGE,
+                executable="demo_node",
+                name="demo_node",
+                output="screen",
+                parameters=[
+                    {
+                        "plot_file": LaunchConfiguration("plot_file"),
+                        "duration": ParameterValue(LaunchConfiguration("duration"), value_type=float),
+                    }
+                ],
+            ),
+        ]
+    )

@@ -149,5 +149,9 @@ def test_ctrl_c_at_any_moment_exits_0_with_at_most_one_line(node):
         finally:
             process.kill()
         assert process.returncode == 0 and "Traceback" not in output, (delay, output)
-        other = [line for line in output.splitlines() if not re.search(r"\]: (model|ready|waiting for)|waiting for sim_node", line)]
+        other = [
+            line
+            for line in output.splitlines()
+            if not re.search(r"\]: (model|ready|waiting for)|waiting for sim_node", line)
+        ]
         assert len(other) <= 1, (delay, output)

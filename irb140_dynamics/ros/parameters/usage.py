@@ -22,12 +22,18 @@ def model_sections() -> list[tuple[str, list[Spec]]]:
         defaults = {}
     names = list(defaults.get("joint_names", []))
     specs = model_specs([JOINT], {})
-    whole = [replace(spec, default=defaults[spec.name]) if spec.name in defaults else spec
-             for spec in specs if not spec.name.startswith(f"{JOINT}.")]
+    whole = [
+        replace(spec, default=defaults[spec.name]) if spec.name in defaults else spec
+        for spec in specs
+        if not spec.name.startswith(f"{JOINT}.")
+    ]
     per_joint = [spec for spec in specs if spec.name.startswith(f"{JOINT}.")]
     joint_names = Spec("joint_names", names or [JOINT], "the model's joints, base to flange", read_only=True)
     return [
-        ("The model (defaults: the built-in IRB-140 model, config/irb140.yaml)", [SOURCE, MODEL_NAME, joint_names, *whole]),
+        (
+            "The model (defaults: the built-in IRB-140 model, config/irb140.yaml)",
+            [SOURCE, MODEL_NAME, joint_names, *whole],
+        ),
         (f"Per joint, {JOINT} = each of joint_names (the built-in model gives every one for its joints)", per_joint),
         ("The model from a URDF (model.source: robot_description)", list(DESCRIPTION_PARAMETERS)),
     ]
@@ -35,5 +41,3 @@ def model_sections() -> list[tuple[str, list[Spec]]]:
 
 def per_joint_section(specs: list[Spec], what: str) -> tuple[str, list[Spec]]:
     return (f"{what}, per joint ({JOINT} = each of joint_names)", specs)
-
-
