@@ -4,23 +4,24 @@ settings and helpers of its own. May import ``ros``, ``core``, ``identification`
 never another node (what several nodes share goes to ``ros``), never ``tools``.
 """
 
-import importlib
 import os
 import signal
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 
-def start(module: str) -> None:
-    """The console script of a node: import ``module`` and run its main(). Ctrl-C while
-    Python is still importing it (NumPy, rclpy, ... take a moment) ends quietly, exit 0:
-    the stop asked for, with no traceback of an import cut short; from main() on, the
-    node's own handling takes over (ros.runtime.spin.run)."""
+@contextmanager
+def quiet_ctrl_c() -> Iterator[None]:
+    """For a node's console script while it imports its node (NumPy, rclpy, ... take a
+    moment): Ctrl-C then ends it quietly, exit 0, the stop asked for, with no traceback of
+    an import cut short. From the node's main() on, its own handling takes over
+    (ros.runtime.spin.run)."""
 
-    def quiet(signum, frame):  # noqa: ARG001
+    def quiet(signum, frame):
         os._exit(0)
 
     previous = signal.signal(signal.SIGINT, quiet)
     try:
-        main = importlib.import_module(module).main
+        yield
     finally:
         signal.signal(signal.SIGINT, previous)
-    main()

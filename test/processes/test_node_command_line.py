@@ -20,7 +20,7 @@ START_LIMIT = 10.0  # s: a node that cannot start says so within this (issue 21 
 
 
 def command(node: str, *arguments: str) -> list[str]:
-    """The node as its console script runs it (nodes.start: quiet Ctrl-C while importing)."""
+    """The node as its console script runs it (nodes.quiet_ctrl_c while importing)."""
     return [sys.executable, "-m", f"irb140_dynamics.nodes.{node}", *arguments]
 
 
@@ -121,7 +121,7 @@ SIGNAL_DELAYS = (0.0, 0.1, 0.3, 0.8, 1.5, 3.0)
 
 
 def wait_for_the_package_code(process, timeout: float = 60.0) -> None:
-    """Until the process has NumPy loaded: nodes.start has set its Ctrl-C handling by then."""
+    """Until the process has NumPy loaded: nodes.quiet_ctrl_c is in force by then."""
     deadline = time.monotonic() + timeout
     maps = f"/proc/{process.pid}/maps"
     while time.monotonic() < deadline and process.poll() is None:

@@ -59,7 +59,7 @@ def test_a_value_out_of_its_range_stops_startup_with_one_line(module, args, mess
 @pytest.mark.parametrize(
     "content, expected",
     [
-        (b"/**:\n  ros__parameters:\n    payload.mass: \xff\xfe 3.0\n", re.compile(r"binary\.yaml: Error parsing")),
+        (b"/**:\n  ros__parameters:\n    payload.mass: \xff\xfe 3.0\n", re.compile(r"binary\.yaml: not UTF-8 text")),
         (np.random.default_rng(8).bytes(400), re.compile(r"binary\.yaml(:\d+)?: ")),
     ],
 )

@@ -1,8 +1,10 @@
 """payload_check_node: can the arm hold this payload; what is on the flange."""
 
-from irb140_dynamics.nodes import start
+from irb140_dynamics.nodes import quiet_ctrl_c
 
 
 def main() -> None:
     """The console script ``payload_check_node`` (``ros2 run irb140_dynamics payload_check_node``)."""
-    start("irb140_dynamics.nodes.payload_check_node.node")
+    with quiet_ctrl_c():
+        from irb140_dynamics.nodes.payload_check_node.node import main as node_main
+    node_main()
