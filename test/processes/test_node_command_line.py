@@ -155,3 +155,18 @@ def test_ctrl_c_at_any_moment_exits_0_with_at_most_one_line(node):
             if not re.search(r"\]: (model|ready|waiting for)|waiting for sim_node", line)
         ]
         assert len(other) <= 1, (delay, output)
+
+
+@pytest.mark.parametrize("text", [None, "<robot name='x'><link name='a'/>"], ids=["missing", "malformed"])
+@pytest.mark.parametrize("node", MODEL_NODES)
+def test_a_bad_urdf_file_is_one_line_naming_it(tmp_path, node, text):
+    path = tmp_path / "arm.urdf"
+    if text is not None:
+        path.write_text(text)
+    arguments = ["--ros-args", "-p", "model.source:=robot_description", "-p", f"model.urdf_file:={path}"]
+    started = time.monotonic()
+    code, output = run_to_exit(command(node, *arguments), timeout=60.0)
+    assert code == 1 and "Traceback" not in output, output
+    fatal = [line for line in output.strip().splitlines() if "[FATAL]" in line]
+    assert len(fatal) == 1 and str(path) in fatal[0] and len(fatal[0]) < 400, output
+    assert time.monotonic() - started < START_LIMIT * 3
