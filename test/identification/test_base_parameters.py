@@ -137,6 +137,7 @@ def test_a_joint_without_limits_gets_defaults():
     assert limits.speed[0] == 1.0 and limits.acceleration[0] == 5.0
 
 
+@pytest.mark.slow
 def test_optimisation_lowers_the_condition_number(irb140_base):
     model = irb140()
     result = optimise_excitation(model, period=4.0, harmonics=3, seed=5, iterations=3, base=irb140_base)

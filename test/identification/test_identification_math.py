@@ -174,6 +174,7 @@ def test_log_cholesky_round_trip_and_jacobian():
         parameters_body("link", pi10, irb140().joints[1].post)  # a physical body: no ModelError
 
 
+@pytest.mark.slow
 def test_consistent_fit_of_a_physical_estimate_reproduces_it(base):
     model, truth = irb140(), true_arm(2)
     states = random_states(model, 400, np.random.default_rng(4))
@@ -190,6 +191,7 @@ def test_consistent_fit_of_a_physical_estimate_reproduces_it(base):
     assert isinstance(fit.model, RobotModel) and fit.model.payload == RigidBody()
 
 
+@pytest.mark.slow
 def test_consistent_fit_of_an_unphysical_estimate_stays_physical(base):
     """Torques asking for a negative mass on the last link get a physical arm, far from them."""
     model = irb140()

@@ -5,6 +5,7 @@ bag; `identify` fits the model to the recording; then the demo's (different) mot
 tracked with the report's model and with the identified one."""
 
 import numpy as np
+import pytest
 from rosbags.typesys import Stores, get_typestore
 
 from irb140_dynamics.core import irb140
@@ -40,6 +41,7 @@ def record(controller, excitation) -> Samples:
     return Samples(t, np.array(positions), np.array(velocities), efforts, efforts)
 
 
+@pytest.mark.slow
 def test_identification_from_the_simulated_arm_tracks_five_times_better(tmp_path):
     report = irb140()
     excitation = optimise_excitation(report, iterations=3, seed=2)

@@ -5,6 +5,7 @@ still where it falls without commands."""
 import time
 
 import numpy as np
+import pytest
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
@@ -43,6 +44,7 @@ def stamp(msg) -> int:
     return msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
 
 
+@pytest.mark.slow
 def test_gravity_compensation_holds_the_arm(probe, process):  # noqa: F811
     process(
         "irb140_dynamics.nodes.sim_node.node",

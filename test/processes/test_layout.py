@@ -85,6 +85,7 @@ def test_config_is_in_the_share_directory(install):
     assert (share / "package.xml").is_file()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", EXECUTABLES)
 def test_installed_nodes_run_on_the_installed_config(install, name):
     executable = str(install / "irb140_dynamics" / "lib" / "irb140_dynamics" / name)

@@ -222,6 +222,7 @@ def processes():
             interrupt(process, timeout=5.0)
 
 
+@pytest.mark.slow
 def test_identified_from_a_ros_recording_tracks_five_times_better(probe, processes, tmp_path):  # noqa: F811
     began = time.monotonic()
     excitation_file, bag, identified = tmp_path / "excitation.yaml", tmp_path / "run", tmp_path / "identified.yaml"

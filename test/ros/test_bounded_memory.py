@@ -8,6 +8,7 @@ import gc
 import threading
 import tracemalloc
 
+import pytest
 from rclpy.parameter import Parameter
 
 from irb140_dynamics.core.payload import family as payload_family
@@ -49,6 +50,7 @@ def measure(feed, warmup: int, count: int, settle=lambda: None) -> tuple[int, li
         tracemalloc.stop()
 
 
+@pytest.mark.slow
 def test_id_node_holds_no_more_memory_after_warming_up(monkeypatch):
     monkeypatch.setattr(id_module, "compiled", lambda *args: False)  # every change through the worker
     fuzz = Fuzzer(seed=11)
@@ -81,6 +83,7 @@ def test_id_node_holds_no_more_memory_after_warming_up(monkeypatch):
         assert not any(key.endswith(".errors") for key in node.counts)
 
 
+@pytest.mark.slow
 def test_payload_check_node_holds_no_more_memory_after_warming_up():
     fuzz = Fuzzer(seed=12)
     with running(PayloadCheckNode, parameter_overrides=[Parameter("diagnostics.period", value=0.0)]) as harness:

@@ -26,6 +26,8 @@ from irb140_dynamics.tools import identify as identify_tool
 
 from ..support.synthetic_arm import Samples, joint_state_messages, true_arm, write_bag, write_csv
 
+pytestmark = pytest.mark.slow  # the workflow fixture records, identifies and plots a synthetic arm
+
 RATE, PERIOD, PERIODS = 250.0, 4.0, 3  # 12 s of data, 3000 messages
 NAMES = irb140().joint_names
 
