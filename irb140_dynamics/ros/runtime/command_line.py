@@ -201,12 +201,14 @@ def params_file_problem(path: str) -> str | None:
 def before_start(name: str, argv: list[str], usage) -> tuple[int, str] | None:
     """What to do before ROS starts: (exit code, text to print) for --help (0, the usage),
     a ROS argument outside --ros-args (2) or a params file rcl should not read (1, the
-    reason); None to start. ``usage()``: the node's Usage."""
-    if wants_help(argv):
-        return 0, usage().text() if usage is not None else f"usage: {name} [-h] [--ros-args ...]\n"
-    refused = refusal(name, argv)
-    if refused:
-        return 2, refused
+    reason); None to start. ``usage()``: the node's Usage; None for a tool that parses its
+    own arguments (then only the params files are checked)."""
+    if usage is not None:
+        if wants_help(argv):
+            return 0, usage().text()
+        refused = refusal(name, argv)
+        if refused:
+            return 2, refused
     files = params_files(argv)
     for path in files:
         problem = params_file_problem(path)
