@@ -82,7 +82,7 @@ stop_all() {  # Ctrl-C to every node still running; then SIGTERM, SIGKILL for th
     local pid running
     if [ ${#pids[@]} -eq 0 ]; then return 0; fi
     for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
-    for _ in $(seq 200); do  # up to 20 s: demo_node writes its plot
+    for _ in $(seq 600); do  # up to 60 s: demo_node writes its plot (slow on a busy machine)
         running=false
         for pid in "${pids[@]}"; do kill -0 "$pid" 2>/dev/null && running=true; done
         $running || return 0

@@ -31,14 +31,14 @@ def run_script(*arguments: str, cwd: Path) -> subprocess.Popen:
     )
 
 
-def processes_naming(text: str) -> list[int]:
-    """Processes whose command line contains ``text`` (nodes run.sh left behind)."""
+def left_behind(process: subprocess.Popen) -> list[str]:
+    """The processes still alive in run.sh's session (it started them: nodes it left behind)."""
     found = []
     for entry in Path("/proc").iterdir():
         if entry.name.isdigit():
             try:
-                if text in (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace"):
-                    found.append(int(entry.name))
+                if os.getsid(int(entry.name)) == process.pid:
+                    found.append((entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace"))
             except OSError:
                 continue
     return found
@@ -70,7 +70,7 @@ def test_a_node_that_cannot_start_stops_the_others_and_is_named(tmp_path):
     assert f"{tmp_path}/negative.yaml" in output and "payload.mass: must be between 0 and 100000, got -3.0" in output
     assert "stopped by itself; stopping the others" in output, output
     assert "interrupted" not in output.lower().replace("interrupted (ctrl-c) before the node was ready", ""), output
-    assert processes_naming(f"{tmp_path}/negative.yaml") == [], output
+    assert left_behind(process) == [], output
 
 
 @pytest.mark.slow
@@ -94,4 +94,4 @@ def test_the_demo_stops_on_ctrl_c_and_writes_its_plot_where_it_says(tmp_path):
     plot = tmp_path / "demo_tracking.png"
     assert f"plot written: {plot}" in output and plot.stat().st_size > 0, output
     assert "tracking error RMS over the last second, per joint [mrad] (id_node on the built-in IRB-140" in output
-    assert processes_naming(str(ROOT / "install" / "irb140_dynamics")) == [], output
+    assert left_behind(process) == [], output

@@ -4,6 +4,8 @@ robot's name as the hardware_id of /diagnostics (model.name, or the URDF's <robo
 
 from __future__ import annotations
 
+import uuid
+
 import pytest
 from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.parameter import Parameter
@@ -31,16 +33,28 @@ def test_an_integer_for_a_double_at_run_time_is_taken_as_that_double():
 
 
 def hardware_ids(harness) -> set[str]:
+    """The hardware_ids of the node's own statuses (other nodes of the domain publish there too)."""
     inbox = harness.listen(DiagnosticArray, "/diagnostics")
-    assert harness.spin_until(lambda: any(msg.status for msg in inbox))
-    return {status.hardware_id for msg in inbox for status in msg.status}
+    own = f"{harness.node.get_name()}:"
+
+    def statuses():
+        return [status for msg in inbox for status in msg.status if status.name.startswith(own)]
+
+    assert harness.spin_until(lambda: statuses())
+    return {status.hardware_id for status in statuses()}
+
+
+def renamed(name: str) -> list[str]:
+    """cli_args giving the node a name of this test's own."""
+    return ["--ros-args", "-r", f"__node:={name}_{uuid.uuid4().hex[:8]}"]
 
 
 @pytest.mark.parametrize("name", sorted(NODES))
 def test_diagnostics_name_the_robot_of_the_model(name):
-    with running(NODES[name]) as harness:
+    with running(NODES[name], cli_args=renamed(name)) as harness:
         assert hardware_ids(harness) == {"irb140"}
-    with running(NODES[name], parameter_overrides=[Parameter("model.name", value="cell_3_arm")]) as harness:
+    overrides = [Parameter("model.name", value="cell_3_arm")]
+    with running(NODES[name], parameter_overrides=overrides, cli_args=renamed(name)) as harness:
         assert hardware_ids(harness) == {"cell_3_arm"}
 
 
@@ -51,5 +65,5 @@ def test_diagnostics_of_a_urdf_model_name_its_robot(name):
         Parameter("model.urdf_file", value=str(URDF_DATA / "ur5.urdf")),
         Parameter("model.tip_link", value="tool0"),
     ]
-    with running(NODES[name], parameter_overrides=overrides) as harness:
+    with running(NODES[name], parameter_overrides=overrides, cli_args=renamed(name)) as harness:
         assert hardware_ids(harness) == {"ur5"}
