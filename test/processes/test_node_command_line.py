@@ -37,7 +37,7 @@ def test_help_lists_the_parameters_and_starts_no_ros(node, flag):
             assert f"  {spec.name} (" in output, (spec.name, output)
     if node in MODEL_NODES:
         # ranges and units of the model's numbers, from the descriptors
-        assert re.search(r"payload\.mass \(double, default 0\.0 kg, 0 to 100000 kg\)", output), output
+        assert re.search(r"payload\.mass \(double, default 0\.0 kg, 0 to 1e\+06 kg\)", output), output
         assert "NAME.torque_limit (double, default 0.0 N m, 0 to 1e+07 N m)" in output, output
 
 

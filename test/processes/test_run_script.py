@@ -67,7 +67,7 @@ def test_a_node_that_cannot_start_stops_the_others_and_is_named(tmp_path):
     finally:
         os.killpg(process.pid, signal.SIGKILL) if process.poll() is None else None
     assert process.returncode == 1, output
-    assert f"{tmp_path}/negative.yaml" in output and "payload.mass: must be between 0 and 100000, got -3.0" in output
+    assert f"{tmp_path}/negative.yaml" in output and "payload.mass: must be between 0 and 1e+06, got -3.0" in output
     assert "stopped by itself; stopping the others" in output, output
     assert "interrupted" not in output.lower().replace("interrupted (ctrl-c) before the node was ready", ""), output
     assert left_behind(process) == [], output

@@ -75,7 +75,7 @@ def test_the_readme_startup_error_is_what_the_node_prints(tmp_path):
     path = tmp_path / "negative.yaml"
     path.write_text(text)
     fatal = one_fatal_line(*run_to_exit(module_command(ID_NODE, "--params-file", str(path))))
-    line = "[FATAL] [id_node]: cannot start: joint_2.link.mass: must be between 0 and 100000, got -25.92"
+    line = "[FATAL] [id_node]: cannot start: joint_2.link.mass: must be between 0 and 1e+06, got -25.92"
     assert re.sub(r" \[\d+\.\d+\]", "", fatal) == line
     assert f"    {line}\n" in (ROOT / "README.md").read_text()
 

@@ -23,6 +23,8 @@ from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from irb140_dynamics.core.io.params_file import read_parameter_file
+from irb140_dynamics.core.model.joints import MAX_FRICTION
+from irb140_dynamics.core.model.rigid_body import MAX_MASS as CORE_MAX_MASS
 from irb140_dynamics.core.model.robot_model import check_joint_names
 from irb140_dynamics.package_files import CONFIG_NAME, PACKAGE, default_config_path  # noqa: F401 (PACKAGE, CONFIG_NAME: re-exported)
 from irb140_dynamics.ros.parameters.live import LiveParameters
@@ -34,12 +36,15 @@ _declare = declare  # the name model_source imports
 
 # The finite ranges of the model's numbers (ParameterDescriptor ranges, `ros2 param describe`):
 # wide, to keep inf, nan and 1e308 out, not to judge the robot.
-MAX_MASS = 1e5  # kg
-MAX_TORQUE = 1e7  # N m (limits and Coulomb friction)
+# Masses and friction: the core's own caps (core.model), so that the descriptor and the
+# model refuse the same values.
+MAX_MASS = CORE_MAX_MASS  # kg
+MAX_TORQUE = 1e7  # N m (torque limits, collision thresholds)
 MAX_VELOCITY = 1e4  # rad/s
 MAX_ACCELERATION = 1e7  # rad/s^2
-MAX_VISCOUS = 1e7  # N m s/rad
-MAX_ARMATURE = 1e5  # kg m^2
+MAX_VISCOUS = MAX_FRICTION  # N m s/rad
+MAX_COULOMB = MAX_FRICTION  # N m
+MAX_ARMATURE = MAX_FRICTION  # kg m^2
 MAX_SMOOTHING_VELOCITY = 1e3  # rad/s
 MAX_QOS_DEPTH = 10_000  # messages: 10 s at 1 kHz; DDS may reserve memory for the whole depth
 RELIABILITIES = {"best_effort": ReliabilityPolicy.BEST_EFFORT, "reliable": ReliabilityPolicy.RELIABLE}
@@ -161,7 +166,7 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
                 "Coulomb friction level (smoothed, see friction.smoothing_velocity)",
                 "N m",
                 minimum=0.0,
-                maximum=MAX_TORQUE,
+                maximum=MAX_COULOMB,
             ),
             Spec(
                 f"{joint}.armature",
