@@ -32,6 +32,9 @@ setup(
             "identify = irb140_dynamics.tools.identify:main",
             "excitation = irb140_dynamics.tools.excitation:main",
             "record = irb140_dynamics.tools.record:main",
+            "equations = irb140_dynamics.tools.equations:main",
+            "retime = irb140_dynamics.tools.retime:main",
+            "trajectory_check_node = irb140_dynamics.nodes.trajectory_check_node.node:main",
         ],
     },
 )

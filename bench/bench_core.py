@@ -11,16 +11,19 @@ to bench/results/core.json. Sections:
 - batch: states per second of the ``*_batch`` functions on N random states against a
   Python loop of the Pinocchio call over the same states.
 - kernel generation: the one-off cost of tracing and compiling each kernel of a fresh model.
-- UR5 from its URDF: the UR5 read by our URDF loader (test/data/urdf/ur5.urdf) against
-  Pinocchio's URDF parser on the same file, per call.
+- URDF arms: the UR5 and the Panda of example-robot-data read by our URDF loader against
+  Pinocchio's URDF parser on the same file, per call (rnea, gravity, mass matrix).
 
 Every pair is checked to give the same numbers before it is timed.
 """
 
 from __future__ import annotations
 
+import importlib.metadata
 import math
 import time
+import timeit
+from dataclasses import replace
 
 import numpy as np
 import pinocchio as pin
@@ -36,6 +39,7 @@ from common import (  # first: puts the checkout on sys.path
 )
 
 from irb140_dynamics.core import (
+    Friction,
     gravity,
     gravity_batch,
     irb140,
@@ -44,7 +48,7 @@ from irb140_dynamics.core import (
     rnea,
     rnea_batch,
 )
-from irb140_dynamics.core import kernels as kernel_cache  # noqa: E402
+from irb140_dynamics.core.codegen import kernels as kernel_cache  # noqa: E402
 from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.io.urdf import load_urdf  # noqa: E402
 from irb140_dynamics.core.model.rigid_body import RigidBody, inertia_matrix  # noqa: E402
@@ -58,7 +62,7 @@ FRESH_MODELS = 3  # kernel generation is timed on this many fresh models
 KERNELS = ("rnea", "rnea_wrench", "gravity_torques", "coriolis", "mass_matrix", "coriolis_matrix")
 TOLERANCE = dict(rtol=1e-9, atol=1e-9)
 SEED = 140
-UR5 = REPO / "test" / "data" / "urdf" / "ur5.urdf"  # the public description, copied with its licence
+PAIRED_BLOCKS = 800  # alternating blocks of the URDF arms' timings
 
 
 # -- the baselines ----------------------------------------------------------------------
@@ -217,32 +221,76 @@ def batch(model, pm, data) -> list[Row]:
     return rows
 
 
-def ur5_from_urdf() -> list[Row]:
-    """Per-call cost on the UR5 as our loader and Pinocchio's parser read its URDF."""
-    text = UR5.read_text()
-    model = load_urdf(text, tip_link="tool0").model
+def urdf_arms() -> list[Row]:
+    """Per-call cost on the UR5 and the Panda of example-robot-data, as our loader and
+    Pinocchio's parser read the same file (Pinocchio's Panda with its fingers locked), and
+    on the DH IRB-140 the same way (no target: no slower than before). The joints'
+    friction (the Panda's damping) is left out of our model: pin.rnea has none."""
+    rows = []
+    arms = {"IRB-140 (DH)": (irb140(), None), **URDF_ARMS}
+    for name, (text, tip) in arms.items():
+        model, pm = _paired_models(text, tip)
+        data = pm.createData()
+        q, qd, qdd = (x[0] for x in random_states(model, 1, np.random.default_rng(SEED + 2)))
+        check_same(f"{name} rnea", rnea(model, q, qd, qdd), pin.rnea(pm, data, q, qd, qdd))
+        check_same(f"{name} gravity", gravity(model, q), pin.computeGeneralizedGravity(pm, data, q))
+        check_same(f"{name} mass_matrix", mass_matrix(model, q), symmetric_from_upper(pin.crba(pm, data, q)))
+        urdf = tip is not None
+        cases = [
+            (f"{name} rnea vs pin.rnea", lambda: rnea(model, q, qd, qdd), lambda: pin.rnea(pm, data, q, qd, qdd), 5),
+            (
+                f"{name} gravity vs computeGeneralizedGravity",
+                lambda: gravity(model, q),
+                lambda: pin.computeGeneralizedGravity(pm, data, q),
+                5,
+            ),
+            (f"{name} mass_matrix vs pin.crba", lambda: mass_matrix(model, q), lambda: pin.crba(pm, data, q), 6),
+        ]
+        group = "arms, alternating blocks (URDF: load_urdf vs buildModelFromXML), per call"
+        for label, ours, baseline, limit in cases:
+            timed = (Figure.cost(t) for t in paired_seconds_per_call(ours, baseline))
+            rows.append(Row(group, label, *timed, Target(limit) if urdf else None))
+    return rows
+
+
+def _paired_models(text, tip):
+    """(our model without friction, Pinocchio's) of a URDF's chain to ``tip``, or of a model."""
+    if tip is None:
+        return text, pinocchio_model(text)
+    loaded = load_urdf(text, tip_link=tip)
+    model = replace(loaded.model, joints=tuple(replace(j, friction=Friction()) for j in loaded.model.joints))
     pm = pin.buildModelFromXML(text)
+    held = [pm.getJointId(joint) for joint in loaded.held_joints]
+    pm = pin.buildReducedModel(pm, held, pin.neutral(pm)) if held else pm
     pm.gravity.linear = np.array(model.gravity)
-    data = pm.createData()
-    q, qd, qdd = (x[0] for x in random_states(model, 1, np.random.default_rng(SEED + 2)))
-    check_same("UR5 rnea", rnea(model, q, qd, qdd), pin.rnea(pm, data, q, qd, qdd))
-    check_same("UR5 gravity", gravity(model, q), pin.computeGeneralizedGravity(pm, data, q))
-    check_same("UR5 mass_matrix", mass_matrix(model, q), symmetric_from_upper(pin.crba(pm, data, q)))
-    cases = [
-        ("UR5 rnea vs pin.rnea", lambda: rnea(model, q, qd, qdd), lambda: pin.rnea(pm, data, q, qd, qdd), Target(8)),
-        (
-            "UR5 gravity vs computeGeneralizedGravity",
-            lambda: gravity(model, q),
-            lambda: pin.computeGeneralizedGravity(pm, data, q),
-            None,
-        ),
-        ("UR5 mass_matrix vs pin.crba", lambda: mass_matrix(model, q), lambda: pin.crba(pm, data, q), None),
-    ]
-    group = "UR5 from its URDF (ours: load_urdf; Pinocchio: buildModelFromXML), per call"
-    return [
-        Row(group, name, Figure.cost(seconds_per_call(ours)), Figure.cost(seconds_per_call(baseline)), target)
-        for name, ours, baseline, target in cases
-    ]
+    return model, pm
+
+
+def paired_seconds_per_call(ours, baseline, blocks: int = PAIRED_BLOCKS, calls: int = 40):
+    """Seconds per call of each in ``blocks`` blocks of ``calls``, the two alternating block
+    by block: on a shared machine both then meet the same load (their best blocks compare)."""
+    timers = timeit.Timer(ours), timeit.Timer(baseline)
+    for timer in timers:
+        timer.timeit(calls)  # warm up
+    times = ([], [])
+    for _ in range(blocks):
+        for timer, samples in zip(timers, times):
+            samples.append(timer.timeit(calls) / calls)
+    return times
+
+
+def _urdf_arms() -> dict[str, tuple[str, str]]:
+    """name -> (URDF text, tip link) of example-robot-data's UR5 and Panda."""
+    files = importlib.metadata.distribution("example-robot-data").files or ()
+    paths = {str(f).split("robots/")[-1]: f for f in files}
+    arms = {
+        "UR5": ("ur_description/urdf/ur5_robot.urdf", "tool0"),
+        "Panda": ("panda_description/urdf/panda.urdf", "panda_hand"),
+    }
+    return {name: (paths[path].locate().read_text(), tip) for name, (path, tip) in arms.items()}
+
+
+URDF_ARMS = _urdf_arms()
 
 
 def kernel_generation() -> tuple[list[Row], dict]:
@@ -280,7 +328,7 @@ def main() -> None:
     pm = pinocchio_model(model)  # the builder the tests check against our core
     data = pm.createData()
     generation, source_lines = kernel_generation()  # first: on fresh models, before any warm-up
-    rows = single_state(model, pm, data) + batch(model, pm, data) + generation + ur5_from_urdf()
+    rows = single_state(model, pm, data) + batch(model, pm, data) + generation + urdf_arms()
     print_table(rows, "irb140_dynamics core vs Pinocchio (ratio = ours / baseline)")
     path = write_results(
         "core",

@@ -28,6 +28,7 @@ from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.model.states import finite_result, finite_results, state, states
 
 ArrayLike = Sequence[float] | np.ndarray
+_ARRAY, _FLOAT64 = np.ndarray, np.dtype(float)
 
 
 def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=None) -> np.ndarray:
@@ -38,19 +39,32 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
     origin) that the environment exerts on the flange, in the flange frame. tau balances
     it: tau = ID(q, qd, qdd) - J(q)^T f_ext, with J the flange Jacobian in the flange frame.
     """
-    kernels = kernels_of(model)
-    args = (state(q, model.n, "q"), state(qd, model.n, "qd"), state(qdd, model.n, "qdd"))
+    kernels, n = kernels_of(model), len(model.joints)
+    if (  # the common case checked at once, inline: rnea is the hot path
+        type(q) is _ARRAY
+        and type(qd) is _ARRAY
+        and type(qdd) is _ARRAY
+        and q.dtype is _FLOAT64
+        and qd.dtype is _FLOAT64
+        and qdd.dtype is _FLOAT64
+        and q.shape == qd.shape == qdd.shape == (n,)
+    ):
+        args = q.tolist(), qd.tolist(), qdd.tolist()
+        if not isfinite(sum(args[0]) + sum(args[1]) + sum(args[2])):
+            args = (state(q, n, "q"), state(qd, n, "qd"), state(qdd, n, "qdd"))  # names the culprit
+    else:
+        args = (state(q, n, "q"), state(qd, n, "qd"), state(qdd, n, "qdd"))
     tau = kernels.rnea.scalar(*args) if f_ext is None else kernels.rnea_wrench.scalar(*args, state(f_ext, 6, "f_ext"))
     if not isfinite(sum(tau)):  # inline: rnea is the hot path
         finite_result(tau, "rnea", q=q, qd=qd, qdd=qdd, **({} if f_ext is None else {"f_ext": f_ext}))
     if model.friction is None:
         return np.array(tau)
-    return np.array(tau) + model.friction.torques(args[1])
+    return np.array(model.friction.added(tau, args[1]))
 
 
 def gravity(model: RobotModel, q: ArrayLike) -> np.ndarray:
     """Gravity torques g(q) [N m]: what holds the arm (and payload) still at q."""
-    return np.array(kernels_of(model).gravity_torques.scalar(state(q, model.n, "q")))
+    return np.array(kernels_of(model).gravity_torques.scalar(state(q, len(model.joints), "q")))
 
 
 def coriolis(model: RobotModel, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
@@ -68,8 +82,9 @@ def coriolis_matrix(model: RobotModel, q: ArrayLike, qd: ArrayLike) -> np.ndarra
 
 def mass_matrix(model: RobotModel, q: ArrayLike) -> np.ndarray:
     """The joint-space mass matrix M(q) [kg m^2], symmetric positive definite."""
-    n = model.n
-    return _symmetric(np.array(kernels_of(model).mass_matrix.scalar(state(q, n, "q"))), n)
+    n = len(model.joints)
+    upper = kernels_of(model).mass_matrix.scalar(state(q, n, "q"))
+    return np.fromiter(upper, float, len(upper))[_upper_to_full(n)]
 
 
 def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext=None) -> np.ndarray:

@@ -43,13 +43,17 @@ def flange_pose(model: RobotModel, q) -> np.ndarray:
 
 
 def flange_jacobian(model: RobotModel, q) -> np.ndarray:
-    """The 6 x n geometric Jacobian of the flange, rows (v; w), in the base frame."""
+    """The 6 x n geometric Jacobian of the flange, rows (v; w), in the base frame (a
+    prismatic joint's column: its axis in v, zero in w)."""
     frames = link_frames(model, q)
     flange = (frames[-1] @ model.flange.matrix())[:3, 3]
     J = np.empty((6, model.n))
     for i, (frame, joint) in enumerate(zip(frames[:-1], model.joints)):
         joint_frame = frame @ joint.pre.matrix()  # joint i+1's axis passes through its origin
         axis, origin = joint_frame[:3, :3] @ np.array(joint.turning_axis), joint_frame[:3, 3]
+        if joint.prismatic:  # sliding: the flange moves along the axis, does not turn
+            J[:3, i], J[3:, i] = axis, 0.0
+            continue
         J[:3, i] = np.cross(axis, flange - origin)
         J[3:, i] = axis
     return J

@@ -5,7 +5,8 @@ placement pre_i * Rot(axis_i, offset_i) * post_i; its hinge turns it by
 post_i^-1 * Rot(axis_i, q_i) * post_i, i.e. about the axis R_post^T axis_i through the
 point -R_post^T t_post (the joint frame's origin) in body i's frame. Then
 T_i(q) = pre Rot(axis, offset) post * post^-1 Rot(axis, q) post = pre Rot(axis, q + offset) post
-and MuJoCo's qpos is our q. Each body carries its link's inertial (mass, CoM, full inertia
+and MuJoCo's qpos is our q. A prismatic joint (URDF form: post is the identity) is a slide
+joint along its axis: T_i(q) = pre Trans(axis q). Each body carries its link's inertial (mass, CoM, full inertia
 about the CoM in the link frame); the payload is a body welded to the last link at
 ``flange``. Joint extras: ``armature`` (added to M's diagonal, as ours), viscous friction as
 ``damping`` (MuJoCo's passive force -damping qd, as our viscous term), Coulomb friction as
@@ -71,7 +72,7 @@ def mjcf(
         indent += "  "
         attributes = {
             "name": joint.name,
-            "type": "hinge",
+            "type": "slide" if joint.prismatic else "hinge",
             "pos": _numbers(-R_post.T @ t_post),
             "axis": _numbers(R_post.T @ np.array(joint.turning_axis)),
             "armature": _number(joint.armature),

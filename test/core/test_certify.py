@@ -221,9 +221,10 @@ def test_the_default_model_is_proven_to_the_tolerance():
     assert check.workspace.max_payload.gap == 0.0
 
 
-def test_a_spent_budget_leaves_a_gap_and_the_verdict_uses_the_bound(monkeypatch):
+def test_a_spent_budget_leaves_a_gap_and_the_verdict_says_unproven(monkeypatch):
     """With almost no budget the proof stops early: the bounds are loose but still bounds,
-    the gap is reported, and a limit between the torque found and the bound fails."""
+    the gap is reported, and a limit between the torque found and the bound is neither
+    passed nor failed: UNPROVEN (issue 23: a bound is never a torque)."""
     model, payload = irb140(), RigidBody(3.0, (0.05, 0.01, 0.1))  # a shape of its own: no proof remembered
     limits = derive_torque_limits(model)
     monkeypatch.setattr(certify, "EVALUATIONS", 0)  # one bound of the whole box per objective
@@ -238,13 +239,24 @@ def test_a_spent_budget_leaves_a_gap_and_the_verdict_uses_the_bound(monkeypatch)
     )
     assert np.all(dense.max(axis=0) <= load.bound + 1e-9)
     params = model.to_params()
+    for j in (0, 2, 3, 4, 5):  # the others above their bounds: proven within
+        params[f"joint_{j + 1}.torque_limit"] = load.bound[j] + 1.0
     params["joint_2.torque_limit"] = abs(load.torque[1]) + 0.5 * load.gap[1]
     strict = RobotModel.from_params(params)
     check = check_payload(strict, payload, derive_torque_limits(strict), workspace=load)
-    assert "joint_2" in check.over
+    assert check.verdict == "UNPROVEN" and not check.ok, check.report()
+    assert check.unproven == ["joint_2"] and check.over == []
+    assert check.report().startswith(
+        f"UNPROVEN: 3.000 kg not proven to fit: joint_2's worst static torque is proven only up to "
+        f"{load.bound[1]:.3f} N m"
+    )
     assert any(
         line.startswith("note: joint_2: worst static torque proven only up to") for line in check.report().splitlines()
     )
     best = load.max_payload  # none proven with so little: the search's mass is all gap
     assert best.gap > 0 and (math.isnan(best.mass) or best.mass + best.gap <= 2.31)
     assert "the proof's budget ran out" in check.report()
+    for limit, verdict in ((0.99 * abs(load.torque[1]), "OVER-LIMIT"), (load.bound[1] + 1.0, "OK")):
+        params["joint_2.torque_limit"] = limit  # below the torque found at a real pose; above the bound
+        strict = RobotModel.from_params(params)
+        assert check_payload(strict, payload, derive_torque_limits(strict), workspace=load).verdict == verdict

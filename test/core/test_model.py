@@ -1,6 +1,7 @@
 """Model validation (each error names its parameter), the flat parameter form and YAML files."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -139,10 +140,26 @@ def test_duplicate_joint_names():
     assert_rejected(changed("joint_names", names), "joint_names", "unique")
 
 
-@pytest.mark.parametrize("bad_name", ["2nd", "joint-1", "joint 1", "", "_joint", 5, None])
+@pytest.mark.parametrize("bad_name", ["joint-1", "joint 1", "", "tab\tname", "x" * 201, 5, None])
 def test_invalid_joint_name(bad_name):
+    """Not a name (empty, too long, not printable, not a string), or one whose parameter
+    prefix is another's ("joint-1" and "joint_1" both use joint_1.*)."""
     names = ["joint_1", bad_name, "joint_3"]
     assert_rejected(changed("joint_names", names), "joint_names")
+
+
+@pytest.mark.parametrize(
+    "name, prefix",
+    [("2nd", "j_2nd"), ("arm-left.1", "arm_left_1"), ("_joint", "j__joint"), ("panda_joint1", "panda_joint1")],
+)
+def test_any_printable_joint_name_has_parameters_under_its_prefix(name, prefix):
+    params = {k.replace("joint_2.", f"{prefix}.", 1): v for k, v in irb140().to_params().items()}
+    params["joint_names"] = ["joint_1", name, "joint_3", "joint_4", "joint_5", "joint_6"]
+    model = RobotModel.from_params(params)
+    renamed = tuple(replace(j, name=name) if j.name == "joint_2" else j for j in irb140().joints)
+    assert model == replace(irb140(), joints=renamed)
+    assert RobotModel.from_params(model.to_params()) == model
+    assert f"{prefix}.link.mass" in model.to_params()
 
 
 @pytest.mark.parametrize("names", ["joint_1", 5])
@@ -174,7 +191,7 @@ def test_non_numeric(key, value):
 
 def test_direct_construction_is_validated_too():
     with pytest.raises(ModelError, match=r"^joint_names: "):
-        RobotModel((Joint("bad name", DH()),))
+        RobotModel((Joint("bad\nname", DH()),))
     with pytest.raises(ModelError, match=r"^elbow\.link\.mass: "):
         RobotModel((Joint("elbow", DH(), RigidBody(-1.0)),))
     with pytest.raises(ModelError, match=r"^payload\.mass: "):

@@ -106,12 +106,14 @@ def test_six_kg_stretched_is_the_report(model, limits):
 def test_heavier_payload_fails_at_joint_2(model, limits):
     check = check_payload(model, RigidBody(7.0), limits, q=STRETCHED)
     assert not check.ok
-    assert not check.within[1] and check.use[1] > 100
+    assert not check.within[1] and check.beyond[1] and check.use[1] > 100
     assert check.max_payload_here.mass == pytest.approx(6.0, rel=1e-12)
     assert check.max_payload_here.joint == 1
     assert check.workspace.max_payload.joint == 1
     report = check.report()
-    assert "OVER THE LIMIT" in report and "joint_2" in report.splitlines()[0]
+    verdict = report.splitlines()[0]
+    assert verdict.startswith("OVER-LIMIT: 7.000 kg does not fit: ") and "joint_2" in verdict
+    assert check.verdict == "OVER-LIMIT" and "joint_2" in check.over
     print(report)
 
 

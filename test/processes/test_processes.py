@@ -45,4 +45,5 @@ def test_payload_check_node_process_answers_check(probe, process):
     future = client.call_async(Trigger.Request())
     probe.spin_until(future.done)
     reply = future.result()
-    assert not reply.success and "OVER THE LIMIT at joint_2" in reply.message
+    assert not reply.success and reply.message.startswith("OVER-LIMIT: 7.000 kg does not fit: "), reply.message
+    assert "joint_2" in reply.message.splitlines()[0]

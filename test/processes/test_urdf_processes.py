@@ -36,9 +36,9 @@ def test_robot_description_from_a_params_file(tmp_path, probe, process):  # noqa
 
 def test_bad_urdf_file_stops_startup_with_one_line(tmp_path):
     bad = tmp_path / "bad.urdf"
-    bad.write_text(arm_text("ur5").replace('type="revolute"', 'type="prismatic"', 1))
+    bad.write_text(arm_text("ur5").replace('type="revolute"', 'type="floating"', 1))
     args = ["-p", "model.source:=robot_description", "-p", f"model.urdf_file:={bad}", "-p", "model.tip_link:=tool0"]
     code, output = run_to_exit(module_command("irb140_dynamics.nodes.id_node.node", *args))
     assert code == 1 and "Traceback" not in output, output
     [fatal] = [line for line in output.splitlines() if "cannot start" in line]
-    assert f'model.urdf_file {bad}: URDF joint "shoulder_pan_joint": a prismatic joint' in fatal, output
+    assert f'model.urdf_file {bad}: URDF joint "shoulder_pan_joint": a floating joint' in fatal, output

@@ -125,17 +125,46 @@ def check(harness):
     return harness.call(lambda: harness.client.call_async(Trigger.Request()))
 
 
-def test_check_answers_pending_at_once_while_the_analysis_runs(gated_payload_node):
+def test_check_right_after_a_change_waits_and_answers_for_the_new_parameters(gated_payload_node):
+    """Issue 21, item 7 (it answered "pending" at once): the request is held until the
+    analysis is in force, and the executor goes on serving the rest meanwhile."""
     node = gated_payload_node
     node.gate.close()
     assert [r.successful for r in unsettled_set(node, [Parameter("payload.mass", value=7.0)])] == [True]
+    future = node.client.call_async(Trigger.Request())
+    assert node.spin_until(lambda: node.node.check_service.held == 1)
+    client = node.parameter_client()  # meanwhile: the parameter services answer, joint states are taken
+    assert node.call(lambda: client.get_parameters(["payload.mass"])).values[0].double_value == 7.0
+    node.publisher(JointState, "joint_states").publish(JointState(name=NAMES, position=Q))
+    assert node.spin_until(lambda: node.node._state is not None)
+    assert not future.done()
+    node.gate.open()
+    assert node.spin_until(future.done)
+    reply = future.result()
+    assert not reply.success and reply.message.startswith("OVER-LIMIT: 7.000 kg does not fit: "), reply.message
+    assert reply.message.splitlines()[1] == "payload 7.000 kg at (0.000, 0.000, 0.000) m"
+    assert node.node.check_service.held == 0
+
+
+def test_check_waits_at_most_check_wait_timeout(gated_payload_node):
+    node = gated_payload_node
+    assert node.set_parameters([Parameter("check.wait_timeout", value=0.2)])[0].successful  # in force at once
+    node.gate.close()
+    assert [r.successful for r in unsettled_set(node, [Parameter("payload.mass", value=7.0)])] == [True]
     reply = check(node)
-    assert not reply.success
-    assert reply.message.startswith("pending: the limits and workspace analysis of the new parameters are running")
+    assert not reply.success and "\n" not in reply.message
+    assert reply.message.startswith("UNPROVEN: the analysis of the new parameters is still running (waited ")
+    assert reply.message.endswith(" s, check.wait_timeout): ask again later")
     node.gate.open()
     node.settle()
-    reply = check(node)
-    assert not reply.success and reply.message.startswith("payload 7.000 kg at (0.000, 0.000, 0.000) m: OVER THE LIMIT")
+    assert check(node).message.startswith("OVER-LIMIT: 7.000 kg does not fit: ")
+
+
+@pytest.mark.parametrize("value", [-1.0, 601.0, float("inf"), float("nan")])
+def test_check_wait_timeout_is_refused_outside_its_range(gated_payload_node, value):
+    [result] = gated_payload_node.set_parameters([Parameter("check.wait_timeout", value=value)])
+    assert not result.successful and "check.wait_timeout out of range Min: 0.0, Max: 600.0" in result.reason
+    assert gated_payload_node.node.get_parameter("check.wait_timeout").value == 30.0
 
 
 def test_a_payload_change_reuses_the_limits_and_a_warn_use_change_the_analysis(gated_payload_node, monkeypatch):
@@ -163,12 +192,14 @@ def test_a_slow_first_analysis_does_not_hold_up_startup(monkeypatch):
             assert harness.node.settings is None
             client = harness.probe.create_client(Trigger, "/payload_check_node/check")
             assert client.wait_for_service(timeout_sec=TIMEOUT)
-            reply = harness.call(lambda: client.call_async(Trigger.Request()))
-            assert not reply.success and reply.message.startswith("pending:")
+            future = client.call_async(Trigger.Request())  # held: the first analysis is under way
+            assert harness.spin_until(lambda: harness.node.check_service.held == 1)
+            assert not future.done()
         finally:
             gate.open()
-        harness.settle()
-        assert harness.call(lambda: client.call_async(Trigger.Request())).success
+        assert harness.spin_until(future.done)
+        reply = future.result()
+        assert reply.success and reply.message.startswith("OK: 0.000 kg fits, worst joint_"), reply.message
 
 
 @pytest.mark.parametrize("make_node", [IdNode, PayloadCheckNode])

@@ -5,9 +5,10 @@ from irb140_dynamics.nodes.demo_node import node as demo_node
 from irb140_dynamics.nodes.id_node import settings as id_node
 from irb140_dynamics.nodes.payload_check_node import node as payload_check_node
 from irb140_dynamics.nodes.sim_node import settings as sim_node
+from irb140_dynamics.nodes.trajectory_check_node import node as trajectory_check_node
 from irb140_dynamics.ros.parameters.catalog import NODE_PARAMETER_NAMES, PER_JOINT_SUFFIXES, sibling_parameter_names
 
-NODE_MODULES = (id_node, payload_check_node, sim_node, demo_node)
+NODE_MODULES = (id_node, payload_check_node, sim_node, demo_node, trajectory_check_node)
 
 
 def declared_names() -> tuple[set[str], set[str]]:

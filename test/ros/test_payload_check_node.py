@@ -39,7 +39,7 @@ def parse_report(text: str) -> dict:
 
 
 def _number(text: str):
-    return None if text in ("-", "none") else float(text.rstrip("%"))
+    return None if text in ("-", "none") else float(text.removeprefix("<=").rstrip("%"))  # <=: of a bound
 
 
 @pytest.fixture
@@ -80,7 +80,8 @@ def test_a_heavier_payload_fails_and_names_the_limiting_joint(node):
     assert [r.successful for r in node.set_parameters([Parameter("payload.mass", value=7.0)])] == [True]
     reply = check(node)
     assert not reply.success
-    assert "OVER THE LIMIT at joint_2" in reply.message.splitlines()[0]
+    verdict = reply.message.splitlines()[0]
+    assert verdict.startswith("OVER-LIMIT: 7.000 kg does not fit: ") and "joint_2" in verdict
     assert parse_report(reply.message)["workspace"][1] == "joint_2"
 
 
@@ -225,7 +226,7 @@ def test_a_failure_of_the_analysis_is_reported_and_the_next_change_recovers(node
     assert node.node.settings is settings
     reply = check(node)
     assert not reply.success
-    assert reply.message == "cannot check: parameters accepted but not applied: payload.com: the sweep failed"
+    assert reply.message == "UNPROVEN: cannot check: parameters accepted but not applied: payload.com: the sweep failed"
 
     built = []
 
@@ -238,7 +239,8 @@ def test_a_failure_of_the_analysis_is_reported_and_the_next_change_recovers(node
     assert len(built) == 1 and node.node.settings.workspace is built[0]  # built once
     assert node.node.settings.model.payload.mass == 3.0
     reply = check(node)
-    assert reply.success and reply.message.startswith("payload 3.000 kg"), reply.message
+    assert reply.success and reply.message.startswith("OK: 3.000 kg fits, worst joint_"), reply.message
+    assert reply.message.splitlines()[1] == "payload 3.000 kg at (0.000, 0.000, 0.000) m"
 
 
 def test_fresh_joint_states_carry_no_age_note(node):

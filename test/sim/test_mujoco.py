@@ -1,5 +1,5 @@
 """The core against MuJoCo, an independent engine, on the MJCF the simulator generates (the
-IRB-140, random DH and URDF-form models, the public UR5 and Panda URDFs):
+IRB-140, random DH and URDF-form models, one with prismatic joints, the public UR5 and Panda URDFs):
 inverse dynamics (mj_inverse), bias forces at rest (gravity), the mass matrix and forward
 dynamics (mj_forward's qacc). Viscous friction (MuJoCo's damping) and armature are on;
 Coulomb friction is off (MuJoCo's frictionloss is a dry-friction constraint, not our tanh),
@@ -34,6 +34,12 @@ def without_coulomb(model):
     return dataclasses.replace(model, joints=joints)
 
 
+def sliding(model, joints):
+    """The model with these joints prismatic (a MuJoCo slide joint)."""
+    kinds = tuple(dataclasses.replace(j, kind="prismatic") if i in joints else j for i, j in enumerate(model.joints))
+    return dataclasses.replace(model, joints=kinds)
+
+
 def public_arm(name):
     """A public URDF's arm (its own damping; Coulomb friction off) with an offset payload at the tip."""
     loaded = load_urdf(arm_text(name), tip_link=ARMS[name][1])
@@ -51,6 +57,9 @@ MODELS = {
         )
         for n in (1, 3, 6, 7)
     },
+    "urdf_form_n5_prismatic_1_3": lambda: sliding(
+        viscous_only(random_urdf_model(np.random.default_rng(405), 5), np.random.default_rng(5)), (1, 3)
+    ),
     "ur5": lambda: public_arm("ur5"),
     "panda": lambda: public_arm("panda"),
 }

@@ -10,9 +10,9 @@ from irb140_dynamics.core.algorithms.recursions import (
     dot,
     inertia_times,
     scale,
+    steps,
     to_child,
     to_parent_wrench,
-    turns,
 )
 from irb140_dynamics.core.model.rigid_body import ZERO3
 from irb140_dynamics.core.scalars.dual import dual_angles, partial
@@ -20,17 +20,21 @@ from irb140_dynamics.core.scalars.dual import dual_angles, partial
 
 def kinetic_energy(links, cs, qd):
     """T = sum over links of 1/2 m v.v + v.(w x h) + 1/2 w.(I w), v the velocity of o_i."""
-    rots = turns(links, cs)
     w, v = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
     energy = 0.0
-    for link, rot, qd_i in zip(links, rots, qd):
-        if link.p0 is not None:
-            v = add(v, cross(w, link.p0))
-        w_parent = to_child(link, rot, w)
-        w = add(w_parent, scale(qd_i, link.b))
+    for link, (rot, p0), qd_i in zip(links, steps(links, cs), qd):
+        v = _joint_velocity(link, p0, w, v, qd_i)
+        w = to_child(link, rot, w) if link.prismatic else add(to_child(link, rot, w), scale(qd_i, link.b))
         v = add(to_child(link, rot, v), cross(w, link.p))
         energy = energy + 0.5 * (link.m * dot(v, v) + dot(w, inertia_times(link.I, w))) + dot(v, cross(w, link.h))
     return energy
+
+
+def _joint_velocity(link, p0, w, v, qd_i):
+    """The velocity of the joint origin o'_i in frame i-1, from o_{i-1}'s v and w."""
+    if p0 is not None:
+        v = add(v, cross(w, p0))
+    return add(v, scale(qd_i, link.e)) if link.prismatic else v
 
 
 def energy_gradient(links, cs, qd):
@@ -51,15 +55,15 @@ def momentum_terms(links, cs, qd):
 
     Forward: each link's velocity (w; u at the joint origin o'_i, v at o_i). Backward: H
     (linear L, angular A about o'_k) gathered like RNEA's wrenches; S_k . (v_k x* H_k) is
-    b . (w x A + u x L).
+    b . (w x A + u x L); for a prismatic joint (S_k = (0, b)) p_k = b . L and
+    S_k . (v_k x* H_k) = b . (w x L).
     """
-    rots = turns(links, cs)
+    moves = steps(links, cs)
     w, v = ZERO3, ZERO3
     frames = []
-    for link, rot, qd_i in zip(links, rots, qd):  # velocities, as forward_motion's
-        if link.p0 is not None:
-            v = add(v, cross(w, link.p0))
-        w = add(to_child(link, rot, w), scale(qd_i, link.b))
+    for link, (rot, p0), qd_i in zip(links, moves, qd):  # velocities, as forward_motion's
+        v = _joint_velocity(link, p0, w, v, qd_i)
+        w = to_child(link, rot, w) if link.prismatic else add(to_child(link, rot, w), scale(qd_i, link.b))
         u = to_child(link, rot, v)  # the joint origin's velocity, in frame i
         v = add(u, cross(w, link.p))
         frames.append((w, u, v))
@@ -69,10 +73,14 @@ def momentum_terms(links, cs, qd):
     for i in reversed(range(n_links)):
         link, (w, u, v) = links[i], frames[i]
         if i + 1 < n_links:
-            L, A = to_parent_wrench(links[i + 1], rots[i + 1], L, A)
+            L, A = to_parent_wrench(links[i + 1], moves[i + 1], L, A)
         L_i = add(scale(link.m, v), cross(w, link.h))
         L = add(L, L_i)
         A = add(A, inertia_times(link.I, w), cross(link.h, v), cross(link.p, L))  # about o'_i
-        p[i] = dot(link.b, A) + link.armature * qd[i]
-        gradient[i] = -dot(link.b, add(cross(w, A), cross(u, L)))
+        if link.prismatic:
+            p[i] = dot(link.b, L) + link.armature * qd[i]
+            gradient[i] = -dot(link.b, cross(w, L))
+        else:
+            p[i] = dot(link.b, A) + link.armature * qd[i]
+            gradient[i] = -dot(link.b, add(cross(w, A), cross(u, L)))
     return p + gradient

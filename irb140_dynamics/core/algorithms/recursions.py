@@ -11,13 +11,18 @@ expressed in its own frame i. Joint i moves link i by T_i = pre Rot(u, theta_i) 
     p            o'_i -> o_i, in frame i (for DH rows o_{i-1} -> o_i)
     m, h, I      link mass, first moment m*c, inertia about o_i
     f, n         force and moment (about o'_i) that link i-1 exerts on link i
-    tau          joint torques, tau_i = b . n_i (+ armature_i qdd_i)
+    tau          joint torques, tau_i = b . n_i (+ armature_i qdd_i); prismatic: b . f_i
+
+A prismatic joint i slides by d_i = q_i along its axis, e = R0 u in frame i-1: its joint
+origin o'_i = o_{i-1} + p0 + d_i e moves with it (``steps``), with velocity qd_i e and
+acceleration qdd_i e relative to frame i-1; its rotation Rot is the identity.
 
 Vectors are 3-tuples, rotations 3x3 tuples of rows. A scalar may be a float, a NumPy array
 (many states at once) or a symbol of ``codegen`` (which turns these functions into
 straight-line code). So only ``+ - *`` are used, the joint angles enter as (cos, sin) pairs
-computed by the caller, and products with the constants 0 and +-1 are left out: for a DH
-row the generated code is the same as that of a hand-written DH recursion.
+computed by the caller (a prismatic joint's as the 1-tuple (d,)), and products with the
+constants 0 and +-1 are left out: for a DH row the generated code is the same as that of a
+hand-written DH recursion.
 """
 
 from __future__ import annotations
@@ -27,7 +32,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from irb140_dynamics.core.model.joints import snap
+from irb140_dynamics.core.model.joints import Z_AXIS, snap
 from irb140_dynamics.core.model.rigid_body import ZERO3, Inertia6, Vector3, shift_inertia
 from irb140_dynamics.core.scalars.dual import Dual, dual_angles, partial  # noqa: F401 (Dual: part of this module's interface)
 
@@ -49,14 +54,23 @@ class Link:
     h: Vector3
     I: Inertia6
     armature: float = 0.0
+    prismatic: bool = False
+    e: Vector3 = ZERO3  # a prismatic joint's axis in frame i-1 (R0 u)
 
 
 def chain(model) -> tuple[Link, ...]:
     """The per-link constants of a RobotModel (payload merged into the last link)."""
     return tuple(
-        Link(*_joint_constants(joint), *body.about_origin(), joint.armature)
+        Link(*_joint_constants(joint), *body.about_origin(), joint.armature, *_slide(joint))
         for joint, body in zip(model.joints, model.bodies)
     )
+
+
+def _slide(joint) -> tuple:
+    """(prismatic, e) of a Link."""
+    if not joint.prismatic:
+        return False, ZERO3
+    return True, tuple(float(x) for x in snap(joint.pre.rotation() @ np.array(joint.axis)))
 
 
 @lru_cache(maxsize=256)  # a model rebuilt with another payload recomputes no joint's
@@ -156,10 +170,12 @@ def turn(u, c, s) -> Rotation:
 
 
 def to_child(link: Link, rot, v):
-    """R_i^T v: a vector of frame i-1 expressed in frame i (R_i = R0 Rot R1, rot = Rot)."""
+    """R_i^T v: a vector of frame i-1 expressed in frame i (R_i = R0 Rot R1, rot = Rot, None
+    for a prismatic joint)."""
     if link.R0 is not None:
         v = rotate_back(link.R0, v)
-    v = rotate_back(rot, v)
+    if rot is not None:
+        v = rotate_back(rot, v)
     return v if link.R1 is None else rotate_back(link.R1, v)
 
 
@@ -167,12 +183,22 @@ def to_parent(link: Link, rot, v):
     """R_i v: a vector of frame i expressed in frame i-1."""
     if link.R1 is not None:
         v = rotate(link.R1, v)
-    v = rotate(rot, v)
+    if rot is not None:
+        v = rotate(rot, v)
     return v if link.R0 is None else rotate(link.R0, v)
 
 
-def turns(links, cs):
-    return [turn(link.u, c, s) for link, (c, s) in zip(links, cs)]
+def steps(links, cs):
+    """(Rot, p0) of each joint at its position: Rot None for a prismatic joint, whose p0
+    (o_{i-1} -> o'_i, frame i-1, None: zero) then carries its slide d e."""
+    out = []
+    for link, x in zip(links, cs):
+        if link.prismatic:
+            slide = scale(x[0], link.e)
+            out.append((None, slide if link.p0 is None else add(link.p0, slide)))
+        else:
+            out.append((turn(link.u, *x), link.p0))
+    return out
 
 
 # -- algorithms ---------------------------------------------------------------------
@@ -186,44 +212,50 @@ def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3):
     moment taken about its origin (see ``flange_wrench``); tau balances it (a load pressing
     on the flange raises tau like a weight would). Friction is not included.
     """
-    rots = turns(links, cs)
-    motion = forward_motion(links, rots, qd, qdd, gravity)
+    moves = steps(links, cs)
+    motion = forward_motion(links, moves, qd, qdd, gravity)
     tau = [0.0] * len(links)
     f, n = scale(-1.0, f_ext), scale(-1.0, n_ext)
     for i in reversed(range(len(links))):
         link, (w, dw, a) = links[i], motion[i]
         if i + 1 < len(links):
-            f, n = to_parent_wrench(links[i + 1], rots[i + 1], f, n)
+            f, n = to_parent_wrench(links[i + 1], moves[i + 1], f, n)
         force = add(scale(link.m, a), cross(dw, link.h), cross(w, cross(w, link.h)))
         moment = add(inertia_times(link.I, dw), cross(w, inertia_times(link.I, w)), cross(link.h, a))
         f = add(force, f)
         n = add(moment, n, cross(link.p, f))
-        tau[i] = dot(link.b, n) + link.armature * qdd[i]
+        tau[i] = dot(link.b, f if link.prismatic else n) + link.armature * qdd[i]
     return tau
 
 
-def forward_motion(links, rots, qd, qdd, gravity, at_joints=False):
+def forward_motion(links, moves, qd, qdd, gravity, at_joints=False):
     """(w, dw, a) of each link, in its frame, a at its origin (``at_joints``: at its joint
-    origin o'_i); gravity as a base acceleration."""
+    origin o'_i); gravity as a base acceleration. ``moves``: see ``steps``."""
     w, dw, a = ZERO3, ZERO3, scale(-1.0, gravity)
     motion = []
-    for link, rot, qd_i, qdd_i in zip(links, rots, qd, qdd):
-        if link.p0 is not None:  # the joint origin's acceleration, in frame i-1
-            a = add(a, cross(dw, link.p0), cross(w, cross(w, link.p0)))
-        w_parent = to_child(link, rot, w)
-        w = add(w_parent, scale(qd_i, link.b))
-        dw = add(to_child(link, rot, dw), scale(qdd_i, link.b), cross(w_parent, scale(qd_i, link.b)))
+    for link, (rot, p0), qd_i, qdd_i in zip(links, moves, qd, qdd):
+        if p0 is not None:  # the joint origin's acceleration, in frame i-1
+            a = add(a, cross(dw, p0), cross(w, cross(w, p0)))
+        if link.prismatic:  # sliding: qdd e, and Coriolis 2 w x (qd e)
+            a = add(a, scale(qdd_i, link.e), cross(scale(2.0 * qd_i, w), link.e))
+            w, dw = to_child(link, None, w), to_child(link, None, dw)
+        else:
+            w_parent = to_child(link, rot, w)
+            w = add(w_parent, scale(qd_i, link.b))
+            dw = add(to_child(link, rot, dw), scale(qdd_i, link.b), cross(w_parent, scale(qd_i, link.b)))
         a_joint = to_child(link, rot, a)
         a = add(a_joint, cross(dw, link.p), cross(w, cross(w, link.p)))
         motion.append((w, dw, a_joint if at_joints else a))
     return motion
 
 
-def to_parent_wrench(child: Link, rot, f, n):
-    """A wrench about o'_child in the child's frame, as one about o_parent in the parent's."""
+def to_parent_wrench(child: Link, move, f, n):
+    """A wrench about o'_child in the child's frame, as one about o_parent in the parent's
+    (``move``: the child's (Rot, p0), see ``steps``)."""
+    rot, p0 = move
     f, n = to_parent(child, rot, f), to_parent(child, rot, n)
-    if child.p0 is not None:
-        n = add(n, cross(child.p0, f))
+    if p0 is not None:
+        n = add(n, cross(p0, f))
     return f, n
 
 
@@ -234,17 +266,17 @@ def crba(links, cs):
     Column j is the torque that a unit qdd_j needs with no velocity and no gravity: the
     composite body j..n turns about joint j's axis, links before j stand still.
     """
-    rots = turns(links, cs)
+    moves = steps(links, cs)
     n_links = len(links)
     composite = [None] * n_links
     for i in reversed(range(n_links)):
         m, h, inertia = links[i].m, links[i].h, links[i].I
         if i + 1 < n_links:
-            child, rot = links[i + 1], rots[i + 1]
+            child, (rot, p0) = links[i + 1], moves[i + 1]
             m_c, h_c, inertia_c = composite[i + 1]
             r = to_parent(child, rot, child.p)  # o_i -> o_(i+1), in frame i
-            if child.p0 is not None:
-                r = add(r, child.p0)
+            if p0 is not None:
+                r = add(r, p0)
             m_c, h_c, inertia_c = shift_inertia(
                 m_c, to_parent(child, rot, h_c), _rotate_inertia(child, rot, inertia_c), r
             )
@@ -254,26 +286,48 @@ def crba(links, cs):
     M = [[0.0] * n_links for _ in range(n_links)]
     for j in range(n_links):
         link, (m, h, inertia) = links[j], composite[j]
-        a = cross(link.b, link.p)  # acceleration of o_j
-        f = add(scale(m, a), cross(link.b, h))
-        n = add(inertia_times(inertia, link.b), cross(h, a), cross(link.p, f))
-        M[j][j] = dot(link.b, n) + link.armature
+        if link.prismatic:  # the composite body slides along b: a = b, no dw
+            f = scale(m, link.b)
+            n = add(cross(h, link.b), cross(link.p, f))
+        else:
+            a = cross(link.b, link.p)  # acceleration of o_j
+            f = add(scale(m, a), cross(link.b, h))
+            n = add(inertia_times(inertia, link.b), cross(h, a), cross(link.p, f))
+        M[j][j] = dot(link.b, f if link.prismatic else n) + link.armature
         for i in reversed(range(j)):
-            f, n = to_parent_wrench(links[i + 1], rots[i + 1], f, n)
+            f, n = to_parent_wrench(links[i + 1], moves[i + 1], f, n)
             n = add(n, cross(links[i].p, f))
-            M[i][j] = M[j][i] = dot(links[i].b, n)
+            M[i][j] = M[j][i] = dot(links[i].b, f if links[i].prismatic else n)
     return M
 
 
 def _rotate_inertia(link, rot, inertia):
-    """R I R^T for the joint rotation R_i: columns of R I, then R (R I)^T."""
+    """R I R^T for the joint rotation R_i = R0 Rot R1, one factor after the other (a turn
+    about z in closed form, fewer operations than by columns)."""
+    if link.R1 is not None:
+        inertia = _turned(link.R1, inertia)
+    if rot is not None:
+        inertia = _turned_about_z(rot, inertia) if link.u == Z_AXIS else _turned(rot, inertia)
+    return inertia if link.R0 is None else _turned(link.R0, inertia)
+
+
+def _turned(R, inertia):
+    """R I R^T: columns of R I, then R (R I)^T."""
     xx, yy, zz, xy, xz, yz = inertia
-    columns = [to_parent(link, rot, col) for col in ((xx, xy, xz), (xy, yy, yz), (xz, yz, zz))]
-    rows_of_ri = list(zip(*columns))
-    col0 = to_parent(link, rot, rows_of_ri[0])
-    col1 = to_parent(link, rot, rows_of_ri[1])
-    col2 = to_parent(link, rot, rows_of_ri[2])
+    rows_of_ri = list(zip(*(rotate(R, col) for col in ((xx, xy, xz), (xy, yy, yz), (xz, yz, zz)))))
+    col0, col1, col2 = (rotate(R, row) for row in rows_of_ri)
     return (col0[0], col1[1], col2[2], col1[0], col2[0], col2[1])
+
+
+def _turned_about_z(rot, inertia):
+    """Rot_z I Rot_z^T by the double angle: with C = cos 2t, S = sin 2t, the xx, yy, xy
+    block turns by 2t about its mean; xz, yz turn by t."""
+    c, s = rot[0][0], rot[1][0]
+    xx, yy, zz, xy, xz, yz = inertia
+    C, S = c * c - s * s, (c * s) * 2.0
+    mean, half = (xx + yy) * 0.5, (xx - yy) * 0.5
+    x = half * C - xy * S
+    return (mean + x, mean - x, zz, half * S + xy * C, c * xz - s * yz, s * xz + c * yz)
 
 
 def christoffel_coriolis(links, cs, qd):

@@ -14,7 +14,7 @@ from irb140_dynamics.core.algorithms.recursions import (
     forward_motion,
     inertia_times,
     rotate,
-    turns,
+    steps,
 )
 
 # Pinocchio's inertia order as entries (xx, yy, zz, xy, xz, yz) of our inertia 6-tuples
@@ -24,8 +24,8 @@ _UNIT_VECTORS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 def rigid_body_regressor(links, cs, qd, qdd, gravity):
     """The n x 10n rigid-body regressor (rows of columns), written on scalars like ``rnea``."""
-    rots = turns(links, cs)
-    motion = forward_motion(links, rots, qd, qdd, gravity, at_joints=True)
+    moves = steps(links, cs)
+    motion = forward_motion(links, moves, qd, qdd, gravity, at_joints=True)
     n = len(links)
     Y = [[0.0] * (10 * n) for _ in range(n)]
     for k in range(n):
@@ -33,8 +33,8 @@ def rigid_body_regressor(links, cs, qd, qdd, gravity):
         for column, (f, moment) in enumerate(_unit_wrenches(w, dw, a)):
             for i in reversed(range(k + 1)):
                 if i < k:
-                    f, moment = _to_parent_joint_frame(links[i + 1], rots[i + 1], links[i], f, moment)
-                Y[i][10 * k + column] = dot(links[i].u, moment)
+                    f, moment = _to_parent_joint_frame(links[i + 1], moves[i + 1], links[i], f, moment)
+                Y[i][10 * k + column] = dot(links[i].u, f if links[i].prismatic else moment)
     return Y
 
 
@@ -54,13 +54,15 @@ def _unit_wrenches(w, dw, a):
         yield (0.0, 0.0, 0.0), add(inertia_times(E, dw), cross(w, inertia_times(E, w)))
 
 
-def _to_parent_joint_frame(child: Link, rot, parent: Link, f, n):
+def _to_parent_joint_frame(child: Link, move, parent: Link, f, n):
     """A wrench about o'_child in its joint frame, as one about o'_parent in the parent's."""
-    f, n = rotate(rot, f), rotate(rot, n)
+    rot, p0 = move
+    if rot is not None:
+        f, n = rotate(rot, f), rotate(rot, n)
     if child.R0 is not None:
         f, n = rotate(child.R0, f), rotate(child.R0, n)
-    if child.p0 is not None:
-        n = add(n, cross(child.p0, f))
+    if p0 is not None:
+        n = add(n, cross(p0, f))
     n = add(n, cross(parent.p, f))  # about o'_parent, parent link frame
     if parent.R1 is not None:
         f, n = rotate(parent.R1, f), rotate(parent.R1, n)

@@ -24,7 +24,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from irb140_dynamics.core.codegen.trace import Sym, angle_lines, input_lines, operand, operands_first, trace
+from irb140_dynamics.core.codegen.trace import Sym, angle_lines, input_lines, merged, operand, operands_first, trace
 
 _UFUNCS = {"*": "mul", "+": "add", "-": "sub"}
 _NAMESPACE = {
@@ -70,7 +70,7 @@ def compile_into(
 
 def _emit_into(outputs: list, scalar_vars: set[str]):
     """(body lines, the input variables used, an array input's name, buffers needed)."""
-    outputs = _merged(outputs)
+    outputs = merged(outputs)
     order = operands_first(outputs)
     scalar = set()  # ids of the nodes that depend on scalar inputs only
     last_use = {}
@@ -119,22 +119,3 @@ def _emit_into(outputs: list, scalar_vars: set[str]):
     used = {x.name for x in order if x.op == "var"}
     first_array = next((x.name for x in order if x.op == "var" and x.name not in scalar_vars), None)
     return lines, used, first_array, len(buffers)
-
-
-def _merged(outputs: list) -> list:
-    """The outputs with each operation done once: the tracer records an operation again
-    each time the algorithm does it, on the same operands, or swapped (exact: IEEE + and *
-    commute)."""
-    done: dict[tuple, Sym] = {}
-    new: dict[int, Sym] = {}
-    for x in operands_first(outputs):
-        if x.op == "var":
-            new[id(x)] = x
-            continue
-        args = tuple(new[id(a)] if isinstance(a, Sym) else a for a in x.args)
-        keys = [("s", id(a)) if isinstance(a, Sym) else ("c", repr(float(a))) for a in args]
-        key = (x.op, *(sorted(keys) if x.op in "+*" else keys))
-        if key not in done:
-            done[key] = Sym(x.op, args)
-        new[id(x)] = done[key]
-    return [new[id(out)] if isinstance(out, Sym) else out for out in outputs]

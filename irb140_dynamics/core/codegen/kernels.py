@@ -73,13 +73,15 @@ class Kernels:
         self.gravity = model.gravity
         last = links[-1]
         constants = (last.m, *last.h, *last.I, *model.gravity)
-        self.constants = tuple(x for x in constants if x != 0.0)
+        # plain floats: a NumPy scalar (a URDF inertial turned by NumPy) would make every
+        # operation it enters several times slower
+        self.constants = tuple(float(x) for x in constants if x != 0.0)
         arm = links[:-1] + (replace(last, m=0.0, h=ZERO3, I=ZERO6),)
         self._arm = _arm(arm, model.flange, tuple(x != 0.0 for x in constants))
 
     @property
     def angles(self) -> list[float]:
-        """The joints' angle offsets (theta_i = q_i + offset_i)."""
+        """The joints' angle offsets (theta_i = q_i + offset_i); None for a prismatic joint."""
         return self._arm.angles
 
     def compiled(self, *names: str) -> bool:
@@ -165,7 +167,7 @@ class _ArmKernels:
         self.links = links
         self.flange = _Flange(flange)
         self.nonzero = nonzero
-        self.angles = [link.theta_offset for link in links]
+        self.angles = [None if link.prismatic else link.theta_offset for link in links]
 
     def _spread(self, k) -> tuple:
         """The 13 numbers from the nonzero ones in k."""

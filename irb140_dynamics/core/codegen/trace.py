@@ -3,7 +3,7 @@
 The algorithms in ``algorithms`` run once on symbols instead of numbers. Every operation
 on a symbol is recorded; operations on the model's constants are done right away, and
 identities that are exact in floating point are folded (x*0 = 0 for finite x, x*1, x+0,
-x+(-y) = x-y). What is left is emitted as one Python function of plain float arithmetic:
+x+(-y) = x-y), and an operation recorded again on the same operands is done once. What is left is emitted as one Python function of plain float arithmetic:
 no loops, no lookups, no zero terms. The same source, compiled with NumPy's cos and sin,
 evaluates many states at once when given arrays.
 
@@ -78,6 +78,13 @@ class Sym:
             if self.op == "neg":  # (-x) c = x (-c)
                 return Sym("*", (self.args[0], -float(other)))
             return Sym("*", (self, float(other)))
+        # (-x) y = -(x y), exactly: the negation moves out, where a sum takes it as a subtraction
+        if self.op == "neg" and other.op == "neg":
+            return Sym("*", (self.args[0], other.args[0]))
+        if self.op == "neg":
+            return -(self.args[0] * other)
+        if other.op == "neg":
+            return -(self * other.args[0])
         return Sym("*", (self, other))
 
     def __rmul__(self, other):
@@ -109,13 +116,17 @@ def trace(algorithm: Callable[..., Sequence], inputs: dict[str, int], angles: Se
 
     ``inputs`` names the argument groups and their lengths, e.g. {"qd": 6, "qdd": 6}.
     With ``angles`` (the theta offsets), a first argument ``q`` is added and the algorithm
-    receives the (cos, sin) pairs of q_i + offset_i (symbols c_i, s_i) as its first argument.
+    receives the (cos, sin) pairs of q_i + offset_i (symbols c_i, s_i) as its first argument;
+    an offset None marks a prismatic joint, whose entry is (q_i,).
     """
     args = {}
     params = []
     if angles is not None:
         params.append("q")
-        args["cs"] = [(Sym("var", name=f"c{i}"), Sym("var", name=f"s{i}")) for i in range(len(angles))]
+        args["cs"] = [
+            (Sym("var", name=f"q{i}"),) if offset is None else (Sym("var", name=f"c{i}"), Sym("var", name=f"s{i}"))
+            for i, offset in enumerate(angles)
+        ]
     for group, length in inputs.items():
         params.append(group)
         args[group] = [Sym("var", name=f"{group}{i}") for i in range(length)]
@@ -133,6 +144,7 @@ def compile_kernel(
     Returns (source, scalar_fn, array_fn): array_fn evaluates the same code on NumPy arrays.
     """
     params, outputs = trace(algorithm, inputs, angles)
+    outputs = merged(outputs)
     lines = [f"def {name}({', '.join(params)}):"]
     lines += input_lines(inputs, angles)
     body, results, used = _emit(outputs)
@@ -158,6 +170,8 @@ def angle_lines(angles: Sequence[float] | None, used: set[str]) -> list[str]:
     """The lines computing the cosines and sines among ``used``."""
     lines = []
     for i, offset in enumerate(angles or ()):
+        if offset is None:  # prismatic: q_i itself
+            continue
         theta = f"q{i}" if offset == 0 else f"q{i} + {offset!r}"
         for var, fn in ((f"c{i}", "cos"), (f"s{i}", "sin")):
             if var in used:
@@ -232,3 +246,22 @@ def operand(x, exprs) -> str:
     if isinstance(x, Sym):
         return exprs[x.index]
     return f"({float(x)!r})" if x < 0 else repr(float(x))
+
+
+def merged(outputs: list) -> list:
+    """The outputs with each operation done once: the tracer records an operation again
+    each time the algorithm does it, on the same operands, or swapped (exact: IEEE + and *
+    commute)."""
+    done: dict[tuple, Sym] = {}
+    new: dict[int, Sym] = {}
+    for x in operands_first(outputs):
+        if x.op == "var":
+            new[id(x)] = x
+            continue
+        args = tuple(new[id(a)] if isinstance(a, Sym) else a for a in x.args)
+        keys = [("s", id(a)) if isinstance(a, Sym) else ("c", repr(float(a))) for a in args]
+        key = (x.op, *(sorted(keys) if x.op in "+*" else keys))
+        if key not in done:
+            done[key] = Sym(x.op, args)
+        new[id(x)] = done[key]
+    return [new[id(out)] if isinstance(out, Sym) else out for out in outputs]

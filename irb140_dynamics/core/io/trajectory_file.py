@@ -21,3 +21,26 @@ def joint_trajectory_text(joint_names, times, Q, QD, QDD, comments: Iterable[str
         ]
         lines.append(f"- {{{', '.join(fields)}, time_from_start: {{sec: {sec}, nanosec: {nanosec}}}}}")
     return "\n".join(lines) + "\n"
+
+
+def read_joint_trajectory(path) -> object:
+    """The first YAML document of ``path``: a JointTrajectory as ``ros2 topic echo`` prints it
+    (the mapping; its fields are checked where it is turned into arrays), or ValueError in
+    one line naming the file."""
+    import yaml
+
+    try:
+        with open(path) as stream:
+            return next((d for d in yaml.safe_load_all(stream) if d is not None), None)
+    except OSError as error:
+        raise ValueError(f"{path}: cannot read: {error.strerror}") from None
+    except yaml.YAMLError as error:
+        raise ValueError(f"{path}: not YAML: {str(error).splitlines()[0]}") from None
+
+
+def joint_trajectory_yaml(message: dict) -> str:
+    """A JointTrajectory mapping (header, joint_names, points) as YAML ``ros2 topic pub`` and
+    ``ros2 topic echo`` both read: a point's lists on one line each, numbers exact."""
+    import yaml
+
+    return yaml.safe_dump(message, sort_keys=False, default_flow_style=None, width=10**6)

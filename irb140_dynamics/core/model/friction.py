@@ -12,7 +12,9 @@ where it reaches tanh(1) = 76 % of its level; at 3 v_s it is 99.5 %. Friction is
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -34,6 +36,23 @@ class JointFriction:
     def coulomb_shape(self, qd) -> np.ndarray:
         """tanh(qd / v_s): the Coulomb torque per N m of level, (n,) or (N, n)."""
         return np.tanh(np.asarray(qd, dtype=float) / self.smoothing_velocity)
+
+    @cached_property
+    def _lists(self) -> tuple[list, list, bool]:
+        return self.viscous.tolist(), self.coulomb.tolist(), bool(self.coulomb.any())
+
+    def listed(self, qd: list) -> list:
+        """The friction at one state, qd a list of floats: plain Python, a few times cheaper
+        than NumPy for the few joints of an arm (equal to ``torques`` to rounding)."""
+        viscous, coulomb, any_coulomb = self._lists
+        if not any_coulomb:
+            return [v * x for v, x in zip(viscous, qd)]
+        s, tanh = self.smoothing_velocity, math.tanh
+        return [v * x + c * tanh(x / s) for v, c, x in zip(viscous, coulomb, qd)]
+
+    def added(self, tau, qd: list) -> list:
+        """tau + the friction at qd (see ``listed``)."""
+        return [t + f for t, f in zip(tau, self.listed(qd))]
 
     def torques(self, qd) -> np.ndarray:
         """Friction torques for velocities qd shaped (n,) or (N, n)."""

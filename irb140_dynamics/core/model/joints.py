@@ -1,6 +1,8 @@
-"""Joints: where each joint sits and how it turns, its limits, friction and rotor inertia.
+"""Joints: where each joint sits and how it moves, its limits, friction and rotor inertia.
 
-Units: m, rad, rad/s, rad/s^2, N m, N m s/rad, kg m^2.
+Units: m, rad, rad/s, rad/s^2, N m, N m s/rad, kg m^2 for revolute joints; for prismatic
+joints q is in m, qd in m/s, qdd in m/s^2, the effort in N, viscous friction in N s/m,
+Coulomb friction in N and armature in kg.
 
 A revolute joint i moves link i relative to link i-1 by
 
@@ -17,12 +19,16 @@ inertial parameters are given in it. Two ways of writing a joint fill these in:
 
 The *joint frame* is the frame after pre * Rot, before post: its origin is on the joint
 axis. For URDF joints it is the link frame; for DH rows it is frame i-1 turned by theta_i.
-Prismatic joints are not supported.
+
+A prismatic joint (``kind`` "prismatic", URDF form only) slides instead of turning:
+
+    T_i(q_i) = pre_i * Trans(axis_i * q_i) * post_i
 """
 
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,6 +46,7 @@ from irb140_dynamics.core.model.rigid_body import (
 )
 
 Z_AXIS: Vector3 = (0.0, 0.0, 1.0)
+KINDS = ("revolute", "prismatic")
 MAX_FRICTION = 1e6  # sanity cap of viscous [N m s/rad], Coulomb [N m] friction and armature [kg m^2]
 
 
@@ -133,11 +140,14 @@ class Friction:
 
 @dataclass(frozen=True)
 class Joint:
-    """A revolute joint, the link it moves, its limits, friction and rotor inertia.
+    """A revolute or prismatic joint, the link it moves, its limits, friction and rotor inertia.
 
     The kinematics are a DH row (``dh``), or, with ``dh`` None, URDF form: ``origin`` (the
     joint frame in the parent link's frame) and ``axis`` (a unit vector in the joint frame).
-    Limits of 0 mean none given.
+    Limits of 0 mean none given. ``kind`` "prismatic" (URDF form only): the joint slides
+    along ``axis``, its limits, effort and friction in m, N (see the module). ``physical``
+    False: the link's inertia is checked finite only, not physically consistent (a vendor
+    URDF's numbers, taken as given with a warning by the URDF loader).
     """
 
     name: str
@@ -151,6 +161,12 @@ class Joint:
     acceleration_limit: float = 0.0  # rad/s^2
     friction: Friction = Friction()
     armature: float = 0.0  # kg m^2: rotor inertia reflected through the gear, on M's diagonal
+    kind: str = "revolute"
+    physical: bool = True
+
+    @property
+    def prismatic(self) -> bool:
+        return self.kind == "prismatic"
 
     @property
     def pre(self) -> Placement:
@@ -171,10 +187,13 @@ class Joint:
         return Placement((self.dh.a, 0.0, self.dh.d), (self.dh.alpha, 0.0, 0.0))
 
     def transform(self, q: float) -> np.ndarray:
-        """T_i(q) = pre Rot(axis, q + offset) post, 4x4."""
-        turn = np.eye(4)
-        turn[:3, :3] = axis_rotation(self.turning_axis, q + self.offset)
-        return self.pre.matrix() @ turn @ self.post.matrix()
+        """T_i(q) = pre Rot(axis, q + offset) post (prismatic: pre Trans(axis q) post), 4x4."""
+        move = np.eye(4)
+        if self.prismatic:
+            move[:3, 3] = np.asarray(self.axis, dtype=float) * q
+        else:
+            move[:3, :3] = axis_rotation(self.turning_axis, q + self.offset)
+        return self.pre.matrix() @ move @ self.post.matrix()
 
 
 def axis_rotation(axis, angle: float) -> np.ndarray:
@@ -194,7 +213,11 @@ def validated_joint(j: Joint) -> Joint:
 
 
 def _validate_joint(j: Joint) -> Joint:
-    name = j.name
+    name = param_prefix(j.name)
+    if j.kind not in KINDS:
+        raise ModelError(f"{name}.type", f"must be one of {', '.join(KINDS)}, got {j.kind!r}")
+    if j.kind == "prismatic" and j.dh is not None:
+        raise ModelError(f"{name}.type", "a prismatic joint is given in URDF form (origin, axis), not as a DH row")
     dh = None
     if j.dh is not None:
         dh = DH(*finite_numbers(f"{name}.dh", (j.dh.a, j.dh.alpha, j.dh.d, j.dh.theta_offset), 4))
@@ -224,9 +247,9 @@ def _validate_joint(j: Joint) -> Joint:
         values[field] = x
     for field, unit in (("friction.viscous", "N m s/rad"), ("friction.coulomb", "N m"), ("armature", "kg m^2")):
         capped(f"{name}.{field}", "", values[field], MAX_FRICTION, unit)
-    link = RigidBody.validated(f"{name}.link", j.link.mass, j.link.com, j.link.inertia)
+    link = RigidBody.validated(f"{name}.link", j.link.mass, j.link.com, j.link.inertia, physical=bool(j.physical))
     return Joint(
-        name,
+        j.name,
         dh,
         link,
         (lower, upper),
@@ -237,4 +260,19 @@ def _validate_joint(j: Joint) -> Joint:
         values["acceleration_limit"],
         Friction(values["friction.viscous"], values["friction.coulomb"]),
         values["armature"],
+        j.kind,
+        bool(j.physical),
     )
+
+
+_PARAMETER_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+
+
+def param_prefix(name: str) -> str:
+    """The parameter prefix of a joint name: the name itself when it is one ([A-Za-z][A-Za-z0-9_]*),
+    else the name with each other character made '_' (and 'j_' before a leading non-letter):
+    "arm-left.1" -> "arm_left_1". The joint keeps its name; only parameters use this."""
+    if _PARAMETER_NAME.match(name):
+        return name
+    prefix = re.sub(r"[^A-Za-z0-9_]", "_", name)
+    return prefix if prefix[:1].isalpha() and prefix.isascii() else f"j_{prefix}"

@@ -99,17 +99,24 @@ def inertia_matrix(inertia: Sequence[float]) -> np.ndarray:
     return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
 
 
-def validate_inertia(field: str, inertia: Sequence[float]) -> Inertia6:
-    """Six finite numbers forming a physically possible inertia tensor, or ModelError."""
+def validate_inertia(field: str, inertia: Sequence[float], physical: bool = True) -> Inertia6:
+    """Six finite numbers forming a physically possible inertia tensor (``physical`` False:
+    six finite numbers within the cap), or ModelError."""
     inertia = finite_numbers(field, inertia, 6)
     capped(field, "each |entry|", max(map(abs, inertia)), MAX_INERTIA, "kg m^2")
+    if physical:
+        physical_inertia(field, inertia)
+    return inertia
+
+
+def physical_inertia(field: str, inertia: Sequence[float]) -> None:
+    """ModelError unless the inertia is positive semi-definite and obeys the triangle inequality."""
     moments = np.linalg.eigvalsh(inertia_matrix(inertia))
     tol = 1e-12 * max(1.0, float(np.max(np.abs(moments))))
     if moments[0] < -tol:
         raise ModelError(field, f"not positive semi-definite (principal moments {moments.tolist()})")
     if moments[0] + moments[1] < moments[2] - tol:
         raise ModelError(field, f"principal moments {moments.tolist()} break the triangle inequality")
-    return inertia
 
 
 @dataclass(frozen=True)
@@ -121,12 +128,14 @@ class RigidBody:
     inertia: Inertia6 = ZERO6
 
     @classmethod
-    def validated(cls, field: str, mass, com=ZERO3, inertia=ZERO6) -> RigidBody:
-        """Build from raw values; errors name ``field.mass``, ``field.com``, ``field.inertia``."""
+    def validated(cls, field: str, mass, com=ZERO3, inertia=ZERO6, physical: bool = True) -> RigidBody:
+        """Build from raw values; errors name ``field.mass``, ``field.com``, ``field.inertia``.
+        ``physical`` False: the inertia need not be physically consistent (finite, capped)."""
         m = checked_mass(f"{field}.mass", mass)
         c = finite_numbers(f"{field}.com", com, 3)
         capped(f"{field}.com", "|com|", math.hypot(*c), MAX_LENGTH, "m")
-        return VALIDATED_BODIES.add(cls(m, c, validate_inertia(f"{field}.inertia", inertia)))
+        body = cls(m, c, validate_inertia(f"{field}.inertia", inertia, physical))
+        return VALIDATED_BODIES.add(body) if physical else body
 
     @classmethod
     def checked(cls, field: str, body: RigidBody) -> RigidBody:

@@ -15,9 +15,11 @@ parameter to fix:
     payload.mass / .com / .inertia
     friction.smoothing_velocity rad/s, of the Coulomb friction's tanh
     flange                      [x, y, z, roll, pitch, yaw] in the last link (identity if absent)
+    <joint>.type                "revolute" (default) or "prismatic" (URDF form only)
     <joint>.dh                  [a, alpha, d, theta_offset], or in URDF form:
     <joint>.origin, .axis       [x, y, z, roll, pitch, yaw] in the parent link; [x, y, z]
     <joint>.link.mass / .com / .inertia
+    <joint>.link.physical       true (default); false: the inertia is checked finite only
     <joint>.position_limits     [lower, upper]
     <joint>.torque_limit        N m, 0 = none given
     <joint>.velocity_limit      rad/s, 0 = none given
@@ -26,6 +28,10 @@ parameter to fix:
     <joint>.friction.coulomb    N m
     <joint>.armature            kg m^2
 
+(prismatic joints: m, N, N s/m, N, kg). ``<joint>`` is the joint's name when it is a
+parameter name ([A-Za-z][A-Za-z0-9_]*), else its ``param_prefix`` ("arm-left.1" ->
+"arm_left_1"); ``joint_names`` holds the names themselves.
+
 Besides being finite, masses, lengths, inertias and gravity are within sanity caps (see
 ``rigid_body``) that keep every number the algorithms derive from them finite.
 """
@@ -33,14 +39,13 @@ Besides being finite, masses, lengths, inertias and gravity are within sanity ca
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
 
 from irb140_dynamics.core.model.friction import JointFriction
-from irb140_dynamics.core.model.joints import DH, Friction, Joint, Placement, validated_joint
+from irb140_dynamics.core.model.joints import DH, KINDS, Friction, Joint, Placement, param_prefix, validated_joint
 from irb140_dynamics.core.model.rigid_body import (
     MAX_GRAVITY,
     ZERO3,
@@ -53,7 +58,7 @@ from irb140_dynamics.core.model.rigid_body import (
     placed,
 )
 
-_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
+MAX_NAME = 200  # characters of a joint name
 DEFAULT_SMOOTHING_VELOCITY = 0.01  # rad/s: Coulomb friction reaches 76 % of its level at 0.01 rad/s
 __all__ = ["DH", "Friction", "Joint", "ModelError", "Placement", "RobotModel"]
 
@@ -127,19 +132,24 @@ class RobotModel:
             params["flange"] = self.flange.flat()
         params.update(_body_params("payload", self.payload))
         for j in self.joints:
+            key = param_prefix(j.name)
+            if j.prismatic:
+                params[f"{key}.type"] = j.kind
             if j.dh is not None:
-                params[f"{j.name}.dh"] = [j.dh.a, j.dh.alpha, j.dh.d, j.dh.theta_offset]
+                params[f"{key}.dh"] = [j.dh.a, j.dh.alpha, j.dh.d, j.dh.theta_offset]
             else:
-                params[f"{j.name}.origin"] = j.origin.flat()
-                params[f"{j.name}.axis"] = list(j.axis)
-            params.update(_body_params(f"{j.name}.link", j.link))
-            params[f"{j.name}.position_limits"] = list(j.position_limits)
-            params[f"{j.name}.torque_limit"] = j.torque_limit
-            params[f"{j.name}.velocity_limit"] = j.velocity_limit
-            params[f"{j.name}.acceleration_limit"] = j.acceleration_limit
-            params[f"{j.name}.friction.viscous"] = j.friction.viscous
-            params[f"{j.name}.friction.coulomb"] = j.friction.coulomb
-            params[f"{j.name}.armature"] = j.armature
+                params[f"{key}.origin"] = j.origin.flat()
+                params[f"{key}.axis"] = list(j.axis)
+            params.update(_body_params(f"{key}.link", j.link))
+            if not j.physical:
+                params[f"{key}.link.physical"] = False
+            params[f"{key}.position_limits"] = list(j.position_limits)
+            params[f"{key}.torque_limit"] = j.torque_limit
+            params[f"{key}.velocity_limit"] = j.velocity_limit
+            params[f"{key}.acceleration_limit"] = j.acceleration_limit
+            params[f"{key}.friction.viscous"] = j.friction.viscous
+            params[f"{key}.friction.coulomb"] = j.friction.coulomb
+            params[f"{key}.armature"] = j.armature
         return params
 
     @classmethod
@@ -166,6 +176,8 @@ class RobotModel:
 
 
 JOINT_FIELDS = (
+    "type",
+    "link.physical",
     "dh",
     "origin",
     "axis",
@@ -188,7 +200,7 @@ def _joint_from_params(name: str, params: Mapping[str, Any], get) -> Joint:
     """The validated joint ``name``, validated once for the same values: a change of other
     parameters (the payload's) re-validates no joint. The values are told apart by their
     repr, exact for the numbers a valid joint has (and True, 1 and 1.0 differ, as 0.0 and -0.0)."""
-    key = name, repr([params.get(f"{name}.{field}") for field in JOINT_FIELDS])
+    key = name, repr([params.get(f"{param_prefix(name)}.{field}") for field in JOINT_FIELDS])
     joint = _joints_by_values.get(key)
     if joint is None:
         joint = validated_joint(_raw_joint(name, params, get))
@@ -198,7 +210,14 @@ def _joint_from_params(name: str, params: Mapping[str, Any], get) -> Joint:
     return joint
 
 
-def _raw_joint(name: str, params: Mapping[str, Any], get) -> Joint:
+def _raw_joint(joint_name: str, params: Mapping[str, Any], get) -> Joint:
+    name = param_prefix(joint_name)
+    kind = get(f"{name}.type", "revolute")
+    if kind not in KINDS:
+        raise ModelError(f"{name}.type", f"must be one of {', '.join(KINDS)}, got {kind!r}")
+    physical = get(f"{name}.link.physical", True)
+    if not isinstance(physical, bool):
+        raise ModelError(f"{name}.link.physical", f"must be true or false, got {physical!r}")
     if params.get(f"{name}.dh") is None and params.get(f"{name}.origin") is not None:
         kinematics = dict(
             origin=Placement.validated(f"{name}.origin", get(f"{name}.origin")),
@@ -207,8 +226,10 @@ def _raw_joint(name: str, params: Mapping[str, Any], get) -> Joint:
     else:
         kinematics = dict(dh=DH(*finite_numbers(f"{name}.dh", get(f"{name}.dh"), 4)))
     return Joint(
-        name,
-        link=_body_from_params(f"{name}.link", get),
+        joint_name,
+        kind=kind,
+        physical=physical,
+        link=_body_from_params(f"{name}.link", get, physical=physical),
         position_limits=finite_numbers(
             f"{name}.position_limits", get(f"{name}.position_limits", (-math.pi, math.pi)), 2
         ),
@@ -222,21 +243,29 @@ def _raw_joint(name: str, params: Mapping[str, Any], get) -> Joint:
 
 
 def check_joint_names(names) -> list[str]:
-    """The names as a list, or ModelError: at least one, unique, each usable as a parameter prefix."""
+    """The names as a list, or ModelError: at least one, unique, printable, their parameter
+    prefixes (see ``param_prefix``) unique."""
     if not isinstance(names, (list, tuple)) or not all(isinstance(x, str) for x in names):
         raise ModelError("joint_names", f"expected a list of names, got {names!r}")
     names = list(names)
     if not names:
         raise ModelError("joint_names", "at least one joint is needed")
     for name in names:
-        if not _NAME.match(name):
-            raise ModelError(
-                "joint_names",
-                f"{name!r} is not a valid joint name (letters, digits, '_'; starts with a letter)",
-            )
+        if not name or len(name) > MAX_NAME or not name.isprintable():
+            shown = repr(name[:MAX_NAME]) + ("..." if len(name) > MAX_NAME else "")
+            raise ModelError("joint_names", f"{shown} is not a valid joint name (1 to {MAX_NAME} printable characters)")
     if len(set(names)) != len(names):
-        raise ModelError("joint_names", f"names must be unique, got {names}")
+        raise ModelError("joint_names", f"names must be unique, got {_shown(names)}")
+    prefixes = [param_prefix(name) for name in names]
+    if len(set(prefixes)) != len(prefixes):
+        twins = sorted({f"{a!r}" for a, p in zip(names, prefixes) if prefixes.count(p) > 1})
+        raise ModelError("joint_names", f"{', '.join(twins)[:200]} share a parameter prefix (see param_prefix)")
     return names
+
+
+def _shown(names: list[str]) -> str:
+    text = ", ".join(names)
+    return text if len(text) < 200 else text[:200] + f"... ({len(names)} names)"
 
 
 def _body_params(prefix: str, body: RigidBody) -> dict[str, Any]:
@@ -247,11 +276,12 @@ def _body_params(prefix: str, body: RigidBody) -> dict[str, Any]:
     }
 
 
-def _body_from_params(prefix: str, get, optional=False) -> RigidBody:
+def _body_from_params(prefix: str, get, optional=False, physical=True) -> RigidBody:
     zeros = (0.0,) * 6 if optional else None
     return RigidBody.validated(
         prefix,
         get(f"{prefix}.mass", 0.0 if optional else None),
         get(f"{prefix}.com", ZERO3 if optional else None),
         get(f"{prefix}.inertia", zeros),
+        physical=physical,
     )

@@ -42,7 +42,7 @@ def monitor_terms(model: RobotModel, q, qd, qdd) -> tuple[list, list, list, list
     if not math.isfinite(sum(tau) + sum(g)):
         finite_result(tau, "rnea", q=q, qd=qd, qdd=qdd)
         finite_result(g, "gravity", q=q)
-    friction = None if model.friction is None else model.friction.torques(qd).tolist()
+    friction = None if model.friction is None else model.friction.listed(qd)
     if friction is not None:
         tau = [t + f for t, f in zip(tau, friction)]
     return tau, g, p, _beta(c, g, friction)
@@ -129,5 +129,5 @@ class MomentumObserver:
         terms = kernels_of(model).momentum.scalar(q, qd)
         n = model.n
         g = gravity(model, q) if g is None else g
-        friction = None if model.friction is None else model.friction.torques(qd).tolist()
+        friction = None if model.friction is None else model.friction.listed(qd)
         return list(terms[:n]), _beta(terms[n:], g.tolist() if type(g) is np.ndarray else g, friction)

@@ -6,6 +6,7 @@
 - ``family``: a payload's torques as affine in its mass, and their proven extremes;
 - ``workspace``: the joint ranges and the sampled search for the worst pose;
 - ``mass_com_estimation``: the payload's mass and centre of mass from efforts at rest;
+- ``stop``: when a long analysis stops early (cancelled, or out of time);
 - ``proof/``: the rigorous bounds (harmonic sums, interval boxes, branch and bound).
 
 May import: ``core.model``, ``core.scalars``, ``core.algorithms``, ``core.codegen``, the

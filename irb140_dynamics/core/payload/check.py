@@ -1,8 +1,14 @@
 """The payload check: a payload against the joint torque limits, now and over the workspace,
 with its figures and report (the same strings for ~/check and /diagnostics).
 
-Units: kg, m, rad (poses shown in degrees), N m. The worst static torques count by their
-proven bounds (see ``payload``): a joint is within its limit only if the bound is.
+Units: kg, m, rad (poses shown in degrees), N m. A verdict is proven or says it is not:
+
+- OK: every joint's torque now and the proven bound of its worst static torque are within
+  its limit (a derived limit: the lowest it may be, see ``TorqueLimits.highest``);
+- OVER-LIMIT: a real torque, now or in a pose the search found, is over the highest the
+  joint's limit may be;
+- UNPROVEN: neither, where a proof's budget or the analysis' time ran out with the true
+  worst torque somewhere between the torque found and its bound, across the limit.
 """
 
 from __future__ import annotations
@@ -28,6 +34,7 @@ from irb140_dynamics.core.payload.limits import (
     payload_family,
     workspace_load,
 )
+from irb140_dynamics.core.payload.proof.harmonic import MAX_JOINTS
 
 VISIBLE = 5e-4  # N m or kg: a gap the report's 3 decimals would show is worth a note
 
@@ -53,29 +60,110 @@ class PayloadCheck:
     @property
     def use(self) -> np.ndarray | None:
         """|torque| / limit in percent (0 where there is no limit)."""
-        return None if self.torque is None else 100 * np.abs(self.torque) / self.limit
+        return None if self.torque is None else _percent_of(np.abs(self.torque), self.limit)
 
     @property
     def worst_use(self) -> np.ndarray:
         """The proven bound of the worst static torque / limit in percent."""
-        return 100 * self.workspace.bound / self.limit
+        return _percent_of(self.workspace.bound, self.limit)
 
     @property
     def within(self) -> np.ndarray:
-        """Per joint: within its limit now (if a state is given) and, proven, in every pose."""
+        """Per joint: proven within its limit, now (if a state is given) and in every pose."""
         ok = self.workspace.bound <= self.limit * (1 + RTOL)
         if self.torque is not None:
             ok &= np.abs(self.torque) <= self.limit * (1 + RTOL)
         return ok
 
     @property
+    def beyond(self) -> np.ndarray:
+        """Per joint: proven over its limit, by a real torque (now, or at a pose found)."""
+        highest = self.limits.highest * (1 + RTOL)
+        over = np.abs(self.workspace.torque) > highest
+        if self.torque is not None:
+            over |= np.abs(self.torque) > highest
+        return over
+
+    @property
+    def verdict(self) -> str:
+        """ "OVER-LIMIT", "OK" or "UNPROVEN" (see the module)."""
+        return "OVER-LIMIT" if self.beyond.any() else "OK" if self.within.all() else "UNPROVEN"
+
+    @property
     def ok(self) -> bool:
-        return bool(self.within.all())
+        return self.verdict == "OK"
 
     @property
     def over(self) -> list[str]:
-        """The names of the joints over their limit."""
-        return [name for name, ok in zip(self.joint_names, self.within) if not ok]
+        """The names of the joints proven over their limit."""
+        return [name for name, over in zip(self.joint_names, self.beyond) if over]
+
+    @property
+    def unproven(self) -> list[str]:
+        """The names of the joints neither proven within nor over their limit."""
+        return [self.joint_names[j] for j in np.flatnonzero(~self.within & ~self.beyond)]
+
+    @property
+    def unfinished(self) -> str:
+        """Why a proof left a gap, in words."""
+        if self.workspace.out_of_time or self.limits.out_of_time:
+            return "the analysis ran out of time"
+        if len(self.joint_names) > MAX_JOINTS:
+            return f"the proof's budget ran out (plain interval bounds: more than {MAX_JOINTS} joints)"
+        return "the proof's budget ran out"
+
+    def headline(self) -> str:
+        """The verdict in one line: OK, OVER-LIMIT or UNPROVEN, with the joint that decides it."""
+        mass = f"{self.payload.mass:.3f} kg"
+        verdict = self.verdict
+        if verdict == "OK":
+            return f"OK: {mass} fits, {self._most_used()}"
+        if verdict == "OVER-LIMIT":
+            return f"OVER-LIMIT: {mass} does not fit: {self._worst_over()}"
+        return f"UNPROVEN: {mass} not proven to fit: {self._most_unproven()}"
+
+    def _most_used(self) -> str:
+        """The joint nearest its limit (proven use), in words."""
+        use = np.fmax(self.worst_use, -np.inf if self.use is None else self.use)
+        use = np.where(np.isfinite(self.limit) & (self.limit > 0), use, -np.inf)  # (a limit 0 held: nothing used)
+        if not np.isfinite(use).any():
+            return "no joint it loads has a limit"
+        j = int(np.argmax(use))
+        return f"worst {self.joint_names[j]} at {use[j]:.1f} % of its limit"
+
+    def _worst_over(self) -> str:
+        """The joint most over its limit, where, and the others over, in words."""
+        highest = self.limits.highest
+        now = np.zeros_like(highest) if self.torque is None else np.abs(self.torque)
+        worst = np.maximum(now, np.abs(self.workspace.torque))
+        j = int(np.argmax(np.where(self.beyond, worst / np.where(highest > 0, highest, 1e-300), -np.inf)))
+        where = "now" if now[j] >= abs(self.workspace.torque[j]) else f"at {_degrees(self.workspace.pose[j])} deg"
+        text = (
+            f"{self.joint_names[j]} needs {worst[j]:.3f} N m {where}, {_of_limit(worst[j], self.limit[j], highest[j])}"
+        )
+        others = [name for name in self.over if name != self.joint_names[j]]
+        return text + (f"; also over: {', '.join(others)}" if others else "")
+
+    def _most_unproven(self) -> str:
+        """The unproven joint whose bound is furthest over its limit (of those whose limit
+        is > 0, if any), the reason, and the others unproven, in words."""
+        unproven = ~self.within & ~self.beyond
+        if (unproven & (self.limit > 0)).any():
+            unproven &= self.limit > 0
+        j = int(np.argmax(np.where(unproven, self.worst_use, -np.inf)))
+        name, load, limit, highest = self.joint_names[j], self.workspace, self.limit[j], self.limits.highest[j]
+        found = abs(load.torque[j])
+        if self.torque is not None and abs(self.torque[j]) > limit * (1 + RTOL):  # between the ends of its limit
+            text = f"{name} needs {abs(self.torque[j]):.3f} N m now, {_of_limit(abs(self.torque[j]), limit, highest)}"
+        else:
+            share = f" ({100 * found / limit:.1f} %)" if 0 < limit < math.inf else ""
+            text = (
+                f"{name}'s worst static torque is proven only up to {load.bound[j]:.3f} N m, "
+                f"{_of_limit(load.bound[j], limit, highest)}; found {found:.3f} N m{share}"
+            )
+        others = len(self.unproven) - 1
+        more = f"; {others} more joint{'s' * (others > 1)} unproven" if others else ""
+        return f"{text}: {self.unfinished}{more}"
 
     @property
     def loaded_without_limit(self) -> list[int]:
@@ -101,7 +189,7 @@ class PayloadCheck:
         load = self.workspace
         return (
             f"{self.joint_names[j]}: worst static torque proven only up to {load.bound[j]:.3f} N m "
-            f"(gap {load.gap[j]:.3g} N m, the proof's budget ran out): the check uses the bound"
+            f"(gap {load.gap[j]:.3g} N m: {self.unfinished})"
         )
 
     # -- the figures, formatted once for the report and /diagnostics --------------------
@@ -109,12 +197,15 @@ class PayloadCheck:
     def joint_figures(self, j: int) -> dict[str, str]:
         """Joint j's figures by label, in the order of the report's columns."""
         L, load, now = self.limit[j], self.workspace, self.torque is not None
+        worst_use = _percent(self.worst_use[j], L)  # of the bound: "<=" where it is not the torque found
+        if load.gap[j] >= VISIBLE and worst_use != "-":
+            worst_use = "<=" + worst_use
         return {
             "torque now [N m]": f"{self.torque[j]:.3f}" if now else "-",
             "limit [N m]": "none" if math.inf == L else f"{L:.3f}",
             "use now": _percent(self.use[j], L) if now else "-",
             "worst static torque [N m]": f"{load.torque[j]:.3f}",
-            "worst use": _percent(self.worst_use[j], L),
+            "worst use": worst_use,
             "worst pose [deg]": _degrees(load.pose[j]),
             "limit source": self.limits.reason(j),
             "worst static bound [N m]": f"{load.bound[j]:.3f}",
@@ -126,7 +217,7 @@ class PayloadCheck:
         figures = {"payload mass [kg]": f"{self.payload.mass:.3f}", "payload com [m]": _vector(self.payload.com)}
         for where, best in (("here", self.max_payload_here), ("over the workspace", self.workspace.max_payload)):
             if best is not None:
-                mass, joint, pose = _max_payload_figures(best, self.joint_names)
+                mass, joint, pose = _max_payload_figures(best, self.joint_names, self.limits)
                 label = f"max payload {where}"
                 figures.update({f"{label} [kg]": mass, f"{label}: limited by": joint, f"{label}: pose [deg]": pose})
         figures["max payload over the workspace: gap [kg]"] = f"{self.workspace.max_payload.gap:.2g}"
@@ -134,12 +225,12 @@ class PayloadCheck:
         return figures
 
     def report(self) -> str:
-        """The check as short text: one line per joint, the largest payloads, then notes."""
-        status = "OVER THE LIMIT at " + ", ".join(self.over) if self.over else "OK"
+        """The check as short text: the verdict in one line (``headline``), then the payload,
+        one line per joint, the largest payloads, then notes."""
         payload = self.payload_figures()
         header = ["joint", "now [N m]", "limit [N m]", "use", "worst [N m]", "use"]
         rows = [[name, *list(self.joint_figures(j).values())[:6]] for j, name in enumerate(self.joint_names)]
-        lines = [f"payload {payload['payload mass [kg]']} kg at {payload['payload com [m]']} m: {status}"]
+        lines = [self.headline(), f"payload {payload['payload mass [kg]']} kg at {payload['payload com [m]']} m"]
         lines += _table(header + ["worst pose [deg]"], rows, widths=(10, 11, 13, 8, 13, 8))
         lines.append("limits: " + self._limits_note())
         here = "" if self.max_payload_here is None else f"{_max_payload_text(payload, 'here')} here, "
@@ -212,16 +303,38 @@ def _degrees(q) -> str:
     return "(" + ", ".join(f"{round(v, 1) + 0.0:g}" for v in np.degrees(q)) + ")"
 
 
+def _percent_of(torque, limit):
+    """torque / limit in percent (inf over a limit 0, nan for 0 of 0)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return 100 * np.asarray(torque, dtype=float) / limit
+
+
+def _of_limit(torque: float, limit: float, highest: float) -> str:
+    """A torque against its limit in words: "110.2 % of its 6.256 N m limit"."""
+    share = f"{100 * torque / limit:.1f} % of " if 0 < limit < math.inf else "against "
+    return share + _limit_text(limit, highest)
+
+
+def _limit_text(limit: float, highest: float) -> str:
+    """A limit in words: "its 290.765 N m limit", and how high a derived one may be where
+    the proof of the rated payload's worst torque left a gap."""
+    if highest > limit * (1 + RTOL):
+        return f"its {limit:.3f} N m limit (derived: it may be up to {highest:.3f} N m)"
+    return f"its {limit:.3f} N m limit"
+
+
 def _percent(use: float, L: float) -> str:
     return "-" if math.inf == L else f"{use:.1f}%"
 
 
-def _max_payload_figures(best: MaxPayload, names) -> tuple[str, str, str]:
-    """(mass [kg]: a number, "none" or "unbounded"; the joint at or over its limit; the
-    pose [deg]), "-" where there is none."""
+def _max_payload_figures(best: MaxPayload, names, limits: TorqueLimits) -> tuple[str, str, str]:
+    """(mass [kg]: a number, "none", "none proven" (over a derived limit the proof left
+    open) or "unbounded"; the joint at or over its limit; the pose [deg]), "-" where there
+    is none."""
     if best.mass == math.inf:
         return "unbounded", "-", "-"
-    mass = "none" if math.isnan(best.mass) else f"{best.mass:.3f}"
+    certain = limits.highest[best.joint] <= limits.values[best.joint] * (1 + RTOL)
+    mass = ("none" if certain else "none proven") if math.isnan(best.mass) else f"{best.mass:.3f}"
     return mass, names[best.joint], _degrees(best.q)
 
 
@@ -234,6 +347,8 @@ def _max_payload_text(figures: dict[str, str], where: str) -> str:
     at = f" at {pose} deg" if where != "here" else ""
     if mass == "unbounded":
         return mass
+    if mass == "none proven":
+        return f"none proven ({joint}{at}: its derived limit is known only up to a gap)"
     if mass == "none" and gap > 0:
         return f"none proven ({joint}{at}; the search found {gap:.3f} kg, the proof's budget ran out)"
     if mass == "none":

@@ -14,7 +14,8 @@ branch and bound of ``certify`` proves how far above them the true maxima can be
 gap; CERTIFY_RTOL of the torque when it closes, always within the budget of
 ``certify.EVALUATIONS`` box bounds per proof). Models beyond harmonic.MAX_JOINTS joints
 get plain interval bounds within the budget of ``certify.interval_maxima``. Proofs are
-remembered per payload mass and joint ranges, families per arm and payload shape.
+remembered per payload mass and joint ranges, families per arm and payload shape; a proof
+the analysis' deadline cut short (see ``stop``) is not remembered.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.payload.proof import certify
 from irb140_dynamics.core.payload.proof.certify import Objective, certify_maxima, interval_maxima
 from irb140_dynamics.core.payload.proof.harmonic import StaticForms
+from irb140_dynamics.core.payload.stop import ran_out
 from irb140_dynamics.core.payload.workspace import JointRanges
 from irb140_dynamics.core.scalars.interval import Interval, bounds_of
 
@@ -101,12 +103,16 @@ class PayloadFamily:
         ``share`` of the proof's budget; ``found``: (values, poses) of a search at m done."""
         rows = np.arange(2 * self.empty.n) if rows is None else np.asarray(rows, dtype=int)
         key = (float(m), ranges.lower.tobytes(), ranges.upper.tobytes(), rows.tobytes())
-        if key not in self._proven:
-            values, poses = self.search(m, ranges, sample_torques, warm) if found is None else found
+        proven = self._proven.get(key)  # (a family may serve several threads: no check-then-get)
+        if proven is not None:
+            return proven
+        values, poses = self.search(m, ranges, sample_torques, warm) if found is None else found
+        proven = self._prove(m, ranges, values, poses, rows, share)
+        if not ran_out():  # cut short by the deadline: not the proof the budget would give
             if len(self._proven) >= 8:
                 self._proven.pop(next(iter(self._proven)))
-            self._proven[key] = self._prove(m, ranges, values, poses, rows, share)
-        return self._proven[key]
+            self._proven[key] = proven
+        return proven
 
     @cached_property
     def _proven(self) -> dict:
@@ -186,8 +192,16 @@ def payload_family(model: RobotModel, payload: RigidBody) -> PayloadFamily:
 
     Built once per arm and shape (the last FAMILIES remembered): the two models validate
     the CoM and inertia (ModelError naming ``payload.com`` or ``payload.inertia``) and
-    compile their kernels then.
+    compile their kernels then. ValueError starting "UNPROVEN:" for an arm with a prismatic
+    joint: the worst-case proof (harmonic sums in the joint angles) does not cover them.
     """
+    sliding = [j.name for j in model.joints if j.prismatic]
+    if sliding:
+        more = f" (and {len(sliding) - 1} more)" if len(sliding) > 1 else ""
+        raise ValueError(
+            f"UNPROVEN: the payload check's worst-case proof covers revolute joints only; joint "
+            f"{sliding[0][:100]!r}{more} is prismatic"
+        )
     arm = tuple(getattr(model, f.name) for f in fields(model) if f.name != "payload")
     key = (arm, tuple(payload.com), tuple(payload.inertia))
     with _LOCK:
@@ -247,9 +261,11 @@ def max_mass(tau0, dtau, limits) -> tuple[np.ndarray, np.ndarray]:
 
 def loads(torque) -> np.ndarray:
     """Per joint: is the (worst) static torque more than rounding noise, i.e. does the load
-    reach the joint at all? Noise: RTOL of the largest, or of 1 N m."""
+    reach the joint at all? Noise: RTOL of the largest finite one, or of 1 N m; an infinite
+    bound (a proof not even begun: out of time) loads: it may."""
     worst = np.abs(torque)
-    return worst > RTOL * max(worst.max(), 1.0)
+    finite = worst[np.isfinite(worst)]
+    return worst > RTOL * max(finite.max(initial=0.0), 1.0)
 
 
 def at_most(x, m):

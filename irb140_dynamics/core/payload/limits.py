@@ -8,12 +8,12 @@ of masses (|tau_j(m)| <= L_j); over the workspace Dinkelbach's iteration finds i
 worst poses at mass m allow a mass <= m; repeat at that mass until it stops falling).
 
 Worst static torques are proven, not only searched: each comes with an upper bound over
-the whole joint box (branch and bound, see ``certify``), and every verdict uses the bound:
-a payload is "within" only if the bound is. Where the budget runs out before the bound
-meets the torque found (the gap), the bound is what counts: "safe" is always sure. The
-largest payload over the workspace is proven the same way at its final mass; if a gap is
-left there, the mass reported is one the bounds prove, and ``MaxPayload.gap`` how much more
-the workspace might hold.
+the whole joint box (branch and bound, see ``certify``). Where the budget (or the analysis'
+time, see ``stop``) runs out before the bound meets the torque found (the gap), the true
+worst torque lies between the two: the verdicts of ``check`` say "unproven" where that
+gap straddles a limit. The largest payload over the workspace is proven the same way at
+its final mass; if a gap is left there, the mass reported is one the bounds prove, and
+``MaxPayload.gap`` how much more the workspace might hold.
 
 The permissible torques follow the report (section 10): the torques of the rated payload,
 6 kg at the flange origin, in the pose that loads each joint most. A given torque limit
@@ -38,6 +38,7 @@ from irb140_dynamics.core.model.rigid_body import MAX_MASS, ModelError, RigidBod
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.model.states import real_numbers, state
 from irb140_dynamics.core.payload.family import RTOL, Extremes, PayloadFamily, at_most, loads, max_mass, payload_family
+from irb140_dynamics.core.payload.stop import out_of_time, ran_out
 from irb140_dynamics.core.payload.workspace import JointRanges
 
 RATED_PAYLOAD = RigidBody(6.0)  # the IRB-140's rated payload: 6 kg at the flange origin
@@ -87,6 +88,13 @@ class TorqueLimits:
     rated_torque: np.ndarray  # (n,) N m, signed
     rated_pose: np.ndarray  # (n, n) rad
     rated_bound: np.ndarray  # (n,) N m: |rated torque| <= this in every pose (inf: not needed, a given limit)
+    out_of_time: bool = False  # the analysis' deadline cut the search and proofs short
+
+    @property
+    def highest(self) -> np.ndarray:
+        """The largest each limit may be (n,) N m: a derived limit is the rated payload's
+        worst torque found, which its proof only bounds (the same where the proof closed)."""
+        return np.where(np.array(self.source) == "derived", np.maximum(self.values, self.rated_bound), self.values)
 
     def reason(self, j: int) -> str:
         """Why joint j has its limit, in words."""
@@ -110,6 +118,7 @@ class WorkspaceLoad:
     pose: np.ndarray  # (n, n) rad
     max_payload: MaxPayload
     bound: np.ndarray  # (n,) N m: |tau_j| <= bound_j in every pose
+    out_of_time: bool = False  # the analysis' deadline cut the search and proofs short
 
     @property
     def gap(self) -> np.ndarray:
@@ -133,7 +142,7 @@ def derive_torque_limits(model: RobotModel, rated_payload: RigidBody = RATED_PAY
     loaded = loads(np.where(given, 0.0, bound))
     source = np.where(given, "given", np.where(loaded, "derived", "none"))
     limits = np.where(given, model.torque_limits, np.where(loaded, np.abs(torque), np.inf))
-    return TorqueLimits(tuple(limits.tolist()), tuple(source.tolist()), rated_payload, torque, pose, bound)
+    return TorqueLimits(tuple(limits.tolist()), tuple(source.tolist()), rated_payload, torque, pose, bound, ran_out())
 
 
 def limit_values(limits: TorqueLimits | Sequence[float], n: int) -> np.ndarray:
@@ -188,7 +197,7 @@ def workspace_load(
     load = family.extremes(payload.mass, ranges, G0 + payload.mass * dG)
     torque, pose, bound = load.largest()
     best = _workspace_max_payload(family, ranges, L, G0, dG, payload.mass, load)
-    return WorkspaceLoad(payload, torque, pose, best, bound)
+    return WorkspaceLoad(payload, torque, pose, best, bound, ran_out())
 
 
 def _workspace_max_payload(family, ranges, L, G0, dG, own_mass: float, load: Extremes) -> MaxPayload:
@@ -201,9 +210,9 @@ def _workspace_max_payload(family, ranges, L, G0, dG, own_mass: float, load: Ext
         _, poses = _most_loaded(family, ranges, dG)
         best = _smallest_max_payload(family, poses, L)
     for round_ in range(_PROOF_ROUNDS):
-        found = None
-        while math.isfinite(best.mass):  # Dinkelbach
-            found = family.search(best.mass, ranges, G0 + best.mass * dG, warm=poses)
+        found, searched = None, math.nan
+        while math.isfinite(best.mass) and not out_of_time():  # Dinkelbach
+            found, searched = family.search(best.mass, ranges, G0 + best.mass * dG, warm=poses), best.mass
             poses = found[1]
             candidate = _smallest_max_payload(family, poses, L)
             if not _lighter(candidate, best):
@@ -212,10 +221,10 @@ def _workspace_max_payload(family, ranges, L, G0, dG, own_mass: float, load: Ext
         if math.isnan(best.mass):
             return best  # a real pose the arm cannot hold even empty
         m = min(best.mass, MAX_MASS)  # beyond the sanity cap no mass is valid anyway
-        found = found if m == best.mass else None  # the last search was at that mass
+        found = found if m == searched else None  # the last search was at that mass
         proven = family.extremes(m, ranges, G0 + m * dG, warm=poses, rows=limited, share=MASS_PROOF_SHARE, found=found)
         candidate = _smallest_max_payload(family, proven.poses, L)
-        if not _lighter(candidate, best) or round_ == _PROOF_ROUNDS - 1:
+        if not _lighter(candidate, best) or round_ == _PROOF_ROUNDS - 1 or out_of_time():
             break  # (in the last round the bounds, over the limits, make the mass proven lower)
         best, poses = candidate, proven.poses
     return _proven_mass(family, ranges, L, G0, best, proven, limited, (own_mass, load))

@@ -10,8 +10,10 @@ since every term is linear in joint k's rotation. Three evaluations give A, B, C
 maximum of A + R cos(q_k - phi) over [lower_k, upper_k] is known in closed form. Coordinate
 ascent with this exact 1-D maximum runs for many starts and many objectives at once (each
 objective a weighted sum w . tau, e.g. +tau_j or -tau_j) until a sweep gains less than
-1e-12 of the torque scale. The samples are quasi-random poses plus the right-angle poses,
-where maxima often lie; of equal maxima the simplest pose is returned.
+1e-12 of the torque scale, or the analysis is out of time or cancelled (see ``stop``: checked
+at each step; the poses reached so far are real, their torques lower bounds of the maxima).
+The samples are quasi-random poses plus the right-angle poses, where maxima often lie; of
+equal maxima the simplest pose is returned.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.payload.stop import out_of_time
 
 StaticTorque = Callable[[np.ndarray], np.ndarray]  # Q (N, n) -> tau (N, n)
 
@@ -127,6 +130,8 @@ class JointRanges:
         for _ in range(max_sweeps):
             before, X_before = F, X.copy()
             for k in range(X.shape[-1]):
+                if out_of_time():
+                    return X, self._values(torque, W, X)
                 X, F = self._coordinate_step(torque, W, X, k, tol)
             step, last = X - X_before, step
             lam = np.sum(step * last, axis=-1) / np.maximum(np.sum(last * last, axis=-1), 1e-300)
@@ -159,6 +164,8 @@ class JointRanges:
         wrapped nearest 0, then 0, then 0 with the next joint turning by it instead."""
         best = self._values(torque, W, poses)
         for k in range(poses.shape[-1]):
+            if out_of_time():
+                break
             for simpler in (_wrapped, _zeroed, _handed_on):
                 trial = np.clip(simpler(poses, k), self.lower, self.upper)
                 keep = self._values(torque, W, trial) >= best - tol

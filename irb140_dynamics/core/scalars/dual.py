@@ -43,9 +43,15 @@ def _unit(n, k, value):
 
 
 def dual_angles(cs):
-    """(cos, sin) pairs of the joint angles as dual numbers carrying d/dq_k."""
+    """(cos, sin) pairs of the joint angles as dual numbers carrying d/dq_k (a prismatic
+    joint's (d,) as (d,): d/dq_k d = 1)."""
     n = len(cs)
-    return [(Dual(c, _unit(n, k, -s)), Dual(s, _unit(n, k, c))) for k, (c, s) in enumerate(cs)]
+    return [
+        (Dual(x[0], _unit(n, k, 1.0)),)
+        if len(x) == 1
+        else (Dual(x[0], _unit(n, k, -x[1])), Dual(x[1], _unit(n, k, x[0])))
+        for k, x in enumerate(cs)
+    ]
 
 
 def partial(x, k):

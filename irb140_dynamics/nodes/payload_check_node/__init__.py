@@ -1,4 +1,5 @@
-"""payload_check_node: can the arm hold this payload; what is on the flange."""
+"""payload_check_node: can the arm hold this payload (``node``; ~/check waiting for the
+analysis of new parameters: ``check_service``); what is on the flange (``payload_estimator``)."""
 
 from irb140_dynamics.nodes import quiet_ctrl_c
 

@@ -3,7 +3,9 @@
 Serves       ~/check        std_srvs/Trigger: the configured payload (payload.* parameters)
                             against the joint torque limits, at the current joint state (if
                             joint_states was received) and in each joint's worst static pose
-                            over the joint ranges; the reply's message is the report
+                            over the joint ranges; success: it fits (proven); the reply's
+                            message: a one-line verdict (OK, OVER-LIMIT or UNPROVEN), then
+                            the report
              ~/estimate_payload, ~/clear_samples   std_srvs/Trigger: payload estimation from the
                             efforts at rest (see ros.estimation)
 Subscribes   joint_states   sensor_msgs/JointState (matched by joint name, as in id_node)
@@ -15,8 +17,10 @@ Torque limits: <joint>.torque_limit when > 0, else derived as in the report: the
 static torque of the rated payload over the joint ranges; none for a joint it cannot load.
 A joint state older than STALE_AFTER (node clock) is still used, and the check says so.
 The limits and the workspace analysis are computed off the executor after each accepted
-change (and at startup, up to STARTUP_WAIT before the node comes up); until they are
-done, ~/check answers success false, "pending", at once.
+change (and at startup, up to STARTUP_WAIT before the node comes up), within
+check.analysis_timeout (what is not proven by then is UNPROVEN); a newer change cancels
+the analysis under way. Until they are done, ~/check waits for them, up to
+check.wait_timeout (see check_service).
 """
 
 from __future__ import annotations
@@ -27,7 +31,6 @@ from dataclasses import dataclass
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
-from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import RigidBody, RobotModel, gravity, rnea
 from irb140_dynamics.core.io.stamps import seconds
@@ -39,6 +42,8 @@ from irb140_dynamics.core.payload import (
     workspace_load,
 )
 from irb140_dynamics.core.payload.mass_com_estimation import EstimationError
+from irb140_dynamics.core.payload.stop import stopping
+from irb140_dynamics.nodes.payload_check_node.check_service import CheckService
 from irb140_dynamics.nodes.payload_check_node.payload_estimator import (
     ESTIMATION_PARAMETERS,
     PayloadEstimator,
@@ -69,6 +74,8 @@ from irb140_dynamics.ros.runtime.spin import run
 
 MIN_DIAGNOSTICS_PERIOD, MAX_DIAGNOSTICS_PERIOD = 0.1, 3600.0  # s
 MAX_WARN_USE = 1e6  # %
+MIN_ANALYSIS_TIME, MAX_ANALYSIS_TIME = 0.1, 3600.0  # s: check.analysis_timeout
+MAX_WAIT = 600.0  # s: check.wait_timeout
 NODE_PARAMETERS = [
     Spec(
         "rated_payload.mass",
@@ -97,6 +104,25 @@ NODE_PARAMETERS = [
         maximum=MAX_DIAGNOSTICS_PERIOD,
         read_only=True,
     ),
+    Spec(
+        "check.analysis_timeout",
+        20.0,
+        f"the analysis of new parameters (limits, workspace) stops after this long, {MIN_ANALYSIS_TIME:g} to "
+        f"{MAX_ANALYSIS_TIME:g}; what it has not proven by then ~/check answers UNPROVEN",
+        "s",
+        minimum=MIN_ANALYSIS_TIME,
+        maximum=MAX_ANALYSIS_TIME,
+        read_only=True,
+    ),
+    Spec(
+        "check.wait_timeout",
+        30.0,
+        f"~/check waits this long for the analysis of new parameters in progress, 0 to {MAX_WAIT:g}; "
+        "after it answers UNPROVEN (still running)",
+        "s",
+        minimum=0.0,
+        maximum=MAX_WAIT,
+    ),
     *ESTIMATION_PARAMETERS,
     *QOS_PARAMETERS,
 ]
@@ -113,6 +139,7 @@ class Draft:
     warn_use: float
     rest_velocity: float  # rad/s, payload estimation
     rest_time: float  # s
+    analysis_timeout: float = MAX_ANALYSIS_TIME  # s
 
 
 @dataclass(frozen=True)
@@ -139,20 +166,28 @@ def check_settings(values: dict) -> Draft:
             f"diagnostics.period: must be 0 (only on ~/check) or between {MIN_DIAGNOSTICS_PERIOD:g} "
             f"and {MAX_DIAGNOSTICS_PERIOD:g} s, got {period}"
         )
+    analysis_timeout = check_number(
+        "check.analysis_timeout", values["check.analysis_timeout"], MIN_ANALYSIS_TIME, MAX_ANALYSIS_TIME, "s"
+    )
+    check_number("check.wait_timeout", values["check.wait_timeout"], 0.0, MAX_WAIT, "s")
     check_qos(values)
     check_estimation(values)
-    return Draft(model, rated, warn_use, values["estimation.rest_velocity"], values["estimation.rest_time"])
+    return Draft(
+        model, rated, warn_use, values["estimation.rest_velocity"], values["estimation.rest_time"], analysis_timeout
+    )
 
 
 def finish_settings(draft: Draft, previous: PayloadCheckSettings | None) -> PayloadCheckSettings:
     """Derive the limits and analyse the workspace (seconds for a large model: runs off the
-    executor); what the previous settings computed for the same arm is reused."""
+    executor, within draft.analysis_timeout); what the previous settings computed for the
+    same arm is reused."""
     model, rated = draft.model, draft.rated_payload
-    limits = previous.limits if _same_arm(draft, previous) else derive_torque_limits(model, rated)
-    if analysed(draft, previous):
-        workspace = previous.workspace
-    else:
-        workspace = workspace_load(model, model.payload, limits)
+    with stopping(seconds=draft.analysis_timeout):
+        limits = previous.limits if _same_arm(draft, previous) else derive_torque_limits(model, rated)
+        if analysed(draft, previous):
+            workspace = previous.workspace
+        else:
+            workspace = workspace_load(model, model.payload, limits)
     return PayloadCheckSettings(model, rated, draft.warn_use, limits, workspace, draft.rest_velocity, draft.rest_time)
 
 
@@ -168,12 +203,6 @@ def _same_arm(draft: Draft, previous: PayloadCheckSettings | None) -> bool:
 def analysed(draft: Draft, previous: PayloadCheckSettings | None) -> bool:
     """Nothing to analyse: the previous settings had the same arm and payload."""
     return _same_arm(draft, previous) and previous.model.payload == draft.model.payload
-
-
-def _failed_check(request, response, error):
-    response.success = False
-    response.message = f"not checked: internal error {type(error).__name__}: {error}"
-    return response
 
 
 class PayloadCheckNode(Node):
@@ -193,7 +222,7 @@ class PayloadCheckNode(Node):
             self._use(self.parameters.current)
 
         self.create_subscription(JointState, "joint_states", self._on_joint_state, joint_states_qos(self))
-        self.create_service(Trigger, "~/check", self._on_check)
+        self.check_service = CheckService(self, self._on_check, lambda: self.parameters.pending_since is not None)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         period = self.get_parameter("diagnostics.period").value
         if period > 0.0:
@@ -205,7 +234,7 @@ class PayloadCheckNode(Node):
             mass, com = self.get_parameter("payload.mass").value, list(self.get_parameter("payload.com").value)
             self.get_logger().info(
                 f"ready: ~/check for a {mass} kg payload at {com} m "
-                "(its workspace analysis still running: ~/check says pending)"
+                "(its workspace analysis still running: ~/check waits for it)"
             )
 
     def _use(self, settings: PayloadCheckSettings) -> None:
@@ -295,7 +324,8 @@ class PayloadCheckNode(Node):
         return result, stale
 
     def _not_ready(self) -> str | None:
-        """None when the parameters in force have been analysed; else why ~/check cannot answer."""
+        """None when the parameters in force have been analysed; else why not (yet), for
+        /diagnostics and ~/check (which first waits while an analysis is pending)."""
         status = self.parameters.status()
         if status is None and self.settings is not None:
             return None
@@ -306,7 +336,7 @@ class PayloadCheckNode(Node):
             return "no model yet: waiting for a URDF on the robot_description topic"
         return (
             f"pending: the limits and workspace analysis of the new parameters are running "
-            f"(for {time.monotonic() - since:.1f} s); ask again shortly"
+            f"(for {time.monotonic() - since:.1f} s); ~/check waits for them"
         )
 
     def _publish(self, statuses) -> None:
@@ -330,11 +360,11 @@ class PayloadCheckNode(Node):
         name = self.get_name()
         self._publish([DiagnosticStatus(level=level, name=f"{name}: payload", hardware_id=name, message=why)])
 
-    @guarded("check", fallback=_failed_check)
     def _on_check(self, request, response):
+        """~/check's answer now (see check_service: it waits for the analysis first)."""
         why = self._not_ready()
         if why is not None:
-            response.success, response.message = False, why
+            response.success, response.message = False, f"UNPROVEN: {why}"
             return response
         result, stale = self.check()
         response.success = result.ok

@@ -8,6 +8,8 @@ NODE_PARAMETER_NAMES = frozenset(
     {
         "acceleration.cutoff_frequency",
         "acceleration.mode",
+        "check.analysis_timeout",
+        "check.wait_timeout",
         "collision.observer_gain",
         "command_timeout",
         "diagnostics.period",
@@ -34,8 +36,10 @@ NODE_PARAMETER_NAMES = frozenset(
         "rated_payload.mass",
         "reference_timeout",
         "reset_hold",
+        "retime.grid",
         "substeps",
         "thread_priority",
+        "watch_topic",
     }
 )
 # per-joint parameters of a node: <joint><suffix>

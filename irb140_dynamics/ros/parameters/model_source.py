@@ -12,14 +12,16 @@
   nothing) until a valid model arrives; each later URDF is checked whole, with the current
   parameters, and then swapped in at once, or refused (logged) keeping the model in use.
   The per-joint parameters are not declared in this mode: the URDF gives the joints, their
-  names, inertials, limits and friction; ``gravity``, ``friction.smoothing_velocity``,
-  ``payload.*`` (on the tip link) and the node's own parameters work as with parameters.
+  names, inertials, limits and friction; ``gravity`` (here in the URDF's root frame, turned
+  into base_link's), ``friction.smoothing_velocity``, ``payload.*`` (on the tip link) and
+  the node's own parameters work as with parameters. The loader's warnings (inertials
+  taken as given) are logged as warnings, its notes (invalid inertials off the chain) as info.
 """
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 import rclpy
@@ -32,7 +34,7 @@ from std_msgs.msg import String
 
 from irb140_dynamics.core import Joint, RigidBody, RobotModel
 from irb140_dynamics.core.errors import one_line
-from irb140_dynamics.core.io.urdf import LoadedUrdf, load_urdf
+from irb140_dynamics.core.io.urdf import LoadedUrdf, UrdfError, load_urdf, read_urdf
 from irb140_dynamics.ros.parameters.live import LiveParameters
 from irb140_dynamics.ros.parameters.specs import Spec, _declare, check_choice, declare_model, model_specs
 from irb140_dynamics.ros.runtime.spin import init_error
@@ -136,9 +138,14 @@ class RobotDescription:
         self.parameters.robot_name = self.urdf.robot_name or "robot"
         names, held = list(self.urdf.model.joint_names), self.urdf.held_joints
         held = f"; held at zero: {', '.join(held)}" if held else ""
-        self._node.get_logger().info(
+        logger = self._node.get_logger()
+        logger.info(
             f"model from the {origin}: {self.urdf.base_link} -> {self.urdf.tip_link}, {len(names)} joints {names}{held}"
         )
+        for warning in self.urdf.warnings:
+            logger.warning(warning)
+        for note in self.urdf.notes:
+            logger.info(f"note: {note}")
 
     def _build(self, values: dict) -> Any:
         """The node's checked configuration (its draft) from the URDF's model and the
@@ -151,6 +158,10 @@ class RobotDescription:
         return self._build_with(self.urdf, values)
 
     def _build_with(self, urdf: LoadedUrdf, values: dict) -> Any:
+        """``gravity`` is given in the URDF's root frame: the model takes it in base_link's."""
+        values = dict(values)
+        with contextlib.suppress(KeyError, TypeError, ValueError):  # absent or not 3 numbers: the check names it
+            values["gravity"] = urdf.in_base(values["gravity"])
         return self._build_node({**urdf.model.to_params(), **values})
 
     def _on_description(self, msg: String) -> None:
@@ -198,7 +209,8 @@ def model_from_arguments(args: list[str], name: str) -> RobotModel:
 
 
 def _read(path: str) -> str:
+    """The file's text, bounded (``read_urdf``: a regular file, of at most MAX_URDF_CHARS)."""
     try:
-        return Path(path).read_text()
-    except (OSError, UnicodeDecodeError) as error:
-        raise ValueError(f"model.urdf_file: cannot read {path}: {getattr(error, 'strerror', None) or error}") from None
+        return read_urdf(path)
+    except UrdfError as error:
+        raise ValueError(f"model.urdf_file: {error.reason}") from None

@@ -23,7 +23,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from irb140_dynamics.core.io.params_file import read_parameter_file
-from irb140_dynamics.core.model.joints import MAX_FRICTION
+from irb140_dynamics.core.model.joints import MAX_FRICTION, param_prefix
 from irb140_dynamics.core.model.rigid_body import MAX_MASS as CORE_MAX_MASS
 from irb140_dynamics.core.model.robot_model import check_joint_names
 from irb140_dynamics.package_files import CONFIG_NAME, PACKAGE, default_config_path  # noqa: F401 (PACKAGE, CONFIG_NAME: re-exported)
@@ -113,7 +113,8 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
             "payload", "the payload on the flange", "flange frame", lambda name, kind: defaults.get(name, kind)
         ),
     ]
-    for joint in joint_names:
+    for name in joint_names:
+        joint = param_prefix(name)  # the joint's parameter prefix (its name, if a parameter name)
         specs += [
             Spec(
                 f"{joint}.dh",

@@ -11,7 +11,11 @@ callback hands it to ``deliver``. The
 timer runs on the steady clock, so that a node on simulated time (use_sim_time) takes its
 parameter changes while the simulation stands still too. Only the newest job waiting is
 kept: jobs submitted while one is being built collapse into the latest, and every job
-finished is delivered (in order), so the newest always follows within two builds.
+finished is delivered (in order). A job submitted while another is being built cancels
+that one (so does the shutdown of the node's context): a build that checks
+``core.payload.stop.out_of_time`` (the payload analysis does) stops at its next check and
+is not delivered, so the newest follows as soon as if the old had never started; a build
+that does not check (compiling kernels) runs to its end, and the newest follows it.
 
 While a build runs, the executor thread must still get the interpreter lock quickly:
 ``submit`` lowers the interpreter's switch interval to SWITCH_INTERVAL (process-wide; it
@@ -28,6 +32,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from rclpy.clock import Clock, ClockType
+
+from irb140_dynamics.core.payload.stop import Cancelled, stopping
 
 SWITCH_INTERVAL = 2e-4  # s: how long the message thread may wait for the interpreter lock
 POLL_PERIOD = 0.002  # s: how soon a finished build is swapped in
@@ -54,17 +60,26 @@ class _Work:
         self.finished: tuple[int, Any] | None = None  # the newest result not yet delivered
         self.done = threading.Event()  # set whenever a result is waiting to be delivered
         self.previous = None  # the last result built
+        self.cancel = threading.Event()  # set to cancel the build under way
+        self.cancelled = 0  # builds cancelled (superseded, or the context shut down)
 
     def run(self) -> None:
         """The worker thread: build jobs until there are none."""
         while True:
             with self.lock:
-                if self.job is None:
-                    self.thread = False
+                if self.job is None:  # (a job dropped by stop() leaves nothing to wait for)
+                    self.thread = self.busy = False
                     return
                 (generation, job), self.job = self.job, None
+                cancel = self.cancel = threading.Event()
             try:
-                result = self.previous = self.build(job, self.previous)
+                with stopping(cancel):
+                    result = self.previous = self.build(job, self.previous)
+            except Cancelled:
+                with self.lock:
+                    self.cancelled += 1
+                    self.busy = self.job is not None
+                continue
             except Exception as error:  # noqa: BLE001  (reported to the node, not raised in a thread)
                 result = Failed(error)
             with self.lock:
@@ -76,9 +91,17 @@ class _Work:
         with self.lock:
             self.job = (generation, job)
             self.busy = True
+            self.cancel.set()  # the build under way, if any, is superseded
             if not self.thread:
                 self.thread = True
                 threading.Thread(target=self.run, name=name, daemon=True).start()
+
+    def stop(self) -> None:
+        """Drop the job waiting and cancel the one under way (superseded by a build done
+        elsewhere, or the context shuts down)."""
+        with self.lock:
+            self.job = None
+            self.cancel.set()
 
 
 class Builder:
@@ -90,6 +113,7 @@ class Builder:
         self._node, self._deliver, self._name = node, deliver, name
         self._work = _Work(build)
         self._poll = None  # the timer, while a build is under way
+        node.context.on_shutdown(self._work.stop)  # (held weakly: a bound method)
 
     @property
     def previous(self):
@@ -109,8 +133,15 @@ class Builder:
             sys.setswitchinterval(SWITCH_INTERVAL)
         self._work.submit(generation, job, self._name)
 
+    @property
+    def cancelled(self) -> int:
+        """How many builds were cancelled."""
+        return self._work.cancelled
+
     def build_here(self, generation: int, job: Any) -> None:
-        """Build ``job`` on this (the executor) thread and deliver it: for quick builds."""
+        """Build ``job`` on this (the executor) thread and deliver it: for quick builds.
+        The worker's jobs, older, are superseded: dropped, and its build cancelled."""
+        self._work.stop()
         try:
             result = self.previous = self._work.build(job, self.previous)
         except Exception as error:  # noqa: BLE001  (reported to the node like a worker's)

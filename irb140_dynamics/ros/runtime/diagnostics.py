@@ -19,13 +19,14 @@ OK, WARN, ERROR = DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.E
 def payload_statuses(
     check: PayloadCheck, node_name: str, warn_use: float, stale: str | None = None
 ) -> list[DiagnosticStatus]:
-    """One status per joint (OK; WARN from ``warn_use`` % or when the payload loads a joint
-    without a limit; ERROR over its limit), then one for the payload with the largest
-    payloads, WARN at least when ``stale`` (how old the joint state is) is given."""
+    """One status per joint (OK; WARN from ``warn_use`` %, when the payload loads a joint
+    without a limit, or when its proof cannot tell whether it is within its limit; ERROR
+    proven over its limit), then one for the payload with the largest payloads and the
+    verdict (``PayloadCheck.headline``), WARN at least when ``stale`` (how old the joint
+    state is) is given."""
     statuses = [_joint_status(check, j, node_name, warn_use) for j in range(len(check.joint_names))]
     figures = check.payload_figures()
-    verdict = "over the limit at " + ", ".join(check.over) if check.over else "OK"
-    message = f"{figures['payload mass [kg]']} kg: {verdict}"
+    message = check.headline()
     level = max(status.level for status in statuses)
     if stale is not None:
         level, message = max(level, WARN), f"{message}; stale joint_states"
@@ -45,13 +46,19 @@ def _joint_status(check: PayloadCheck, j: int, node_name: str, warn_use: float) 
     limit = check.limit[j]
     uses = {"worst use": check.worst_use[j], **({} if check.use is None else {"use now": check.use[j]})}
     most = max(uses, key=uses.get)
-    if not check.within[j]:
+    if check.beyond[j]:
         level = ERROR
+    elif not check.within[j]:
+        level = WARN
     elif math.isfinite(limit):
         level = WARN if uses[most] >= warn_use else OK
     else:
         level = WARN if j in check.loaded_without_limit else OK
-    if math.isfinite(limit):
+    if not check.beyond[j] and not check.within[j]:
+        message = (
+            f"unproven: {figures[most]} of its {figures['limit [N m]']} N m limit by its bound: {check.unfinished}"
+        )
+    elif math.isfinite(limit):
         message = f"{figures[most]} of its {figures['limit [N m]']} N m limit"
     elif level == WARN:
         message = check.no_limit_note(j)

@@ -1,20 +1,30 @@
 """A URDF's chain from base_link to tip_link as a RobotModel.
 
-- The chain's revolute and continuous joints become the model's joints, in URDF form
-  (origin, axis; link frames are the URDF's child links' frames), named as in the URDF.
+- The chain's revolute, continuous and prismatic joints become the model's joints, in
+  URDF form (origin, axis; link frames are the URDF's child links' frames), named as in
+  the URDF (any name: the parameter form maps it, see ``model``).
 - Fixed joints are merged: a body fixed to a moving link is lumped into it (inertial
   moved and turned into the link's frame), and the fixed joints between two moving
   joints make up the next one's origin. Fixed joints after the last moving joint up to
   tip_link give the model's ``flange`` (the tip_link frame, where the payload sits).
 - Joints hanging off the chain (a gripper's fingers) are held at zero: their bodies are
   lumped into the chain link they hang from, and their names are returned.
-- Bodies that do not move (base_link, what is fixed to it, what is above it) are left out.
+- Bodies that do not move (base_link, what is fixed to it, what is above it) are left out;
+  their inertials are not checked (an invalid one is a ``note``).
+- Gravity is the root link's -z (9.81 m/s^2), expressed in base_link's frame with the
+  joints between them at zero.
 - <limit lower upper> are the position limits (continuous joints: CONTINUOUS_LIMITS),
-  ``effort`` the torque limit, ``velocity`` the velocity limit (0 or absent: none);
-  <dynamics damping friction> are viscous and Coulomb friction.
-- Refused, with UrdfError naming the element: prismatic, floating and planar joints and
-  mimic joints in the chain; a revolute joint without <limit>; a moving link without
-  <inertial> when nothing it carries has mass; besides everything ``tree`` refuses.
+  ``effort`` the torque (prismatic: force) limit, ``velocity`` the velocity limit (0 or
+  absent: none); <dynamics damping friction> are viscous and Coulomb friction.
+- The inertials the chain carries are checked: unreadable, not finite, a negative mass:
+  refused; finite but not physically possible (triangle inequality, slightly negative
+  moments, as vendor files have them): taken as given, with a ``warning`` naming the link.
+- A joint that moves no mass (nothing after it has an inertial) is a ``warning``: M(q) is
+  then singular, forward dynamics needs a payload.
+- Refused, with UrdfError naming the element: floating and planar joints and mimic joints
+  in the chain; a revolute or prismatic joint without <limit>; a chain of more than
+  ``max_joints`` moving joints; besides everything ``tree`` refuses (size, binary input,
+  loops).
 """
 
 from __future__ import annotations
@@ -25,13 +35,25 @@ from functools import reduce
 
 import numpy as np
 
-from irb140_dynamics.core.io.urdf.tree import UrdfError, UrdfJoint, UrdfTree, number, parse_tree
+from irb140_dynamics.core.io.text_files import InputFileError, read_text_file
+from irb140_dynamics.core.io.urdf.tree import (
+    UrdfError,
+    UrdfJoint,
+    UrdfTree,
+    checked_text,
+    clipped,
+    inertial_problem,
+    number,
+    parse_tree,
+)
 from irb140_dynamics.core.model.joints import Friction, Joint, Placement, matrix_rpy
 from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, combine, placed
 from irb140_dynamics.core.model.robot_model import RobotModel
 
-MOVING = ("revolute", "continuous")
+MOVING = ("revolute", "continuous", "prismatic")
 CONTINUOUS_LIMITS = (-4 * math.pi, 4 * math.pi)  # rad: two turns either way, every angle within
+MAX_JOINTS = 100  # moving joints in a chain at most (the longest public arms and legs have 10)
+GRAVITY = 9.81  # m/s^2, along the root link's -z
 
 
 @dataclass(frozen=True)
@@ -42,26 +64,50 @@ class LoadedUrdf:
     base_link: str
     tip_link: str
     held_joints: tuple[str, ...]  # moving joints off the chain, held at zero, bodies lumped
+    warnings: tuple[str, ...] = ()  # the chain's inertials taken as given though not physical
+    notes: tuple[str, ...] = ()  # invalid inertials off the chain, ignored
+    base_rotation: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))  # base_link's axes in the root's
     robot_name: str = ""  # <robot name="...">: the hardware_id of the nodes' /diagnostics
 
+    def in_base(self, vector) -> tuple[float, float, float]:
+        """A vector given in the root link's frame (gravity) in base_link's frame."""
+        return tuple(float(x) + 0.0 for x in np.asarray(self.base_rotation).T @ np.asarray(vector, dtype=float))
 
-def load_urdf(text: str, base_link: str | None = None, tip_link: str | None = None) -> LoadedUrdf:
+
+def load_urdf(
+    text: str,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    max_chars: int | None = None,
+    max_joints: int = MAX_JOINTS,
+) -> LoadedUrdf:
     """The chain from ``base_link`` (default: the root link) to ``tip_link`` (default: the
-    only leaf below base_link) as a RobotModel (gravity and payload: the defaults)."""
-    tree = parse_tree(text)
+    only leaf below base_link) as a RobotModel (gravity: the root's -z; payload: none).
+    ``max_chars``: the text's size limit (default: MAX_URDF_CHARS, or IRB140_MAX_FILE_BYTES)."""
+    tree = parse_tree(text, max_chars)
     base, tip, path = tree.chain(base_link, tip_link)
+    span = f"from {clipped(repr(base), 60)} to {clipped(repr(tip), 60)}"
     for joint in path:
         if joint.kind not in ("fixed", *MOVING):
             raise UrdfError(
                 joint.label,
-                f"a {joint.kind} joint in the chain from {base!r} to {tip!r}: only "
-                "revolute, continuous and fixed joints are supported there",
+                f"a {joint.kind} joint in the chain {span}: only revolute, continuous, "
+                "prismatic and fixed joints are supported there",
             )
-        if joint.element.find("mimic") is not None:
-            raise UrdfError(f"{joint.label} <mimic>", "a mimic joint in the chain is not supported")
+        mimic = joint.element.find("mimic")
+        if mimic is not None:
+            raise UrdfError(
+                f"{joint.label} <mimic>",
+                f"a mimic joint (following {clipped(repr(mimic.get('joint')), 60)}"
+                ") in the chain is not supported: end the chain before it (tip_link)",
+            )
     moving = [joint for joint in path if joint.kind in MOVING]
     if not moving:
-        raise UrdfError("chain", f"no revolute or continuous joint from {base!r} to {tip!r}")
+        raise UrdfError("chain", f"no revolute, continuous or prismatic joint {span}")
+    if len(moving) > max_joints:
+        raise UrdfError(
+            "chain", f"{len(moving)} moving joints {span}, more than the limit of {max_joints} (max_joints)"
+        )
 
     origins, since_last = [], Placement()
     for joint in path:
@@ -71,22 +117,81 @@ def load_urdf(text: str, base_link: str | None = None, tip_link: str | None = No
             origins.append(compose(since_last, joint.origin))
             since_last = Placement()
     held: list[str] = []
+    carried: list[list[str]] = []
     bodies = [
-        lumped(tree, joint.child, moving[k + 1].name if k + 1 < len(moving) else None, held)
+        lumped(tree, joint.child, moving[k + 1].name if k + 1 < len(moving) else None, held, carried)
         for k, joint in enumerate(moving)
     ]
-    for k, (joint, (_, has_inertial)) in enumerate(zip(moving, bodies)):
-        if not has_inertial and sum(body.mass for body, _ in bodies[k:]) == 0.0:
-            raise UrdfError(
-                f'link "{joint.child}"',
-                f'moved by joint "{joint.name}": no <inertial>, and nothing it carries has mass',
+    warnings, physical = _checked_inertials(tree, carried)
+    for k, joint in enumerate(moving):
+        if sum(body.mass for body, _ in bodies[k:]) == 0.0:
+            warnings.append(
+                f'URDF joint "{clipped(joint.name, 100)}": moves no mass (M(q) is singular: forward '
+                "dynamics needs a payload)"
             )
-    joints = [_joint(joint, placement, body) for joint, placement, (body, _) in zip(moving, origins, bodies)]
+    joints = [
+        _joint(joint, placement, body, ok) for joint, placement, (body, _), ok in zip(moving, origins, bodies, physical)
+    ]
     try:
-        model = RobotModel(tuple(joints), flange=since_last)
+        model = RobotModel(tuple(joints), gravity=base_gravity(tree, base), flange=since_last)
     except ModelError as error:
         raise UrdfError("chain", str(error)) from None
-    return LoadedUrdf(model, base, tip, tuple(held), tree.name)
+    on_chain = {name for names in carried for name in names}
+    notes = [
+        f"{problem[1]} (off the chain: ignored)"
+        for name, body in tree.inertials.items()
+        if name not in on_chain and (problem := inertial_problem(name, body))
+    ]
+    rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
+    return LoadedUrdf(model, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name)
+
+
+def _checked_inertials(tree: UrdfTree, carried: list[list[str]]) -> tuple[list[str], list[bool]]:
+    """The warnings of the chain's inertials, and for each moving link whether all it
+    carries is physical; UrdfError for an inertial that cannot be used."""
+    warnings, physical = [], []
+    for names in carried:
+        ok = True
+        for name in names:
+            problem = inertial_problem(name, tree.inertials[name])
+            if problem is None:
+                continue
+            kind, error = problem
+            if kind == "refused":
+                raise error
+            warnings.append(f"{error}; taken as given")
+            ok = False
+        physical.append(ok)
+    return warnings, physical
+
+
+def base_rotation(tree: UrdfTree, base: str) -> np.ndarray:
+    """base_link's axes in the root link's frame, the joints between them at zero."""
+    R = np.eye(3)
+    for joint in tree.path_from_root(base):
+        R = R @ joint.origin.rotation()
+    return R
+
+
+def base_gravity(tree: UrdfTree, base: str) -> tuple[float, float, float]:
+    """The root link's -z gravity in ``base``'s frame, the joints between them at zero."""
+    g = base_rotation(tree, base).T @ np.array([0.0, 0.0, -GRAVITY])
+    g[np.abs(g) < 1e-12] = 0.0
+    return tuple(float(x) + 0.0 for x in g)
+
+
+def read_urdf(path, max_chars: int | None = None) -> str:
+    """The text of a URDF file, or UrdfError in one line: a regular file (not a device, a
+    pipe or a folder) of at most ``max_chars`` bytes (default: the input files' limit) of
+    UTF-8 text without control characters (``core.io.text_files``)."""
+    try:
+        text = read_text_file(path, "URDF file", max_chars)
+    except InputFileError as error:
+        raise UrdfError("file", clipped(str(error), 250)) from None
+    try:
+        return checked_text(text, len(text))
+    except UrdfError as error:
+        raise UrdfError("file", f"{clipped(str(path), 120)}: {error.reason}") from None
 
 
 def compose(a: Placement, b: Placement) -> Placement:
@@ -103,28 +208,37 @@ def compose(a: Placement, b: Placement) -> Placement:
     return Placement(xyz, matrix_rpy(a.rotation() @ b.rotation()))
 
 
-def lumped(tree: UrdfTree, link: str, stop: str | None, held: list[str]) -> tuple[RigidBody, bool]:
+def lumped(
+    tree: UrdfTree, link: str, stop: str | None, held: list[str], carried: list[list[str]]
+) -> tuple[RigidBody, bool]:
     """Everything rigidly attached to ``link`` (joints off the chain at zero), up to the
-    chain joint ``stop``, as one body in ``link``'s frame; and whether any had an inertial."""
-    bodies, stack = [], [(link, np.eye(4))]
-    while stack:
-        name, T = stack.pop()
-        if tree.inertials[name] is not None:
-            bodies.append(placed(tree.inertials[name], T[:3, :3], T[:3, 3]) if name != link else tree.inertials[name])
-        for joint in tree.child_joints[name]:
-            if joint.name == stop:
-                continue
-            if joint.kind != "fixed":
-                held.append(joint.name)
-            stack.append((joint.child, T @ joint.origin.matrix()))
-    return (reduce(combine, bodies) if bodies else RigidBody()), bool(bodies)
+    chain joint ``stop``, as one body in ``link``'s frame; and whether any had an inertial.
+    The names of the links with an inertial are appended to ``carried`` as a list."""
+    bodies, stack, names = [], [(link, np.eye(4))], []
+    carried.append(names)
+    with np.errstate(all="ignore"):  # a non-finite inertial is refused by _checked_inertials
+        while stack:
+            name, T = stack.pop()
+            inertial = tree.inertials[name]
+            if inertial is not None:
+                names.append(name)
+                if not isinstance(inertial, RigidBody):  # unreadable: _checked_inertials refuses it
+                    continue
+                bodies.append(placed(inertial, T[:3, :3], T[:3, 3]) if name != link else inertial)
+            for joint in tree.child_joints[name]:
+                if joint.name == stop:
+                    continue
+                if joint.kind != "fixed":
+                    held.append(joint.name)
+                stack.append((joint.child, T @ joint.origin.matrix()))
+        return (reduce(combine, bodies) if bodies else RigidBody()), bool(names)
 
 
-def _joint(joint: UrdfJoint, origin: Placement, body: RigidBody) -> Joint:
+def _joint(joint: UrdfJoint, origin: Placement, body: RigidBody, physical: bool) -> Joint:
     where = f"{joint.label} <limit>"
     limit = joint.element.find("limit")
-    if limit is None and joint.kind == "revolute":
-        raise UrdfError(joint.label, "a revolute joint needs <limit lower upper effort velocity>")
+    if limit is None and joint.kind in ("revolute", "prismatic"):
+        raise UrdfError(joint.label, f"a {joint.kind} joint needs <limit lower upper effort velocity>")
     if joint.kind == "continuous":
         lower, upper = CONTINUOUS_LIMITS
     else:
@@ -152,4 +266,6 @@ def _joint(joint: UrdfJoint, origin: Placement, body: RigidBody) -> Joint:
         axis=joint.axis,
         velocity_limit=velocity,
         friction=Friction(damping, friction),
+        kind="prismatic" if joint.kind == "prismatic" else "revolute",
+        physical=physical,
     )

@@ -3,18 +3,39 @@
 Only what dynamics needs is read: joints (type, parent, child, origin, axis, limit,
 dynamics, mimic) and link inertials. Visuals, collisions, meshes, transmissions and
 gazebo tags are ignored (a <transmission>'s <joint> is not a joint of the tree).
+
+Inertials are read as written, not checked here: the loader checks those its chain
+carries (``inertial_problem``), the others do not matter. The input is bounded: at most
+``max_chars`` characters (default MAX_URDF_CHARS, or the environment's IRB140_MAX_FILE_BYTES,
+as every input file: ``core.io.text_files``), text only, and no walk of the tree recurses.
 """
 
 from __future__ import annotations
 
 import math
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
+import numpy as np
+
+from irb140_dynamics.core.io.text_files import MAX_TEXT_BYTES, size_limit
 from irb140_dynamics.core.model.joints import Placement
-from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, Vector3, placed
+from irb140_dynamics.core.model.rigid_body import (
+    MAX_INERTIA,
+    MAX_LENGTH,
+    MAX_MASS,
+    ZERO3,
+    ModelError,
+    RigidBody,
+    Vector3,
+    physical_inertia,
+    placed,
+)
 
 KINDS = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+MAX_URDF_CHARS = MAX_TEXT_BYTES  # characters of URDF text at most (IRB140_MAX_FILE_BYTES changes it)
+MAX_LINE = 299  # characters of a refusal line at most
 RIGHT_ANGLE_TOLERANCE = 1e-10  # rad: an <origin rpy> angle this close to a multiple of pi/2 is taken as it
 
 
@@ -22,7 +43,26 @@ class UrdfError(ModelError):
     """A URDF that cannot be used; ``field`` names the element (``URDF joint "x" <limit>``)."""
 
     def __init__(self, element: str, reason: str):
-        super().__init__(f"URDF {element}", reason)
+        element = clipped(element, 100)
+        super().__init__(f"URDF {element}", clipped(reason, MAX_LINE - len(element) - 7))
+
+
+def clipped(text: str, size: int) -> str:
+    """``text`` on one line, at most ``size`` characters ("..." where cut)."""
+    text = " ".join(str(text).split())
+    return text if len(text) <= size else text[: size - 3] + "..."
+
+
+def listed(names, size: int = 120) -> str:
+    """Names joined by ", ", cut to about ``size`` characters with the count of the rest."""
+    names = list(names)
+    shown, length = [], 0
+    for name in names:
+        length += len(name) + 2
+        if length > size:
+            return ", ".join(shown) + f", ... ({len(names) - len(shown)} more)"
+        shown.append(name)
+    return ", ".join(shown)
 
 
 @dataclass(frozen=True)
@@ -45,7 +85,7 @@ class UrdfTree:
     """Links (their inertial in the link frame, or None), joints, and the tree's shape."""
 
     name: str
-    inertials: dict[str, RigidBody | None]
+    inertials: dict[str, RigidBody | UrdfError | None]  # as written (unchecked), or why unreadable
     joints: dict[str, UrdfJoint]
     parent_joint: dict[str, UrdfJoint]  # link -> the joint whose child it is
     child_joints: dict[str, list[UrdfJoint]]  # link -> joints whose parent it is
@@ -61,36 +101,78 @@ class UrdfTree:
         else:
             leaves = self.leaves(base)
             if len(leaves) != 1:
-                raise UrdfError("tip_link", f"{len(leaves)} leaf links below {base!r}: {', '.join(leaves)}; name one")
+                raise UrdfError(
+                    "tip_link", f"{len(leaves)} leaf links below {clipped(repr(base), 60)}: {listed(leaves)}; name one"
+                )
             tip = leaves[0]
         joints, link = [], tip
         while link != base:
             if link not in self.parent_joint:
-                raise UrdfError("tip_link", f"{tip!r} is not below base_link {base!r}")
+                raise UrdfError(
+                    "tip_link", f"{clipped(repr(tip), 80)} is not below base_link {clipped(repr(base), 80)}"
+                )
             joints.append(self.parent_joint[link])
             link = joints[-1].parent
         return base, tip, joints[::-1]
 
     def leaves(self, link: str) -> list[str]:
-        children = self.child_joints[link]
-        return [link] if not children else [leaf for j in children for leaf in self.leaves(j.child)]
+        """The leaf links below ``link``, depth first (without recursion)."""
+        leaves, stack = [], [link]
+        while stack:
+            name = stack.pop()
+            children = self.child_joints[name]
+            if not children:
+                leaves.append(name)
+            stack += [j.child for j in reversed(children)]
+        return leaves
+
+    def path_from_root(self, link: str) -> list[UrdfJoint]:
+        """The joints from the root down to ``link``."""
+        joints = []
+        while link in self.parent_joint:
+            joints.append(self.parent_joint[link])
+            link = joints[-1].parent
+        return joints[::-1]
 
     def _known(self, what: str, link: str) -> None:
         if link not in self.inertials:
-            raise UrdfError(what, f"no link {link!r} in the URDF (links: {', '.join(self.inertials)})")
+            raise UrdfError(what, f"no link {clipped(repr(link), 80)} in the URDF (links: {listed(self.inertials)})")
 
 
-def parse_tree(text: str) -> UrdfTree:
-    """The tree of a URDF document, or UrdfError naming what is wrong."""
-    if not isinstance(text, str) or not text.strip():
+def checked_text(text, max_chars: int | None = None) -> str:
+    """``text`` if it can be URDF text: a str of at most ``max_chars`` characters (default:
+    the input files' limit, ``text_files.size_limit()``) without NUL or other control
+    characters (binary data); else UrdfError in one line."""
+    max_chars = size_limit(MAX_URDF_CHARS) if max_chars is None else max_chars
+    if isinstance(text, (bytes, bytearray)):
+        raise UrdfError("document", "bytes given, not text (decode it first)")
+    if not isinstance(text, str):
+        raise UrdfError("document", f"expected text, got {type(text).__name__}")
+    if len(text) > max_chars:
+        raise UrdfError("document", f"{len(text)} characters, more than the limit of {max_chars} (max_chars)")
+    binary = _CONTROL.search(text)
+    if binary:
+        raise UrdfError("document", f"binary data, not text (character {ord(binary.group()):#04x} at {binary.start()})")
+    if not text.strip():
         raise UrdfError("document", "empty")
+    return text
+
+
+_CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")
+
+
+def parse_tree(text: str, max_chars: int | None = None) -> UrdfTree:
+    """The tree of a URDF document, or UrdfError naming what is wrong."""
+    text = checked_text(text, max_chars)
     try:
         robot = ET.fromstring(text)
     except ET.ParseError as error:
         raise UrdfError("XML", f"does not parse: {error}") from None
+    except RecursionError:  # not with expat, kept as a guard: one line whatever the parser
+        raise UrdfError("XML", "nested too deeply") from None
     if robot.tag != "robot":
         raise UrdfError("document", f"the root element is <{robot.tag}>, not <robot>")
-    inertials: dict[str, RigidBody | None] = {}
+    inertials: dict[str, RigidBody | UrdfError | None] = {}
     for element in robot.findall("link"):
         name = _name(element, "link")
         if name in inertials:
@@ -114,7 +196,7 @@ def parse_tree(text: str) -> UrdfTree:
     if not roots:
         raise UrdfError("tree", "a loop: every link is the child of a joint")
     if len(roots) > 1:
-        raise UrdfError("tree", f"{len(roots)} root links (links no joint leads to): {', '.join(roots)}")
+        raise UrdfError("tree", f"{len(roots)} root links (links no joint leads to): {listed(roots)}")
     reached, stack = set(), [roots[0]]
     while stack:
         link = stack.pop()
@@ -122,7 +204,7 @@ def parse_tree(text: str) -> UrdfTree:
         stack += [j.child for j in child_joints[link]]
     if len(reached) != len(inertials):
         loop = [name for name in inertials if name not in reached]
-        raise UrdfError("tree", f"a loop through links {', '.join(loop)}")
+        raise UrdfError("tree", f"a loop through links {listed(loop)}")
     return UrdfTree(robot.get("name", ""), inertials, joints, parent_joint, child_joints, roots[0])
 
 
@@ -133,8 +215,10 @@ def _name(element: ET.Element, tag: str) -> str:
     return name
 
 
-def numbers(element: ET.Element | None, attribute: str, count: int, where: str, default=None) -> tuple[float, ...]:
-    """``count`` finite numbers from an attribute like xyz="0 0 0.1", or UrdfError."""
+def numbers(
+    element: ET.Element | None, attribute: str, count: int, where: str, default=None, finite: bool = True
+) -> tuple[float, ...]:
+    """``count`` finite numbers (``finite`` False: any) from an attribute like xyz="0 0 0.1", or UrdfError."""
     text = None if element is None else element.get(attribute)
     if text is None:
         if default is None:
@@ -144,13 +228,16 @@ def numbers(element: ET.Element | None, attribute: str, count: int, where: str, 
         values = tuple(float(x) for x in text.split())
     except ValueError:
         values = ()
-    if len(values) != count or not all(map(math.isfinite, values)):
-        raise UrdfError(where, f'{attribute}="{text}": expected {count} finite number{"s" * (count > 1)}')
+    if len(values) != count or (finite and not all(map(math.isfinite, values))):
+        shown = clipped(text, 60)
+        raise UrdfError(where, f'{attribute}="{shown}": expected {count} {"finite " * finite}number{"s" * (count > 1)}')
     return values
 
 
-def number(element: ET.Element | None, attribute: str, where: str, default: float | None = None) -> float:
-    return numbers(element, attribute, 1, where, None if default is None else (default,))[0]
+def number(
+    element: ET.Element | None, attribute: str, where: str, default: float | None = None, finite: bool = True
+) -> float:
+    return numbers(element, attribute, 1, where, None if default is None else (default,), finite)[0]
 
 
 def origin(parent: ET.Element, where: str) -> Placement:
@@ -170,22 +257,63 @@ def right_angle_snapped(angle: float) -> float:
     return exact if abs(angle - exact) < RIGHT_ANGLE_TOLERANCE else angle
 
 
-def _inertial(link: ET.Element, name: str) -> RigidBody | None:
+def _inertial(link: ET.Element, name: str) -> RigidBody | UrdfError | None:
+    """The link's inertial in its frame, as written (unchecked); or why it cannot be read."""
     element = link.find("inertial")
     if element is None:
         return None
     where = f'link "{name}" <inertial>'
-    mass = number(element.find("mass"), "value", f"{where} <mass>")
-    inertia = element.find("inertia")
-    moments = tuple(
-        number(inertia, key, f"{where} <inertia>", 0.0) for key in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
-    )
-    frame = origin(element, where)
-    try:  # checks the mass, positive semi-definiteness and the triangle inequality
-        body = RigidBody.validated("inertial", mass, inertia=moments)
+    try:
+        mass = number(element.find("mass"), "value", f"{where} <mass>", finite=False)
+        inertia = element.find("inertia")
+        moments = tuple(
+            number(inertia, key, f"{where} <inertia>", 0.0, finite=False)
+            for key in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+        )
+        frame = origin(element, where)
+    except UrdfError as error:
+        return error
+    body = RigidBody(mass, ZERO3, moments)
+    if frame.is_identity:
+        return body
+    with np.errstate(all="ignore"):
+        return placed(body, frame.rotation(), frame.xyz)
+
+
+def inertial_problem(name: str, body: RigidBody | UrdfError | None) -> tuple[str, UrdfError] | None:
+    """What is wrong with link ``name``'s inertial: ("refused", error) when it cannot be
+    used (unreadable, not finite, a negative mass, beyond the sanity caps), ("unphysical",
+    error) when it is finite but not physically possible (not positive semi-definite,
+    breaking the triangle inequality); None when it is fine."""
+    if body is None:
+        return None
+    if isinstance(body, UrdfError):
+        return "refused", body
+    if _plainly_fine(body):
+        return None
+    where = f'link "{clipped(name, 100)}" <inertial>'
+    try:
+        RigidBody.validated("", body.mass, body.com, body.inertia, physical=False)
     except ModelError as error:
-        raise UrdfError(f"{where} <{error.field.split('.')[-1]}>", error.reason) from None
-    return placed(body, frame.rotation(), frame.xyz)
+        return "refused", UrdfError(f"{where} <{error.field.split('.')[-1]}>", error.reason)
+    try:
+        physical_inertia("", body.inertia)
+    except ModelError as error:
+        return "unphysical", UrdfError(f"{where} <inertia>", error.reason)
+    return None
+
+
+def _plainly_fine(body: RigidBody) -> bool:
+    """Whether the inertial is finite, within the caps and physical, decided without NumPy
+    for the common case of principal axes (no products of inertia): a tree of thousands of
+    links is checked quickly. False: see ``inertial_problem``'s full checks."""
+    m, (cx, cy, cz), (xx, yy, zz, xy, xz, yz) = body.mass, body.com, body.inertia
+    if xy or xz or yz or not all(map(math.isfinite, (m, cx, cy, cz, xx, yy, zz))):
+        return False
+    if not (0.0 <= m <= MAX_MASS and math.hypot(cx, cy, cz) <= MAX_LENGTH and max(xx, yy, zz) <= MAX_INERTIA):
+        return False
+    a, b, c = sorted((xx, yy, zz))
+    return a >= 0.0 and a + b >= c
 
 
 def _joint(element: ET.Element, links) -> UrdfJoint:

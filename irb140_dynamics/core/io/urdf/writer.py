@@ -1,6 +1,6 @@
 """RobotModel -> URDF text, for robot_state_publisher, RViz and other URDF readers.
 
-Joint i is written in URDF form, whatever its form in the model: URDF link i's frame is
+Joint i is written in URDF form (revolute, or prismatic), whatever its form in the model: URDF link i's frame is
 joint i's *joint frame* (the model's link frame i-1 placed by pre_i and turned by
 Rot(axis_i, q_i + offset_i)), so that
 
@@ -57,7 +57,8 @@ def export_urdf(model: RobotModel, name: str = "robot", shapes: Mapping[str, Box
         turn = (
             Placement(rpy=matrix_rpy(axis_rotation(joint.turning_axis, joint.offset))) if joint.offset else Placement()
         )
-        element = _joint(robot, joint.name, "revolute", parent, link, compose(previous_post, compose(joint.pre, turn)))
+        kind = "prismatic" if joint.prismatic else "revolute"
+        element = _joint(robot, joint.name, kind, parent, link, compose(previous_post, compose(joint.pre, turn)))
         ET.SubElement(element, "axis", xyz=_text(joint.turning_axis))
         lower, upper = joint.position_limits
         ET.SubElement(

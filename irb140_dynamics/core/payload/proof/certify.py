@@ -26,7 +26,9 @@ bound of the exact maxima of the model's static torques.
 Cost: at most EVALUATIONS box bounds per call, each counted in units of a sum of TERMS
 terms (a box over a sum of d joints costs O(d 3^d)), in batches of at most BATCH boxes:
 the budget bounds the time whatever the model; for the IRB-140 and its rated payload the
-proof closes long before it is spent.
+proof closes long before it is spent. The analysis' stop (see ``stop``) is checked
+before each batch: cancelled, the proof is abandoned; out of time, it ends as when the
+budget is spent, its bounds proven but looser.
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ from irb140_dynamics.core.payload.proof.bounds import (
     sizes_of_s,
 )
 from irb140_dynamics.core.payload.proof.harmonic import Reduced
+from irb140_dynamics.core.payload.stop import out_of_time
 
 EVALUATIONS = 50_000  # box bounds per call, shared by the groups of objectives, counted in
 TERMS = 200  # bounds of sums of this many terms (the IRB-140's): a box over more terms counts more
@@ -102,7 +105,7 @@ def certify_maxima(objectives, lower, upper, incumbent, tol, polish=None, evalua
         climb = None if polish is None else (lambda local, theta, ks=ks: polish(ks[local], theta))
         groups.append((ks, _Group([objectives[k] for k in ks], lower[ks], upper[ks], incumbent[ks], tol[ks], climb)))
     spent = sum(group.advance(group.boxes) * group.cost for _, group in groups)  # the whole box, whatever the budget
-    while spent < evaluations:
+    while spent < evaluations and not out_of_time():
         open_groups = [group for _, group in groups if group.boxes]
         if not open_groups:
             break
@@ -155,6 +158,8 @@ class _Group:
         """Bound, drop, close or split up to ``evaluations`` boxes, best first; the number done."""
         spent = 0
         while self.owner.size and spent < evaluations:
+            if spent and out_of_time():  # (the first batch always: a bound of the whole box)
+                break
             lo, hi, owner, inherited, best, tol = self.lo, self.hi, self.owner, self.inherited, self.best, self.tol
             take = min(owner.size, BATCH, evaluations - spent)
             order = np.argsort(-inherited, kind="stable")
@@ -273,11 +278,12 @@ INTERVAL_WORK = 20_000  # box x joint evaluations of plain interval bounds (beyo
 def interval_maxima(evaluate, joints, signs, lower, upper, incumbent, tol, work: int = INTERVAL_WORK):
     """Upper bounds of sign_k tau[joint_k] over q in [lower, upper] (n,), from plain
     interval evaluations ``evaluate(lo, hi)`` -> (lo, hi) of the torques (n, B) over boxes
-    (B, n), bisecting the widest joint range while ``work`` lasts: loose, but proven."""
+    (B, n), bisecting the widest joint range while ``work`` (and the analysis' time) lasts:
+    loose, but proven."""
     K, n = len(joints), len(lower)
     lo, hi, owner = np.tile(lower, (K, 1)), np.tile(upper, (K, 1)), np.arange(K)
     inherited, closed, spent = np.full(K, np.inf), np.full(K, -np.inf), 0
-    while owner.size and spent + owner.size * n <= work:
+    while owner.size and spent + owner.size * n <= work and not out_of_time():
         low, high = evaluate(lo, hi)
         box = np.arange(owner.size)
         bound = np.where(signs[owner] > 0, high[joints[owner], box], -low[joints[owner], box])

@@ -1,0 +1,52 @@
+"""The equations of motion in closed form: LaTeX, SymPy, C99 and NumPy Python.
+
+The core's own scalar recursions (``algorithms``) run on SymPy symbols (``symbolic``), the
+common subexpressions are shared, and one emitter per form writes the files. Imports the
+core (algorithms, regressor, rigid_body) and SymPy; nothing of ROS.
+
+    files = generate(model, ("c",), prefix="irb140")      # {file name: text}
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from . import c_code, latex, python_code, sympy_code
+from .printing import reduced_quantities
+from .symbolic import DEFAULT_QUANTITIES, QUANTITIES, Equations, derive
+
+FORMS = ("latex", "sympy", "c", "python")
+_EMITTERS = {"c": c_code.render, "python": python_code.render, "sympy": sympy_code.render}
+
+__all__ = ["DEFAULT_QUANTITIES", "Equations", "FORMS", "QUANTITIES", "derive", "generate"]
+
+
+def generate(
+    model,
+    forms=("c",),
+    what=DEFAULT_QUANTITIES,
+    symbolic: bool = False,
+    prefix: str = "robot",
+    source: str = "a robot arm",
+    progress: Callable[[str], None] | None = None,
+) -> dict[str, str]:
+    """The files of the ``forms`` (of FORMS) for ``model``: {file name: text}. Same input,
+    same bytes. ``progress(stage)`` is told what is being done."""
+    unknown = [form for form in forms if form not in FORMS]
+    if unknown:
+        raise ValueError(f"unknown form {unknown[0]!r}: choose from {', '.join(FORMS)}")
+    if not prefix.isidentifier() or not prefix.isascii():
+        raise ValueError(f"prefix {prefix!r} is not a C identifier")
+    progress = progress or (lambda stage: None)
+    equations = derive(model, what, symbolic, progress)
+    progress("common subexpressions")
+    reduced = reduced_quantities(equations)
+    files = {}
+    for form in forms:
+        progress(f"writing the {form} form")
+        if form == "latex":
+            expanded = {} if symbolic else latex.series(model, set(reduced) & {"M", "Cqd", "g"})
+            files.update(latex.render(equations, reduced, prefix, source, expanded))
+        else:
+            files.update(_EMITTERS[form](equations, reduced, prefix, source))
+    return files

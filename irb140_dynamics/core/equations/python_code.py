@@ -1,0 +1,80 @@
+"""NumPy form: a module with functions tau, M, Cqd, g (and regressor) of one state or a batch.
+
+Each function takes arrays shaped (n,) (one state) or (N, n) (N states) and returns (n,) /
+(N, n) (M: (n, n) / (N, n, n)). The straight-line code runs once on whole columns of
+states, chunk by chunk so that its intermediates stay in the CPU caches.
+"""
+
+from __future__ import annotations
+
+from .printing import DESCRIPTIONS, PythonPrinter, header_lines, used_names
+from .symbolic import Equations
+
+_PRELUDE = '''
+import numpy as np
+from numpy import cos, sin, tanh  # noqa: F401 (used by the generated expressions)
+
+CHUNK = 4096  # states per pass
+
+
+def _run(kernel, shape, *arrays):
+    """kernel(columns...) -> entries, over one state or a batch of them, shaped (..., *shape)."""
+    arrays = [np.asarray(a, dtype=float) for a in arrays]
+    single = arrays[0].ndim == 1
+    columns = [np.ascontiguousarray(np.atleast_2d(a).T) for a in arrays]
+    N = columns[0].shape[1]
+    out = np.empty((N, *shape))
+    flat = out.reshape(N, -1)
+    for start in range(0, N, CHUNK):
+        part = slice(start, start + CHUNK)
+        for k, entry in enumerate(kernel(*(c[:, part] for c in columns))):
+            flat[part, k] = entry
+    return out[0] if single else out
+'''
+
+
+def render(eq: Equations, reduced: dict, prefix: str, source: str) -> dict[str, str]:
+    """{file name: text} of the module."""
+    doc = "\n".join(header_lines(eq, source))
+    lines = [f'"""{doc}\n\nFunctions of one state (arrays (n,)) or N states ((N, n)).\n"""', _PRELUDE]
+    lines.append(f"N_JOINTS = {eq.n}")
+    lines.append(f"JOINT_NAMES = {tuple(eq.joint_names)!r}")
+    if eq.parameters:
+        lines.append(f"PARAMETER_NAMES = {tuple(p.symbol.name for p in eq.parameters)!r}")
+        lines.append(f"PARAMETERS = np.array({[p.value for p in eq.parameters]!r})  # the model's values")
+    if eq.regressor_columns:
+        lines.append(f"REGRESSOR_COLUMNS = {eq.regressor_columns!r}")
+    for name, (replacements, outputs) in reduced.items():
+        lines += ["", ""] + _function(eq, name, replacements, outputs)
+    return {f"{prefix}_eom.py": "\n".join(lines) + "\n"}
+
+
+def _function(eq: Equations, name: str, replacements, outputs) -> list[str]:
+    printer = PythonPrinter()
+    args = list(eq.arguments[name])
+    shape = {"M": (eq.n, eq.n), "regressor": (eq.n, 13 * eq.n)}.get(name, (eq.n,))
+    signature = ", ".join(args + (["p=PARAMETERS"] if eq.parameters else []))
+    used = used_names(replacements, outputs)
+    kernel_args = args + (["p"] if eq.parameters else [])
+    lines = [f"def {name}({signature}):", f'    """{DESCRIPTIONS[name]}"""']
+    if eq.parameters:
+        lines.append("    p = np.asarray(p, dtype=float)")
+        lines.append(
+            f"    return _run(lambda {', '.join(args)}: _{name}({', '.join(args)}, p), {shape!r}, {', '.join(args)})"
+        )
+    else:
+        lines.append(f"    return _run(_{name}, {shape!r}, {', '.join(args)})")
+    lines += ["", "", f"def _{name}({', '.join(kernel_args)}):"]
+    for arg in args:
+        names = [f"{arg}{i + 1}" for i in range(eq.n)]
+        if any(v in used for v in names):
+            lines.append(f"    {', '.join(v if v in used else '_' for v in names)} = {arg}")
+    for k, p in enumerate(eq.parameters):
+        if p.symbol.name in used:
+            lines.append(f"    {p.symbol.name} = p[{k}]")
+    for symbol, expr in replacements:
+        lines.append(f"    {symbol} = {printer.doprint(expr)}")
+    lines.append("    return (")
+    lines += [f"        {printer.doprint(expr)}," for expr in outputs]
+    lines.append("    )")
+    return lines

@@ -1,0 +1,189 @@
+"""equations: the equations of motion in closed form, as LaTeX, SymPy, C99 or NumPy Python.
+
+    equations --params-file config/irb140.yaml --form c --out gen/
+    equations --urdf arm.urdf [--base LINK --tip LINK] --form latex|sympy|c|python --out DIR
+              [--what tau,M,C,g,regressor] [--symbolic-parameters] [--payload-mass KG] [--prefix NAME]
+
+Derived by running the package's own recursions on symbols (irb140_dynamics.core.equations).
+--what defaults to tau,M,C,g (C: the torques C(q, qd) qd). --out may exist: the tool's files
+in it are replaced, nothing else is touched; on any error nothing is written there.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import shutil
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+from ..core import RigidBody, load_model
+from ..core.equations import DEFAULT_QUANTITIES, FORMS, QUANTITIES, generate
+from ..core.errors import one_line
+from ..core.urdf import load_urdf
+from .common import ToolError, run
+
+NAME = "equations"
+QUIET_SECONDS = 2.0  # a progress line on stderr once the work takes longer than this
+
+
+class _ArgumentParser(argparse.ArgumentParser):
+    def error(self, message):
+        raise ToolError(message)
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = _ArgumentParser(prog=NAME, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    source = parser.add_mutually_exclusive_group(required=True)
+    source.add_argument("--params-file", help="a parameter file (YAML) of the model")
+    source.add_argument("--urdf", help="a URDF file")
+    parser.add_argument("--base", help="the URDF chain's base link (default: the root)")
+    parser.add_argument("--tip", help="the URDF chain's tip link (default: the only leaf)")
+    parser.add_argument("--form", required=True, help=f"one of {', '.join(FORMS)}")
+    parser.add_argument("--out", required=True, help="the folder to write into")
+    parser.add_argument("--what", default=",".join(DEFAULT_QUANTITIES), help=f"of {','.join(QUANTITIES)}")
+    parser.add_argument(
+        "--symbolic-parameters",
+        action="store_true",
+        help="masses, first moments, inertias, friction, armature and payload as named symbols",
+    )
+    parser.add_argument(
+        "--payload-mass", type=float, help="kg: a point mass at the flange origin, replacing the model's payload"
+    )
+    parser.add_argument("--prefix", help="name of the C functions and the files (default: the input file's stem)")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    return run(NAME, lambda: _main(sys.argv[1:] if argv is None else argv))
+
+
+def _main(argv: list[str]) -> int:
+    args = _parser().parse_args(argv)
+    if args.form not in FORMS:
+        raise ToolError(f"unknown form {args.form!r}: choose from {', '.join(FORMS)}")
+    what = tuple(w.strip() for w in args.what.split(",") if w.strip())
+    unknown = [w for w in what if w not in QUANTITIES]
+    if unknown or not what:
+        raise ToolError(
+            f"unknown quantity {unknown[0] if unknown else args.what!r}: choose from {','.join(QUANTITIES)}"
+        )
+    if args.urdf is None and (args.base or args.tip):
+        raise ToolError("--base and --tip go with --urdf")
+    model, path = _model(args)
+    prefix = args.prefix or _identifier(path.stem)
+    if not prefix.isidentifier() or not prefix.isascii():
+        raise ToolError(f"--prefix {prefix!r} is not a C identifier")
+    out = Path(args.out)
+    staging = _staging_folder(out)
+    try:
+        with _Progress() as progress:
+            files = generate(model, (args.form,), what, args.symbolic_parameters, prefix, path.name, progress)
+        for name, text in files.items():
+            _write_synced(staging / name, text)
+        for name in files:
+            os.replace(staging / name, out / name)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    for name in files:
+        print(out / name)
+    return 0
+
+
+def _model(args):
+    path = Path(args.params_file or args.urdf)
+    if not path.is_file():
+        raise ToolError(f"{path}: no such file")
+    try:
+        if args.params_file:
+            model = load_model(path)
+        else:
+            model = load_urdf(path.read_text(), args.base, args.tip).model
+        if args.payload_mass is not None:
+            model = model.with_payload(RigidBody(args.payload_mass))
+    except (ValueError, OSError) as error:  # ModelError, UrdfError, YAML errors are ValueErrors
+        raise ToolError(f"{path}: {one_line(error) or type(error).__name__}") from None
+    return model, path
+
+
+def _identifier(stem: str) -> str:
+    name = re.sub(r"\W", "_", stem.lower())
+    return name if name[:1].isalpha() else f"robot_{name}"
+
+
+def _staging_folder(out: Path) -> Path:
+    """A temporary folder in ``out`` (created if absent): files are written there, then moved."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        return Path(tempfile.mkdtemp(prefix=".equations-", dir=out))
+    except OSError as error:
+        raise ToolError(f"--out {out}: cannot write there ({error.strerror or error})") from None
+
+
+def _write_synced(path: Path, text: str) -> None:
+    with open(path, "w", encoding="utf-8", newline="\n") as stream:
+        stream.write(text)
+        stream.flush()
+        os.fsync(stream.fileno())
+
+
+class _Progress:
+    """stage(text): noted; once the work has taken QUIET_SECONDS, each stage and the time
+    are shown on stderr (redrawn in place on a terminal, a line per stage otherwise)."""
+
+    def __init__(self, stream=None):
+        self.stream = stream or sys.stderr
+        self.tty = self.stream.isatty()
+        self.stage, self.last = "starting", None
+        self.start = time.monotonic()
+        self.shown = False
+        self._lock = threading.Lock()
+        self._done = threading.Event()
+        self._thread = threading.Thread(target=self._show, daemon=True)
+
+    def __call__(self, stage: str) -> None:
+        with self._lock:
+            self.stage = stage
+            if self.shown:
+                self._draw()
+
+    def __enter__(self):
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self._done.set()
+        self._thread.join()
+        if self.shown:
+            line = f"{NAME}: done in {time.monotonic() - self.start:.0f} s"
+            self.stream.write(f"\r{line}\033[K\n" if self.tty else f"{line}\n")
+            self.stream.flush()
+
+    def _show(self):
+        if self._done.wait(QUIET_SECONDS):
+            return
+        while True:
+            with self._lock:
+                if self._done.is_set():
+                    return
+                self.shown = True
+                self._draw()
+            if self._done.wait(1.0):
+                return
+
+    def _draw(self):
+        elapsed = time.monotonic() - self.start
+        if self.tty:
+            self.stream.write(f"\r{NAME}: {self.stage}, {elapsed:.0f} s\033[K")
+        elif self.stage != self.last:
+            self.stream.write(f"{NAME}: {self.stage} ({elapsed:.0f} s)\n")
+        self.last = self.stage
+        self.stream.flush()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

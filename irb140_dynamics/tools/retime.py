@@ -1,0 +1,190 @@
+"""retime: check a JointTrajectory against the arm's limits, or re-time it time-optimally.
+
+    retime --params-file F [--urdf U [--tip-link L]] [--payload-mass M] IN.yaml OUT.yaml [--plot P.png]
+    retime --check-only --params-file F [--urdf U [--tip-link L]] [--payload-mass M] IN.yaml [--plot P.png]
+
+IN.yaml: a trajectory_msgs/JointTrajectory as ``ros2 topic echo --once`` prints it (header,
+joint_names, points with positions, velocities, accelerations, effort, time_from_start
+{sec, nanosec}); joints in any order, matched to the model's by name. The model: the params
+file (its ``/**`` section), or the URDF's chain with the params file's limits, friction and
+armature for its joints; --payload-mass puts that mass at the flange origin. Torque limits
+of 0 are derived as the payload check derives them (said in the report).
+
+Re-timing writes OUT.yaml (the same path, a point per grid point, timed time-optimally, as
+``ros2 topic pub`` takes it) and prints the check of the input and of the output.
+--check-only prints the check: per joint the peak torque, velocity and acceleration against
+the limits, when and in which segment. Exit status: 0; 3 when --check-only finds a limit
+exceeded; 1 with one line on bad input (nothing written: the output and the plot are
+written both or neither).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+import yaml
+
+from ..core import RigidBody, RobotModel, read_parameter_file
+from ..core.io.atomic import write_files
+from ..core.io.trajectory_file import joint_trajectory_yaml, read_joint_trajectory
+from ..core.trajectories import Trajectory, TrajectoryError, check_trajectory, retime, trajectory_limits
+from .common import ToolError, run
+
+NAME = "retime"
+OVER_LIMIT = 3
+_URDF_FIELDS = (
+    "position_limits",
+    "torque_limit",
+    "velocity_limit",
+    "acceleration_limit",
+    "friction.viscous",
+    "friction.coulomb",
+    "armature",
+)
+_GLOBAL = ("gravity", "friction.smoothing_velocity")
+
+
+def parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog=NAME, description=__doc__.split("\n\n")[0].split(": ", 1)[1])
+    p.add_argument("input", metavar="IN.yaml", help="the JointTrajectory (ros2 topic echo layout)")
+    p.add_argument("output", metavar="OUT.yaml", nargs="?", help="the re-timed JointTrajectory to write")
+    p.add_argument("--params-file", required=True, metavar="F", help="the model's parameter file")
+    p.add_argument("--urdf", metavar="U", help="take the kinematics and inertials from this URDF")
+    p.add_argument("--base-link", help="the URDF link the chain starts from (default: the root)")
+    p.add_argument("--tip-link", help="the URDF link the chain ends at, the payload's frame (default: the only leaf)")
+    p.add_argument("--payload-mass", type=float, metavar="KG", help="payload at the flange origin (default: F's)")
+    p.add_argument("--check-only", action="store_true", help="only check IN.yaml; write nothing but --plot")
+    p.add_argument("--plot", metavar="P.png", help="per joint the use of each limit over time, before and after")
+    p.add_argument("--grid", type=int, default=1000, help="grid steps over the path, about (default 1000)")
+    p.add_argument(
+        "--accelerations",
+        action="store_true",
+        help="give the output's points accelerations too (quintic; slower, see docs/trajectories.md)",
+    )
+    return p
+
+
+def model_of(params_file: str, urdf: str | None, payload_mass: float | None, chain=(None, None)) -> RobotModel:
+    """The model of the params file, or of the URDF with the file's limits and friction."""
+    path = Path(params_file)
+    if not path.is_file():
+        raise ToolError(f"{path}: no such parameter file")
+    try:
+        params = read_parameter_file(path)
+        if urdf is not None:
+            params = _with_urdf(params, urdf, chain)
+        model = RobotModel.from_params(params)
+    except (ValueError, OSError, yaml.YAMLError) as error:
+        raise ToolError(f"{urdf or path}: {str(error).splitlines()[0]}") from None
+    if payload_mass is not None:
+        if not (math.isfinite(payload_mass) and payload_mass >= 0):
+            raise ToolError(f"--payload-mass: must be a mass >= 0 kg, got {payload_mass}")
+        try:
+            model = model.with_payload(RigidBody(payload_mass))
+        except ValueError as error:
+            raise ToolError(f"--payload-mass: {error}") from None
+    return model
+
+
+def _with_urdf(params: dict, urdf: str, chain) -> dict:
+    from ..core.urdf import load_urdf
+
+    try:
+        text = Path(urdf).read_text()
+    except OSError as error:
+        raise ToolError(f"{urdf}: cannot read: {error.strerror}") from None
+    model = load_urdf(text, *chain).model
+    own = {f"{name}.{field}" for name in model.joint_names for field in _URDF_FIELDS}
+    kept = {k: v for k, v in params.items() if k in own or k in _GLOBAL or k.startswith("payload.")}
+    return {**model.to_params(), **kept}
+
+
+def read_trajectory(path: str, model: RobotModel) -> Trajectory:
+    try:
+        return Trajectory.from_message(read_joint_trajectory(path), model.joint_names)
+    except TrajectoryError as error:
+        raise ToolError(f"{path}: {error}") from None
+
+
+def write_all(files: dict[str, bytes]) -> None:
+    """Every file whole or none (see ``write_files``)."""
+    try:
+        write_files(files)
+    except OSError as error:
+        raise ToolError(f"{error.filename}: cannot write: {error.strerror}") from None
+
+
+def report_text(title: str, report) -> str:
+    lines = [
+        (
+            f"{title}: {report.duration:.4f} s, {'within every limit' if report.ok else 'OVER A LIMIT'} "
+            f"(worst: {report.worst.line()})"
+        )
+    ]
+    lines += [f"  {line}" for line in report.lines()]
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    args = parser().parse_args(sys.argv[1:] if argv is None else argv)
+
+    def body() -> int:
+        if not args.check_only and not args.output:
+            raise ToolError("OUT.yaml: missing (or give --check-only)")
+        model = model_of(args.params_file, args.urdf, args.payload_mass, (args.base_link, args.tip_link))
+        tr = read_trajectory(args.input, model)
+        limits = trajectory_limits(model)
+        notes = _torque_notes(model, limits)
+        before = check_trajectory(model, tr, limits)
+        if args.check_only:
+            files = {args.plot: _plot(model, limits, tr, None)} if args.plot else {}
+            write_all(files)
+            print("\n".join([*notes, report_text("input", before)]))
+            return 0 if before.ok else OVER_LIMIT
+        try:
+            result = retime(model, tr, limits, grid=args.grid, accelerations=args.accelerations)
+        except TrajectoryError as error:
+            raise ToolError(f"{args.input}: {error}") from None
+        after = check_trajectory(model, result.trajectory, limits)
+        files = {args.output: joint_trajectory_yaml(result.trajectory.to_message()).encode()}
+        if args.plot:
+            files[args.plot] = _plot(model, limits, tr, result.trajectory)
+        write_all(files)
+        print(
+            "\n".join(
+                [
+                    *notes,
+                    report_text("input", before),
+                    report_text("re-timed", after),
+                    f"{len(result.trajectory.t)} points, {result.rounds} round(s); wrote {', '.join(files)}",
+                ]
+            )
+        )
+        return 0
+
+    return run(NAME, body)
+
+
+def _torque_notes(model, limits) -> list[str]:
+    notes = []
+    for source, text in (
+        ("derived", "derived as the payload check does: the rated payload's worst static torque (torque_limit 0)"),
+        ("none", "none: the rated payload cannot load them (torque_limit 0)"),
+    ):
+        names = [n for n, s in zip(model.joint_names, limits.torque_source) if s == source]
+        if names:
+            notes.append(f"torque limits of {', '.join(names)}: {text}")
+    return notes
+
+
+def _plot(model, limits, before, after) -> bytes:
+    from .retime_plot import limit_use_png
+
+    return limit_use_png(model, limits, before, after)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
