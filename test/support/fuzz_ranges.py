@@ -12,8 +12,15 @@ from irb140_dynamics.nodes.demo_node.node import DemoNode
 from irb140_dynamics.nodes.id_node.node import IdNode
 from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
 from irb140_dynamics.nodes.sim_node.node import SimNode
+from irb140_dynamics.nodes.trajectory_check_node.node import TrajectoryCheckNode
 
-NODES = {"id_node": IdNode, "payload_check_node": PayloadCheckNode, "sim_node": SimNode, "demo_node": DemoNode}
+NODES = {
+    "id_node": IdNode,
+    "payload_check_node": PayloadCheckNode,
+    "sim_node": SimNode,
+    "demo_node": DemoNode,
+    "trajectory_check_node": TrajectoryCheckNode,
+}
 SEED = 23
 HOSTILE = (math.inf, -math.inf, math.nan, 1e308, -1e308, -1.0, 0.0, -1, 0, 1, 3, 2**62, 5e-324)
 
