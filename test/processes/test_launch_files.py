@@ -20,6 +20,7 @@ from ..support.paths import ROOT
 LAUNCH_FILES = sorted((ROOT / "launch").glob("*.launch.py"))
 SCRIPTS = console_scripts(ROOT / "setup.py")
 SHARE = Path("/opt/share/irb140_dynamics")  # where FindPackageShare points: mapped to the source tree
+READY = 120.0  # s: a node's ready line, three nodes starting at once on two busy cores
 
 
 def setup_keywords(monkeypatch) -> dict:
@@ -104,7 +105,7 @@ def test_its_nodes_start_with_its_parameters_and_stop_on_ctrl_c(launch_file, giv
             lines: list[str] = []
             process = start(node_command(node, arguments))
             processes.append((process, lines))
-            assert wait_for_line(process, "ready", lines), "".join(lines)
+            assert wait_for_line(process, "ready", lines, READY), "".join(lines)
     finally:
         stopped = [interrupt(process, lines) for process, lines in processes]
     output = "".join(text for _, text in stopped)
