@@ -13,6 +13,7 @@ setup(
         (f"share/{package_name}", ["package.xml"]),
         (f"share/{package_name}/config", glob("config/*.yaml")),
         (f"share/{package_name}/urdf", glob("urdf/*.urdf")),
+        (f"share/{package_name}/launch", glob("launch/*.launch.py")),
     ],
     install_requires=["setuptools"],
     zip_safe=True,
@@ -23,10 +24,10 @@ setup(
     tests_require=["pytest"],
     entry_points={
         "console_scripts": [
-            "id_node = irb140_dynamics.nodes.id_node.node:main",
-            "payload_check_node = irb140_dynamics.nodes.payload_check_node.node:main",
-            "demo_node = irb140_dynamics.nodes.demo_node.node:main",
-            "sim_node = irb140_dynamics.nodes.sim_node.node:main",
+            "id_node = irb140_dynamics.nodes.id_node:main",
+            "payload_check_node = irb140_dynamics.nodes.payload_check_node:main",
+            "demo_node = irb140_dynamics.nodes.demo_node:main",
+            "sim_node = irb140_dynamics.nodes.sim_node:main",
             "export_urdf = irb140_dynamics.tools.export_urdf:main",
             "identify = irb140_dynamics.tools.identify:main",
             "excitation = irb140_dynamics.tools.excitation:main",

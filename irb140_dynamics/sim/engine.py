@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 
 import mujoco
 import numpy as np
@@ -119,8 +120,19 @@ class SimulatedArm:
         return x.copy()
 
 
+WARNING_PERIOD = 2.0  # s: MuJoCo's warnings are logged at most once per period (a model it
+# cannot step stably warns on every step); those held back are counted in the next
+_warnings = {"next": 0.0, "held": 0}
+
+
 def _log_warning(message: str) -> None:
-    logging.getLogger(__name__).warning("MuJoCo: %s", message)
+    now = time.monotonic()
+    if now < _warnings["next"]:
+        _warnings["held"] += 1
+        return
+    held = f" (and {_warnings['held']} more since the last)" if _warnings["held"] else ""
+    _warnings["next"], _warnings["held"] = now + WARNING_PERIOD, 0
+    logging.getLogger(__name__).warning("MuJoCo: %s%s", message, held)
 
 
 def data_warning(data: mujoco.MjData, kind) -> int:

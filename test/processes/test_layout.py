@@ -82,6 +82,9 @@ def test_config_is_in_the_share_directory(install):
     )
     assert (share / "config" / "irb140.yaml").read_text() == CONFIG.read_text()
     assert (share / "urdf" / "irb140.urdf").read_text() == URDF.read_text()
+    for launch_file in sorted((ROOT / "launch").glob("*.launch.py")):  # ros2 launch looks in share/<pkg>/launch
+        assert (share / "launch" / launch_file.name).read_text() == launch_file.read_text()
+    assert (share / "config" / "true_arm.yaml").is_file()  # sim_demo.launch.py's default
     assert (share / "package.xml").is_file()
 
 

@@ -105,7 +105,6 @@ def config_with(old: str, new: str, tmp_path) -> str:
         (lambda tmp: ["--params-file", str(tmp / "missing.yaml")], "missing.yaml"),
         (lambda tmp: ["-p", "joint_4.link.inertia:=[1.0, 1.0, 3.0, 0.0, 0.0, 0.0]"], "joint_4.link.inertia"),
         (lambda tmp: ["-p", "payload.mass:=-2.0"], "payload.mass"),
-        (lambda tmp: ["-p", "payload.mass:=2"], "payload.mass"),
         (lambda tmp: ["-p", "joint_names:=[a, b]"], "a.dh: missing"),
     ],
 )

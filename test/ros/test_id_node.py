@@ -256,7 +256,7 @@ def reference_point(q, qd=(), qdd=()):
 
 
 def test_reference_expires_and_an_empty_one_lets_it_go():
-    overrides = [Parameter("reference_timeout", value=0.3)]
+    overrides = [Parameter("reference_timeout", value=1.0)]  # a stall shorter than this changes nothing
     with running(IdNode, parameter_overrides=overrides) as harness:
         harness.feedforward = harness.listen(JointState, "feedforward_torques")
         harness.gravity = harness.listen(JointState, "gravity_torques")
@@ -273,8 +273,11 @@ def test_reference_expires_and_an_empty_one_lets_it_go():
             if clear:
                 reference.publish(JointTrajectory())
                 assert harness.spin_until(lambda: harness.node.tracker.trajectory is None)
-            else:
-                harness.spin_for(0.4)
+            else:  # until the node's clock is past the timeout (its reference let go)
+                node = harness.node
+                assert harness.spin_until(
+                    lambda: node.tracker.sample(node.get_clock().now().nanoseconds * 1e-9, 1.0) is None
+                )
             ff, _ = send(harness, joint_state(q))
             np.testing.assert_allclose(ff.effort, rnea(model, q, zeros, zeros), rtol=1e-12, atol=1e-12)
 
@@ -335,7 +338,7 @@ def test_diagnostics_warn_about_dropped_messages(node):
     def warned():
         return any(s.level == DiagnosticStatus.WARN for d in diagnostics for s in d.status)
 
-    assert node.spin_until(warned, timeout=5.0)
+    assert node.spin_until(warned)
     status = [s for d in diagnostics for s in d.status if s.level == DiagnosticStatus.WARN][0]
     assert status.name == "id_node: messages" and "dropped" in status.message
     assert {kv.key: kv.value for kv in status.values}["joint_states.dropped_not_finite"] == "1"

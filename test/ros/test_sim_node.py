@@ -15,7 +15,7 @@ from irb140_dynamics.core import RigidBody, gravity, irb140
 from irb140_dynamics.nodes.sim_node import node as sim_node
 from irb140_dynamics.nodes.sim_node.node import SimNode
 
-from ..support.ros_harness import running
+from ..support.ros_harness import TIMEOUT, running
 
 NAMES = [f"joint_{i}" for i in range(1, 7)]
 POSE = [0.0, -0.5, 0.5, 0.0, 0.5, 0.0]  # rad: without torques the arm falls from here
@@ -46,7 +46,7 @@ def states_after(sim, count: int):
     return sim.states[start : start + count]
 
 
-def wait_for_effort(sim, tau, timeout=10.0):
+def wait_for_effort(sim, tau, timeout=TIMEOUT):
     assert sim.spin_until(lambda: sim.states and np.array_equal(sim.states[-1].effort, tau), timeout), (
         f"effort never became {list(tau)}"
     )
@@ -90,7 +90,7 @@ def test_a_command_older_than_the_timeout_gives_zero_torque(sim):
     command(sim, COMMAND)
     wait_for_effort(sim, COMMAND)
     applied = [msg for msg in sim.states if np.array_equal(msg.effort, COMMAND)]
-    wait_for_effort(sim, np.zeros(6), timeout=3.0)
+    wait_for_effort(sim, np.zeros(6))
     held = stamp(sim.states[-1]) - stamp(applied[0])
     assert 0.15e9 < held < 1e9
     assert sim.node.counts["command_timeouts"] == 1
@@ -112,7 +112,6 @@ def test_bad_commands_are_dropped_counted_and_never_applied(sim):
         lambda: any(
             s.level == DiagnosticStatus.WARN and "dropped" in s.message for msg in diagnostics for s in msg.status
         ),
-        timeout=3.0,
     )
 
 
@@ -142,7 +141,6 @@ def test_no_exception_leaves_a_callback(sim, monkeypatch):
             for msg in diagnostics
             for s in msg.status
         ),
-        timeout=3.0,
     )
     states_after(sim, 50)  # still stepping
 
@@ -157,7 +155,6 @@ def test_diagnostics_warn_when_real_time_is_lost(sim):
             for msg in diagnostics
             for s in msg.status
         ),
-        timeout=3.0,
     )
     assert sim.node.schedule.skipped > 0
 
@@ -182,7 +179,7 @@ def test_reset_puts_the_arm_back_and_holds_it(sim):
     held = held[next(i for i, msg in enumerate(held) if msg.position.tolist() == POSE) :]  # from the reset on
     assert len(held) > 50
     assert all(msg.position.tolist() == POSE and not np.any(msg.velocity) and not np.any(msg.effort) for msg in held)
-    assert sim.spin_until(lambda: sim.states[-1].position[1] < POSE[1] - 1e-3, timeout=3.0)  # released
+    assert sim.spin_until(lambda: sim.states[-1].position[1] < POSE[1] - 1e-3)  # released
 
 
 @pytest.mark.parametrize("sim", [{"reset_hold": 100.0, "noise.position": 0.01, "noise.effort": 2.0}], indirect=True)

@@ -76,21 +76,30 @@ def follow(harness, msg):
     assert harness.spin_until(lambda: harness.node.tracker.trajectory is not None)
 
 
-def test_a_trajectory_is_followed_in_time_held_at_its_end_then_let_go(node):
+def elapsed(harness) -> float:
+    """s on the node's clock since the reference in force started."""
+    return harness.node.get_clock().now().nanoseconds * 1e-9 - harness.node.tracker._start
+
+
+def test_a_trajectory_is_followed_in_time_held_at_its_end_then_let_go():
+    """Waits on the node's clock (past the end, past the timeout), not on sleeps: a stall of
+    the machine shorter than the 2 s reference_timeout changes nothing."""
     model, zeros = irb140(), np.zeros(6)
-    follow(node, trajectory([(0.0, A), (0.3, B)]))
-    ff, _ = send(node, A, tracking=True)
-    q_ref = np.add(A, node.tracking[-1].position)  # on the way from A to B
-    moving = np.subtract(B, A) != 0.0
-    w = (q_ref - A)[moving] / np.subtract(B, A)[moving]
-    assert 0.0 <= w[0] <= 1.0 and np.allclose(w, w[0], atol=1e-12)
-    np.testing.assert_allclose(ff, rnea(model, q_ref, zeros, zeros), rtol=1e-9, atol=1e-9)
-    node.spin_for(0.4)  # past the last point: it is held
-    ff, _ = send(node, A, tracking=True)
-    np.testing.assert_allclose(ff, rnea(model, B, zeros, zeros), rtol=1e-12, atol=1e-12)
-    np.testing.assert_allclose(node.tracking[-1].position, np.subtract(B, A), atol=1e-12)
-    node.spin_for(0.5)  # reference_timeout after the last point: let go, the measured state
-    ff, _ = send(node, A)
+    with tracking(Parameter("reference_timeout", value=2.0)) as node:
+        follow(node, trajectory([(0.0, A), (0.3, B)]))
+        ff, _ = send(node, A, tracking=True)
+        q_ref = np.add(A, node.tracking[-1].position)  # on the way from A to B (or at B)
+        moving = np.subtract(B, A) != 0.0
+        w = (q_ref - A)[moving] / np.subtract(B, A)[moving]
+        assert 0.0 <= w[0] <= 1.0 and np.allclose(w, w[0], atol=1e-12)
+        np.testing.assert_allclose(ff, rnea(model, q_ref, zeros, zeros), rtol=1e-9, atol=1e-9)
+        assert node.spin_until(lambda: elapsed(node) > 0.3)  # past the last point: it is held
+        ff, _ = send(node, A, tracking=True)
+        assert elapsed(node) < 0.3 + 2.0, "the machine stalled for the whole reference_timeout"
+        np.testing.assert_allclose(ff, rnea(model, B, zeros, zeros), rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(node.tracking[-1].position, np.subtract(B, A), atol=1e-12)
+        assert node.spin_until(lambda: elapsed(node) > 0.3 + 2.0)  # let go: the measured state
+        ff, _ = send(node, A)
     np.testing.assert_allclose(ff, rnea(model, A, zeros, zeros), rtol=1e-12, atol=1e-12)
 
 

@@ -16,7 +16,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 
-TIMEOUT = 10.0  # s, for anything that should happen at once on an idle machine
+TIMEOUT = 30.0  # s, for anything that should happen at once on an idle machine (generous: 2 busy cores)
 
 
 class Harness:

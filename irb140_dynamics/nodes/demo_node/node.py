@@ -4,15 +4,18 @@ how well the simulated arm (sim_node) follows it under computed-torque control.
 Publishes    /id_node/reference         trajectory_msgs/JointTrajectory: one period of a
                                         smooth motion of every joint, sent again each period
 Subscribes   joint_states, /id_node/tracking_error (sensor_msgs/JointState)
-Prints       the tracking error RMS per joint [mrad] over the last second, every second;
-             at the end (Ctrl-C, or after ``duration``) a plot of reference and actual
-             positions per joint is written to ``plot_file`` (PNG)
+Prints       the tracking error RMS per joint [mrad] over the last second, every second,
+             each figure labelled with its joint; at the end (Ctrl-C, or after
+             ``duration``) a plot of reference and actual positions per joint is written to
+             ``plot_file`` (PNG; a relative path is from the directory the node started in;
+             the full path is printed at the start and when written)
 """
 
 from __future__ import annotations
 
 import math
 from collections import deque
+from pathlib import Path
 
 import numpy as np
 from builtin_interfaces.msg import Duration
@@ -21,13 +24,25 @@ from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from irb140_dynamics.core.io.stamps import nanoseconds, sec_nanosec
+from irb140_dynamics.ros.parameters.spec import Spec, declare
+from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.spin import run
 
 NAMES = [f"joint_{i}" for i in range(1, 7)]
 CENTRE = [0.0, -0.6, 1.0, 0.0, 0.5, 0.0]  # rad: where the motion starts and ends (sim_node's initial_positions)
 AMPLITUDE = [0.8, 0.5, 0.5, 1.0, 0.6, 1.5]  # rad
 POINTS_PER_SECOND = 50
-PARAMETER_NAMES = ("period", "plot_file", "duration")  # declared below; known to the other nodes' warnings
+NODE_PARAMETERS = [
+    Spec("period", 8.0, "the reference motion's period", "s", read_only=True, minimum=1.0, maximum=3600.0),
+    Spec("plot_file", "demo_tracking.png", "the plot written at the end (PNG)", read_only=True),
+    Spec("duration", 0.0, "stop after this long; 0 = until Ctrl-C", "s", read_only=True, minimum=0.0, maximum=1e6),
+    Spec(
+        "model_label",
+        "id_node's model on sim_node's arm",
+        "which model controls which arm, for the printout and the plot",
+        read_only=True,
+    ),
+]
 
 
 def motion(t: np.ndarray, period: float):
@@ -58,9 +73,8 @@ def reference_message(period: float) -> JointTrajectory:
 class DemoNode(Node):
     def __init__(self, **kwargs):
         super().__init__("demo_node", **kwargs)
-        self.period = self.declare_parameter("period", 8.0).value  # s
-        self.plot_file = self.declare_parameter("plot_file", "demo_tracking.png").value
-        duration = self.declare_parameter("duration", 0.0).value  # s, 0 = until Ctrl-C
+        self.period, plot_file, duration, self.label = (declare(self, spec) for spec in NODE_PARAMETERS)
+        self.plot_file = str(Path(plot_file).expanduser().resolve())
         self._reference_pub = self.create_publisher(JointTrajectory, "/id_node/reference", 10)
         self._positions = {}  # stamp [ns] -> q, of the latest joint states
         self._stamps = deque(maxlen=2000)
@@ -69,11 +83,15 @@ class DemoNode(Node):
         self.create_subscription(JointState, "joint_states", self._on_joint_state, 10)
         self.create_subscription(JointState, "/id_node/tracking_error", self._on_error, 10)
         self._start = self.get_clock().now()
+        self._headed = False  # the printout's header printed
         self._sender = self.create_timer(0.1, self._start_when_heard)
         self.create_timer(1.0, self._print)
         if duration > 0.0:
             self.create_timer(duration, self._finish)
-        self.get_logger().info(f"ready: a {self.period} s reference motion for id_node, sent every period")
+        self.get_logger().info(
+            f"ready: a {self.period:g} s reference motion of {', '.join(NAMES)} for id_node, sent every period "
+            f"({self.label}); the plot goes to {self.plot_file} at the end"
+        )
 
     def _start_when_heard(self) -> None:
         """Send the first reference once id_node listens, then one every period."""
@@ -114,7 +132,13 @@ class DemoNode(Node):
             print(f"t={t:6.1f} s  waiting for sim_node and id_node ...", flush=True)
             return
         rms = np.sqrt(np.mean(np.square(errors), axis=0)) * 1e3
-        print(f"t={t:6.1f} s  tracking error RMS [mrad] " + " ".join(f"{x:7.3f}" for x in rms), flush=True)
+        if not np.isfinite(rms).all():
+            return
+        if not self._headed:
+            self._headed = True
+            print(f"tracking error RMS over the last second, per joint [mrad] ({self.label}):", flush=True)
+        figures = "  ".join(f"{name} {x:7.3f}" for name, x in zip(NAMES, rms))
+        print(f"t={t:6.1f} s  {figures}  mrad", flush=True)
 
     def _finish(self) -> None:
         self.context.try_shutdown()  # main() then destroys the node, which writes the plot
@@ -139,6 +163,7 @@ class DemoNode(Node):
             )
             axis.set_ylabel("q [rad]")
         axes.flat[0].legend()
+        figure.suptitle(f"demo_node: reference and actual joint positions ({self.label})")
         for axis in axes[-1]:
             axis.set_xlabel("t [s]")
         figure.tight_layout()
@@ -155,8 +180,13 @@ class DemoNode(Node):
         return super().destroy_node()
 
 
+def usage() -> Usage:
+    """What ``demo_node --help`` prints: this module's docstring and its parameters."""
+    return Usage("demo_node", __doc__, [("demo_node's own", NODE_PARAMETERS)])
+
+
 def main(args=None):
-    raise SystemExit(run("demo_node", DemoNode, args))
+    raise SystemExit(run("demo_node", DemoNode, args, usage=usage))
 
 
 if __name__ == "__main__":

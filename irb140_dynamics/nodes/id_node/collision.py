@@ -23,7 +23,7 @@ from std_msgs.msg import Bool
 from irb140_dynamics.core.monitoring.observer import MomentumObserver
 from irb140_dynamics.ros.messages.joint_messages import publish_efforts
 from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage
-from irb140_dynamics.ros.parameters.specs import Spec
+from irb140_dynamics.ros.parameters.specs import MAX_TORQUE, Spec
 from irb140_dynamics.ros.runtime.listened import ListenedPublisher
 
 MAX_GAIN = 1e4  # 1/s: beyond any sampling rate a joint state stream has
@@ -54,6 +54,7 @@ def collision_threshold_specs(joint_names) -> list[Spec]:
             "a collision is flagged while |external torque| exceeds this; 0 = off",
             "N m",
             minimum=0.0,
+            maximum=MAX_TORQUE,
         )
         for name in joint_names
     ]

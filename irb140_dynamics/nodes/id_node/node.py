@@ -62,6 +62,8 @@ from irb140_dynamics.ros.messages.joint_messages import (
 from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage, read_joint_state_cdr
 from irb140_dynamics.ros.parameters.model_source import declare_model_source
 from irb140_dynamics.ros.parameters.specs import joint_states_qos
+from irb140_dynamics.ros.parameters.usage import JOINT, model_sections, per_joint_section
+from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.diagnostics import message_status
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
 from irb140_dynamics.ros.runtime.listened import ListenedPublisher
@@ -266,15 +268,28 @@ class IdNode(Node):
         """Message counts (see message_status) and the collision status."""
         recent = self.counts - self._reported
         self._reported = self.counts.copy()
-        name, hardware_id = self.get_name(), self.get_fully_qualified_name()
+        name, hardware_id = self.get_name(), self.parameters.robot_name or self.get_fully_qualified_name()
         status = message_status(name, hardware_id, self.counts, recent, self.parameters, self.settings is None)
         msg = DiagnosticArray(status=[status, self.collision.status(name, hardware_id)])
         msg.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(msg)
 
 
+def usage() -> Usage:
+    """What ``id_node --help`` prints: this module's docstring and every parameter."""
+    return Usage(
+        "id_node",
+        __doc__,
+        [
+            *model_sections(),
+            ("id_node's own", NODE_PARAMETERS),
+            per_joint_section(PER_JOINT_PARAMETERS([JOINT]), "id_node's own"),
+        ],
+    )
+
+
 def main(args=None):
-    raise SystemExit(run("id_node", IdNode, args))
+    raise SystemExit(run("id_node", IdNode, args, usage=usage))
 
 
 if __name__ == "__main__":

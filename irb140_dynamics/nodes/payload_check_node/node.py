@@ -58,7 +58,16 @@ from irb140_dynamics.ros.messages.joint_messages import (
     read_joint_state,
 )
 from irb140_dynamics.ros.parameters.model_source import declare_model_source
-from irb140_dynamics.ros.parameters.specs import QOS_PARAMETERS, Spec, check_number, check_qos, joint_states_qos
+from irb140_dynamics.ros.parameters.specs import (
+    MAX_MASS,
+    QOS_PARAMETERS,
+    Spec,
+    check_number,
+    check_qos,
+    joint_states_qos,
+)
+from irb140_dynamics.ros.parameters.usage import model_sections
+from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.diagnostics import payload_statuses
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
 from irb140_dynamics.ros.runtime.spin import run
@@ -68,7 +77,14 @@ MAX_WARN_USE = 1e6  # %
 MIN_ANALYSIS_TIME, MAX_ANALYSIS_TIME = 0.1, 3600.0  # s: check.analysis_timeout
 MAX_WAIT = 600.0  # s: check.wait_timeout
 NODE_PARAMETERS = [
-    Spec("rated_payload.mass", 6.0, "the rated payload the torque limits are derived from", "kg", minimum=0.0),
+    Spec(
+        "rated_payload.mass",
+        6.0,
+        "the rated payload the torque limits are derived from",
+        "kg",
+        minimum=0.0,
+        maximum=MAX_MASS,
+    ),
     Spec("rated_payload.com", [0.0, 0.0, 0.0], "its centre of mass, in the flange frame", "m"),
     Spec(
         "diagnostics.warn_use",
@@ -324,6 +340,8 @@ class PayloadCheckNode(Node):
         )
 
     def _publish(self, statuses) -> None:
+        for status in statuses:  # the robot's name (model.name, or the URDF's), as rqt_robot_monitor groups them
+            status.hardware_id = self.parameters.robot_name or status.hardware_id
         diagnostics = DiagnosticArray(status=statuses)
         diagnostics.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(diagnostics)
@@ -358,8 +376,13 @@ class PayloadCheckNode(Node):
         return response
 
 
+def usage() -> Usage:
+    """What ``payload_check_node --help`` prints: this module's docstring and every parameter."""
+    return Usage("payload_check_node", __doc__, [*model_sections(), ("payload_check_node's own", NODE_PARAMETERS)])
+
+
 def main(args=None):
-    raise SystemExit(run("payload_check_node", PayloadCheckNode, args))
+    raise SystemExit(run("payload_check_node", PayloadCheckNode, args, usage=usage))
 
 
 if __name__ == "__main__":

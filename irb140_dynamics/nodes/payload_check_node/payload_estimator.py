@@ -21,6 +21,8 @@ from irb140_dynamics.core.payload.mass_com_estimation import (
 from irb140_dynamics.ros.parameters.specs import Spec
 from irb140_dynamics.ros.runtime.guard import guarded
 
+MAX_REST_VELOCITY = 1e3  # rad/s
+MAX_REST_TIME = 3600.0  # s
 ESTIMATION_PARAMETERS = [
     Spec(
         "estimation.rest_velocity",
@@ -28,8 +30,16 @@ ESTIMATION_PARAMETERS = [
         "a joint state is at rest when every joint is slower than this",
         "rad/s",
         minimum=1e-6,
+        maximum=MAX_REST_VELOCITY,
     ),
-    Spec("estimation.rest_time", 0.5, "a rest this long becomes a sample (one per distinct pose)", "s", minimum=0.0),
+    Spec(
+        "estimation.rest_time",
+        0.5,
+        "a rest this long becomes a sample (one per distinct pose)",
+        "s",
+        minimum=0.0,
+        maximum=MAX_REST_TIME,
+    ),
     Spec("estimation.apply", False, "on a successful ~/estimate_payload, set payload.mass and payload.com"),
 ]
 

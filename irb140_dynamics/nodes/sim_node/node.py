@@ -38,6 +38,8 @@ from std_srvs.srv import Trigger
 from irb140_dynamics.nodes.sim_node.settings import NODE_PARAMETERS, SimNodeSettings, build_settings, read_command  # noqa: F401 (NODE_PARAMETERS: read by ros.overrides)
 from irb140_dynamics.ros.messages.joint_messages import BadMessage
 from irb140_dynamics.ros.parameters.model_source import declare_model_source
+from irb140_dynamics.ros.parameters.usage import model_sections
+from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
 from irb140_dynamics.ros.runtime.spin import run
 from irb140_dynamics.sim.engine import SimulatedArm, SimulationError
@@ -230,6 +232,9 @@ class SimNode(Node):
             q += self._rng.normal(0.0, settings.position_noise, len(q))
         if settings.effort_noise > 0.0:
             effort = effort + self._rng.normal(0.0, settings.effort_noise, len(q))
+        if not (np.isfinite(q).all() and np.isfinite(qd).all() and np.isfinite(effort).all()):
+            self.tally.drop("joint_states", BadMessage("not_finite", "a state that is not finite was not published"))
+            return
         msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp, 1_000_000_000)
         msg.position, msg.velocity, msg.effort = q.tolist(), qd.tolist(), effort.tolist()
         self._state_pub.publish(msg)
@@ -267,7 +272,8 @@ class SimNode(Node):
             self.counts["skipped_steps"] = self.schedule.skipped
         recent = self.counts - self._reported
         self._reported = self.counts.copy()
-        status = DiagnosticStatus(name=f"{self.get_name()}: simulation", hardware_id=self.get_fully_qualified_name())
+        hardware_id = self.parameters.robot_name or self.get_fully_qualified_name()
+        status = DiagnosticStatus(name=f"{self.get_name()}: simulation", hardware_id=hardware_id)
         steps = recent["steps"]
         problems = [] if self.settings is not None else ["waiting for the model (robot_description)"]
         if recent["late_steps"] > WARN_LATE_SHARE * steps or recent["skipped_steps"]:
@@ -292,8 +298,13 @@ class SimNode(Node):
         self._diagnostics_pub.publish(msg)
 
 
+def usage() -> Usage:
+    """What ``sim_node --help`` prints: this module's docstring and every parameter."""
+    return Usage("sim_node", __doc__, [*model_sections(), ("sim_node's own", NODE_PARAMETERS)])
+
+
 def main(args=None):
-    raise SystemExit(run("sim_node", SimNode, args))
+    raise SystemExit(run("sim_node", SimNode, args, usage=usage))
 
 
 if __name__ == "__main__":

@@ -11,10 +11,14 @@ from std_msgs.msg import Float64MultiArray
 from irb140_dynamics.core import RobotModel
 from irb140_dynamics.ros.messages.joint_messages import BadMessage
 from irb140_dynamics.ros.parameters.model_source import STAND_IN
-from irb140_dynamics.ros.parameters.specs import MAX_QOS_DEPTH, Spec, check_choice, check_qos_depth
+from irb140_dynamics.ros.parameters.specs import MAX_QOS_DEPTH, Spec, check_choice, check_number, check_qos_depth
 from irb140_dynamics.sim.engine import DEFAULT_INTEGRATOR, SimulatedArm
 from irb140_dynamics.sim.mjcf import INTEGRATORS
 
+MAX_SUBSTEPS = 1000
+MAX_TIME = 3600.0  # s: command_timeout, reset_hold
+MAX_POSITION_NOISE = 10.0  # rad (std dev)
+MAX_EFFORT_NOISE = 1e4  # N m (std dev)
 NODE_PARAMETERS = [
     Spec(
         "rate",
@@ -25,7 +29,14 @@ NODE_PARAMETERS = [
         maximum=100000.0,
         read_only=True,
     ),
-    Spec("substeps", 1, "MuJoCo steps per step (the integration step is 1 / (rate * substeps))", read_only=True),
+    Spec(
+        "substeps",
+        1,
+        "MuJoCo steps per step (the integration step is 1 / (rate * substeps))",
+        read_only=True,
+        minimum=1,
+        maximum=MAX_SUBSTEPS,
+    ),
     Spec("integrator", DEFAULT_INTEGRATOR, f"MuJoCo's integrator: {', '.join(INTEGRATORS)}", read_only=True),
     Spec(
         "lockstep",
@@ -51,6 +62,7 @@ NODE_PARAMETERS = [
         "(in real time; in lockstep each step applies the command it answers)",
         "s",
         minimum=0.0,
+        maximum=MAX_TIME,
     ),
     Spec(
         "initial_positions",
@@ -64,15 +76,32 @@ NODE_PARAMETERS = [
         "after startup and each ~/reset the arm is held still (brakes on, no torque) this long (simulated time)",
         "s",
         minimum=0.0,
+        maximum=MAX_TIME,
     ),
-    Spec("noise.position", 0.0, "std dev of the noise added to the published positions", "rad", minimum=0.0),
-    Spec("noise.effort", 0.0, "std dev of the noise added to the published efforts", "N m", minimum=0.0),
+    Spec(
+        "noise.position",
+        0.0,
+        "std dev of the noise added to the published positions",
+        "rad",
+        minimum=0.0,
+        maximum=MAX_POSITION_NOISE,
+    ),
+    Spec(
+        "noise.effort",
+        0.0,
+        "std dev of the noise added to the published efforts",
+        "N m",
+        minimum=0.0,
+        maximum=MAX_EFFORT_NOISE,
+    ),
     Spec(
         "thread_priority",
         0,
         "SCHED_FIFO priority (1..99) of the stepping and executor threads, as "
         "ros2_control's controller manager runs its loop; 0 = ordinary scheduling",
         read_only=True,
+        minimum=0,
+        maximum=99,
     ),
     Spec(
         "qos.depth",
@@ -103,10 +132,17 @@ def build_settings(values: dict) -> SimNodeSettings:
     model = RobotModel.from_params(values)
     waiting = model.joint_names == STAND_IN.joint_names  # checked on a stand-in until a URDF comes
     check_choice("integrator", values["integrator"], INTEGRATORS)
-    if values["substeps"] < 1:
-        raise ValueError(f"substeps: must be >= 1, got {values['substeps']}")
+    if not 1 <= values["substeps"] <= MAX_SUBSTEPS:
+        raise ValueError(f"substeps: must be between 1 and {MAX_SUBSTEPS}, got {values['substeps']}")
     if not 0 <= values["thread_priority"] <= 99:
         raise ValueError(f"thread_priority: must be 0..99, got {values['thread_priority']}")
+    for name, limit in (
+        ("command_timeout", MAX_TIME),
+        ("reset_hold", MAX_TIME),
+        ("noise.position", MAX_POSITION_NOISE),
+        ("noise.effort", MAX_EFFORT_NOISE),
+    ):
+        check_number(name, values[name], 0.0, limit)
     check_qos_depth(values["qos.depth"])
     engine = SimulatedArm(model, 1.0 / values["rate"], values["substeps"], values["integrator"])
     initial = np.zeros(model.n) if waiting else initial_positions(model, values["initial_positions"])

@@ -24,6 +24,7 @@ NODE_PARAMETER_NAMES = frozenset(
         "integrator",
         "lockstep",
         "lockstep_timeout",
+        "model_label",
         "noise.effort",
         "noise.position",
         "period",

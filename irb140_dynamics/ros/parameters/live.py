@@ -69,6 +69,7 @@ class LiveParameters:
         }  # kept in step by _apply
         warn_unknown_overrides(node)
         self.current = None
+        self.robot_name = ""  # the hardware_id of /diagnostics: model.name, or the URDF's <robot name>
         self.failure: str | None = None
         self.pending_since: float | None = time.monotonic()
         self._declaring = self._starting = False

@@ -130,6 +130,7 @@ class RobotDescription:
             raise ValueError(f"{origin}: {error}") from None
 
     def _announce(self, origin: str) -> None:
+        self.parameters.robot_name = self.urdf.robot_name or "robot"
         names, held = list(self.urdf.model.joint_names), self.urdf.held_joints
         held = f"; held at zero: {', '.join(held)}" if held else ""
         logger = self._node.get_logger()

@@ -25,25 +25,28 @@ class Spec:
     minimum: float | None = None  # for double and integer parameters
     maximum: float | None = None
 
+    @property
+    def numeric(self) -> bool:
+        """An integer or double parameter (not bool, not an array)."""
+        kind = self.default
+        if isinstance(kind, Parameter.Type):
+            return kind in (Parameter.Type.INTEGER, Parameter.Type.DOUBLE)
+        return isinstance(kind, (int, float)) and not isinstance(kind, bool)
+
     def descriptor(self) -> ParameterDescriptor:
+        """The descriptor, with the range; a numeric parameter must have a finite one (no
+        inf, nan or 1e308 gets past rclpy's range check then)."""
         unit = f" [{self.unit}]" if self.unit else ""
         descriptor = ParameterDescriptor(description=self.description + unit, read_only=self.read_only)
-        if isinstance(self.default, int) and not isinstance(self.default, bool):
-            if self.minimum is not None or self.maximum is not None:
-                descriptor.integer_range = [
-                    IntegerRange(
-                        from_value=-(2**63) if self.minimum is None else int(self.minimum),
-                        to_value=2**63 - 1 if self.maximum is None else int(self.maximum),
-                        step=1,
-                    )
-                ]
-        elif self.minimum is not None or self.maximum is not None:
+        if not self.numeric:
+            return descriptor
+        if self.minimum is None or self.maximum is None or not math.isfinite(self.maximum - self.minimum):
+            raise ValueError(f"{self.name}: a numeric parameter needs a finite range (minimum and maximum)")
+        if self.default == Parameter.Type.INTEGER or isinstance(self.default, int):
+            descriptor.integer_range = [IntegerRange(from_value=int(self.minimum), to_value=int(self.maximum), step=1)]
+        else:
             descriptor.floating_point_range = [
-                FloatingPointRange(
-                    from_value=-math.inf if self.minimum is None else self.minimum,
-                    to_value=math.inf if self.maximum is None else self.maximum,
-                    step=0.0,
-                )
+                FloatingPointRange(from_value=float(self.minimum), to_value=float(self.maximum), step=0.0)
             ]
         return descriptor
 
@@ -58,6 +61,7 @@ def _range_text(spec: Spec) -> str:
 
 def declare(node: Node, spec) -> Any:
     """Declare a parameter of a Spec; a value rclpy refuses is a ValueError naming it."""
+    _as_double(node, spec)
     try:
         return node.declare_parameter(spec.name, spec.default, spec.descriptor()).value
     except InvalidParameterTypeException:
@@ -71,3 +75,23 @@ def declare(node: Node, spec) -> Any:
         if given is None or (spec.minimum is None and spec.maximum is None):
             raise ValueError(f"{spec.name}: {error}") from None
         raise ValueError(f"{spec.name}: {_range_text(spec)}, got {given.value}") from None
+
+
+def _as_double(node: Node, spec) -> None:
+    """An integer given for a double parameter (``-p payload.mass:=2``, a params file's
+    ``mass: 2``) is taken as that double, as ``ros2 param set`` users expect."""
+    given = node._parameter_overrides.get(spec.name)
+    if given is None:
+        return
+    kind = spec.default if isinstance(spec.default, Parameter.Type) else None
+    if kind is None and not isinstance(spec.default, bool):
+        if isinstance(spec.default, float):
+            kind = Parameter.Type.DOUBLE
+        elif isinstance(spec.default, list) and spec.default and all(isinstance(x, float) for x in spec.default):
+            kind = Parameter.Type.DOUBLE_ARRAY
+    if kind == Parameter.Type.DOUBLE and given.type_ == Parameter.Type.INTEGER:
+        node._parameter_overrides[spec.name] = Parameter(spec.name, Parameter.Type.DOUBLE, float(given.value))
+    elif kind == Parameter.Type.DOUBLE_ARRAY and given.type_ == Parameter.Type.INTEGER_ARRAY:
+        node._parameter_overrides[spec.name] = Parameter(
+            spec.name, Parameter.Type.DOUBLE_ARRAY, [float(x) for x in given.value]
+        )

@@ -23,15 +23,29 @@ from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from irb140_dynamics.core.io.params_file import read_parameter_file
-from irb140_dynamics.core.model.joints import param_prefix
+from irb140_dynamics.core.model.joints import MAX_FRICTION, param_prefix
+from irb140_dynamics.core.model.rigid_body import MAX_MASS as CORE_MAX_MASS
 from irb140_dynamics.core.model.robot_model import check_joint_names
 from irb140_dynamics.package_files import CONFIG_NAME, PACKAGE, default_config_path  # noqa: F401 (PACKAGE, CONFIG_NAME: re-exported)
 from irb140_dynamics.ros.parameters.live import LiveParameters
 from irb140_dynamics.ros.parameters.spec import Spec, declare
+from irb140_dynamics.ros.runtime.command_line import params_files_given
 
 _declare = declare  # the name model_source imports
 
 
+# The finite ranges of the model's numbers (ParameterDescriptor ranges, `ros2 param describe`):
+# wide, to keep inf, nan and 1e308 out, not to judge the robot.
+# Masses and friction: the core's own caps (core.model), so that the descriptor and the
+# model refuse the same values.
+MAX_MASS = CORE_MAX_MASS  # kg
+MAX_TORQUE = 1e7  # N m (torque limits, collision thresholds)
+MAX_VELOCITY = 1e4  # rad/s
+MAX_ACCELERATION = 1e7  # rad/s^2
+MAX_VISCOUS = MAX_FRICTION  # N m s/rad
+MAX_COULOMB = MAX_FRICTION  # N m
+MAX_ARMATURE = MAX_FRICTION  # kg m^2
+MAX_SMOOTHING_VELOCITY = 1e3  # rad/s
 MAX_QOS_DEPTH = 10_000  # messages: 10 s at 1 kHz; DDS may reserve memory for the whole depth
 RELIABILITIES = {"best_effort": ReliabilityPolicy.BEST_EFFORT, "reliable": ReliabilityPolicy.RELIABLE}
 QOS_PARAMETERS = [
@@ -93,6 +107,7 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
             "Coulomb friction is coulomb * tanh(qd / this)",
             "rad/s",
             minimum=1e-9,
+            maximum=MAX_SMOOTHING_VELOCITY,
         ),
         *_body_specs(
             "payload", "the payload on the flange", "flange frame", lambda name, kind: defaults.get(name, kind)
@@ -120,6 +135,7 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
                 "joint torque limit, 0 = none given",
                 "N m",
                 minimum=0.0,
+                maximum=MAX_TORQUE,
             ),
             Spec(
                 f"{joint}.velocity_limit",
@@ -127,6 +143,7 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
                 "joint speed limit, 0 = none given",
                 "rad/s",
                 minimum=0.0,
+                maximum=MAX_VELOCITY,
             ),
             Spec(
                 f"{joint}.acceleration_limit",
@@ -134,6 +151,7 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
                 "joint acceleration limit, 0 = none given",
                 "rad/s^2",
                 minimum=0.0,
+                maximum=MAX_ACCELERATION,
             ),
             Spec(
                 f"{joint}.friction.viscous",
@@ -141,6 +159,7 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
                 "viscous friction coefficient",
                 "N m s/rad",
                 minimum=0.0,
+                maximum=MAX_VISCOUS,
             ),
             Spec(
                 f"{joint}.friction.coulomb",
@@ -148,6 +167,7 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
                 "Coulomb friction level (smoothed, see friction.smoothing_velocity)",
                 "N m",
                 minimum=0.0,
+                maximum=MAX_COULOMB,
             ),
             Spec(
                 f"{joint}.armature",
@@ -155,6 +175,7 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
                 "rotor inertia reflected through the gear, added to M's diagonal",
                 "kg m^2",
                 minimum=0.0,
+                maximum=MAX_ARMATURE,
             ),
         ]
     return specs
@@ -170,6 +191,7 @@ def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
             f"mass of {what}",
             "kg",
             minimum=0.0,
+            maximum=MAX_MASS,
         ),
         Spec(
             f"{prefix}.com",
@@ -184,6 +206,14 @@ def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
             "kg m^2",
         ),
     ]
+
+
+MODEL_NAME = Spec(
+    "model.name",
+    "irb140",
+    "the robot's name, the hardware_id of the nodes' /diagnostics (a URDF model: its <robot name>)",
+    read_only=True,
+)
 
 
 def declare_model(
@@ -202,15 +232,24 @@ def declare_model(
     if not path.is_file():
         raise ValueError(f"default model: no {path}; is the package installed? (or give --params-file)")
     defaults = read_parameter_file(path)
-    node.get_logger().info(f"default model: {path}")
+    given = params_files_given()
+    if given:
+        node.get_logger().info(f"model: params file {', '.join(given)} (over the built-in IRB-140 model, {path})")
+    else:
+        node.get_logger().info(f"model: the built-in IRB-140 model ({path})")
     names = declare(
         node,
         Spec("joint_names", defaults["joint_names"], "the model's joints, base to flange", read_only=True),
     )
     names = check_joint_names(names)  # they become parameter prefixes: check them first
+    robot_name = declare(node, MODEL_NAME)
     own = per_joint(names) if per_joint else []
     specs = [*model_specs(names, defaults), *extra, *own]
-    return LiveParameters(node, specs, check, finish, declared=["joint_names"], startup_wait=startup_wait, quick=quick)
+    parameters = LiveParameters(
+        node, specs, check, finish, declared=["joint_names", "model.name"], startup_wait=startup_wait, quick=quick
+    )
+    parameters.robot_name = robot_name
+    return parameters
 
 
 def check_number(name: str, value, minimum: float, maximum: float, unit: str = "") -> float:

@@ -24,6 +24,7 @@ from rclpy.signals import (
 from rclpy.utilities import remove_ros_args
 
 from irb140_dynamics.core.errors import one_line
+from irb140_dynamics.ros.runtime.command_line import Usage, before_start
 
 EXECUTORS = ("events", "single_threaded")
 
@@ -37,18 +38,42 @@ def tool_arguments(argv: list[str]) -> list[str]:
         raise ValueError(init_error(error)) from None
 
 
-def run(name: str, make_node: Callable[[], Node], args: list[str] | None = None, executor: str = "events") -> int:
+def run(
+    name: str,
+    make_node: Callable[[], Node],
+    args: list[str] | None = None,
+    executor: str = "events",
+    usage: Callable[[], Usage] | None = None,
+) -> int:
     """Init rclpy, build the node, spin until Ctrl-C or shutdown; 0 on a clean exit.
 
-    A model or parameter error at startup prints one line naming the bad field and
-    returns 1 (no traceback); so does Ctrl-C before the node is ready. ``executor``: see
-    ``spin``.
+    Before ROS starts: ``--help`` prints ``usage()`` (0); a ROS argument outside
+    ``--ros-args`` (2) or a params file that is missing, not a file or too large (1) is
+    refused in one line (see command_line). A model or parameter error at startup prints
+    one line naming the bad field and returns 1 (no traceback). Ctrl-C is the normal stop
+    at any moment: 0, at most one line. ``executor``: see ``spin``.
     """
     args = sys.argv if args is None else args
-    node = _start(make_node, args, rclpy.logging.get_logger(name))
+    try:
+        answered = before_start(name, args, usage)
+        if answered is None:
+            return _run(make_node, args, executor, rclpy.logging.get_logger(name))
+    except KeyboardInterrupt:  # before the node's own handling, or a second while shutting down
+        rclpy.try_shutdown()
+        return 0
+    code, text = answered
+    if code == 0:
+        sys.stdout.write(text)
+    else:
+        rclpy.logging.get_logger(name).fatal(text)
+    return code
+
+
+def _run(make_node: Callable[[], Node], args: list[str], executor: str, logger) -> int:
+    node, code = _start(make_node, args, logger)
     if node is None:
         rclpy.try_shutdown()
-        return 1
+        return code
     try:
         freeze_startup_objects()
         spin(node, executor)
@@ -60,7 +85,7 @@ def run(name: str, make_node: Callable[[], Node], args: list[str] | None = None,
     return 0
 
 
-INTERRUPTED = "cannot start: interrupted (Ctrl-C) before the node was ready"
+INTERRUPTED = "interrupted (Ctrl-C) before the node was ready"
 
 
 def freeze_startup_objects() -> None:
@@ -71,18 +96,23 @@ def freeze_startup_objects() -> None:
     gc.freeze()
 
 
-def _start(make_node: Callable[[], Node], args: list[str], logger) -> Node | None:
-    """The node, or None after one FATAL line: rcl refused the arguments, a parameter is
-    bad (ValueError), or Ctrl-C came first (rclpy then shuts the context down, and the
-    next rclpy call of the half-built node fails, or KeyboardInterrupt is raised)."""
+def _start(make_node: Callable[[], Node], args: list[str], logger) -> tuple[Node | None, int]:
+    """(the node, 0), or (None, exit code) after one line: 1 and FATAL when rcl refused the
+    arguments or a parameter is bad (ValueError); 0 when Ctrl-C came first (rclpy then
+    shuts the context down, and the next rclpy call of the half-built node fails, or
+    KeyboardInterrupt is raised)."""
     try:
         try:
-            rclpy.init(args=args)
+            with quiet_rcl():
+                rclpy.init(args=args)
+        except rclpy_implementation.UnknownROSArgsError as error:
+            logger.fatal(f"cannot start: rcl does not know the ROS arguments {error} (see --help)")
+            return None, 1
         except rclpy_implementation.RCLError as error:
             logger.fatal(f"cannot start: {init_error(error)}")
-            return None
+            return None, 1
         try:
-            return make_node()
+            return make_node(), 0
         except Exception as error:  # noqa: BLE001  (sorted here: ours, or Ctrl-C half-way)
             if rclpy.ok() and not isinstance(error, ValueError):
                 raise
@@ -92,8 +122,24 @@ def _start(make_node: Callable[[], Node], args: list[str], logger) -> Node | Non
     # out of the except blocks: the half-built node is gone with the traceback, and with it
     # its /rosout publisher, which would complain of the shut-down context
     gc.collect()
+    if why == INTERRUPTED:
+        logger.info(why)
+        return None, 0
     logger.fatal(why)
-    return None
+    return None, 1
+
+
+@contextmanager
+def quiet_rcl() -> Iterator[None]:
+    """rcl's own log of a refused argument ("Failed to parse global arguments") held back:
+    the refusal is said once, in the node's FATAL line."""
+    rcl = rclpy.logging.get_logger("rcl")
+    level = rcl.get_effective_level()
+    rcl.set_level(rclpy.logging.LoggingSeverity.FATAL)
+    try:
+        yield
+    finally:
+        rcl.set_level(level)
 
 
 def spin(node: Node, executor: str = "events") -> None:
@@ -162,7 +208,7 @@ def ctrl_c_as_a_flag() -> Iterator[list]:
 
 _PARAMS_FILE_ERROR = re.compile(
     r"params file: '--params-file (?P<path>.+?)'\. Error: (?P<reason>.+?)"
-    r"(?: (?:at line_num|near line) (?P<line>\d+))?(?:, at /|$)"
+    r"(?:(?: at line_num| near line|\. Error at line) (?P<line>\d+))?\s*(?:, at /|$)"
 )
 
 

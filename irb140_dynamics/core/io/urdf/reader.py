@@ -67,6 +67,7 @@ class LoadedUrdf:
     warnings: tuple[str, ...] = ()  # the chain's inertials taken as given though not physical
     notes: tuple[str, ...] = ()  # invalid inertials off the chain, ignored
     base_rotation: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))  # base_link's axes in the root's
+    robot_name: str = ""  # <robot name="...">: the hardware_id of the nodes' /diagnostics
 
     def in_base(self, vector) -> tuple[float, float, float]:
         """A vector given in the root link's frame (gravity) in base_link's frame."""
@@ -142,7 +143,7 @@ def load_urdf(
         if name not in on_chain and (problem := inertial_problem(name, body))
     ]
     rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
-    return LoadedUrdf(model, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation)
+    return LoadedUrdf(model, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name)
 
 
 def _checked_inertials(tree: UrdfTree, carried: list[list[str]]) -> tuple[list[str], list[bool]]:

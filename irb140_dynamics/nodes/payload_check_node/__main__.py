@@ -1,0 +1,5 @@
+"""``python -m irb140_dynamics.nodes.payload_check_node``: the node, as its console script starts it."""
+
+from irb140_dynamics.nodes.payload_check_node import main
+
+main()

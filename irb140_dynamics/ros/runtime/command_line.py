@@ -1,0 +1,218 @@
+"""A node's command line before ROS starts: ``--help``, and ROS arguments without ``--ros-args``.
+
+A node takes no arguments of its own: everything it reads comes after ``--ros-args``
+(``-p NAME:=VALUE``, ``--params-file FILE``, remappings). ``-h``/``--help`` prints the
+node's usage, its parameters listed from their Specs (name, type, default, range, unit,
+description), and exits 0 without starting ROS. A ROS argument typed before
+``--ros-args`` (``id_node -p payload.mass:=2.0``) would be ignored by rcl and leave the
+default in force without a word: it is refused, with the line to type instead.
+"""
+
+from __future__ import annotations
+
+import math
+import textwrap
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from irb140_dynamics.core.io.text_files import InputFileError, read_text_file
+
+ROS_ARGS = "--ros-args"
+HELP = ("-h", "--help")
+# the flags rcl reads after --ros-args (design.ros2.org "ROS command line arguments")
+ROS_FLAGS = (
+    "-p",
+    "--param",
+    "--params-file",
+    "-r",
+    "--remap",
+    "-e",
+    "--enclave",
+    "--log-level",
+    "--log-config-file",
+    "--enable-rosout-logs",
+    "--disable-rosout-logs",
+    "--enable-stdout-logs",
+    "--disable-stdout-logs",
+    "--enable-external-lib-logs",
+    "--disable-external-lib-logs",
+)
+
+
+@dataclass
+class Usage:
+    """What ``--help`` prints for a node: a summary and its parameters by section."""
+
+    name: str
+    summary: str
+    sections: list[tuple[str, list]] = field(default_factory=list)  # (title, Specs)
+    notes: list[str] = field(default_factory=list)
+
+    def text(self) -> str:
+        lines = [
+            f"usage: {self.name} [-h] [--ros-args [--params-file FILE] [-p NAME:=VALUE] ...]",
+            f"       ros2 run irb140_dynamics {self.name} --ros-args -p NAME:=VALUE",
+            "",
+            self.summary.strip(),
+            "",
+            "Parameters are given after --ros-args: -p NAME:=VALUE, or --params-file FILE (YAML, as",
+            "config/irb140.yaml); most can be changed while running (ros2 param set), each change",
+            "validated whole, a bad value refused with its reason.",
+        ]
+        for note in self.notes:
+            lines += ["", *textwrap.wrap(note, 92)]
+        for title, specs in self.sections:
+            lines += ["", f"{title}:"]
+            for spec in specs:
+                lines += describe_spec(spec)
+        return "\n".join(lines) + "\n"
+
+
+def describe_spec(spec) -> list[str]:
+    """Two or more lines for one parameter: name (type, default, range, unit), then its description."""
+    unit = f" {spec.unit}" if spec.unit else ""
+    facts = [type_name(spec.default)]
+    default = default_text(spec.default)
+    if default is not None:
+        facts.append(f"default {default}{unit}")
+    bounds = range_text(spec)
+    if bounds:
+        facts.append(f"{bounds}{unit}")
+    elif unit and default is None:
+        facts.append(unit.strip())
+    if spec.read_only:
+        facts.append("read-only: set at startup")
+    body = textwrap.wrap(spec.description, 88, initial_indent="      ", subsequent_indent="      ")
+    return [f"  {spec.name} ({', '.join(facts)})", *body]
+
+
+def type_name(default: Any) -> str:
+    """The ROS parameter type of a Spec's default (a value, or a Parameter.Type)."""
+    if hasattr(default, "name") and not isinstance(default, (str, bool, int, float, list, tuple)):
+        return {
+            "DOUBLE_ARRAY": "double[]",
+            "INTEGER_ARRAY": "integer[]",
+            "STRING_ARRAY": "string[]",
+            "BOOL_ARRAY": "bool[]",
+        }.get(default.name, default.name.lower())
+    if isinstance(default, bool):
+        return "bool"
+    if isinstance(default, int):
+        return "integer"
+    if isinstance(default, float):
+        return "double"
+    if isinstance(default, str):
+        return "string"
+    if isinstance(default, (list, tuple)):
+        item = type_name(default[0]) if default else "double"
+        return f"{item}[]"
+    return type(default).__name__
+
+
+def default_text(default: Any) -> str | None:
+    """The default as a user would write it; None when there is none (a type only)."""
+    if hasattr(default, "name") and not isinstance(default, (str, bool, int, float, list, tuple)):
+        return None
+    if isinstance(default, bool):
+        return "true" if default else "false"
+    if isinstance(default, str):
+        return f"'{default}'"
+    if isinstance(default, (list, tuple)):
+        return "[" + ", ".join(default_text(x) or "" for x in default) + "]"
+    return repr(default)
+
+
+def range_text(spec) -> str:
+    low, high = getattr(spec, "minimum", None), getattr(spec, "maximum", None)
+    if low is None and high is None:
+        return ""
+    low = "-inf" if low is None or math.isinf(low) else f"{low:g}"
+    high = "inf" if high is None or math.isinf(high) else f"{high:g}"
+    return f"{low} to {high}"
+
+
+def own_arguments(argv: Iterable[str]) -> list[str]:
+    """The arguments outside every ``--ros-args ... [--]`` span (argv without the program)."""
+    own, inside = [], False
+    for argument in list(argv)[1:]:
+        if argument == ROS_ARGS:
+            inside = True
+        elif inside and argument == "--":
+            inside = False
+        elif not inside:
+            own.append(argument)
+    return own
+
+
+def refusal(name: str, argv: list[str]) -> str | None:
+    """Why the node will not start with these arguments (one line), or None. Help is not
+    a refusal (see ``wants_help``)."""
+    own = [a for a in own_arguments(argv) if a not in HELP]
+    if not own:
+        return None
+    first = own[0]
+    if first in ROS_FLAGS or ":=" in first or first.startswith("__"):
+        rest = " ".join(own)
+        return (
+            f"cannot start: '{rest}' is a ROS argument and would be ignored: add --ros-args before it, "
+            f"e.g. {name} --ros-args {rest}"
+        )
+    return f"cannot start: unknown argument '{first}': {name} takes only ROS arguments, after --ros-args (see --help)"
+
+
+def wants_help(argv: list[str]) -> bool:
+    return any(a in HELP for a in own_arguments(argv))
+
+
+_given: list[str] = []  # the params files of the node's command line (set by ``before_start``)
+
+
+def params_files(argv: list[str]) -> list[str]:
+    """The files of every ``--params-file`` inside ``--ros-args``, in order."""
+    files, inside, arguments = [], False, list(argv)[1:]
+    for i, argument in enumerate(arguments):
+        if argument == ROS_ARGS:
+            inside = True
+        elif inside and argument == "--":
+            inside = False
+        elif inside and argument == "--params-file" and i + 1 < len(arguments):
+            files.append(arguments[i + 1])
+    return files
+
+
+def params_files_given() -> list[str]:
+    """The params files the running node was started with (empty in-process)."""
+    return list(_given)
+
+
+def params_file_problem(path: str) -> str | None:
+    """Why rcl should not be given this params file (one line naming it), or None: missing,
+    not a regular file (a device, /dev/zero), too large, not text (core.io.text_files)."""
+    try:
+        read_text_file(path, "params file")
+    except InputFileError as error:
+        where = f" (relative paths are read from {Path.cwd()})" if not Path(path).is_absolute() else ""
+        return f"{error}{where}"
+    return None
+
+
+def before_start(name: str, argv: list[str], usage) -> tuple[int, str] | None:
+    """What to do before ROS starts: (exit code, text to print) for --help (0, the usage),
+    a ROS argument outside --ros-args (2) or a params file rcl should not read (1, the
+    reason); None to start. ``usage()``: the node's Usage; None for a tool that parses its
+    own arguments (then only the params files are checked)."""
+    if usage is not None:
+        if wants_help(argv):
+            return 0, usage().text()
+        refused = refusal(name, argv)
+        if refused:
+            return 2, refused
+    files = params_files(argv)
+    for path in files:
+        problem = params_file_problem(path)
+        if problem:
+            return 1, f"cannot start: {problem}"
+    _given[:] = files
+    return None
