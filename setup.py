@@ -34,12 +34,14 @@ setup(
             "record = irb140_dynamics.tools.record:main",
             "equations = irb140_dynamics.tools.equations:main",
             "retime = irb140_dynamics.tools.retime:main",
-            "trajectory_check_node = irb140_dynamics.nodes.trajectory_check_node.node:main",
+            "trajectory_check_node = irb140_dynamics.nodes.trajectory_check_node:main",
             # the tools under names of their own, for an install without the ros2 CLI (pip)
             "irb140-export-urdf = irb140_dynamics.tools.export_urdf:main",
             "irb140-identify = irb140_dynamics.tools.identify:main",
             "irb140-excitation = irb140_dynamics.tools.excitation:main",
             "irb140-record = irb140_dynamics.tools.record:main",
+            "irb140-equations = irb140_dynamics.tools.equations:main",
+            "irb140-retime = irb140_dynamics.tools.retime:main",
         ],
     },
 )

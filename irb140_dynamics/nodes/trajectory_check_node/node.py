@@ -46,6 +46,8 @@ from irb140_dynamics.nodes.trajectory_check_node.messages import (
 )
 from irb140_dynamics.ros.parameters.model_source import declare_model_source
 from irb140_dynamics.ros.parameters.specs import Spec, check_number
+from irb140_dynamics.ros.parameters.usage import model_sections
+from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
 from irb140_dynamics.ros.runtime.spin import run
 
@@ -209,8 +211,15 @@ class TrajectoryCheckNode(Node):
         self._report_pub.publish(status)
 
 
+def usage() -> Usage:
+    """What ``trajectory_check_node --help`` prints: this module's docstring and every parameter."""
+    return Usage(
+        "trajectory_check_node", __doc__, [*model_sections(), ("trajectory_check_node's own", NODE_PARAMETERS)]
+    )
+
+
 def main(args=None):
-    raise SystemExit(run("trajectory_check_node", TrajectoryCheckNode, args))
+    raise SystemExit(run("trajectory_check_node", TrajectoryCheckNode, args, usage=usage))
 
 
 if __name__ == "__main__":
