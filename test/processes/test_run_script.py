@@ -44,6 +44,19 @@ def left_behind(process: subprocess.Popen) -> list[str]:
     return found
 
 
+def kill_session(process: subprocess.Popen) -> None:
+    """SIGKILL to run.sh and everything in its session (its nodes are in process groups of
+    their own): a failed test leaves nothing running."""
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                if os.getsid(int(entry.name)) == process.pid:
+                    os.kill(int(entry.name), signal.SIGKILL)
+            except OSError:
+                continue
+    process.wait(timeout=30)
+
+
 def test_help_is_usage_and_exit_0(tmp_path):
     done = subprocess.run([str(RUN), "--help"], cwd=tmp_path, capture_output=True, text=True, timeout=60)
     assert done.returncode == 0 and "Traceback" not in done.stdout + done.stderr, done
@@ -65,12 +78,13 @@ def test_a_node_that_cannot_start_stops_the_others_and_is_named(tmp_path):
     try:
         output, _ = process.communicate(timeout=BUILD_AND_START)
     finally:
-        os.killpg(process.pid, signal.SIGKILL) if process.poll() is None else None
+        leftovers = left_behind(process)
+        kill_session(process)
     assert process.returncode == 1, output
     assert f"{tmp_path}/negative.yaml" in output and "payload.mass: must be between 0 and 1e+06, got -3.0" in output
     assert "stopped by itself; stopping the others" in output, output
     assert "interrupted" not in output.lower().replace("interrupted (ctrl-c) before the node was ready", ""), output
-    assert left_behind(process) == [], output
+    assert leftovers == [], output
 
 
 @pytest.mark.slow
@@ -87,11 +101,11 @@ def test_the_demo_stops_on_ctrl_c_and_writes_its_plot_where_it_says(tmp_path):
         os.kill(process.pid, signal.SIGINT)  # Ctrl-C: the terminal sends it to run.sh
         rest, _ = process.communicate(timeout=120)
     finally:
-        if process.poll() is None:
-            os.killpg(process.pid, signal.SIGKILL)
+        leftovers = left_behind(process)
+        kill_session(process)
     output = "".join(lines) + rest
     assert process.returncode == 0 and "Traceback" not in output, output
     plot = tmp_path / "demo_tracking.png"
     assert f"plot written: {plot}" in output and plot.stat().st_size > 0, output
     assert "tracking error RMS over the last second, per joint [mrad] (id_node on the built-in IRB-140" in output
-    assert left_behind(process) == [], output
+    assert leftovers == [], output
