@@ -1,4 +1,6 @@
-"""Recorded joint states, read in chunks: ROS 2 bags (through rosbags) and CSV files.
+"""Recorded joint states, read in chunks: ROS 2 bags (through rosbags) and CSV files; and the
+bags `record` writes (``open_bag``, ``bag_connection``), so that the format is read and
+written in one place.
 
 A recording yields ``RawChunk``s of at most ``chunk_size`` samples, so that memory stays
 bounded whatever its length. A sample is one JointState message (one CSV row): its time,
@@ -357,3 +359,26 @@ def _scan(path: Path) -> int:
     except OSError as error:
         raise RecordingError(path, f"cannot be read ({error.strerror})") from None
     return lines + pending
+
+
+# -- writing: the recordings `record` makes, read back by the readers above ----------------
+
+
+def open_bag(path: Path):
+    """rosbags' writer of a new ROS 2 bag directory (.mcap) at ``path`` (ValueError when it
+    exists); give each topic a connection (``bag_connection``), then ``write``, ``close``."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    if path.exists():
+        raise ValueError(f"{path}: exists already; give a new name")
+    writer = Writer(path, version=9, storage_plugin=StoragePlugin.MCAP)
+    writer.open()
+    return writer
+
+
+def bag_connection(writer, topic: str, type_name: str):
+    """A topic of ``type_name`` (e.g. sensor_msgs/msg/JointState) in the bag ``writer`` writes,
+    its messages as CDR bytes (the ROS 2 Jazzy types)."""
+    from rosbags.typesys import Stores, get_typestore
+
+    return writer.add_connection(topic, type_name, typestore=get_typestore(Stores.ROS2_JAZZY))

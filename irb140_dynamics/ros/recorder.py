@@ -23,6 +23,8 @@ from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
+from irb140_dynamics.identification.recording import bag_connection, open_bag
+
 DEFAULT_DEPTH = 1000  # the subscription's queue: a burst the writer may lag behind
 POLL_PERIOD = 0.1  # s between looks at the graph while waiting for the topic
 
@@ -31,17 +33,6 @@ def message_class(type_name: str):
     """sensor_msgs/msg/JointState -> the class sensor_msgs.msg.JointState."""
     package, kind, name = type_name.split("/")
     return getattr(importlib.import_module(f"{package}.{kind}"), name)
-
-
-def open_bag(path: Path):
-    """rosbags' writer of a new bag directory at ``path`` (ValueError when it exists)."""
-    from rosbags.rosbag2 import StoragePlugin, Writer
-
-    if path.exists():
-        raise ValueError(f"{path}: exists already; give a new name")
-    writer = Writer(path, version=9, storage_plugin=StoragePlugin.MCAP)
-    writer.open()
-    return writer
 
 
 class Recorder(Node):
@@ -85,13 +76,9 @@ class Recorder(Node):
             return
         self._waiting.cancel()
         type_name = publishers[0].topic_type
-        from rosbags.typesys import Stores, get_typestore
-
         try:
             message = message_class(type_name)
-            self._connection = self._writer.add_connection(
-                self.topic, type_name, typestore=get_typestore(Stores.ROS2_JAZZY)
-            )
+            self._connection = bag_connection(self._writer, self.topic, type_name)
         except Exception as error:  # noqa: BLE001  (an unknown type: rosbags and importlib raise many kinds)
             self.failure = f"{self.topic}: cannot record its type {type_name} ({type(error).__name__}: {error})"
             return
