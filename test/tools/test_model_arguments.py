@@ -121,10 +121,13 @@ def test_identify_writes_a_params_file_and_a_urdf_that_load_back(identified):
 
 
 def test_identify_refuses_a_bad_urdf_in_one_line_and_writes_nothing(tmp_path, capsys):
-    out = tmp_path / "out.yaml"
-    assert identify_tool.main(["x.csv", "--out", str(out), "--urdf", str(tmp_path / "none.urdf"), "--quiet"]) == 1
+    out, recording = tmp_path / "out.yaml", tmp_path / "x.csv"
+    recording.write_text("t,q_1\n")  # the recording exists: the URDF is what is refused (every input checked first)
+    assert (
+        identify_tool.main([str(recording), "--out", str(out), "--urdf", str(tmp_path / "none.urdf"), "--quiet"]) == 1
+    )
     error = capsys.readouterr().err
-    assert error.count("\n") == 1 and "no such URDF file" in error and not out.exists()
+    assert error.count("\n") == 1 and "none.urdf: no such file" in error and not out.exists()
 
 
 BLOCK_ROS = """
