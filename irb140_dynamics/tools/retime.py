@@ -28,7 +28,14 @@ from ..core import RigidBody, RobotModel
 from ..core.io.atomic import write_files
 from ..core.io.model_source import tool_model
 from ..core.io.trajectory_file import joint_trajectory_yaml, read_joint_trajectory
-from ..core.trajectories import Trajectory, TrajectoryError, check_trajectory, retime, trajectory_limits
+from ..core.trajectories import (
+    Trajectory,
+    TrajectoryError,
+    check_trajectory,
+    retime,
+    torque_limit_notes,
+    trajectory_limits,
+)
 from .cli import ToolError, run
 
 NAME = "retime"
@@ -107,7 +114,7 @@ def main(argv=None) -> int:
         model = model_of(args.params_file, args.urdf, args.payload_mass, (args.base_link, args.tip_link))
         tr = read_trajectory(args.input, model)
         limits = trajectory_limits(model)
-        notes = _torque_notes(model, limits)
+        notes = list(torque_limit_notes(model, limits))
         before = check_trajectory(model, tr, limits)
         if args.check_only:
             files = {args.plot: _plot(model, limits, tr, None)} if args.plot else {}
@@ -136,18 +143,6 @@ def main(argv=None) -> int:
         return 0
 
     return run(NAME, lambda interrupts: body())
-
-
-def _torque_notes(model, limits) -> list[str]:
-    notes = []
-    for source, text in (
-        ("derived", "derived as the payload check does: the rated payload's worst static torque (torque_limit 0)"),
-        ("none", "none: the rated payload cannot load them (torque_limit 0)"),
-    ):
-        names = [n for n, s in zip(model.joint_names, limits.torque_source) if s == source]
-        if names:
-            notes.append(f"torque limits of {', '.join(names)}: {text}")
-    return notes
 
 
 def _plot(model, limits, before, after) -> bytes:

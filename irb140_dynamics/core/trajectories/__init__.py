@@ -14,11 +14,12 @@ May import: ``core.model``, the verbs in ``core.dynamics``, ``core.payload`` (li
 """
 
 from .check import JointPeak, TrajectoryReport, check_trajectory
-from .limits import Limits, trajectory_limits
+from .limits import Limits, torque_limit_notes, trajectory_limits
 from .message import Trajectory, TrajectoryError
 from .retiming import Retimed, retime
 
 __all__ = [
+    "torque_limit_notes",
     "JointPeak",
     "Limits",
     "Retimed",

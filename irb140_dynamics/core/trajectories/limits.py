@@ -47,3 +47,16 @@ def trajectory_limits(model: RobotModel) -> Limits:
 def _or_inf(values) -> np.ndarray:
     values = np.array(values, dtype=float)
     return np.where(values > 0, values, np.inf)
+
+
+def torque_limit_notes(model: RobotModel, limits: Limits) -> tuple[str, ...]:
+    """Lines saying which joints' torque limits were derived (or are none), for a report."""
+    notes = []
+    for source, text in (
+        ("derived", "derived as the payload check does: the rated payload's worst static torque (torque_limit 0)"),
+        ("none", "none: the rated payload cannot load them (torque_limit 0)"),
+    ):
+        names = [n for n, s in zip(model.joint_names, limits.torque_source) if s == source]
+        if names:
+            notes.append(f"torque limits of {', '.join(names)}: {text}")
+    return tuple(notes)

@@ -36,6 +36,7 @@ from irb140_dynamics.core.trajectories import (
     TrajectoryError,
     check_trajectory,
     retime,
+    torque_limit_notes,
     trajectory_limits,
 )
 from irb140_dynamics.nodes.trajectory_check_node.messages import (
@@ -106,7 +107,9 @@ def finish_settings(draft: Draft, previous: TrajectoryCheckSettings | None) -> T
         draft.model.gravity,
     )
     limits = previous.limits if same else trajectory_limits(draft.model)
-    return TrajectoryCheckSettings(draft.model, draft.grid, draft.warn_use, limits, torque_notes(draft.model, limits))
+    return TrajectoryCheckSettings(
+        draft.model, draft.grid, draft.warn_use, limits, torque_limit_notes(draft.model, limits)
+    )
 
 
 def quick(draft: Draft, previous: TrajectoryCheckSettings | None) -> bool:
@@ -114,18 +117,6 @@ def quick(draft: Draft, previous: TrajectoryCheckSettings | None) -> bool:
         draft.model.joints,
         draft.model.gravity,
     )
-
-
-def torque_notes(model: RobotModel, limits: Limits) -> tuple[str, ...]:
-    notes = []
-    for source, text in (
-        ("derived", "derived as payload_check_node does: the rated payload's worst static torque (torque_limit 0)"),
-        ("none", "none: the rated payload cannot load them (torque_limit 0)"),
-    ):
-        names = [n for n, s in zip(model.joint_names, limits.torque_source) if s == source]
-        if names:
-            notes.append(f"torque limits of {', '.join(names)}: {text}")
-    return tuple(notes)
 
 
 class TrajectoryCheckNode(Node):
