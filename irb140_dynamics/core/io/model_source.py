@@ -33,19 +33,11 @@ from typing import Any
 
 from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.core.io.urdf import LoadedUrdf, UrdfError, load_urdf, read_urdf
-from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.model.robot_model import JOINT_DRIVE_FIELDS, RobotModel
 
 SOURCES = ("parameters", "robot_description")
 DESCRIPTION_PARAMETERS = ("gravity", "friction.smoothing_velocity")  # and payload.*: what a URDF's model takes
-JOINT_PARAMETERS = (  # and of each of its joints
-    "position_limits",
-    "torque_limit",
-    "velocity_limit",
-    "acceleration_limit",
-    "friction.viscous",
-    "friction.coulomb",
-    "armature",
-)
+JOINT_PARAMETERS = JOINT_DRIVE_FIELDS  # and of each of its joints
 
 
 @dataclass(frozen=True, eq=False)

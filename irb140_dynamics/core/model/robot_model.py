@@ -175,6 +175,16 @@ class RobotModel:
         )
 
 
+# a joint's limits, friction and rotor inertia: what a URDF's model may take from a params file
+JOINT_DRIVE_FIELDS = (
+    "position_limits",
+    "torque_limit",
+    "velocity_limit",
+    "acceleration_limit",
+    "friction.viscous",
+    "friction.coulomb",
+    "armature",
+)
 JOINT_FIELDS = (
     "type",
     "link.physical",
@@ -184,13 +194,7 @@ JOINT_FIELDS = (
     "link.mass",
     "link.com",
     "link.inertia",
-    "position_limits",
-    "torque_limit",
-    "velocity_limit",
-    "acceleration_limit",
-    "friction.viscous",
-    "friction.coulomb",
-    "armature",
+    *JOINT_DRIVE_FIELDS,
 )
 JOINTS_KEPT = 256  # joints remembered by their parameter values
 _joints_by_values: dict[tuple, Joint] = {}
