@@ -27,14 +27,15 @@ from dataclasses import replace
 
 import numpy as np
 import pinocchio as pin
-from common import (  # first: puts the checkout on sys.path
-    REPO,
+from common import (
+    # first: puts the checkout on sys.path
     Figure,
     Row,
     Target,
     machine_info,
     print_table,
     seconds_per_call,
+    shown,
     write_results,
 )
 
@@ -346,7 +347,7 @@ def main() -> None:
             "runtime_s": time.perf_counter() - started,
         },
     )
-    print(f"raw figures: {path.relative_to(REPO)} ({time.perf_counter() - started:.0f} s)")
+    print(f"raw figures: {shown(path)} ({time.perf_counter() - started:.0f} s)")
 
 
 if __name__ == "__main__":

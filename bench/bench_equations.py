@@ -27,7 +27,8 @@ from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
-from common import (  # first: puts the checkout on sys.path
+from common import (
+    # first: puts the checkout on sys.path
     REPO,
     Figure,
     Row,
@@ -36,6 +37,7 @@ from common import (  # first: puts the checkout on sys.path
     machine_info,
     print_table,
     seconds_per_call,
+    shown,
     write_results,
 )
 
@@ -212,7 +214,7 @@ def main() -> None:
     path = write_results(
         "equations", {"machine": machine_info(("numpy", "pinocchio", "sympy")), "rows": [row.as_dict() for row in rows]}
     )
-    print(f"\nwritten: {path.relative_to(REPO)}")
+    print(f"\nwritten: {shown(path)}")
 
 
 if __name__ == "__main__":

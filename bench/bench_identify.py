@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
-from common import REPO, Figure, Row, Target, machine_info, print_table, seconds_per_call, write_results
+from common import REPO, Figure, Row, Target, machine_info, print_table, seconds_per_call, shown, write_results
 
 from irb140_dynamics.core import irb140
 from irb140_dynamics.core.regressor import regressor_batch
@@ -227,7 +227,7 @@ def main() -> None:
             "runtime_s": time.perf_counter() - started,
         },
     )
-    print(f"raw figures: {path.relative_to(REPO)} ({time.perf_counter() - started:.0f} s)")
+    print(f"raw figures: {shown(path)} ({time.perf_counter() - started:.0f} s)")
 
 
 if __name__ == "__main__":

@@ -33,7 +33,7 @@ import argparse
 import os
 import time
 
-from common import REPO, machine_info, print_table, write_results  # first: puts the checkout on sys.path
+from common import machine_info, print_table, shown, write_results  # first: puts the checkout on sys.path
 from machine_load import OTHERS_WARNING, STOLEN_WARNING
 from node_processes import QOS_DEPTH, isolated_domain
 from payload_section import payload_rows
@@ -130,7 +130,7 @@ def main(argv=None) -> None:
                 "runtime_s": time.perf_counter() - started,
             },
         )
-        print(f"raw figures: {path.relative_to(REPO)}")
+        print(f"raw figures: {shown(path)}")
         return
 
     rows, runs, payload = [], [], {}
@@ -201,7 +201,7 @@ def main(argv=None) -> None:
             "runtime_s": time.perf_counter() - started,
         },
     )
-    print(f"raw figures: {path.relative_to(REPO)} ({time.perf_counter() - started:.0f} s)")
+    print(f"raw figures: {shown(path)} ({time.perf_counter() - started:.0f} s)")
 
 
 if __name__ == "__main__":

@@ -29,7 +29,15 @@ import sys
 import time
 
 import numpy as np
-from common import REPO, Row, Target, Value, machine_info, print_table, write_results  # first: the checkout on sys.path
+from common import (  # first: the checkout on sys.path
+    Row,
+    Target,
+    Value,
+    machine_info,
+    print_table,
+    shown,
+    write_results,
+)
 from machine_load import OTHERS_WARNING, load_between, snapshot
 from node_processes import STARTUP_TIMEOUT, NodeProcess, isolated_domain, wait_for
 from receiver import Receiver
@@ -300,7 +308,7 @@ def main(argv=None) -> None:
             "runtime_s": time.perf_counter() - started,
         },
     )
-    print(f"raw figures: {path.relative_to(REPO)} ({time.perf_counter() - started:.0f} s)")
+    print(f"raw figures: {shown(path)} ({time.perf_counter() - started:.0f} s)")
 
 
 if __name__ == "__main__":

@@ -22,7 +22,8 @@ from importlib import metadata
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-RESULTS = REPO / "bench" / "results"
+# where write_results puts the JSON (the doc-test harness points it elsewhere)
+RESULTS = Path(os.environ.get("IRB140_BENCH_RESULTS") or REPO / "bench" / "results")
 
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
@@ -230,6 +231,11 @@ def machine_info(modules: Sequence[str] = ("numpy",)) -> dict:
     info["git_commit"] = _git_commit()
     info["date"] = datetime.now(UTC).isoformat(timespec="seconds")
     return info
+
+
+def shown(path: Path) -> Path:
+    """``path`` as printed: relative to the checkout when inside it."""
+    return path.relative_to(REPO) if path.is_relative_to(REPO) else path
 
 
 def write_results(name: str, results: dict) -> Path:

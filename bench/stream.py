@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from common import REPO, RESULTS, Row, set_priority  # first: puts the checkout on sys.path
+from common import RESULTS, Row, set_priority, shown  # first: puts the checkout on sys.path
 from machine_load import load_between, snapshot
 from node_processes import QOS_DEPTH, STARTUP_TIMEOUT, NodeProcess, node_command, wait_for
 from parameter_changes import ParameterChanger
@@ -228,7 +228,7 @@ def stream_run(
     run["parameter_changes"] = changes
     run["publisher_sched_fifo"] = realtime
     if profile:
-        run["profile"] = {"file": str(profile_path.relative_to(REPO)), "top": profile_summary(profile_path)}
+        run["profile"] = {"file": str(shown(profile_path)), "top": profile_summary(profile_path)}
     return run
 
 

@@ -51,6 +51,8 @@ def environment(tmp_path_factory) -> dict:
         "PYTHONPATH": str(ROOT),
         "PYTHONUNBUFFERED": "1",
         "MPLBACKEND": "Agg",
+        # a benchmark a doc shows writes its figures here, not over the clone's bench/results
+        "IRB140_BENCH_RESULTS": str(tmp_path_factory.mktemp("bench_results")),
     }
 
 
@@ -149,9 +151,24 @@ def clone_view(directory: Path) -> Path:
     return directory
 
 
+def clone_files() -> dict[str, tuple[int, int]]:
+    """path -> (size, mtime) of the clone's files a block can reach through its links."""
+    files = {}
+    for name in CLONE[1:]:
+        for folder, subfolders, names in os.walk(ROOT / name):
+            subfolders[:] = [d for d in subfolders if d != "__pycache__"]
+            for file in names:
+                stat = (Path(folder) / file).stat()
+                files[os.path.join(folder, file)] = (stat.st_size, stat.st_mtime_ns)
+    return files
+
+
 @pytest.mark.parametrize("doc", DOCS, ids=lambda path: path.name)
 def test_every_command_block_runs_as_typed(doc, environment, tmp_path):
+    """Each block as typed; what it writes goes to the user's working folder, never into
+    the clone (a second run would meet it, and git would see it)."""
     failures, ran = [], 0
+    before = clone_files()
     clone_view(tmp_path)
     for name in doc_files(doc):
         shutil.copy(ROOT / name, tmp_path / Path(name).name)
@@ -163,6 +180,9 @@ def test_every_command_block_runs_as_typed(doc, environment, tmp_path):
         if problem:
             failures.append(f"{block.where} ({first_word(block.text)} ...): {problem}")
     assert not failures, "\n\n".join(failures)
+    after = clone_files()
+    written = sorted(path for path in after if after[path] != before.get(path))
+    assert not written, f"{doc.name}'s blocks wrote into the clone: {written}"
 
 
 def test_most_command_blocks_really_run():

@@ -16,6 +16,7 @@ from sensor_msgs.msg import JointState
 
 from irb140_dynamics.identification.recording import Recording
 
+from ..support.common import sweep
 from ..support.node_process import TIMEOUT, start, wait_for_line
 
 NAMES = [f"joint_{i}" for i in range(1, 7)]
@@ -30,7 +31,7 @@ def handles_sigterm(pid: int) -> bool:
     return bool(int(caught.split()[1], 16) >> (signal.SIGTERM - 1) & 1)
 
 
-def cases(seed: int = 23, count: int = 8):
+def cases(seed: int = 23, count: int = sweep(4, 32)):
     rng = np.random.default_rng(seed)
     phases = ["starting", "waiting", "recording", "recording"]
     for k in range(count):

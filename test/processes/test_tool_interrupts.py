@@ -17,6 +17,7 @@ import pytest
 from irb140_dynamics.core import irb140, rnea_batch
 from irb140_dynamics.identification.excitation import optimise_excitation
 
+from ..support.common import sweep
 from ..support.node_process import TIMEOUT
 from ..support.paths import ROOT
 from ..support.synthetic_arm import Samples, true_arm, write_csv
@@ -67,7 +68,7 @@ def interrupted(command, folder, delay, signals):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("delay, signals", list(moments(7, 6, 8.0)))
+@pytest.mark.parametrize("delay, signals", list(moments(7, sweep(3, 12), 8.0)))
 def test_identify_interrupted_at_any_moment(recording, tmp_path, delay, signals):
     (tmp_path / "run.csv").write_bytes(recording.read_bytes())
     command = [
@@ -101,7 +102,7 @@ def test_identify_interrupted_at_any_moment(recording, tmp_path, delay, signals)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("delay, signals", list(moments(8, 3, 3.0)))
+@pytest.mark.parametrize("delay, signals", list(moments(8, sweep(3, 12), 3.0)))
 def test_excitation_interrupted_at_any_moment(tmp_path, delay, signals):
     command = [
         sys.executable,
@@ -125,7 +126,7 @@ def test_excitation_interrupted_at_any_moment(tmp_path, delay, signals):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("delay, signals", list(moments(9, 3, 3.0)))
+@pytest.mark.parametrize("delay, signals", list(moments(9, sweep(3, 12), 3.0)))
 def test_export_urdf_interrupted_at_any_moment(tmp_path, delay, signals):
     command = [sys.executable, "-m", "irb140_dynamics.tools.export_urdf", "--out", "arm.urdf"]
     code, output = interrupted(command, tmp_path, delay, signals)

@@ -1,6 +1,7 @@
 """Shared test helpers: seeded random models and states, and a norm-wise closeness check."""
 
 import math
+import os
 
 import numpy as np
 
@@ -14,6 +15,12 @@ OFFSET_PAYLOAD = RigidBody(
     com=(0.03, -0.02, 0.08),
     inertia=(0.021, 0.026, 0.017, 0.0021, -0.0013, 0.0032),
 )
+
+
+def sweep(quick: int, full: int) -> int:
+    """How many seeded cases a sweep test runs: ``quick`` in the suite, ``full`` with
+    IRB140_SWEEP=full (docs/development.md); the quick ones are the first of the full ones."""
+    return full if os.environ.get("IRB140_SWEEP") == "full" else quick
 
 
 def loaded_irb140() -> RobotModel:

@@ -32,6 +32,7 @@ NAMES = [f"joint_{i}" for i in range(1, 7)]
 CENTRE = [0.0, -0.6, 1.0, 0.0, 0.5, 0.0]  # rad: where the motion starts and ends (sim_node's initial_positions)
 AMPLITUDE = [0.8, 0.5, 0.5, 1.0, 0.6, 1.5]  # rad
 POINTS_PER_SECOND = 50
+HISTORY_STEP = 0.01  # s between the samples kept for the plot
 NODE_PARAMETERS = [
     Spec("period", 8.0, "the reference motion's period", "s", read_only=True, minimum=1.0, maximum=3600.0),
     Spec("plot_file", "demo_tracking.png", "the plot written at the end (PNG)", read_only=True),
@@ -79,7 +80,8 @@ class DemoNode(Node):
         self._positions = {}  # stamp [ns] -> q, of the latest joint states
         self._stamps = deque(maxlen=2000)
         self._recent = deque(maxlen=5000)  # (time [s], error) of the last seconds
-        self._history = []  # (time [s], q_ref, q) for the plot, every 10th sample
+        self._history = []  # (time [s], q_ref, q) for the plot, one every HISTORY_STEP seconds
+        self._latest = None  # q of the latest joint state
         self.create_subscription(JointState, "joint_states", self._on_joint_state, 10)
         self.create_subscription(JointState, "/id_node/tracking_error", self._on_error, 10)
         self._start = self.get_clock().now()
@@ -116,13 +118,17 @@ class DemoNode(Node):
         if len(self._stamps) == self._stamps.maxlen:
             self._positions.pop(self._stamps[0], None)
         self._stamps.append(stamp)
-        self._positions[stamp] = np.array(msg.position)
+        self._positions[stamp] = self._latest = np.array(msg.position)
 
     def _on_error(self, msg: JointState) -> None:
         t, error = self._elapsed(), np.array(msg.position)
         self._recent.append((t, error))
-        q = self._positions.get(self._ns(msg))
-        if q is not None and len(self._recent) % 10 == 0:
+        if self._history and t - self._history[-1][0] < HISTORY_STEP:
+            return
+        # the joint state this error was computed from, else the latest (a busy machine may
+        # drop it from the queue): the plot then shifts by a sample, its error RMS stays exact
+        q = self._positions.get(self._ns(msg), self._latest)
+        if q is not None and len(q) == len(error):
             self._history.append((t, q + error, q))
 
     def _print(self) -> None:
@@ -144,8 +150,10 @@ class DemoNode(Node):
         self.context.try_shutdown()  # main() then destroys the node, which writes the plot
 
     def write_plot(self) -> str | None:
-        """Reference and actual positions per joint, as a PNG; its path, or None without data."""
+        """Reference and actual positions per joint, as a PNG; its path, or None without data
+        (then it says so)."""
         if not self._history:
+            print(f"no plot: no tracking error received from id_node yet ({self.plot_file} not written)", flush=True)
             return None
         import matplotlib
 

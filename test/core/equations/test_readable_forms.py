@@ -52,8 +52,10 @@ def test_the_written_forms_equal_the_core(arm):
     runs = tp.angle_runs(list(series.values()), model.n)
     Q, QD, _ = random_states(model.n, seed=6, count=50)
 
+    products = {name: [tp.products(x, runs, 0.0) for x in entries] for name, entries in series.items()}
+
     def values(name, q, qd=()):
-        return [tp.value(tp.products(x, runs, 0.0), runs, q, qd) for x in series[name]]
+        return [tp.value(x, runs, q, qd) for x in products[name]]
 
     assert_close(np.array([values("g", q) for q in Q]), gravity_batch(model, Q), "g written")
     M = np.array([values("M", q) for q in Q]).reshape(-1, model.n, model.n)
