@@ -39,7 +39,8 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
     origin) that the environment exerts on the flange, in the flange frame. tau balances
     it: tau = ID(q, qd, qdd) - J(q)^T f_ext, with J the flange Jacobian in the flange frame.
     """
-    kernels, n = kernels_of(model), len(model.joints)
+    kernels = kernels_of(model)
+    shape = kernels.shape
     if (  # the common case checked at once, inline: rnea is the hot path
         type(q) is _ARRAY
         and type(qd) is _ARRAY
@@ -47,13 +48,15 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
         and q.dtype is _FLOAT64
         and qd.dtype is _FLOAT64
         and qdd.dtype is _FLOAT64
-        and q.shape == qd.shape == qdd.shape == (n,)
+        and q.shape == shape
+        and qd.shape == shape
+        and qdd.shape == shape
     ):
         args = q.tolist(), qd.tolist(), qdd.tolist()
-        if not isfinite(sum(args[0]) + sum(args[1]) + sum(args[2])):
-            args = (state(q, n, "q"), state(qd, n, "qd"), state(qdd, n, "qdd"))  # names the culprit
+        if not isfinite(sum(args[2], sum(args[1], sum(args[0])))):  # a finite sum: all finite
+            args = (state(q, kernels.n, "q"), state(qd, kernels.n, "qd"), state(qdd, kernels.n, "qdd"))
     else:
-        args = (state(q, n, "q"), state(qd, n, "qd"), state(qdd, n, "qdd"))
+        args = (state(q, kernels.n, "q"), state(qd, kernels.n, "qd"), state(qdd, kernels.n, "qdd"))
     tau = kernels.rnea.scalar(*args) if f_ext is None else kernels.rnea_wrench.scalar(*args, state(f_ext, 6, "f_ext"))
     if not isfinite(sum(tau)):  # inline: rnea is the hot path
         finite_result(tau, "rnea", q=q, qd=qd, qdd=qdd, **({} if f_ext is None else {"f_ext": f_ext}))
@@ -64,7 +67,14 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
 
 def gravity(model: RobotModel, q: ArrayLike) -> np.ndarray:
     """Gravity torques g(q) [N m]: what holds the arm (and payload) still at q."""
-    return np.array(kernels_of(model).gravity_torques.scalar(state(q, len(model.joints), "q")))
+    kernels = kernels_of(model)
+    if type(q) is _ARRAY and q.dtype is _FLOAT64 and q.shape == kernels.shape:  # the common case, inline
+        q_list = q.tolist()
+        if not isfinite(sum(q_list)):
+            q_list = state(q, kernels.n, "q")
+    else:
+        q_list = state(q, kernels.n, "q")
+    return np.array(kernels.gravity_torques.scalar(q_list))
 
 
 def coriolis(model: RobotModel, q: ArrayLike, qd: ArrayLike) -> np.ndarray:

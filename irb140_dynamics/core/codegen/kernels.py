@@ -69,6 +69,7 @@ class Kernels:
 
     def __init__(self, model):
         self.n = model.n
+        self.shape = (model.n,)  # of a state array, compared on the hot paths
         self.links = links = algorithms.chain(model)  # the whole model's, for other number types
         self.gravity = model.gravity
         last = links[-1]
