@@ -1,15 +1,20 @@
-"""Test session setup: DDS isolated to this machine and to this session's own domain, and
-the markers of the test folders: test/ros/ spins nodes (``ros``), test/processes/ starts
-executables (``process``)."""
+"""Test session setup: DDS isolated to this machine and to this session's own domain, a
+cache of native kernels of its own, and the markers of the test folders: test/ros/ spins
+nodes (``ros``), test/processes/ starts executables (``process``)."""
 
 import os
 import random
+import tempfile
 from pathlib import Path
 
 # Set before rclpy is imported anywhere: a domain of our own, discovery on localhost only.
 os.environ["ROS_DOMAIN_ID"] = str(random.SystemRandom().randint(1, 100))
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ.pop("ROS_STATIC_PEERS", None)
+# Native kernels (core.codegen.native) compiled by this session into a folder of its own,
+# not into the user's cache: a test sees its own compiles, and leaves nothing behind.
+_CACHE = tempfile.TemporaryDirectory(prefix="irb140_kernels_")
+os.environ["IRB140_CACHE"] = _CACHE.name
 
 
 import pytest  # noqa: E402

@@ -29,6 +29,7 @@ from irb140_dynamics.core.model.states import finite_result, finite_results, sta
 
 ArrayLike = Sequence[float] | np.ndarray
 _ARRAY, _FLOAT64 = np.ndarray, np.dtype(float)
+_frombuffer = np.frombuffer  # a native kernel's ctypes array as a NumPy array, without a copy
 
 
 def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=None) -> np.ndarray:
@@ -52,6 +53,12 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
         and qd.shape == shape
         and qdd.shape == shape
     ):
+        kernel = kernels.rnea
+        if f_ext is None and kernel.native is not None and model.friction is None:
+            tau = kernel.native(q.tobytes() + qd.tobytes() + qdd.tobytes())
+            if tau is not None:  # else not finite: the Python form below says which
+                return _frombuffer(tau)
+        kernel.used()
         args = q.tolist(), qd.tolist(), qdd.tolist()
         if not isfinite(sum(args[2], sum(args[1], sum(args[0])))):  # a finite sum: all finite
             args = (state(q, kernels.n, "q"), state(qd, kernels.n, "qd"), state(qdd, kernels.n, "qdd"))
@@ -69,6 +76,12 @@ def gravity(model: RobotModel, q: ArrayLike) -> np.ndarray:
     """Gravity torques g(q) [N m]: what holds the arm (and payload) still at q."""
     kernels = kernels_of(model)
     if type(q) is _ARRAY and q.dtype is _FLOAT64 and q.shape == kernels.shape:  # the common case, inline
+        kernel = kernels.gravity_torques
+        if kernel.native is not None:
+            g = kernel.native(q.tobytes())
+            if g is not None:
+                return _frombuffer(g)
+        kernel.used()
         q_list = q.tolist()
         if not isfinite(sum(q_list)):
             q_list = state(q, kernels.n, "q")
@@ -92,8 +105,15 @@ def coriolis_matrix(model: RobotModel, q: ArrayLike, qd: ArrayLike) -> np.ndarra
 
 def mass_matrix(model: RobotModel, q: ArrayLike) -> np.ndarray:
     """The joint-space mass matrix M(q) [kg m^2], symmetric positive definite."""
-    n = len(model.joints)
-    upper = kernels_of(model).mass_matrix.scalar(state(q, n, "q"))
+    kernels = kernels_of(model)
+    kernel, n = kernels.mass_matrix, kernels.n
+    if type(q) is _ARRAY and q.dtype is _FLOAT64 and q.shape == kernels.shape:
+        if kernel.native is not None:
+            M = kernel.native(q.tobytes())  # the whole matrix, row by row
+            if M is not None:
+                return _frombuffer(M).reshape(n, n)
+        kernel.used()
+    upper = kernel.scalar(state(q, n, "q"))
     return np.fromiter(upper, float, len(upper))[_upper_to_full(n)]
 
 

@@ -17,6 +17,7 @@ from functools import cached_property, lru_cache
 from irb140_dynamics.core.algorithms import recursions as algorithms
 from irb140_dynamics.core.algorithms.momentum import momentum_terms
 from irb140_dynamics.core.algorithms.regressor import rigid_body_regressor
+from irb140_dynamics.core.codegen import native
 from irb140_dynamics.core.codegen.array_code import compile_into
 from irb140_dynamics.core.codegen.trace import compile_kernel
 from irb140_dynamics.core.model.rigid_body import ZERO3, ZERO6
@@ -26,11 +27,17 @@ ARMS_CACHED = 16  # arms whose compiled code is kept (a model change is a new ar
 
 class Kernel:
     """One compiled algorithm: ``scalar`` on floats, ``array`` on NumPy arrays, and ``into``
-    on NumPy arrays writing the outputs into given arrays (see array_code)."""
+    on NumPy arrays writing the outputs into given arrays (see array_code).
 
-    def __init__(self, name, algorithm, inputs, angles, constants: int):
+    ``native`` (bound kernels): None, or the same code compiled as C, which ``used()`` asks
+    for once the Python form has run native.PROMOTE_AFTER times (see native)."""
+
+    native = None
+    _calls = 0
+
+    def __init__(self, name, algorithm, inputs, angles, constants: int, full_matrix: int = 0):
         self._recipe = (name, algorithm, {**inputs, "k": constants}, angles)
-        self._unbound, self._constants = self, None
+        self._unbound, self._constants, self._full_matrix = self, None, full_matrix
         self.source, self.scalar, self.array = compile_kernel(*self._recipe)
 
     def bound(self, constants: tuple) -> Kernel:
@@ -40,6 +47,20 @@ class Kernel:
         kernel.source = self.source
         kernel.scalar, kernel.array = (_with_default(fn, constants) for fn in (self.scalar, self.array))
         return kernel
+
+    def used(self) -> None:
+        """Count a call of the Python form; the PROMOTE_AFTER-th asks for the native one."""
+        self._calls += 1
+        if self._calls == native.PROMOTE_AFTER and self._constants is not None and native.enabled():
+            native.COMPILER.request(self)
+
+    def native_recipe(self) -> tuple:
+        """(the traced recipe, n to write M whole or 0) for native.c_source."""
+        return self._unbound._recipe, self._unbound._full_matrix
+
+    @property
+    def constants(self) -> tuple:
+        return self._constants
 
     @cached_property
     def _compiled_into(self) -> tuple:
@@ -183,8 +204,8 @@ class _ArmKernels:
     def _gravity(self, k):
         return self._spread(k)[10:13]
 
-    def _kernel(self, name, algorithm, **inputs) -> Kernel:
-        return Kernel(name, algorithm, inputs, self.angles, sum(self.nonzero))
+    def _kernel(self, name, algorithm, full_matrix: int = 0, **inputs) -> Kernel:
+        return Kernel(name, algorithm, inputs, self.angles, sum(self.nonzero), full_matrix)
 
     @cached_property
     def rnea(self) -> Kernel:
@@ -234,7 +255,7 @@ class _ArmKernels:
             M = algorithms.crba(self._links(k), cs)
             return [M[i][j] for i in range(self.n) for j in range(i, self.n)]
 
-        return self._kernel("mass_matrix", upper)
+        return self._kernel("mass_matrix", upper, full_matrix=self.n)
 
     @cached_property
     def coriolis_matrix(self) -> Kernel:

@@ -1,0 +1,232 @@
+"""A kernel's straight-line code compiled as C, for the single-state public functions.
+
+The traced code of a kernel (see ``trace``) is plain arithmetic on doubles, cos and sin: the
+same text is C. Compiled without contraction or fast-math (``-ffp-contract=off``: no fused
+multiply-add) and with cos and sin left to libm, the C performs the very operations of the
+Python code in the same order, so its results are the same, bit for bit. That is checked
+before a native kernel is used: on random inputs it must equal the Python kernel exactly,
+else it is never used.
+
+Compiling takes a C compiler (``$CC``, ``cc`` or ``gcc``) and a fraction of a second per
+kernel, so it never delays a call: a kernel whose Python form has run ``PROMOTE_AFTER``
+times is compiled by one background thread (at the lowest CPU priority), and calls use the
+native code once it is ready. Without a compiler, or with ``IRB140_NATIVE=0``, everything
+stays in Python. Libraries are kept in ``$IRB140_CACHE`` (else ``$XDG_CACHE_HOME`` or
+``~/.cache``, ``irb140_dynamics/kernels``), named by a hash of their source, flags and
+compiler: another process, or the next run, loads them without compiling.
+"""
+
+from __future__ import annotations
+
+import array
+import contextlib
+import ctypes
+import hashlib
+import os
+import queue
+import random
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+from pathlib import Path
+
+from irb140_dynamics.core.codegen.trace import _emit, angle_lines, merged, trace
+
+PROMOTE_AFTER = 1000  # calls of a kernel's Python form before it is compiled
+CHECKS = 20  # random inputs on which the native code must equal the Python code exactly
+FLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math", "-fno-builtin")
+COMPILE_TIMEOUT = 120.0  # s
+FUNCTIONS_KEPT = 64  # compiled kernels kept for the next model of the same arm
+INPUT_NOT_FINITE, OUTPUT_NOT_FINITE = 1, 2  # what a native kernel returns instead of 0
+
+
+def enabled() -> bool:
+    return os.environ.get("IRB140_NATIVE", "1") != "0" and compiler() is not None
+
+
+def compiler() -> str | None:
+    return shutil.which(os.environ.get("CC") or "cc") or shutil.which("gcc")
+
+
+def cache_dir() -> Path:
+    base = os.environ.get("IRB140_CACHE") or os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "irb140_dynamics" / "kernels"
+
+
+def c_source(recipe, full_matrix: int = 0) -> tuple[str, int, int]:
+    """(C source, number of input doubles, number of outputs) of a kernel's recipe (see
+    ``kernels.Kernel``): ``int kernel(const double *x, const double *k, double *out)`` with x
+    the inputs (q, then the other groups but k, in order). It returns 0, or
+    INPUT_NOT_FINITE / OUTPUT_NOT_FINITE (then ``out`` is not to be used). With
+    ``full_matrix`` n, the outputs (an upper triangle row by row) are written as the whole
+    n x n matrix."""
+    name, algorithm, inputs, angles = recipe
+    params, outputs = trace(algorithm, inputs, angles)
+    body, results, used = _emit(merged(outputs))
+    if full_matrix:
+        results = whole_matrix(results, full_matrix)
+    lines = ["#include <math.h>", "", "int kernel(const double *x, const double *k, double *out) {"]
+    count = 0
+    for group in params:
+        length = len(angles) if group == "q" else inputs[group]
+        for i in range(length):
+            if group == "k":
+                lines.append(f"    const double k{i} = k[{i}];")
+            else:
+                lines.append(f"    const double {group}{i} = x[{count}];")
+                count += 1
+    lines.append("    double check = 0.0;")
+    lines.append(f"    for (int i = 0; i < {count}; ++i) check += x[i];")
+    lines.append(f"    if (!isfinite(check)) return {INPUT_NOT_FINITE};")
+    lines += [f"    const double {line.strip()};" for line in angle_lines(angles, used) + body]
+    lines += [f"    out[{j}] = {expression};" for j, expression in enumerate(results)]
+    lines.append("    check = 0.0;")
+    lines.append(f"    for (int i = 0; i < {len(results)}; ++i) check += out[i];")
+    lines.append(f"    return isfinite(check) ? 0 : {OUTPUT_NOT_FINITE};")
+    return "\n".join(lines) + "\n}\n", count, len(results)
+
+
+def library(source: str) -> Path:
+    """The shared library of ``source``, compiled unless cached; OSError or
+    subprocess.SubprocessError when it cannot be."""
+    cc = compiler()
+    if cc is None:
+        raise OSError("no C compiler")
+    key = hashlib.sha256("\0".join([source, cc, *FLAGS, sys.platform]).encode()).hexdigest()[:32]
+    folder = cache_dir()
+    path = folder / f"{key}.so"
+    if path.exists():
+        return path
+    folder.mkdir(parents=True, exist_ok=True, mode=0o700)
+    with tempfile.TemporaryDirectory(dir=folder) as work:
+        (Path(work) / "kernel.c").write_text(source)
+        built = Path(work) / "kernel.so"
+        process = subprocess.Popen(
+            [cc, *FLAGS, "kernel.c", "-o", built.name, "-lm"],
+            cwd=work,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+        )
+        with contextlib.suppress(OSError):
+            os.setpriority(os.PRIO_PROCESS, process.pid, 19)  # a node's loop comes first
+        try:
+            _, error = process.communicate(timeout=COMPILE_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+            raise
+        if process.returncode != 0:
+            raise subprocess.SubprocessError(error.decode(errors="replace").strip()[:300])
+        os.replace(built, path)  # atomic: another process sees the whole library or none
+    return path
+
+
+class NativeKernel:
+    """A compiled kernel with one model's constants: ``(inputs: bytes) -> ctypes array or
+    None`` (None: an input or output not finite; the Python path then says which)."""
+
+    def __init__(self, function, constants, outputs: int):
+        self._function = function
+        self._constants = (ctypes.c_double * max(len(constants), 1))(*constants)
+        self._out = ctypes.c_double * outputs
+
+    def __call__(self, inputs: bytes):
+        out = self._out()
+        return out if self._function(inputs, self._constants, out) == 0 else None
+
+
+def load(source: str):
+    """The C function of ``source`` (compiled or loaded from the cache)."""
+    function = ctypes.PyDLL(str(library(source))).kernel  # the GIL stays held: a call is short
+    function.restype = ctypes.c_int
+    function.argtypes = (ctypes.c_char_p, ctypes.c_void_p, ctypes.c_void_p)
+    return function
+
+
+def same_as_python(native: NativeKernel, python, inputs: int, groups: list[int], full_matrix: int) -> bool:
+    """Does ``native`` give exactly the Python kernel's numbers (bound: k defaulted)?"""
+    rng = random.Random(140)
+    for _ in range(CHECKS):
+        x = [rng.uniform(-4.0, 4.0) for _ in range(inputs)]
+        args, start = [], 0
+        for length in groups:
+            args.append(x[start : start + length])
+            start += length
+        want = list(python(*args))
+        if full_matrix:
+            want = whole_matrix(want, full_matrix)
+        got = native(array.array("d", x).tobytes())
+        if got is None or list(got) != want:
+            return False
+    return True
+
+
+def whole_matrix(upper: list, n: int) -> list:
+    """The n x n entries, row by row, of a symmetric matrix given by its upper triangle."""
+    at, entries = {}, iter(upper)
+    for i in range(n):
+        for j in range(i, n):
+            at[i, j] = at[j, i] = next(entries)
+    return [at[i, j] for i in range(n) for j in range(n)]
+
+
+class _Compiler:
+    """One background thread compiling the kernels asked for, one at a time."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._functions: dict[str, object] = {}  # source -> C function (None: failed), the newest last
+        self._restart()
+        os.register_at_fork(after_in_child=self._restart)  # a forked child has no worker thread
+
+    def _restart(self) -> None:
+        self._requests: queue.Queue = queue.Queue()
+        self._thread: threading.Thread | None = None
+
+    def request(self, kernel) -> None:
+        with self._lock:
+            if self._thread is None:
+                self._thread = threading.Thread(target=self._run, name="irb140-native", daemon=True)
+                self._thread.start()
+        self._requests.put(kernel)
+
+    def wait(self, timeout: float | None = None) -> bool:
+        """Until every kernel asked for so far is compiled (or given up): True if so in time."""
+        done = threading.Event()
+        self._requests.put(done)
+        return done.wait(timeout)
+
+    def _run(self) -> None:
+        while True:
+            kernel = self._requests.get()
+            if isinstance(kernel, threading.Event):
+                kernel.set()
+                continue
+            try:
+                kernel.native = self._native(kernel)
+            except Exception:  # never let the worker die: the Python form stays in use
+                kernel.native = None
+
+    def _native(self, kernel):
+        recipe, full_matrix = kernel.native_recipe()
+        source, inputs, outputs = c_source(recipe, full_matrix)
+        if source not in self._functions:
+            try:
+                function = load(source)
+            except (OSError, subprocess.SubprocessError):
+                function = None
+            if len(self._functions) >= FUNCTIONS_KEPT:
+                del self._functions[next(iter(self._functions))]
+        else:
+            function = self._functions.pop(source)
+        self._functions[source] = function
+        if function is None:
+            return None
+        native = NativeKernel(function, kernel.constants, outputs)
+        groups = [len(recipe[3])] + [length for group, length in recipe[2].items() if group != "k"]
+        return native if same_as_python(native, kernel.scalar, inputs, groups, full_matrix) else None
+
+
+COMPILER = _Compiler()

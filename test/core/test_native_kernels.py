@@ -1,0 +1,151 @@
+"""Native kernels (core.codegen.native): the C form of a kernel gives the Python form's
+numbers bit for bit, refuses what the Python form refuses, and is only ever an
+acceleration: without a compiler, with IRB140_NATIVE=0, or when compiling fails, the
+Python form answers. The session's cache is its own (test/conftest.py)."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from irb140_dynamics.core import Friction, gravity, irb140, mass_matrix, rnea
+from irb140_dynamics.core.codegen import native
+from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.urdf import load_urdf
+
+from ..support.common import OFFSET_PAYLOAD
+from ..support.paths import URDF_DATA
+
+pytestmark = pytest.mark.skipif(native.compiler() is None, reason="no C compiler on this machine")
+
+KERNELS = ("rnea", "gravity_torques", "mass_matrix")
+
+
+def arms() -> dict:
+    def urdf(name, **chain):
+        return load_urdf((URDF_DATA / name).read_text(), **chain).model
+
+    return {
+        "irb140 with an offset payload": lambda: irb140(payload=OFFSET_PAYLOAD),
+        "ur5": lambda: urdf("ur5.urdf", tip_link="tool0"),
+        "panda": lambda: urdf("panda.urdf", tip_link="panda_link8"),
+        "prismatic arm": lambda: urdf("prismatic_arm.urdf"),
+    }
+
+
+def frictionless(model):
+    return replace(model, joints=tuple(replace(j, friction=Friction()) for j in model.joints))
+
+
+def promoted(model, names=KERNELS):
+    """The model with its kernels compiled as C (asked for at once, not after PROMOTE_AFTER calls)."""
+    kernels = kernels_of(model)
+    for name in names:
+        native.COMPILER.request(getattr(kernels, name))
+    assert native.COMPILER.wait(timeout=120.0)
+    assert all(getattr(kernels, name).native is not None for name in names), "not compiled"
+    return model
+
+
+def states(model, count=200, seed=5):
+    rng = np.random.default_rng(seed)
+    shape = (count, model.n)
+    return rng.uniform(-3.0, 3.0, shape), rng.uniform(-3.0, 3.0, shape), rng.uniform(-10.0, 10.0, shape)
+
+
+@pytest.mark.parametrize("arm", sorted(arms()))
+def test_native_kernels_give_the_python_numbers_bit_for_bit(arm):
+    python_model, native_model = (frictionless(arms()[arm]()) for _ in range(2))
+    promoted(native_model)
+    for q, qd, qdd in zip(*states(native_model)):
+        np.testing.assert_array_equal(rnea(native_model, q, qd, qdd), rnea(python_model, q, qd, qdd))
+        np.testing.assert_array_equal(gravity(native_model, q), gravity(python_model, q))
+        np.testing.assert_array_equal(mass_matrix(native_model, q), mass_matrix(python_model, q))
+    assert kernels_of(python_model).rnea.native is None  # compared with the Python form indeed
+
+
+def test_a_kernel_is_compiled_after_enough_calls_and_used_from_then_on():
+    model = frictionless(irb140(payload=OFFSET_PAYLOAD))
+    q = np.linspace(-1.0, 1.0, 6)
+    want = rnea(model, q, q, q)
+    for _ in range(native.PROMOTE_AFTER):
+        rnea(model, q, q, q)
+    assert native.COMPILER.wait(timeout=120.0)
+    kernel = kernels_of(model).rnea
+    assert kernel.native is not None
+    calls = kernel._calls
+    got = rnea(model, q, q, q)
+    assert kernel._calls == calls  # the native form answered
+    np.testing.assert_array_equal(got, want)
+
+
+def test_results_are_arrays_of_their_own():
+    model = promoted(frictionless(irb140()))
+    q = np.zeros(6)
+    first, second = rnea(model, q, q, q), rnea(model, q + 0.5, q, q)
+    kept = first.copy()
+    first += 1.0  # writable, and writing to it changes no other result
+    np.testing.assert_array_equal(first - 1.0, kept)
+    assert not np.array_equal(second, kept)
+    M = mass_matrix(model, q)
+    assert M.shape == (6, 6) and M.flags.writeable
+    np.testing.assert_array_equal(M, M.T)
+
+
+def test_non_finite_inputs_and_results_are_refused_as_by_the_python_form():
+    model = promoted(frictionless(irb140()))
+    q = np.zeros(6)
+    with pytest.raises(ValueError, match="qd: must be finite"):
+        rnea(model, q, np.array([0.0, np.inf, 0, 0, 0, 0]), q)
+    with pytest.raises(ValueError, match="q: must be finite"):
+        gravity(model, np.full(6, np.nan))
+    with pytest.raises(ValueError, match="q: must be finite"):
+        mass_matrix(model, np.full(6, np.nan))
+    with pytest.raises(ValueError, match="rnea: the result is not finite"):
+        rnea(model, q, np.full(6, 1e200), q)
+
+
+def test_models_with_friction_or_a_flange_wrench_take_the_python_form():
+    def with_friction():
+        model = irb140()
+        return replace(model, joints=tuple(replace(j, friction=Friction(0.5, 2.0)) for j in model.joints))
+
+    model, python_model = promoted(with_friction()), with_friction()
+    assert model.friction is not None
+    q = np.full(6, 0.3)
+    np.testing.assert_array_equal(rnea(model, q, q, q), rnea(python_model, q, q, q))
+    wrench = np.arange(6.0)
+    np.testing.assert_array_equal(rnea(model, q, q, q, wrench), rnea(python_model, q, q, q, wrench))
+
+
+def test_without_a_compiler_or_when_disabled_everything_stays_python(monkeypatch):
+    monkeypatch.setenv("IRB140_NATIVE", "0")
+    assert not native.enabled()
+    model = frictionless(irb140(payload=OFFSET_PAYLOAD))
+    q = np.full(6, 0.2)
+    for _ in range(native.PROMOTE_AFTER + 1):
+        rnea(model, q, q, q)
+    assert native.COMPILER.wait(timeout=120.0)
+    assert kernels_of(model).rnea.native is None
+    monkeypatch.setenv("IRB140_NATIVE", "1")
+    monkeypatch.setattr(native.shutil, "which", lambda name: None)
+    assert native.compiler() is None and not native.enabled()
+
+
+def test_a_compile_that_fails_leaves_the_python_form(monkeypatch):
+    monkeypatch.setattr(native, "FLAGS", (*native.FLAGS, "--no-such-flag"))
+    model = frictionless(irb140(payload=OFFSET_PAYLOAD).with_gravity((0.0, 0.1, -9.8)))
+    kernels = kernels_of(model)
+    native.COMPILER.request(kernels.gravity_torques)
+    assert native.COMPILER.wait(timeout=120.0)
+    assert kernels.gravity_torques.native is None
+    q = np.full(6, 0.4)
+    np.testing.assert_array_equal(gravity(model, q), np.array(kernels.gravity_torques.scalar(q.tolist())))
+
+
+def test_a_library_is_compiled_once_and_then_loaded_from_the_cache():
+    source, _, _ = native.c_source(kernels_of(irb140()).gravity_torques.native_recipe()[0])
+    path = native.library(source)
+    stamp = path.stat().st_mtime_ns
+    assert native.library(source) == path and path.stat().st_mtime_ns == stamp
+    assert path.parent == native.cache_dir() and str(path).startswith(native.os.environ["IRB140_CACHE"])
