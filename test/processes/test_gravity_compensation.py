@@ -1,24 +1,32 @@
 """Gravity compensation closes the loop: sim_node (the true arm, in MuJoCo) and id_node
 (effort_commands = g(q)) as their own processes, as `ros2 run` starts them, hold the arm
-still where it falls without commands."""
+still where it falls without commands.
 
-import time
+The loop runs in lockstep on simulated time (sim_node `lockstep:=true`, id_node
+`use_sim_time:=true`, docs/sim.md, Lockstep): each state k+1 is one engine step with the
+command id_node computed from state k, so what the arm does no longer depends on the
+machine's load (in real time, on two busy cores, commands came late and the arm drifted
+0.029 rad). The probe sees every state; each after the hold is checked to carry as its
+effort g of the state before it (to 1e-12): no step went without its command or took a
+stale one.
+"""
 
 import numpy as np
 import pytest
 from sensor_msgs.msg import JointState
-from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import RigidBody, gravity, irb140
 from irb140_dynamics.sim.engine import SimulatedArm
 
-from ..support.node_process import TIMEOUT
-
 POSE = [0.0, -0.5, 0.5, 0.0, 0.5, 0.0]  # rad
 PAYLOAD = RigidBody(3.0, (0.02, 0.0, 0.05))  # both nodes' model: the true one
 MODEL_ARGS = ["-p", "payload.mass:=3.0", "-p", "payload.com:=[0.02, 0.0, 0.05]"]
-HOLD = 0.5  # s: the arm is held at POSE after ~/reset while the commands for POSE come in
-DURATION = 5.0  # s
+HOLD = 0.5  # s of simulated time: the arm is held at POSE after startup while the commands for POSE come in
+DURATION = 5.0  # s of simulated time
+RATE = 1000.0  # Hz: steps of simulated time, as the two checks below step
+PERIOD = round(1e9 / RATE)  # ns
+READY = 120.0  # s: both processes started and the loop closed, on two busy cores
+LOOP = 60 * (HOLD + DURATION)  # s: the loop's wall-clock time, far beyond what a busy machine needs
 FALL, DRIFT = 0.1, 1e-3  # rad: without commands it falls more than FALL in 1 s; held, drifts < DRIFT
 
 
@@ -46,40 +54,37 @@ def stamp(msg) -> int:
 
 @pytest.mark.slow
 def test_gravity_compensation_holds_the_arm(probe, process):  # noqa: F811
+    states = {}  # by stamp: sim_node publishes a state again, same stamp, while no command answers it
+    probe.create_subscription(JointState, "joint_states", lambda msg: states.__setitem__(stamp(msg), msg), 10000)
     process(
         "irb140_dynamics.nodes.sim_node.node",
         *MODEL_ARGS,
-        "-p",
-        f"initial_positions:={POSE}",
-        "-p",
-        f"reset_hold:={HOLD}",
+        *("-p", f"initial_positions:={POSE}", "-p", f"reset_hold:={HOLD}"),
+        *("-p", "lockstep:=true", "-p", f"rate:={RATE}", "-p", "qos.depth:=10000"),
     )
+    # Nothing steps before id_node answers: sim_node publishes its first state again every
+    # lockstep_timeout. Once the probe has one, it is matched and will miss none of the loop.
+    probe.spin_until(lambda: states, timeout=READY)
     process(
         "irb140_dynamics.nodes.id_node.node",
         *MODEL_ARGS,
-        "-p",
-        "effort_commands.enabled:=true",
-        "-p",
-        "effort_commands.source:=gravity",
+        *("-p", "effort_commands.enabled:=true", "-p", "effort_commands.source:=gravity"),
+        *("-p", "use_sim_time:=true", "-p", "qos.depth:=1"),
     )
-    states = []
-    probe.create_subscription(JointState, "joint_states", states.append, 1000)
-    probe.spin_until(lambda: states and np.any(states[-1].effort))  # the loop is closed
+    released = round(HOLD * 1e9)  # [ns] simulated: the startup hold ends, the commands apply
+    end = released + round(DURATION * 1e9)
+    probe.spin_until(lambda: states and max(states) >= end, timeout=READY + LOOP)
 
-    client = probe.create_client(Trigger, "/sim_node/reset")
-    assert client.wait_for_service(timeout_sec=TIMEOUT)
-    future = client.call_async(Trigger.Request())
-    probe.spin_until(future.done)
-    assert future.result().success
-    replied = time.time_ns()  # sim_node stamps on the system clock: later states are after the reset
-
-    end = replied + round((HOLD + DURATION + 0.1) * 1e9)
-    probe.spin_until(lambda: states and stamp(states[-1]) > end, timeout=DURATION + HOLD + TIMEOUT)
-    after_reset = [msg for msg in states if stamp(msg) > replied]
-    assert after_reset[0].position.tolist() == POSE and not np.any(after_reset[0].effort)  # held at first
-    released = [msg for msg in after_reset if np.any(msg.effort)]
-    assert stamp(released[-1]) - stamp(released[0]) > DURATION * 1e9
-    assert len(released) > 1000  # of the 5000 states: the probe keeps up with most
-    position = np.array([msg.position for msg in released])
+    held = [msg for s, msg in sorted(states.items()) if s <= released]
+    assert all(msg.position.tolist() == POSE and not np.any(msg.effort) for msg in held)  # still at first
+    stamps = [s for s in sorted(states) if released < s <= end]
+    assert stamps == [released + k * PERIOD for k in range(1, len(stamps) + 1)], "a step missing or misplaced"
+    assert len(stamps) == round(DURATION * RATE), "the probe missed joint states"
+    model = irb140(payload=PAYLOAD)
+    for s in stamps:  # the command applied in each step is g of the state before it
+        before, after = states[s - PERIOD], states[s]
+        expected = gravity(model, before.position)
+        np.testing.assert_allclose(after.effort, expected, rtol=1e-12, atol=1e-9, err_msg=f"command of {s - PERIOD}")
+    position = np.array([states[s].position for s in stamps])
     drift = np.abs(position - POSE).max()
     assert drift < DRIFT, f"drifted {drift} rad"

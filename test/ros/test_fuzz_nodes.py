@@ -164,6 +164,10 @@ def test_fuzz_payload_check_node():
     overrides = [Parameter("diagnostics.period", value=0.0)]
     with running(PayloadCheckNode, parameter_overrides=overrides) as harness:
         node = harness.node
+        # The first analysis may outlast the node's STARTUP_WAIT on a busy machine: until it is
+        # done the node has no settings and keeps no joint state. Fuzz the node once it is ready.
+        harness.settle()
+        assert node.settings is not None, node.parameters.status()
         state = None
         deadline = time.monotonic() + BUDGET
         for k in range(MESSAGES // 3):

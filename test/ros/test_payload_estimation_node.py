@@ -38,6 +38,10 @@ def node():
         *FRICTION,
     ]
     with running(PayloadCheckNode, parameter_overrides=overrides) as harness:
+        # The first analysis may outlast the node's STARTUP_WAIT on a busy machine, and until it
+        # is done the node has no settings and keeps no joint state: wait for it before feeding.
+        harness.settle()
+        assert harness.node.settings is not None, harness.node.parameters.status()
         harness.diagnostics = harness.listen(DiagnosticArray, "/diagnostics")
         harness.joint_states = harness.publisher(JointState, "joint_states")
         harness.clients = {}
