@@ -6,13 +6,15 @@ Prints one table (ours, baseline, ratio ours/baseline, target) and writes the ra
 to bench/results/core.json. Sections:
 
 - single state: per-call cost of the public functions on NumPy (6,) arrays against
-  Pinocchio's; the raw generated kernels on Python lists (the public functions less
-  their conversions); a textbook NumPy RNEA, the approach the generated code avoids.
+  Pinocchio's, with their kernels compiled as C (core.codegen.native: what a program that
+  calls them often gets); the kernels' Python form on Python lists; a textbook NumPy RNEA,
+  the approach the generated code avoids.
 - batch: states per second of the ``*_batch`` functions on N random states against a
   Python loop of the Pinocchio call over the same states.
 - kernel generation: the one-off cost of tracing and compiling each kernel of a fresh model.
 - URDF arms: the UR5 and the Panda of example-robot-data read by our URDF loader against
-  Pinocchio's URDF parser on the same file, per call (rnea, gravity, mass matrix).
+  Pinocchio's URDF parser on the same file, per call (rnea, gravity, mass matrix), with
+  native kernels, then in the kernels' Python form (IRB140_NATIVE=0).
 
 Every pair is checked to give the same numbers before it is timed.
 """
@@ -21,8 +23,10 @@ from __future__ import annotations
 
 import importlib.metadata
 import math
+import os
 import time
 import timeit
+from contextlib import contextmanager
 from dataclasses import replace
 
 import numpy as np
@@ -50,6 +54,7 @@ from irb140_dynamics.core import (
     rnea_batch,
 )
 from irb140_dynamics.core.codegen import kernels as kernel_cache  # noqa: E402
+from irb140_dynamics.core.codegen import native
 from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.io.urdf import load_urdf  # noqa: E402
 from irb140_dynamics.core.model.rigid_body import RigidBody, inertia_matrix  # noqa: E402
@@ -112,6 +117,34 @@ class TextbookRnea:
 # -- the benchmarks -----------------------------------------------------------------------
 
 
+def with_native(model):
+    """``model`` with its single-state kernels compiled as C (core.codegen.native), as a
+    program that calls them often has them: PROMOTE_AFTER calls each, then the compiler's
+    background work waited for. Says so when there is no native code (no compiler)."""
+    q = np.zeros(model.n)
+    for _ in range(native.PROMOTE_AFTER):
+        rnea(model, q, q, q), gravity(model, q), mass_matrix(model, q)
+    native.COMPILER.wait(timeout=300.0)
+    kernels = kernels_of(model)
+    if any(getattr(kernels, k).native is None for k in ("rnea", "gravity_torques", "mass_matrix")):
+        print("note: no native kernels (no C compiler, or IRB140_NATIVE=0): the Python forms are timed")
+    return model
+
+
+@contextmanager
+def python_form():
+    """Calls in this block stay in the kernels' Python form (IRB140_NATIVE=0), on fresh models."""
+    before = os.environ.get("IRB140_NATIVE")
+    os.environ["IRB140_NATIVE"] = "0"
+    try:
+        yield
+    finally:
+        if before is None:
+            del os.environ["IRB140_NATIVE"]
+        else:
+            os.environ["IRB140_NATIVE"] = before
+
+
 def random_states(model, count: int, rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """q uniform within the joint limits, qd in +-2 rad/s, qdd in +-5 rad/s^2."""
     lower, upper = np.array([j.position_limits for j in model.joints]).T
@@ -132,7 +165,7 @@ def single_state(model, pm, data) -> list[Row]:
     """Per-call cost of one state: public functions, raw kernels and the textbook RNEA."""
     q, qd, qdd = (x[0] for x in random_states(model, 1, np.random.default_rng(SEED)))
     lists = q.tolist(), qd.tolist(), qdd.tolist()
-    kernels = kernels_of(model)
+    kernels = kernels_of(with_native(model))  # the public functions' rows: native
     textbook = TextbookRnea(model)
 
     tau = rnea(model, q, qd, qdd)
@@ -148,17 +181,22 @@ def single_state(model, pm, data) -> list[Row]:
     ours_rnea = lambda: rnea(model, q, qd, qdd)  # noqa: E731
     cases = [  # name, ours, baseline, target
         ("rnea vs pin.rnea", ours_rnea, pin_rnea, Target(8)),
-        ("rnea kernel (lists) vs pin.rnea", lambda: kernels.rnea.scalar(*lists), pin_rnea, None),
+        ("rnea kernel, Python form (lists) vs pin.rnea", lambda: kernels.rnea.scalar(*lists), pin_rnea, None),
         ("rnea vs textbook NumPy RNEA", ours_rnea, lambda: textbook(q, qd, qdd), None),
         ("gravity vs computeGeneralizedGravity", lambda: gravity(model, q), pin_gravity, Target(8)),
         (
-            "gravity kernel (list) vs computeGeneralizedGravity",
+            "gravity kernel, Python form (list) vs computeGeneralizedGravity",
             lambda: kernels.gravity_torques.scalar(lists[0]),
             pin_gravity,
             None,
         ),
         ("mass_matrix vs pin.crba", lambda: mass_matrix(model, q), pin_crba, Target(15)),
-        ("mass_matrix kernel (list) vs pin.crba", lambda: kernels.mass_matrix.scalar(lists[0]), pin_crba, None),
+        (
+            "mass_matrix kernel, Python form (list) vs pin.crba",
+            lambda: kernels.mass_matrix.scalar(lists[0]),
+            pin_crba,
+            None,
+        ),
     ]
     group = "single state, per call"
     return [
@@ -226,7 +264,8 @@ def urdf_arms() -> list[Row]:
     """Per-call cost on the UR5 and the Panda of example-robot-data, as our loader and
     Pinocchio's parser read the same file (Pinocchio's Panda with its fingers locked), and
     on the DH IRB-140 the same way (no target: no slower than before). The joints'
-    friction (the Panda's damping) is left out of our model: pin.rnea has none."""
+    friction (the Panda's damping) is left out of our model: pin.rnea has none. Ours with
+    native kernels (the default where a C compiler is), then in their Python form."""
     rows = []
     arms = {"IRB-140 (DH)": (irb140(), None), **URDF_ARMS}
     for name, (text, tip) in arms.items():
@@ -237,20 +276,27 @@ def urdf_arms() -> list[Row]:
         check_same(f"{name} gravity", gravity(model, q), pin.computeGeneralizedGravity(pm, data, q))
         check_same(f"{name} mass_matrix", mass_matrix(model, q), symmetric_from_upper(pin.crba(pm, data, q)))
         urdf = tip is not None
-        cases = [
-            (f"{name} rnea vs pin.rnea", lambda: rnea(model, q, qd, qdd), lambda: pin.rnea(pm, data, q, qd, qdd), 5),
-            (
-                f"{name} gravity vs computeGeneralizedGravity",
-                lambda: gravity(model, q),
-                lambda: pin.computeGeneralizedGravity(pm, data, q),
-                5,
-            ),
-            (f"{name} mass_matrix vs pin.crba", lambda: mass_matrix(model, q), lambda: pin.crba(pm, data, q), 6),
-        ]
-        group = "arms, alternating blocks (URDF: load_urdf vs buildModelFromXML), per call"
-        for label, ours, baseline, limit in cases:
-            timed = (Figure.cost(t) for t in paired_seconds_per_call(ours, baseline))
-            rows.append(Row(group, label, *timed, Target(limit) if urdf else None))
+        for form in ("native", "Python"):
+            ours = with_native(model) if form == "native" else replace(model)  # a fresh model: no kernels yet
+            cases = [
+                ("rnea vs pin.rnea", lambda m=ours: rnea(m, q, qd, qdd), lambda: pin.rnea(pm, data, q, qd, qdd), 5),
+                (
+                    "gravity vs computeGeneralizedGravity",
+                    lambda m=ours: gravity(m, q),
+                    lambda: pin.computeGeneralizedGravity(pm, data, q),
+                    5,
+                ),
+                ("mass_matrix vs pin.crba", lambda m=ours: mass_matrix(m, q), lambda: pin.crba(pm, data, q), 6),
+            ]
+            group = f"arms, ours {form}, alternating blocks (URDF: load_urdf vs buildModelFromXML), per call"
+            for label, call, baseline, limit in cases:
+                if form == "native":
+                    timed = paired_seconds_per_call(call, baseline)
+                else:
+                    with python_form():
+                        timed = paired_seconds_per_call(call, baseline)
+                target = Target(limit) if urdf and form == "native" else None
+                rows.append(Row(group, f"{name} {label}", *(Figure.cost(t) for t in timed), target))
     return rows
 
 
