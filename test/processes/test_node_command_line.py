@@ -118,16 +118,17 @@ def test_a_params_file_rcl_cannot_parse_is_one_line_with_its_line(tmp_path):
 # building, running. Not before: a SIGINT in the interpreter's own startup (site, .pth
 # files), before any code of the package runs, gets Python's "Fatal Python error:
 # init_import_site", as for any Python program.
-# Each node takes every other one (an early, a middle and a late moment), the nodes in turn
-# the two halves: the suite covers every moment; each node at each with IRB140_SWEEP=full
-# (docs/development.md).
+# Each node takes two: an early one and a later one (SIGNAL_DELAYS[k] and [k + 3], k the
+# node's index mod 3), so that the nodes together cover every moment; each node at each
+# with IRB140_SWEEP=full (docs/development.md).
 SIGNAL_DELAYS = (0.0, 0.1, 0.3, 0.8, 1.5, 3.0)
 
 
 def delays_of(node: str) -> tuple[float, ...]:
     if os.environ.get("IRB140_SWEEP") == "full":
         return SIGNAL_DELAYS
-    return SIGNAL_DELAYS[NODES.index(node) % 2 :: 2]
+    k = NODES.index(node) % 3
+    return SIGNAL_DELAYS[k], SIGNAL_DELAYS[k + 3]
 
 
 def wait_for_the_package_code(process, timeout: float = 60.0) -> None:
