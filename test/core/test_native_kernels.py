@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from irb140_dynamics.core import Friction, gravity, irb140, mass_matrix, rnea
+from irb140_dynamics.core import Friction, RigidBody, gravity, irb140, mass_matrix, rnea
 from irb140_dynamics.core.codegen import native
 from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.urdf import load_urdf
@@ -30,7 +30,18 @@ def arms() -> dict:
         "ur5": lambda: urdf("ur5.urdf", tip_link="tool0"),
         "panda": lambda: urdf("panda.urdf", tip_link="panda_link8"),
         "prismatic arm": lambda: urdf("prismatic_arm.urdf"),
+        "no payload or gravity constants": no_constants,
     }
+
+
+def no_constants():
+    """The IRB-140 with a massless last link and no payload in zero gravity: its kernels'
+    ``k`` is empty."""
+    model = irb140().with_gravity((0.0, 0.0, 0.0))
+    last = replace(model.joints[-1], link=RigidBody())
+    model = replace(model, joints=(*model.joints[:-1], last))
+    assert kernels_of(model).constants == ()
+    return model
 
 
 def frictionless(model):
