@@ -3,12 +3,18 @@ numbers bit for bit, refuses what the Python form refuses, and is only ever an
 acceleration: without a compiler, with IRB140_NATIVE=0, or when compiling fails, the
 Python form answers. The session's cache is its own (test/conftest.py)."""
 
+import os
+import shutil
+import subprocess
+import sys
+import time
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from irb140_dynamics.core import Friction, gravity, irb140, mass_matrix, rnea
+from irb140_dynamics.core import Friction, RigidBody, gravity, irb140, mass_matrix, rnea
 from irb140_dynamics.core.codegen import native
 from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.urdf import load_urdf
@@ -30,7 +36,18 @@ def arms() -> dict:
         "ur5": lambda: urdf("ur5.urdf", tip_link="tool0"),
         "panda": lambda: urdf("panda.urdf", tip_link="panda_link8"),
         "prismatic arm": lambda: urdf("prismatic_arm.urdf"),
+        "no payload or gravity constants": no_constants,
     }
+
+
+def no_constants():
+    """The IRB-140 with a massless last link and no payload in zero gravity: its kernels'
+    ``k`` is empty."""
+    model = irb140().with_gravity((0.0, 0.0, 0.0))
+    last = replace(model.joints[-1], link=RigidBody())
+    model = replace(model, joints=(*model.joints[:-1], last))
+    assert kernels_of(model).constants == ()
+    return model
 
 
 def frictionless(model):
@@ -149,3 +166,94 @@ def test_a_library_is_compiled_once_and_then_loaded_from_the_cache():
     stamp = path.stat().st_mtime_ns
     assert native.library(source) == path and path.stat().st_mtime_ns == stamp
     assert path.parent == native.cache_dir() and str(path).startswith(native.os.environ["IRB140_CACHE"])
+
+
+def test_waiting_with_nothing_asked_for_returns_at_once():
+    assert native._Compiler().wait(timeout=30.0)  # was: no worker thread, so the timeout
+
+
+def test_the_check_before_use_compares_bits():
+    python = lambda q, k=(): [0.0, 1.0]  # noqa: E731
+    native_form = lambda inputs: (native.ctypes.c_double * 2)(-0.0, 1.0)  # noqa: E731
+    assert not native.same_as_python(native_form, python, 1, [1], 0)
+
+
+@pytest.mark.parametrize("damage", ["truncated", "emptied", "garbage"])
+def test_a_damaged_library_in_the_cache_is_compiled_again(damage):
+    source, _, _ = native.c_source(kernels_of(irb140(payload=OFFSET_PAYLOAD)).gravity_torques.native_recipe()[0])
+    path = native.library(source)
+    whole = path.read_bytes()
+    path.unlink()  # a new file: this process may have the library loaded, and writing into it would crash it
+    path.write_bytes({"truncated": whole[: len(whole) // 2], "emptied": b"", "garbage": b"x" * len(whole)}[damage])
+    assert native.library(source) == path and path.read_bytes() == whole  # loading it could crash (SIGBUS)
+    assert native.load(source) is not None
+
+
+def test_stale_working_folders_are_removed_by_a_compile(monkeypatch):
+    folder = native.cache_dir()
+    folder.mkdir(parents=True, exist_ok=True)
+    old, recent = folder / f"{native.WORKING_PREFIX}old", folder / f"{native.WORKING_PREFIX}recent"
+    for work in (old, recent):
+        work.mkdir()
+        (work / "kernel.c").write_text("")
+    os.utime(old, (0, time.time() - native.STALE_AFTER - 10.0))
+    monkeypatch.setattr(native, "FLAGS", (*native.FLAGS, "-DSTALE_TEST"))  # not cached: compiled
+    native.library(native.c_source(kernels_of(irb140()).gravity_torques.native_recipe()[0])[0])
+    assert not old.exists() and recent.exists()
+    shutil.rmtree(recent)
+
+
+@pytest.mark.parametrize("cc", ["true", "false"])
+def test_a_cc_that_is_not_a_compiler_leaves_the_python_form(monkeypatch, cc):
+    monkeypatch.setenv("CC", shutil.which(cc))
+    model = frictionless(irb140().with_gravity((0.0, 0.3, -9.7)))
+    kernels = kernels_of(model)
+    native.COMPILER.request(kernels.gravity_torques)
+    assert native.COMPILER.wait(timeout=120.0) and kernels.gravity_torques.native is None
+    assert not [p for p in native.cache_dir().iterdir() if p.name.startswith(native.WORKING_PREFIX)]
+
+
+def test_a_forked_child_computes_and_waits():
+    model, python_model = promoted(frictionless(irb140())), frictionless(irb140())
+    q = np.full(6, 0.7)
+    pid = os.fork()
+    if pid == 0:  # the child: no worker thread until asked; exit code 0 if all right
+        right = np.array_equal(rnea(model, q, q, q), rnea(python_model, q, q, q))
+        os._exit(0 if right and native.COMPILER.wait(timeout=30.0) else 1)
+    assert os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]) == 0
+
+
+EXITING = """
+import sys, time
+from irb140_dynamics.core import irb140
+from irb140_dynamics.core.codegen import native
+from irb140_dynamics.core.codegen.kernels import kernels_of
+native.COMPILER.request(kernels_of(irb140()).gravity_torques)
+while not list(native.cache_dir().glob(native.WORKING_PREFIX + "*/started")):
+    time.sleep(0.02)
+sys.exit(0)  # during the compile
+"""
+
+
+def test_exiting_during_a_compile_leaves_nothing(tmp_path):
+    compiler = tmp_path / "slow-cc"  # a compiler that takes its time
+    compiler.write_text(f"#!/bin/sh\necho $$ > {tmp_path}/pid\ntouch started\nexec sleep 60\n")
+    compiler.chmod(0o755)
+    cache = tmp_path / "cache"
+    env = {**os.environ, "CC": str(compiler), "IRB140_CACHE": str(cache)}
+    done = subprocess.run([sys.executable, "-c", EXITING], env=env, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0 and done.stderr == ""
+    assert list((cache / "irb140_dynamics" / "kernels").iterdir()) == []  # no working folder
+    assert not running(int((tmp_path / "pid").read_text())), "the compiler outlived the process"
+
+
+def running(pid: int) -> bool:
+    """Whether process ``pid`` is alive (not gone or a zombie) 5 s from now at the latest."""
+    for _ in range(100):
+        try:
+            if Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "Z":
+                return False
+        except FileNotFoundError:
+            return False
+        time.sleep(0.05)
+    return True

@@ -49,9 +49,11 @@ class Kernel:
         return kernel
 
     def used(self) -> None:
-        """Count a call of the Python form; the PROMOTE_AFTER-th asks for the native one."""
-        self._calls += 1
-        if self._calls == native.PROMOTE_AFTER and self._constants is not None and native.enabled():
+        """Count a call of the Python form; the PROMOTE_AFTER-th asks for the native one.
+        Each call compares the count it wrote: with threads, a count can be written twice
+        (then asked for twice, harmless) but none is skipped, so it is asked for."""
+        calls = self._calls = self._calls + 1
+        if calls == native.PROMOTE_AFTER and self._constants is not None and native.enabled():
             native.COMPILER.request(self)
 
     def native_recipe(self) -> tuple:

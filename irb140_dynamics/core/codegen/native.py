@@ -7,29 +7,38 @@ Python code in the same order, so its results are the same, bit for bit. That is
 before a native kernel is used: on random inputs it must equal the Python kernel exactly,
 else it is never used.
 
-Compiling takes a C compiler (``$CC``, ``cc`` or ``gcc``) and a fraction of a second per
-kernel, so it never delays a call: a kernel whose Python form has run ``PROMOTE_AFTER``
-times is compiled by one background thread (at the lowest CPU priority), and calls use the
-native code once it is ready. Without a compiler, or with ``IRB140_NATIVE=0``, everything
-stays in Python. Libraries are kept in ``$IRB140_CACHE`` (else ``$XDG_CACHE_HOME`` or
-``~/.cache``, ``irb140_dynamics/kernels``), named by a hash of their source, flags and
-compiler: another process, or the next run, loads them without compiling.
+Compiling takes a C compiler (``$CC``, ``cc`` or ``gcc``), so no call waits for it: a
+kernel whose Python form has run ``PROMOTE_AFTER`` times is compiled by one background
+thread (the compiler at the lowest CPU priority), and calls use the native code once it is
+ready. Without a compiler, or with ``IRB140_NATIVE=0``, everything stays in Python; so does
+a kernel whose compile fails in any way (no usable cache folder, a ``$CC`` that is not a
+compiler): the caller never sees it. Libraries are kept in ``$IRB140_CACHE`` (else
+``$XDG_CACHE_HOME`` or ``~/.cache``, ``irb140_dynamics/kernels``), named by a hash of their
+source, flags, compiler and machine, and by a digest of their own bytes, checked before one
+is loaded (a truncated library could crash the process): another process, or the next run,
+loads them without compiling. A compile runs in a working folder of the cache folder,
+removed when it ends, also when the interpreter exits during it; one left by a process that
+was killed is removed by a later compile once it is ``STALE_AFTER`` old.
 """
 
 from __future__ import annotations
 
 import array
+import atexit
 import contextlib
 import ctypes
 import hashlib
 import os
+import platform
 import queue
 import random
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
 import threading
+import time
 from pathlib import Path
 
 from irb140_dynamics.core.codegen.trace import _emit, angle_lines, merged, trace
@@ -38,6 +47,8 @@ PROMOTE_AFTER = 1000  # calls of a kernel's Python form before it is compiled
 CHECKS = 20  # random inputs on which the native code must equal the Python code exactly
 FLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math", "-fno-builtin")
 COMPILE_TIMEOUT = 120.0  # s
+STALE_AFTER = 3600.0  # s: a working folder this old is no running compile's (see library)
+WORKING_PREFIX = "build-"  # a compile's working folder in the cache folder
 FUNCTIONS_KEPT = 64  # compiled kernels kept for the next model of the same arm
 INPUT_NOT_FINITE, OUTPUT_NOT_FINITE = 1, 2  # what a native kernel returns instead of 0
 
@@ -61,7 +72,8 @@ def c_source(recipe, full_matrix: int = 0) -> tuple[str, int, int]:
     the inputs (q, then the other groups but k, in order). It returns 0, or
     INPUT_NOT_FINITE / OUTPUT_NOT_FINITE (then ``out`` is not to be used). With
     ``full_matrix`` n, the outputs (an upper triangle row by row) are written as the whole
-    n x n matrix."""
+    n x n matrix. The checks are on the sum of the inputs, then of the outputs: finite
+    values whose sum overflows are sent to the Python form too, which tells them apart."""
     name, algorithm, inputs, angles = recipe
     params, outputs = trace(algorithm, inputs, angles)
     body, results, used = _emit(merged(outputs))
@@ -90,37 +102,137 @@ def c_source(recipe, full_matrix: int = 0) -> tuple[str, int, int]:
 
 def library(source: str) -> Path:
     """The shared library of ``source``, compiled unless cached; OSError or
-    subprocess.SubprocessError when it cannot be."""
+    subprocess.SubprocessError when it cannot be.
+
+    It is named by the key of what it is built from and the digest of its bytes
+    (``<key>-<digest>.so``), written whole by an atomic rename and checked before it is
+    returned: a file that does not match its name (cut short by a full disk, a crash before
+    its data reached the disk, an edit) is removed and compiled again. The compile runs in a
+    working folder of its own, removed when it ends; a working folder left by a process
+    killed during a compile is removed here once older than STALE_AFTER (a compile lasts
+    COMPILE_TIMEOUT at most, so it is no running one's)."""
     cc = compiler()
     if cc is None:
         raise OSError("no C compiler")
-    key = hashlib.sha256("\0".join([source, cc, *FLAGS, sys.platform]).encode()).hexdigest()[:32]
+    parts = [source, cc, *FLAGS, sys.platform, platform.machine()]
+    key = hashlib.sha256("\0".join(parts).encode()).hexdigest()[:32]
     folder = cache_dir()
-    path = folder / f"{key}.so"
-    if path.exists():
+    path = _cached(folder, key)
+    if path is not None:
         return path
     folder.mkdir(parents=True, exist_ok=True, mode=0o700)
-    with tempfile.TemporaryDirectory(dir=folder) as work:
-        (Path(work) / "kernel.c").write_text(source)
-        built = Path(work) / "kernel.so"
-        process = subprocess.Popen(
-            [cc, *FLAGS, "kernel.c", "-o", built.name, "-lm"],
-            cwd=work,
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.PIPE,
-        )
-        with contextlib.suppress(OSError):
-            os.setpriority(os.PRIO_PROCESS, process.pid, 19)  # a node's loop comes first
+    _remove_stale(folder)
+    work = Path(tempfile.mkdtemp(prefix=WORKING_PREFIX, dir=folder))
+    try:
+        (work / "kernel.c").write_text(source)
+        built = work / "kernel.so"
+        process = _BUILDS.start([cc, *FLAGS, "kernel.c", "-o", built.name, "-lm"], work)
         try:
             _, error = process.communicate(timeout=COMPILE_TIMEOUT)
         except subprocess.TimeoutExpired:
-            process.kill()
+            _BUILDS.kill(process)
             process.wait()
             raise
+        finally:
+            _BUILDS.done(process)
         if process.returncode != 0:
             raise subprocess.SubprocessError(error.decode(errors="replace").strip()[:300])
+        path = folder / f"{key}-{_digest(built.read_bytes())}.so"
         os.replace(built, path)  # atomic: another process sees the whole library or none
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
     return path
+
+
+def _digest(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()[:16]
+
+
+def _cached(folder: Path, key: str) -> Path | None:
+    """The library of ``key`` in ``folder`` whose bytes match its name; the others of
+    ``key`` are removed (loading one could crash the process)."""
+    try:
+        names = sorted(name for name in os.listdir(folder) if name.startswith(f"{key}-") and name.endswith(".so"))
+    except OSError:  # no cache folder (yet), or not a folder
+        return None
+    for name in names:
+        path = folder / name
+        try:
+            intact = name == f"{key}-{_digest(path.read_bytes())}.so"
+        except OSError:
+            continue
+        if intact:
+            return path
+        with contextlib.suppress(OSError):
+            path.unlink()
+    return None
+
+
+def _remove_stale(folder: Path) -> None:
+    """Remove the working folders in ``folder`` older than STALE_AFTER."""
+    with contextlib.suppress(OSError):
+        for entry in os.scandir(folder):
+            if entry.name.startswith(WORKING_PREFIX):
+                with contextlib.suppress(OSError):
+                    if time.time() - entry.stat(follow_symlinks=False).st_mtime > STALE_AFTER:
+                        shutil.rmtree(entry.path, ignore_errors=True)
+
+
+class _Builds:
+    """The compiler processes running in this process, each in a process group of its own
+    (the driver's children too), killed at interpreter exit, whose working folders are then
+    removed: a daemon thread is stopped at exit wherever it is, so it could not. After exit
+    has begun, no compile starts. A forked child has none (its parent's are its parent's)."""
+
+    def __init__(self):
+        self._reset()
+        os.register_at_fork(after_in_child=self._reset)
+        atexit.register(self.stop)
+
+    def _reset(self) -> None:
+        self._lock = threading.Lock()
+        self._running: dict[subprocess.Popen, Path] = {}  # process -> its working folder
+        self._stopped = False
+
+    def start(self, args: list[str], work: Path) -> subprocess.Popen:
+        with self._lock:
+            if self._stopped:
+                raise OSError("the interpreter is exiting")
+            process = subprocess.Popen(
+                args,
+                cwd=work,
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.PIPE,
+                start_new_session=True,
+            )
+            self._running[process] = work
+        with contextlib.suppress(OSError):  # a node's loop comes first; the group: the driver's
+            os.setpriority(os.PRIO_PGRP, process.pid, 19)  # children started already too
+        return process
+
+    def done(self, process: subprocess.Popen) -> None:
+        with self._lock:
+            self._running.pop(process, None)
+
+    @staticmethod
+    def kill(process: subprocess.Popen) -> None:
+        if process.poll() is None:
+            with contextlib.suppress(OSError):
+                os.killpg(process.pid, signal.SIGKILL)
+
+    def stop(self) -> None:
+        with self._lock:
+            self._stopped = True
+            running = list(self._running.items())
+        for process, work in running:
+            self.kill(process)
+            with contextlib.suppress(subprocess.SubprocessError, OSError):
+                process.wait(timeout=5.0)
+            shutil.rmtree(work, ignore_errors=True)
+
+
+_BUILDS = _Builds()
 
 
 class NativeKernel:
@@ -158,7 +270,7 @@ def same_as_python(native: NativeKernel, python, inputs: int, groups: list[int],
         if full_matrix:
             want = whole_matrix(want, full_matrix)
         got = native(array.array("d", x).tobytes())
-        if got is None or list(got) != want:
+        if got is None or bytes(got) != array.array("d", want).tobytes():  # bits: -0.0 is not 0.0
             return False
     return True
 
@@ -176,26 +288,32 @@ class _Compiler:
     """One background thread compiling the kernels asked for, one at a time."""
 
     def __init__(self):
-        self._lock = threading.Lock()
         self._functions: dict[str, object] = {}  # source -> C function (None: failed), the newest last
         self._restart()
-        os.register_at_fork(after_in_child=self._restart)  # a forked child has no worker thread
+        # a forked child has no worker thread, and its lock may have been held by another thread
+        os.register_at_fork(after_in_child=self._restart)
 
     def _restart(self) -> None:
+        self._lock = threading.Lock()
         self._requests: queue.Queue = queue.Queue()
         self._thread: threading.Thread | None = None
 
-    def request(self, kernel) -> None:
+    def _started(self) -> queue.Queue:
+        """The queue of requests, with the worker thread started to take them."""
         with self._lock:
             if self._thread is None:
                 self._thread = threading.Thread(target=self._run, name="irb140-native", daemon=True)
                 self._thread.start()
-        self._requests.put(kernel)
+            return self._requests
+
+    def request(self, kernel) -> None:
+        self._started().put(kernel)
 
     def wait(self, timeout: float | None = None) -> bool:
-        """Until every kernel asked for so far is compiled (or given up): True if so in time."""
+        """Until every kernel asked for so far (in this process) is compiled or given up:
+        True if so in time. Nothing asked for: True at once."""
         done = threading.Event()
-        self._requests.put(done)
+        self._started().put(done)
         return done.wait(timeout)
 
     def _run(self) -> None:

@@ -161,9 +161,10 @@ def compile_kernel(
 
 
 def input_lines(inputs: dict[str, int], angles: Sequence[float] | None) -> list[str]:
-    """The lines unpacking the argument groups into variables q0, q1, ..., qd0, ..."""
+    """The lines unpacking the argument groups into variables q0, q1, ..., qd0, ... (none for
+    an empty group: ``k`` of a model whose payload, last link and gravity are all zero)."""
     lines = [f"    {_unpack('q', len(angles))} = q"] if angles is not None else []
-    return lines + [f"    {_unpack(group, length)} = {group}" for group, length in inputs.items()]
+    return lines + [f"    {_unpack(group, length)} = {group}" for group, length in inputs.items() if length]
 
 
 def angle_lines(angles: Sequence[float] | None, used: set[str]) -> list[str]:
