@@ -257,3 +257,14 @@ def running(pid: int) -> bool:
             return False
         time.sleep(0.05)
     return True
+
+
+def test_a_cache_folder_others_can_write_to_is_not_used(tmp_path, monkeypatch):
+    shared = tmp_path / "shared"
+    (shared / "irb140_dynamics" / "kernels").mkdir(parents=True)
+    (shared / "irb140_dynamics" / "kernels").chmod(0o777)
+    monkeypatch.setenv("IRB140_CACHE", str(shared))
+    source, _, _ = native.c_source(kernels_of(irb140()).gravity_torques.native_recipe()[0])
+    with pytest.raises(OSError, match="not private to this user"):
+        native.library(source)
+    assert list((shared / "irb140_dynamics" / "kernels").iterdir()) == []

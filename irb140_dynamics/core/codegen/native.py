@@ -117,10 +117,12 @@ def library(source: str) -> Path:
     parts = [source, cc, *FLAGS, sys.platform, platform.machine()]
     key = hashlib.sha256("\0".join(parts).encode()).hexdigest()[:32]
     folder = cache_dir()
+    folder.mkdir(parents=True, exist_ok=True, mode=0o700)
+    _private(folder)
     path = _cached(folder, key)
     if path is not None:
+        _private(path)
         return path
-    folder.mkdir(parents=True, exist_ok=True, mode=0o700)
     _remove_stale(folder)
     work = Path(tempfile.mkdtemp(prefix=WORKING_PREFIX, dir=folder))
     try:
@@ -142,6 +144,14 @@ def library(source: str) -> Path:
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return path
+
+
+def _private(path: Path) -> None:
+    """OSError unless ``path`` is this user's and writable by nobody else: a library loaded
+    from a folder that others can write to would run their code in this process."""
+    status = path.stat()
+    if (hasattr(os, "getuid") and status.st_uid != os.getuid()) or status.st_mode & 0o022:
+        raise OSError(f"{path}: not private to this user (owner or group/other write): not used")
 
 
 def _digest(data: bytes) -> str:
