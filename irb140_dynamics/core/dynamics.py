@@ -54,10 +54,11 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
         and qdd.shape == shape
     ):
         kernel = kernels.rnea
-        if f_ext is None and kernel.native is not None and model.friction is None:
+        if f_ext is None and kernel.native is not None:
             tau = kernel.native(q.tobytes() + qd.tobytes() + qdd.tobytes())
             if tau is not None:  # else not finite: the Python form below says which
-                return _frombuffer(tau)
+                friction = model.friction  # added as the Python form adds it: the same floats
+                return _frombuffer(tau) if friction is None else np.array(friction.added(tau, qd.tolist()))
         kernel.used()
         args = q.tolist(), qd.tolist(), qdd.tolist()
         if not isfinite(sum(args[2], sum(args[1], sum(args[0])))):  # a finite sum: all finite
