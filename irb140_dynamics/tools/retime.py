@@ -1,7 +1,7 @@
 """retime: check a JointTrajectory against the arm's limits, or re-time it time-optimally.
 
-    retime --params-file F [--urdf U [--tip-link L]] [--payload-mass M] IN.yaml OUT.yaml [--plot P.png]
-    retime --check-only --params-file F [--urdf U [--tip-link L]] [--payload-mass M] IN.yaml [--plot P.png]
+    retime --params-file F [--urdf U [--base L] [--tip L]] [--payload-mass M] IN.yaml OUT.yaml [--plot P.png]
+    retime --check-only --params-file F [--urdf U [--base L] [--tip L]] [--payload-mass M] IN.yaml [--plot P.png]
 
 IN.yaml: a trajectory_msgs/JointTrajectory as ``ros2 topic echo --once`` prints it (header,
 joint_names, points with positions, velocities, accelerations, effort, time_from_start
@@ -48,8 +48,15 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("output", metavar="OUT.yaml", nargs="?", help="the re-timed JointTrajectory to write")
     p.add_argument("--params-file", required=True, metavar="F", help="the model's parameter file")
     p.add_argument("--urdf", metavar="U", help="take the kinematics and inertials from this URDF")
-    p.add_argument("--base-link", help="the URDF link the chain starts from (default: the root)")
-    p.add_argument("--tip-link", help="the URDF link the chain ends at, the payload's frame (default: the only leaf)")
+    p.add_argument(  # --base/--tip as in the other tools; --base-link/--tip-link kept
+        "--base", "--base-link", dest="base_link", help="the URDF link the chain starts from (default: the root)"
+    )
+    p.add_argument(
+        "--tip",
+        "--tip-link",
+        dest="tip_link",
+        help="the URDF's chain end, the payload's frame (default: the only leaf)",
+    )
     p.add_argument("--payload-mass", type=float, metavar="KG", help="payload at the flange origin (default: F's)")
     p.add_argument("--check-only", action="store_true", help="only check IN.yaml; write nothing but --plot")
     p.add_argument("--plot", metavar="P.png", help="per joint the use of each limit over time, before and after")
