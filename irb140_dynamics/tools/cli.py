@@ -208,7 +208,8 @@ def threading_is_not_main() -> bool:
 def run(tool: str, body: Callable[[Interrupts], int]) -> int:
     """``body(interrupts)`` -> exit status. A ToolError or bad input becomes one line
     'tool: error: ...' and status 1; Ctrl-C (or SIGTERM) one line 'tool: interrupted' and
-    130 (143); the body's ``Outputs`` leave nothing behind in both cases."""
+    130 (143); a closed standard output (``tool | head``) nothing, and 141 as for SIGPIPE;
+    the body's ``Outputs`` leave nothing behind in each case."""
     from irb140_dynamics.tools import EARLY_SIGNALS
 
     interrupts = Interrupts()
@@ -237,6 +238,9 @@ def _failed(tool: str, error: BaseException, interrupts: Interrupts) -> int:
         _say(f"{tool}: interrupted")
         _exit_now_if_the_program(interrupts.status)
         return interrupts.status
+    if isinstance(error, BrokenPipeError):  # `tool | head`: the reader has gone, as with SIGPIPE
+        _quiet_stdout()
+        return 128 + signal.SIGPIPE
     if isinstance(error, ToolError):
         _say(f"{tool}: error: {error}")
     elif isinstance(error, (ValueError, OSError, ArithmeticError, MemoryError, RecursionError)):
@@ -248,6 +252,16 @@ def _failed(tool: str, error: BaseException, interrupts: Interrupts) -> int:
     else:  # GeneratorExit and the like
         raise error
     return 1
+
+
+def _quiet_stdout() -> None:
+    """Standard output to /dev/null: the interpreter's last flush then has no closed pipe to
+    complain about (Python's documented way, "Note on SIGPIPE")."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):  # no real stdout (a test's capture)
+        pass
 
 
 def _exit_now_if_the_program(status: int) -> None:
