@@ -27,6 +27,13 @@ pytestmark = pytest.mark.skipif(native.compiler() is None, reason="no C compiler
 KERNELS = ("rnea", "gravity_torques", "mass_matrix")
 
 
+@pytest.fixture(autouse=True)
+def compiles_at_normal_priority(monkeypatch):
+    """These tests wait for their compiles: at the lowest priority, on two cores kept busy,
+    each would take minutes (the priority is for a node's loop, not a test's wait)."""
+    monkeypatch.setattr(native, "NICENESS", 0)
+
+
 def arms() -> dict:
     def urdf(name, **chain):
         return load_urdf((URDF_DATA / name).read_text(), **chain).model

@@ -47,6 +47,7 @@ PROMOTE_AFTER = 1000  # calls of a kernel's Python form before it is compiled
 CHECKS = 20  # random inputs on which the native code must equal the Python code exactly
 FLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math", "-fno-builtin")
 COMPILE_TIMEOUT = 120.0  # s
+NICENESS = 19  # of the compiler: the lowest CPU priority, so that a node's loop comes first
 STALE_AFTER = 3600.0  # s: a working folder this old is no running compile's (see library)
 WORKING_PREFIX = "build-"  # a compile's working folder in the cache folder
 FUNCTIONS_KEPT = 64  # compiled kernels kept for the next model of the same arm
@@ -218,7 +219,7 @@ class _Builds:
             )
             self._running[process] = work
         with contextlib.suppress(OSError):  # a node's loop comes first; the group: the driver's
-            os.setpriority(os.PRIO_PGRP, process.pid, 19)  # children started already too
+            os.setpriority(os.PRIO_PGRP, process.pid, NICENESS)  # children started already too
         return process
 
     def done(self, process: subprocess.Popen) -> None:
