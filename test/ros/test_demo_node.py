@@ -1,5 +1,6 @@
 """demo_node's plot: written from the tracking errors it received, even when a busy machine
-dropped the joint states they were computed from; a line saying why when there is none."""
+dropped the joint states they were computed from; a line saying what is missing when there
+is none; the tracking figures printed only once there is."""
 
 import numpy as np
 from rclpy.parameter import Parameter
@@ -39,4 +40,19 @@ def test_without_tracking_errors_it_says_why_there_is_no_plot(tmp_path, capsys):
     with running(DemoNode, parameter_overrides=[Parameter("plot_file", value=str(plot))]) as harness:
         assert harness.node.write_plot() is None
     assert not plot.exists()
-    assert f"no plot: no tracking error received from id_node yet ({plot} not written)" in capsys.readouterr().out
+    assert f"no plot: no tracking error from id_node received yet ({plot} not written)" in capsys.readouterr().out
+
+
+def test_tracking_errors_without_joint_states_print_no_figures_and_say_what_is_missing(tmp_path, capsys):
+    """The figures (what the demo's users, and test_run_script, wait for) come once a
+    sample for the plot exists: then a Ctrl-C after them always writes the plot."""
+    plot = tmp_path / "plot.png"
+    with running(DemoNode, parameter_overrides=[Parameter("plot_file", value=str(plot))]) as harness:
+        errors = harness.publisher(JointState, "/id_node/tracking_error")
+        errors.publish(joint_state(np.full(6, 1e-3), 2_000))
+        assert harness.spin_until(lambda: len(harness.node._recent) == 1)
+        harness.node._print()
+        assert harness.node.write_plot() is None
+    out = capsys.readouterr().out
+    assert "waiting for sim_node and id_node" in out and "mrad" not in out
+    assert f"no plot: no joint_states from sim_node received yet ({plot} not written)" in out

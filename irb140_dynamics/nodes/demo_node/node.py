@@ -134,7 +134,7 @@ class DemoNode(Node):
     def _print(self) -> None:
         t = self._elapsed()
         errors = [e for s, e in self._recent if s > t - 1.0]
-        if not errors:
+        if not errors or not self._history:  # the loop's figures once both its ends are heard
             print(f"t={t:6.1f} s  waiting for sim_node and id_node ...", flush=True)
             return
         rms = np.sqrt(np.mean(np.square(errors), axis=0)) * 1e3
@@ -153,7 +153,8 @@ class DemoNode(Node):
         """Reference and actual positions per joint, as a PNG; its path, or None without data
         (then it says so)."""
         if not self._history:
-            print(f"no plot: no tracking error received from id_node yet ({self.plot_file} not written)", flush=True)
+            missing = "tracking error from id_node" if not self._recent else "joint_states from sim_node"
+            print(f"no plot: no {missing} received yet ({self.plot_file} not written)", flush=True)
             return None
         import matplotlib
 
