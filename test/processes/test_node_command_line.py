@@ -4,7 +4,6 @@ moment (issue 21 items 5 and 6, issue 23 item 6)."""
 
 from __future__ import annotations
 
-import os
 import re
 import signal
 import sys
@@ -12,6 +11,7 @@ import time
 
 import pytest
 
+from ..support.common import full_sweep
 from ..support.node_process import interrupt, module_command, run_to_exit, start, wait_for_line
 from ..support.paths import CONFIG
 
@@ -125,7 +125,7 @@ SIGNAL_DELAYS = (0.0, 0.1, 0.3, 0.8, 1.5, 3.0)
 
 
 def delays_of(node: str) -> tuple[float, ...]:
-    if os.environ.get("IRB140_SWEEP") == "full":
+    if full_sweep():
         return SIGNAL_DELAYS
     k = NODES.index(node) % 3
     return SIGNAL_DELAYS[k], SIGNAL_DELAYS[k + 3]

@@ -17,10 +17,15 @@ OFFSET_PAYLOAD = RigidBody(
 )
 
 
+def full_sweep() -> bool:
+    """Whether sweep tests run every seeded case (IRB140_SWEEP=full, docs/development.md)."""
+    return os.environ.get("IRB140_SWEEP") == "full"
+
+
 def sweep(quick: int, full: int) -> int:
     """How many seeded cases a sweep test runs: ``quick`` in the suite, ``full`` with
-    IRB140_SWEEP=full (docs/development.md); the quick ones are the first of the full ones."""
-    return full if os.environ.get("IRB140_SWEEP") == "full" else quick
+    IRB140_SWEEP=full; the quick ones are the first of the full ones."""
+    return full if full_sweep() else quick
 
 
 def loaded_irb140() -> RobotModel:
