@@ -137,25 +137,39 @@ class Loop:
 
     def __init__(self, probe):
         self.probe = probe
-        self.states, self.latest, self._errors = {}, -1, None
-        probe.create_subscription(JointState, "joint_states", self._on_state, 10000)
+        self._subscriptions = []
         self.reference = probe.create_publisher(JointTrajectory, "/id_node/reference", 10)
         self.reset_client = probe.create_client(Trigger, "/sim_node/reset")
         self.parameters = AsyncParameterClient(probe, "sim_node")
 
-    def listen(self) -> None:
-        """Tracking errors from now on: a new subscription, so that none still queued from
-        before (or from an id_node stopped since) comes in."""
-        if self._errors is not None:
-            self.probe.destroy_subscription(self._errors)
-        self.errors = {}
-        self._errors = self.probe.create_subscription(
-            JointState, "/id_node/tracking_error", lambda m: self.errors.__setitem__(stamp(m), m), 10000
-        )
+    def listen(self, toward) -> None:
+        """Joint states and tracking errors from now on, and whether id_node tracks
+        ``toward``: new subscriptions, so that nothing queued while the probe did not spin
+        (or sent by an id_node stopped since) comes in, and states and errors arrive alike."""
+        for subscription in self._subscriptions:
+            self.probe.destroy_subscription(subscription)
+        self.states, self.errors, self.latest, self.latest_error = {}, {}, -1, -1
+        self.toward, self.tracking = list(toward), False
+        self._subscriptions = [
+            self.probe.create_subscription(JointState, "joint_states", self._on_state, 10000),
+            self.probe.create_subscription(JointState, "/id_node/tracking_error", self._on_error, 10000),
+        ]
 
     def _on_state(self, msg: JointState) -> None:
-        self.states[stamp(msg)] = msg
-        self.latest = max(self.latest, stamp(msg))
+        s = stamp(msg)
+        self.states[s], self.latest = msg, max(self.latest, s)
+        if not self.tracking and s in self.errors:
+            self.tracking = self._toward(msg, self.errors[s])
+
+    def _on_error(self, msg: JointState) -> None:
+        s = stamp(msg)
+        self.errors[s], self.latest_error = msg, max(self.latest_error, s)
+        if not self.tracking and s in self.states:
+            self.tracking = self._toward(self.states[s], msg)
+
+    def _toward(self, state: JointState, error: JointState) -> bool:
+        """Is ``error`` (reference - position) the error toward ``self.toward``?"""
+        return all(abs(q + e - p) <= 1e-12 for q, e, p in zip(state.position, error.position, self.toward, strict=True))
 
     def send_until(self, msg: JointTrajectory, done) -> None:
         """Publish ``msg`` every 50 ms until ``done()`` (a message sent before id_node's end of
@@ -169,26 +183,19 @@ class Loop:
 
         self.probe.spin_until(done, each=send)
 
-    def tracks(self, positions) -> bool:
-        """Has id_node published a tracking error toward ``positions``?"""
-        return any(
-            s in self.states and np.allclose(np.add(self.states[s].position, e.position), positions, rtol=0, atol=1e-12)
-            for s, e in list(self.errors.items())[-20:]
-        )
-
     def move(self, msg: JointTrajectory, duration: float, reset: bool = True, also=lambda: True) -> list[int]:
         """Hold the arm at the first point of ``msg``; ``reset``: reset it there, held still
         HOLD s, and follow ``msg`` from the end of the hold (deterministic: the same state at
         the same time), else from HOLD s on; for ``duration`` s: the stamps of those states."""
         pose = list(msg.points[0].positions)
-        self.listen()
-        self.send_until(hold_message(msg.joint_names, pose), lambda: self.tracks(pose))
+        self.listen(toward=pose)
+        self.send_until(hold_message(msg.joint_names, pose), lambda: self.tracking)
         if reset:
             start = self.reset(pose)
         else:
             start = self.latest + round(HOLD * 1e9)
         msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(start, 1_000_000_000)
-        self.send_until(msg, lambda: any(s >= start for s in self.errors) and also())
+        self.send_until(msg, lambda: self.latest_error >= start and also())
         end = start + round(duration * 1e9)
         self.probe.spin_until(lambda: self.latest >= end, timeout=duration * 4 + TIMEOUT)
         stamps = [s for s in sorted(self.states) if start <= s < end]
