@@ -18,12 +18,12 @@ sanity caps keep them finite.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from functools import cache
 from math import isfinite
 
 import numpy as np
 
 from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.codegen.layout import upper_to_full
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.model.states import finite_result, finite_results, state, states
 
@@ -115,7 +115,7 @@ def mass_matrix(model: RobotModel, q: ArrayLike) -> np.ndarray:
                 return _frombuffer(M).reshape(n, n)
         kernel.used()
     upper = kernel.scalar(state(q, n, "q"))
-    return np.fromiter(upper, float, len(upper))[_upper_to_full(n)]
+    return np.fromiter(upper, float, len(upper))[upper_to_full(n)]
 
 
 def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, f_ext=None) -> np.ndarray:
@@ -203,13 +203,4 @@ def _evaluate(kernel, *columns: np.ndarray) -> np.ndarray:
 
 def _symmetric(upper: np.ndarray, n: int) -> np.ndarray:
     """Symmetric (..., n, n) matrices from their upper triangles stored row by row."""
-    return upper[..., _upper_to_full(n)]
-
-
-@cache
-def _upper_to_full(n: int) -> np.ndarray:
-    """For each entry of an n x n matrix, its index in the row-by-row upper triangle."""
-    index = np.empty((n, n), dtype=np.intp)
-    rows, cols = np.triu_indices(n)
-    index[rows, cols] = index[cols, rows] = np.arange(len(rows))
-    return index
+    return upper[..., upper_to_full(n)]

@@ -41,6 +41,7 @@ import threading
 import time
 from pathlib import Path
 
+from irb140_dynamics.core.codegen.layout import whole_matrix
 from irb140_dynamics.core.codegen.trace import _emit, angle_lines, merged, trace
 
 PROMOTE_AFTER = 1000  # calls of a kernel's Python form before it is compiled
@@ -284,15 +285,6 @@ def same_as_python(native: NativeKernel, python, inputs: int, groups: list[int],
         if got is None or bytes(got) != array.array("d", want).tobytes():  # bits: -0.0 is not 0.0
             return False
     return True
-
-
-def whole_matrix(upper: list, n: int) -> list:
-    """The n x n entries, row by row, of a symmetric matrix given by its upper triangle."""
-    at, entries = {}, iter(upper)
-    for i in range(n):
-        for j in range(i, n):
-            at[i, j] = at[j, i] = next(entries)
-    return [at[i, j] for i in range(n) for j in range(n)]
 
 
 class _Compiler:
