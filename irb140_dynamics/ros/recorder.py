@@ -10,23 +10,107 @@ reliable, else best effort (as rosbag2 adapts).
 It finishes by itself (``finished`` says why) ``duration`` s after the first message, or
 ``tail`` s after the end of the motion last sent on a ``reference`` topic (a
 JointTrajectory, as id_node follows it: from its header stamp, or from its arrival when
-unstamped; a single point, a hold, is no motion). Nothing here stops the process: the
-tool's loop reads ``finished`` and closes the bag.
+unstamped; a single point, a hold, is no motion). Nothing here stops the process:
+``record`` spins it until it is finished, fails or is asked to stop, and closes the bag.
 """
 
 from __future__ import annotations
 
 import importlib
+import time
 from pathlib import Path
 
+import rclpy
 from rclpy.clock import Clock, ClockType
+from rclpy.expand_topic_name import expand_topic_name
+from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
+from rclpy.validate_full_topic_name import validate_full_topic_name
 
 from irb140_dynamics.identification.recording import bag_connection, open_bag
+from irb140_dynamics.ros.runtime.spin import init_error
 
 DEFAULT_DEPTH = 1000  # the subscription's queue: a burst the writer may lag behind
 POLL_PERIOD = 0.1  # s between looks at the graph while waiting for the topic
+DRAIN_TIME = 1.0  # s: after a stop is asked for, messages already received are written, for at most this long
+DRAIN_QUIET = 0.05  # s: until none has come for this long
+
+
+class RecordingError(Exception):
+    """The recording cannot start (one line)."""
+
+
+def topic_error(name: str) -> str | None:
+    """Why ``name`` cannot be a topic name, in one line (rcl's reason); None when it can."""
+    try:
+        validate_full_topic_name(expand_topic_name(name, "record", "/"))
+    except Exception as error:  # noqa: BLE001  (rclpy's InvalidTopicNameException and others)
+        return str(error).splitlines()[0].split(", at /")[0]
+    return None
+
+
+def record(argv: list[str], options, out: Path, stop, progress) -> tuple[str, str | None, str | None]:
+    """rclpy started with ``argv``'s ROS arguments (its signal handlers left alone), then
+    ``options.topic`` recorded into the new bag ``out`` (``options.out`` as typed, named in
+    errors; a Recorder of ``options``' duration, depth, reference and tail) until it is
+    finished, fails or ``stop`` is true;
+    ``progress(line)`` is called as it goes. The bag is closed whole whatever happens.
+    Returns why it ended, what the bag holds (None if it could not be closed) and the
+    failure (None); RecordingError when it cannot start."""
+    try:
+        rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    except rclpy_implementation.RCLError as error:
+        raise RecordingError(init_error(error)) from None
+    try:
+        try:
+            recorder = Recorder(options.topic, out, options.duration, options.depth, options.reference, options.tail)
+        except (ValueError, OSError) as error:
+            raise RecordingError(f"{options.out}: {getattr(error, 'strerror', None) or error}") from None
+        summary = None
+        try:
+            why = _spin(recorder, stop, progress)
+        finally:  # whatever happened: the bag closed whole (signals only set flags meanwhile)
+            try:
+                summary = recorder.close()
+            except (OSError, ValueError) as error:  # a full disk
+                recorder.failure = recorder.failure or f"{options.out}: cannot close the bag ({error})"
+            recorder.destroy_node()
+    finally:
+        rclpy.try_shutdown()
+    return why, summary, recorder.failure
+
+
+def _spin(recorder: Recorder, stop, progress) -> str:
+    """Spin until the recording is complete, fails or is stopped: why it ended."""
+    executor = _executor(recorder)
+    try:
+        while not stop and not recorder.failure and not recorder.check() and recorder.context.ok():
+            executor.spin_once(timeout_sec=0.1)
+            progress(recorder.progress())
+        if stop and not recorder.finished:  # what is queued was received before the stop
+            deadline, count, quiet = time.monotonic() + DRAIN_TIME, -1, time.monotonic()
+            while time.monotonic() < min(deadline, quiet + DRAIN_QUIET) and not recorder.failure:
+                if recorder.count != count:
+                    count, quiet = recorder.count, time.monotonic()
+                executor.spin_once(timeout_sec=0.01)
+    finally:
+        executor.shutdown()
+    return recorder.failure or recorder.finished or ("interrupted" if stop else "the ROS context shut down")
+
+
+def _executor(node: Node):
+    try:
+        from rclpy.experimental import EventsExecutor
+
+        executor = EventsExecutor(context=node.context)
+    except (ImportError, OSError, ValueError):  # (it enables faulthandler: a stderr without a file fails)
+        from rclpy.executors import SingleThreadedExecutor
+
+        executor = SingleThreadedExecutor(context=node.context)
+    executor.add_node(node)
+    return executor
 
 
 def message_class(type_name: str):

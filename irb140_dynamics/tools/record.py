@@ -29,8 +29,6 @@ from irb140_dynamics.tools.cli import Parser, ToolError, number, one_line, outpu
 
 DEFAULT_TOPIC = "/joint_states"  # as identification.recording's
 PROGRESS_PERIOD = 2.0  # s between progress lines when stderr is not a terminal (0.2 on one)
-DRAIN_TIME = 1.0  # s: after Ctrl-C, messages already received are written, for at most this long
-DRAIN_QUIET = 0.05  # s: until none has come for this long
 
 
 def parser() -> Parser:
@@ -103,9 +101,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _record(argv: list[str], stop: Stop) -> int:
-    from rclpy.expand_topic_name import expand_topic_name
-    from rclpy.validate_full_topic_name import validate_full_topic_name
-
+    from irb140_dynamics.ros.recorder import RecordingError, record, topic_error
     from irb140_dynamics.ros.runtime.spin import tool_arguments
 
     try:
@@ -113,87 +109,26 @@ def _record(argv: list[str], stop: Stop) -> int:
     except ValueError as error:  # rcl refused the ROS arguments
         raise ToolError(str(error)) from None
     for option, name in (("--topic", args.topic), ("--reference", args.reference)):
-        if name is None:
-            continue
-        try:
-            validate_full_topic_name(expand_topic_name(name, "record", "/"))
-        except Exception as error:  # noqa: BLE001  (rclpy's InvalidTopicNameException and others)
-            raise ToolError(f"{option} {name!r}: {str(error).splitlines()[0].split(', at /')[0]}") from None
+        if name is not None and (reason := topic_error(name)):
+            raise ToolError(f"{option} {name!r}: {reason}")
     out = output_directory(args.out, must_be_new=True)
     if stop:
         _say("record: stopped before recording: nothing written")
         return 0
-    return _spin(argv, args, out, stop)
-
-
-def _spin(argv: list[str], args, out, stop: Stop) -> int:
-    import rclpy
-    from rclpy.impl.implementation_singleton import rclpy_implementation
-    from rclpy.signals import SignalHandlerOptions
-
-    from irb140_dynamics.ros.recorder import Recorder
-    from irb140_dynamics.ros.runtime.spin import init_error
-
+    progress = _Progress()
     try:
-        rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    except rclpy_implementation.RCLError as error:
-        raise ToolError(init_error(error)) from None
-    recorder, summary, why = None, None, None
-    try:
-        try:
-            recorder = Recorder(args.topic, out, args.duration, args.depth, args.reference, args.tail)
-        except (ValueError, OSError) as error:
-            raise ToolError(f"{args.out}: {getattr(error, 'strerror', None) or error}") from None
-        try:
-            why = _loop(recorder, stop)
-        finally:  # whatever happened: the bag closed whole (signals only set flags meanwhile)
-            try:
-                summary = recorder.close()
-            except (OSError, ValueError) as error:  # a full disk
-                recorder.failure = recorder.failure or f"{args.out}: cannot close the bag ({error})"
-            recorder.destroy_node()
+        why, summary, failure = record(argv, args, out, stop, progress)
+    except RecordingError as error:
+        raise ToolError(str(error)) from None
     finally:
-        rclpy.try_shutdown()
+        progress.end()
     print(f"stopped: {why}", file=sys.stderr, flush=True)
     if summary is not None:
         print(summary, flush=True)
-    if recorder.failure:
-        _say(f"record: error: {recorder.failure}")
+    if failure:
+        _say(f"record: error: {failure}")
         return 1
     return 0
-
-
-def _loop(recorder, stop: Stop) -> str:
-    """Spin until the recording is complete, fails or is stopped: why it ended."""
-    executor = _executor(recorder)
-    progress = _Progress()
-    try:
-        while not stop and not recorder.failure and not recorder.check() and recorder.context.ok():
-            executor.spin_once(timeout_sec=0.1)
-            progress(recorder.progress())
-        if stop and not recorder.finished:  # what is queued was received before the signal
-            deadline, count, quiet = time.monotonic() + DRAIN_TIME, -1, time.monotonic()
-            while time.monotonic() < min(deadline, quiet + DRAIN_QUIET) and not recorder.failure:
-                if recorder.count != count:
-                    count, quiet = recorder.count, time.monotonic()
-                executor.spin_once(timeout_sec=0.01)
-    finally:
-        progress.end()
-        executor.shutdown()
-    return recorder.failure or recorder.finished or ("interrupted" if stop else "the ROS context shut down")
-
-
-def _executor(node):
-    try:
-        from rclpy.experimental import EventsExecutor
-
-        executor = EventsExecutor(context=node.context)
-    except (ImportError, OSError, ValueError):  # (it enables faulthandler: a stderr without a file fails)
-        from rclpy.executors import SingleThreadedExecutor
-
-        executor = SingleThreadedExecutor(context=node.context)
-    executor.add_node(node)
-    return executor
 
 
 class _Progress:
