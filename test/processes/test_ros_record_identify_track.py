@@ -53,7 +53,10 @@ DEMO_PERIOD = 8.0  # s: demo_node's default motion
 TRACKED = 4.0  # s of it compared: out to its far end
 TAIL = 1.0  # s recorded after the excitation: record's default --tail
 ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
-HOLD = 0.5  # s of simulated time the arm is held still after a reset: the reference arrives meanwhile
+HOLD = (
+    2.0  # s of simulated time (~1 s of wall time) the arm is held still after a reset: the reference arrives meanwhile
+)
+READY = 120.0  # s: processes just started, on two busy cores, until id_node tracks the first hold
 SIM = [
     "--params-file",
     str(ROOT / "config" / "true_arm.yaml"),
@@ -171,7 +174,7 @@ class Loop:
         """Is ``error`` (reference - position) the error toward ``self.toward``?"""
         return all(abs(q + e - p) <= 1e-12 for q, e, p in zip(state.position, error.position, self.toward, strict=True))
 
-    def send_until(self, msg: JointTrajectory, done) -> None:
+    def send_until(self, msg: JointTrajectory, done, timeout: float = TIMEOUT) -> None:
         """Publish ``msg`` every 50 ms until ``done()`` (a message sent before id_node's end of
         the connection is up is lost; sending it again changes nothing)."""
         sent = [0.0]
@@ -181,7 +184,7 @@ class Loop:
                 self.reference.publish(msg)
                 sent[0] = time.monotonic()
 
-        self.probe.spin_until(done, each=send)
+        self.probe.spin_until(done, timeout=timeout, each=send)
 
     def move(self, msg: JointTrajectory, duration: float, reset: bool = True, also=lambda: True) -> list[int]:
         """Hold the arm at the first point of ``msg``; ``reset``: reset it there, held still
@@ -189,7 +192,7 @@ class Loop:
         the same time), else from HOLD s on; for ``duration`` s: the stamps of those states."""
         pose = list(msg.points[0].positions)
         self.listen(toward=pose)
-        self.send_until(hold_message(msg.joint_names, pose), lambda: self.tracking)
+        self.send_until(hold_message(msg.joint_names, pose), lambda: self.tracking, READY)  # (id_node may be new)
         if reset:
             start = self.reset(pose)
         else:
@@ -277,7 +280,7 @@ def test_identified_from_a_ros_recording_tracks_five_times_better(probe, process
     recorder = processes(tool("record", *typed["record"]))
     loop = Loop(probe)
     lines = []
-    assert wait_for_line(recorder, "recording /joint_states", lines, TIMEOUT), "".join(lines)
+    assert wait_for_line(recorder, "recording /joint_states (", lines, READY), "".join(lines)  # subscribed
     # the excitation is sent until id_node follows it and record has seen it (its "following" line)
     loop.move(excitation, EXCITATION_PERIOD + TAIL, reset=False, also=lambda: saw(recorder, lines, "following"))
     output, _ = recorder.communicate(timeout=4 * TIMEOUT)

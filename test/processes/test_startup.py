@@ -44,7 +44,9 @@ with ctrl_c_as_a_flag() as interrupted:
     except KeyboardInterrupt:
         print("second Ctrl-C raises")
     os.kill(os.getpid(), signal.SIGTERM)
-    time.sleep(0.2)
+    deadline = time.monotonic() + 5.0  # rclpy's signal thread shuts the context down
+    while rclpy.ok() and time.monotonic() < deadline:
+        time.sleep(0.01)
     print("SIGTERM ok", rclpy.ok())
 context = rclpy.Context()
 rclpy.init(context=context)

@@ -47,12 +47,14 @@ def node():
 def send(harness, msg, expect=1):
     """Publish one joint state and wait for ``expect`` new torque messages on each topic."""
     ff, g = len(harness.feedforward), len(harness.gravity)
+    received = harness.node.counts["joint_states.received"]
     harness.joint_states.publish(msg)
     if expect:
         assert harness.spin_until(
             lambda: len(harness.feedforward) >= ff + expect and len(harness.gravity) >= g + expect
         )
         return harness.feedforward[-1], harness.gravity[-1]
+    assert harness.spin_until(lambda: harness.node.counts["joint_states.received"] > received)  # it was read
     harness.spin_for(0.3)
     assert (len(harness.feedforward), len(harness.gravity)) == (ff, g), "a bad message yielded torques"
     return None

@@ -43,7 +43,10 @@ def _number(text: str):
 
 
 @pytest.fixture
-def node():
+def node(monkeypatch):
+    """The node on wall time: a stall of the test under load must not make its joint state
+    stale (staleness is tested on simulated time, sim_node below)."""
+    monkeypatch.setattr(module, "STALE_AFTER", 60.0)
     overrides = [Parameter("payload.mass", value=6.0), Parameter("diagnostics.period", value=0.0)]
     with running(PayloadCheckNode, parameter_overrides=overrides) as harness:
         harness.diagnostics = harness.listen(DiagnosticArray, "/diagnostics")

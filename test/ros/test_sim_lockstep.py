@@ -51,10 +51,10 @@ def step(sim, tau) -> JointState:
 
 def first_step(sim) -> JointState:
     """The first command may reach sim_node before its subscription has matched ours: send
-    zero torque until a step is taken."""
-    for _ in range(50):
+    zero torque until a step is taken (each given long enough that a late one is not sent twice)."""
+    for _ in range(10):
         sim.commands.publish(Float64MultiArray(data=[0.0] * 6))
-        if sim.spin_until(lambda: sim.states and stamp(sim.states[-1]) > 0, timeout=0.5):
+        if sim.spin_until(lambda: sim.states and stamp(sim.states[-1]) > 0, timeout=3.0):
             return sim.states[-1]
     raise AssertionError("sim_node never stepped")
 

@@ -67,7 +67,7 @@ def states_after_reset(sim, count: int):
 
 
 def test_states_are_named_stamped_every_period_and_the_arm_falls_without_torque(sim):
-    states = states_after(sim, 300)
+    states = states_after_reset(sim, 300)  # from the pose: the arm rests on its joint limit 0.5 s later
     assert all(msg.name == NAMES for msg in states)
     steps = np.diff([stamp(msg) for msg in states]) / 1_000_000  # ms: the probe may miss some under load
     assert steps.min() >= 1 and np.abs(steps - np.round(steps)).max() < 1e-6  # 1 kHz in stamps
@@ -88,12 +88,13 @@ def test_a_gravity_command_is_applied_and_held(sim):
 
 @pytest.mark.parametrize("sim", [{"command_timeout": 0.2}], indirect=True)
 def test_a_command_older_than_the_timeout_gives_zero_torque(sim):
+    sent = time.monotonic()  # the node ages commands on this clock (stamps are the steps' due times)
     command(sim, COMMAND)
     wait_for_effort(sim, COMMAND)
     applied = [msg for msg in sim.states if np.array_equal(msg.effort, COMMAND)]
     wait_for_effort(sim, np.zeros(6))
-    held = stamp(sim.states[-1]) - stamp(applied[0])
-    assert 0.15e9 < held < 1e9
+    assert time.monotonic() - sent >= 0.2  # not dropped before its time
+    assert 0 < stamp(sim.states[-1]) - stamp(applied[0]) < 2e9  # and dropped (the bound: a stall)
     assert sim.node.counts["command_timeouts"] == 1
     command(sim, COMMAND)  # a fresh command applies again
     wait_for_effort(sim, COMMAND)
@@ -168,10 +169,11 @@ def test_a_blow_up_resets_the_arm_and_the_node_goes_on(sim):
     assert np.isfinite(sim.states[-1].position).all()
 
 
-@pytest.mark.parametrize("sim", [{"reset_hold": 0.3}], indirect=True)
+@pytest.mark.parametrize("sim", [{"reset_hold": 1.0}], indirect=True)
 def test_reset_puts_the_arm_back_and_holds_it(sim):
-    states_after(sim, 400)  # after the first hold, the arm has fallen
-    assert abs(sim.states[-1].position[1] - POSE[1]) > 1e-3
+    assert sim.spin_until(
+        lambda: sim.states and abs(sim.states[-1].position[1] - POSE[1]) > 1e-3
+    )  # after the first hold
     client = sim.probe.create_client(Trigger, "/sim_node/reset")
     assert client.wait_for_service(timeout_sec=10.0)
     reply = sim.call(lambda: client.call_async(Trigger.Request()))
