@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from ..support.node_process import communicate
 from ..support.paths import ROOT
 
 RUN = ROOT / "scripts" / "run.sh"
@@ -99,7 +100,7 @@ def test_the_demo_stops_on_ctrl_c_and_writes_its_plot_where_it_says(tmp_path):
                 break
             assert time.monotonic() < deadline, "".join(lines)
         os.kill(process.pid, signal.SIGINT)  # Ctrl-C: the terminal sends it to run.sh
-        rest, _ = process.communicate(timeout=120)
+        rest, _ = communicate(process, 120)
     finally:
         leftovers = left_behind(process)
         kill_session(process)

@@ -8,6 +8,7 @@ import subprocess
 import sys
 import time
 
+from .hang_report import hang_report
 from .paths import ROOT
 
 TIMEOUT = 30.0  # s, a process start included
@@ -27,10 +28,19 @@ def run_to_exit(command: list[str], env: dict | None = None, timeout: float = 60
     """(exit code, output) of a node that is expected to stop by itself."""
     process = start(command, env)
     try:
-        output, _ = process.communicate(timeout=timeout)
+        output, _ = communicate(process, timeout)
     finally:
         process.kill()
     return process.returncode, output
+
+
+def communicate(process: subprocess.Popen, timeout: float) -> tuple[str, str]:
+    """``process.communicate``; if it has not ended in ``timeout`` s, an AssertionError that
+    says what it and its children are doing (hang_report)."""
+    try:
+        return process.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        raise AssertionError(f"{process.args} has not ended after {timeout:g} s:\n{hang_report(process.pid)}") from None
 
 
 def wait_for_line(process: subprocess.Popen, text: str, lines: list[str], timeout: float = 60.0) -> bool:
@@ -55,7 +65,7 @@ def interrupt(process: subprocess.Popen, lines: list[str] | None = None, timeout
     """Stop a process with Ctrl-C: (exit code, its output, after ``lines`` read before)."""
     try:
         process.send_signal(signal.SIGINT)
-        rest, _ = process.communicate(timeout=timeout)
+        rest, _ = communicate(process, timeout)
     finally:
         process.kill()
     return process.returncode, "".join(lines or []) + (rest or "")
