@@ -38,7 +38,7 @@ DRAIN_TIME = 1.0  # s: after a stop is asked for, messages already received are 
 DRAIN_QUIET = 0.05  # s: until none has come for this long
 
 
-class RecordingError(Exception):
+class CannotRecord(Exception):
     """The recording cannot start (one line)."""
 
 
@@ -55,22 +55,22 @@ def record(argv: list[str], options, out: Path, stop, progress) -> tuple[str, st
     """rclpy started with ``argv``'s ROS arguments (its signal handlers left alone), then
     ``options.topic`` recorded into the new bag ``out`` (``options.out`` as typed, named in
     errors; a Recorder of ``options``' duration, depth, reference and tail) until it is
-    finished, fails or ``stop`` is true;
-    ``progress(line)`` is called as it goes. The bag is closed whole whatever happens.
-    Returns why it ended, what the bag holds (None if it could not be closed) and the
-    failure (None); RecordingError when it cannot start."""
+    finished, fails or ``stop`` is true; ``progress(line)`` is called as it goes, and
+    ``progress.end()`` when it stops. The bag is closed whole whatever happens. Returns why
+    it ended, what the bag holds (None if it could not be closed) and the failure (None);
+    CannotRecord when it cannot start."""
     try:
         rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     except rclpy_implementation.RCLError as error:
-        raise RecordingError(init_error(error)) from None
+        raise CannotRecord(init_error(error)) from None
     try:
         try:
             recorder = Recorder(options.topic, out, options.duration, options.depth, options.reference, options.tail)
         except (ValueError, OSError) as error:
-            raise RecordingError(f"{options.out}: {getattr(error, 'strerror', None) or error}") from None
+            raise CannotRecord(f"{options.out}: {getattr(error, 'strerror', None) or error}") from None
         summary = None
         try:
-            why = _spin(recorder, stop, progress)
+            why = _spin_until_done(recorder, stop, progress)
         finally:  # whatever happened: the bag closed whole (signals only set flags meanwhile)
             try:
                 summary = recorder.close()
@@ -82,7 +82,7 @@ def record(argv: list[str], options, out: Path, stop, progress) -> tuple[str, st
     return why, summary, recorder.failure
 
 
-def _spin(recorder: Recorder, stop, progress) -> str:
+def _spin_until_done(recorder: Recorder, stop, progress) -> str:
     """Spin until the recording is complete, fails or is stopped: why it ended."""
     executor = _executor(recorder)
     try:
@@ -96,6 +96,7 @@ def _spin(recorder: Recorder, stop, progress) -> str:
                     count, quiet = recorder.count, time.monotonic()
                 executor.spin_once(timeout_sec=0.01)
     finally:
+        progress.end()
         executor.shutdown()
     return recorder.failure or recorder.finished or ("interrupted" if stop else "the ROS context shut down")
 

@@ -101,7 +101,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _record(argv: list[str], stop: Stop) -> int:
-    from irb140_dynamics.ros.recorder import RecordingError, record, topic_error
+    from irb140_dynamics.ros.recorder import CannotRecord, record, topic_error
     from irb140_dynamics.ros.runtime.spin import tool_arguments
 
     try:
@@ -109,19 +109,16 @@ def _record(argv: list[str], stop: Stop) -> int:
     except ValueError as error:  # rcl refused the ROS arguments
         raise ToolError(str(error)) from None
     for option, name in (("--topic", args.topic), ("--reference", args.reference)):
-        if name is not None and (reason := topic_error(name)):
+        if name is not None and (reason := topic_error(name)) is not None:
             raise ToolError(f"{option} {name!r}: {reason}")
     out = output_directory(args.out, must_be_new=True)
     if stop:
         _say("record: stopped before recording: nothing written")
         return 0
-    progress = _Progress()
     try:
-        why, summary, failure = record(argv, args, out, stop, progress)
-    except RecordingError as error:
+        why, summary, failure = record(argv, args, out, stop, _Progress())
+    except CannotRecord as error:
         raise ToolError(str(error)) from None
-    finally:
-        progress.end()
     print(f"stopped: {why}", file=sys.stderr, flush=True)
     if summary is not None:
         print(summary, flush=True)
