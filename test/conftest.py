@@ -1,9 +1,10 @@
 """Test session setup: DDS isolated to this machine and to this session's own domain, a
-cache of native kernels of its own, and the markers of the test folders: test/ros/ spins
-nodes (``ros``), test/processes/ starts executables (``process``)."""
+cache of native kernels of its own, Ctrl-C as from a terminal, and the markers of the test
+folders: test/ros/ spins nodes (``ros``), test/processes/ starts executables (``process``)."""
 
 import os
 import random
+import signal
 import tempfile
 from pathlib import Path
 
@@ -15,6 +16,12 @@ os.environ.pop("ROS_STATIC_PEERS", None)
 # not into the user's cache: a test sees its own compiles, and leaves nothing behind.
 _CACHE = tempfile.TemporaryDirectory(prefix="irb140_kernels_")
 os.environ["IRB140_CACHE"] = _CACHE.name
+# A run started with SIGINT ignored (a background job of a script, nohup, some CI runners)
+# passes the ignoring on to every process it starts: run.sh could not trap the tests'
+# Ctrl-C, nor Python turn it into KeyboardInterrupt. A handler here is reset to the default
+# in each child, as a terminal starts them.
+if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 import pytest  # noqa: E402
