@@ -53,9 +53,8 @@ DEMO_PERIOD = 8.0  # s: demo_node's default motion
 TRACKED = 4.0  # s of it compared: out to its far end
 TAIL = 1.0  # s recorded after the excitation: record's default --tail
 ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
-HOLD = (
-    2.0  # s of simulated time (~1 s of wall time) the arm is held still after a reset: the reference arrives meanwhile
-)
+# s of simulated time (~1 s of wall time) the arm is held still after a reset: the reference arrives meanwhile
+HOLD = 2.0
 READY = 120.0  # s: processes just started, on two busy cores, until id_node tracks the first hold
 SIM = [
     "--params-file",

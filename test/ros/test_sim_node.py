@@ -61,9 +61,14 @@ def stamp(msg) -> int:
 def states_after_reset(sim, count: int):
     """Reset the arm, and the first ``count`` joint states after it."""
     sim.node.reset()
-    reset_at = sim.node.reset_stamp
+    return states_stepped_after(sim, sim.node.reset_stamp, count)[-count:]
+
+
+def states_stepped_after(sim, reset_at: int, count: int):
+    """Once the last ``count`` states received were stepped after ``reset_at`` (a reset's
+    ``reset_stamp``), every state stamped after it, in order: by stamp, as the probe may lag."""
     assert sim.spin_until(lambda: sum(stamp(msg) > reset_at for msg in sim.states[-count:]) == count)
-    return sim.states[-count:]
+    return [msg for msg in sim.states if stamp(msg) > reset_at]
 
 
 def test_states_are_named_stamped_every_period_and_the_arm_falls_without_torque(sim):
@@ -171,16 +176,12 @@ def test_a_blow_up_resets_the_arm_and_the_node_goes_on(sim):
 
 @pytest.mark.parametrize("sim", [{"reset_hold": 1.0}], indirect=True)
 def test_reset_puts_the_arm_back_and_holds_it(sim):
-    assert sim.spin_until(
-        lambda: sim.states and abs(sim.states[-1].position[1] - POSE[1]) > 1e-3
-    )  # after the first hold
+    assert sim.spin_until(lambda: sim.states and abs(sim.states[-1].position[1] - POSE[1]) > 1e-3)  # fallen
     client = sim.probe.create_client(Trigger, "/sim_node/reset")
     assert client.wait_for_service(timeout_sec=10.0)
     reply = sim.call(lambda: client.call_async(Trigger.Request()))
     assert reply.success and "reset" in reply.message
-    reset_at = sim.node.reset_stamp  # states stamped later were stepped after the reset
-    assert sim.spin_until(lambda: sum(stamp(msg) > reset_at for msg in sim.states[-150:]) == 150)
-    after = [msg for msg in sim.states if stamp(msg) > reset_at]  # by stamp: the probe may lag under load
+    after = states_stepped_after(sim, sim.node.reset_stamp, 150)
     held = list(itertools.takewhile(lambda msg: msg.position.tolist() == POSE, after))
     assert len(held) > 50, [msg.position.tolist() for msg in after[:3]]
     assert all(not np.any(msg.velocity) and not np.any(msg.effort) for msg in held)

@@ -19,12 +19,17 @@ def hang_report(pid: int) -> str:
     return "\n".join(lines)
 
 
+def _stat(path: Path) -> list[str]:
+    """The fields of a /proc stat file after the command name: state, parent, ..."""
+    return (path / "stat").read_text().rsplit(")", 1)[1].split()
+
+
 def _descendants(pid: int) -> list[int]:
     children = {}
     for entry in Path("/proc").iterdir():
         if entry.name.isdigit():
             try:
-                parent = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
+                parent = int(_stat(entry)[1])
             except (OSError, IndexError, ValueError):
                 continue
             children.setdefault(parent, []).append(int(entry.name))
@@ -45,7 +50,7 @@ def _describe(pid: int) -> list[str]:
         for task in threads:
             name = (task / "comm").read_text().strip()
             wchan = (task / "wchan").read_text().strip() or "-"
-            state = (task / "stat").read_text().rsplit(")", 1)[1].split()[0]
+            state = _stat(task)[0]
             lines.append(f"   thread {task.name} {name!r} state {state} waiting in {wchan}")
     except OSError as error:
         return [f"-- process {pid}: gone ({error.strerror})"]
