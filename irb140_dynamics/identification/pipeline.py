@@ -133,7 +133,7 @@ def identify(
         recordings.append(Recording(validate, prior.joint_names, settings.topic, settings.chunk_size))
     tallies, held_points, training_points = [], None, None
     for k, recording in enumerate(recordings):
-        tally, points = _read(prior, recording, settings, progress)
+        tally, points = read_fit_points(prior, recording, settings, progress)
         fraction = settings.held_out if validate is None else (0.0 if k == 0 else 1.0)
         held, training = _accumulate(
             prior, tally, points, fraction, min_speed, (train, held_out), settings.correlation_points
@@ -143,7 +143,7 @@ def identify(
         tallies.append(tally)
     for tally, equations, use in ((tallies[0], train, "to fit"), (tallies[-1], held_out, "to validate")):
         if equations.rows.sum() == 0:
-            raise RecordingError(tally.path, _nothing_usable(tally, use, min_speed))
+            raise RecordingError(tally.path, nothing_usable(tally, use, min_speed))
     base = find_base_parameters(prior)  # after the recordings are read: a bad one is refused at once
     filter_correlation = tallies[0].design.noise_correlation()
     estimate = weighted_least_squares(train.centred() if settings.offsets else train, base, filter_correlation)
@@ -180,7 +180,7 @@ def identify(
     )
 
 
-def _read(prior, recording, settings, progress) -> tuple[SampleTally, FitPoints | None]:
+def read_fit_points(prior, recording, settings, progress) -> tuple[SampleTally, FitPoints | None]:
     """A recording's fit points (all of them, in order) and its tally."""
     tally = SampleTally(str(recording.path), recording.total, slow_rows=np.zeros(prior.n, dtype=np.int64))
     differentiator, parts, times = None, [], []
@@ -269,7 +269,7 @@ def _rate(recording: Recording, chunk) -> float:
     return 1.0 / float(np.median(steps))
 
 
-def _nothing_usable(tally: SampleTally, use: str, min_speed: float) -> str:
+def nothing_usable(tally: SampleTally, use: str, min_speed: float) -> str:
     if tally.read == 0:
         reasons = ", ".join(f"{count} {kind.replace('_', ' ')}" for kind, count in tally.skipped.items())
         return f"no usable joint states of the model's joints ({reasons or 'no messages'})"

@@ -64,9 +64,11 @@ def excitation(model: RobotModel, seed: int, period: float = 8.0, harmonics: int
     return shaped(free, model.n, harmonics, period, limits)
 
 
-def simulate(arm: RobotModel, trajectory, duration: float, seed: int = 0, stuck=None):
+def simulate(arm: RobotModel, trajectory, duration: float, seed: int = 0, stuck=None, noise=NOISE, gains=None):
     """(t, Q, QD, TAU measured) of the MuJoCo arm following ``trajectory`` for ``duration`` s.
-    ``stuck``: (joint, t0, t1): that joint's reference held still between t0 and t1."""
+    ``stuck``: (joint, t0, t1): that joint's reference held still between t0 and t1;
+    ``noise``: of each joint's peak torque; ``gains``: the feedback's scale per joint
+    [kg m^2] (default: the UR5's)."""
     from irb140_dynamics.sim.engine import SimulatedArm
 
     t = np.arange(int(round(duration * RATE))) / RATE
@@ -80,7 +82,7 @@ def simulate(arm: RobotModel, trajectory, duration: float, seed: int = 0, stuck=
     sim = SimulatedArm(arm, period=1.0 / RATE, substeps=2)
     sim.reset(Q_ref[0], QD_ref[0])
     kp, kd = 400.0, 40.0  # 1/s^2, 1/s: through the mass matrix's diagonal scale below
-    scale = np.array([5.0, 5.0, 2.0, 0.3, 0.3, 0.1])
+    scale = np.array([5.0, 5.0, 2.0, 0.3, 0.3, 0.1]) if gains is None else np.asarray(gains, dtype=float)
     Q, QD, TAU = (np.empty_like(Q_ref) for _ in range(3))
     for k in range(len(t)):
         q, qd = sim.q, sim.qd
@@ -88,7 +90,7 @@ def simulate(arm: RobotModel, trajectory, duration: float, seed: int = 0, stuck=
         sim.step(tau)
         Q[k], QD[k], TAU[k] = q, qd, sim.applied
     peak = np.abs(TAU).max(axis=0)
-    measured = TAU + np.random.default_rng(seed).normal(size=TAU.shape) * NOISE * peak
+    measured = TAU + np.random.default_rng(seed).normal(size=TAU.shape) * noise * peak
     return t, Q, QD, measured
 
 

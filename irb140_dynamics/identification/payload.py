@@ -1,0 +1,247 @@
+"""Load identification: a payload's mass, centre of mass and inertia from a recording of the
+arm carrying it, the arm's own parameters known.
+
+The arm's torques are linear in its parameters (``core.regressor``): with the payload's ten
+inertial parameters phi in the flange frame ([m, m c_x, m c_y, m c_z, Ixx, Ixy, Iyy, Ixz,
+Iyz, Izz], the inertia about the flange's origin, as ``core.regressor`` orders a link's),
+
+    tau - tau_arm(q, qd, qdd) = Y_last(q, qd, qdd) T phi
+
+tau_arm the arm without payload (links, friction, rotor inertia of its params file),
+Y_last the last link's ten regressor columns and T the linear map of a body's parameters
+from the flange frame to the last joint's frame (``flange_map``). Every fit point's rows
+are summed into normal equations (``least_squares``): a moving joint's row where it is fast
+enough for the Coulomb model (as ``identify`` uses rows), and every row of a joint held
+still throughout (it carries the payload's static load). Weighted least squares gives
+phi_hat and its covariance; a parameter the motion does not tell from the others (the sine
+of the angle between its column and the others' span below ``MIN_EXCITATION``, rows
+weighted as in the fit) refuses the recording, naming it. The payload is then the physical
+body closest to phi_hat in its covariance's metric: phi = phi(theta) through the
+log-Cholesky pseudo-inertia of ``consistent`` (mass > 0, inertia about the CoM positive
+definite, triangle inequality hold for any theta), so a phi_hat that is physical is kept
+as it is.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from irb140_dynamics.core.model.joints import Placement
+from irb140_dynamics.core.model.rigid_body import RigidBody
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.regressor import (
+    LINK_PARAMETERS,
+    body_parameters,
+    inertial_parameters,
+    parameters_body,
+    regressor_batch,
+)
+from irb140_dynamics.identification.base import BaseParameters
+from irb140_dynamics.identification.consistent import (
+    _positive,
+    log_cholesky_of,
+    parameters_and_jacobian,
+    pseudo_inertia,
+)
+from irb140_dynamics.identification.least_squares import Estimate, NormalEquations, weighted_least_squares
+from irb140_dynamics.identification.pipeline import (
+    FIT_BATCH,
+    SLOW_SPEEDS,
+    IdentificationSettings,
+    Progress,
+    SampleTally,
+    nothing_usable,
+    read_fit_points,
+)
+from irb140_dynamics.identification.recording import Recording, RecordingError
+from irb140_dynamics.identification.selection import rows_used, select
+
+MIN_EXCITATION = 0.01  # sine of the angle between a parameter's column and the others' span
+PARAMETER_MEANINGS = (
+    "mass",
+    "first moment m c_x",
+    "first moment m c_y",
+    "first moment m c_z",
+    "inertia Ixx about the flange origin",
+    "inertia Ixy about the flange origin",
+    "inertia Iyy about the flange origin",
+    "inertia Ixz about the flange origin",
+    "inertia Iyz about the flange origin",
+    "inertia Izz about the flange origin",
+)
+_ALL_INDEPENDENT = BaseParameters(tuple(LINK_PARAMETERS), np.arange(10), np.arange(0), np.zeros((10, 0)), np.arange(0))
+
+
+def _moved(pi10: np.ndarray, R: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """A body's ten parameters in frame F, in the frame where x' = R x + p."""
+    m, hx, hy, hz, xx, xy, yy, xz, yz, zz = pi10
+    I = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    h = R @ np.array([hx, hy, hz])
+    cross = 2.0 * (h @ p) * np.eye(3) - np.outer(h, p) - np.outer(p, h)
+    I = R @ I @ R.T + cross + m * (p @ p * np.eye(3) - np.outer(p, p))
+    return np.array([m, *(h + m * p), I[0, 0], I[0, 1], I[1, 1], I[0, 2], I[1, 2], I[2, 2]])
+
+
+def flange_map(model: RobotModel) -> np.ndarray:
+    """T (10 x 10): a payload's parameters in the flange frame -> in the last joint's frame."""
+    post = model.joints[-1].post
+    R_post, R_flange = post.rotation(), model.flange.rotation()
+    R = R_post @ R_flange
+    p = R_post @ np.asarray(model.flange.xyz, dtype=float) + np.asarray(post.xyz, dtype=float)
+    return np.column_stack([_moved(e, R, p) for e in np.eye(10)])
+
+
+def payload_regressor(arm: RobotModel, Q, QD, QDD) -> tuple[np.ndarray, np.ndarray]:
+    """(Y_p (N, n, 10), tau_arm (N, n)): the payload's regressor in the flange frame and the
+    torques of the arm without its payload (friction and rotor inertia included)."""
+    free = arm.with_payload(RigidBody())
+    n = arm.n
+    Y = regressor_batch(free, Q, QD, QDD)
+    tau_arm = Y @ inertial_parameters(free)
+    return Y[:, :, 10 * (n - 1) : 10 * n] @ flange_map(arm), tau_arm
+
+
+def payload_parameters(payload: RigidBody) -> np.ndarray:
+    """phi (10,) of a payload given as the params file gives it (flange frame, about its CoM)."""
+    return body_parameters(payload, Placement())
+
+
+def payload_of(phi) -> RigidBody:
+    """The payload (mass, CoM, inertia about the CoM in flange axes) of phi; ModelError if none."""
+    return parameters_body("payload", phi, Placement())
+
+
+def excitation(information: np.ndarray) -> np.ndarray:
+    """Per parameter, the sine of the angle between its (weighted) regressor column and the
+    span of the others': 1 / sqrt(N_jj (N^-1)_jj) of the normal matrix N; 0 when unseen."""
+    diagonal = np.diag(information).copy()
+    seen = diagonal > 0.0
+    out = np.zeros(len(diagonal))
+    if not seen.any():
+        return out
+    scale = 1.0 / np.sqrt(diagonal[seen])
+    C = information[np.ix_(seen, seen)] * np.outer(scale, scale)
+    eigenvalues, vectors = np.linalg.eigh((C + C.T) / 2.0)
+    inverse_diagonal = (vectors**2) @ (1.0 / np.maximum(eigenvalues, 1e-300))
+    out[seen] = 1.0 / np.sqrt(inverse_diagonal)
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class PayloadFit:
+    payload: RigidBody  # the physical payload closest to the estimate
+    phi: np.ndarray  # (10,) its parameters, flange frame
+    estimate: Estimate  # phi_hat: weighted least squares, unconstrained
+    excitation: np.ndarray  # (10,) see ``excitation``
+    std: dict  # "mass" float, "com" (3,), "inertia" (6,): standard deviations (delta method)
+    tally: SampleTally
+    rows: np.ndarray  # (n,) torque rows used per joint
+    residual_rms: np.ndarray  # (n,) N m, of the fitted payload, per joint
+    peak: np.ndarray  # (n,) N m: largest |tau - tau_arm| per joint among the rows used
+    misfit: float  # | L^T (phi - phi_hat) |^2: 0 when phi_hat is physical
+
+
+def fit_payload(
+    arm: RobotModel,
+    path,
+    settings: IdentificationSettings | None = None,
+    progress: Progress | None = None,
+) -> PayloadFit:
+    """The payload of ``arm`` (its own parameters known) from the recording at ``path``.
+    RecordingError (one line) when the recording is unusable or leaves a parameter unexcited."""
+    settings = settings or IdentificationSettings()
+    recording = Recording(path, arm.joint_names, settings.topic, settings.chunk_size)
+    tally, points = read_fit_points(arm, recording, settings, progress)
+    min_speed = settings.min_speed if settings.min_speed is not None else SLOW_SPEEDS * arm.smoothing_velocity
+    if points is not None and len(points):
+        half_window = tally.design.half / tally.design.rate
+        fast = rows_used(points.qd, points.qdd, min_speed, half_window)
+        tally.selection = select(fast.any(axis=1))
+    if points is None or not len(points) or tally.selection is None:
+        raise RecordingError(tally.path, nothing_usable(tally, "to fit", min_speed))
+    span = tally.selection.train
+    points, fast = points.take(span), fast[span]
+    use = fast | ~fast.any(axis=0)  # a joint held still throughout: all its rows
+    equations = NormalEquations(arm.n, 10)
+    for start in range(0, len(points), FIT_BATCH):
+        batch = points.take(slice(start, start + FIT_BATCH))
+        Y, tau_arm = payload_regressor(arm, batch.q, batch.qd, batch.qdd)
+        equations.add(Y, batch.tau - tau_arm, use[start : start + FIT_BATCH])
+    _check_excitation(tally.path, equations)
+    estimate = weighted_least_squares(equations, _ALL_INDEPENDENT, tally.design.noise_correlation())
+    _check_excitation(tally.path, equations, estimate.information())
+    phi, misfit = _nearest_physical(estimate)
+    return PayloadFit(
+        payload_of(phi),
+        phi,
+        estimate,
+        excitation(estimate.information()),
+        _standard_deviations(phi, estimate.covariance),
+        tally,
+        equations.rows.copy(),
+        equations.rms(phi),
+        equations.peak.copy(),
+        misfit,
+    )
+
+
+def _check_excitation(path, equations: NormalEquations, information: np.ndarray | None = None) -> None:
+    """RecordingError naming the parameters the rows do not excite (rows weighted by their
+    joint's mean square torque until the fit's own weights are known)."""
+    if information is None:
+        mean_square = equations.c / np.maximum(equations.rows, 1)
+        weights = np.where(mean_square > 0.0, 1.0 / np.where(mean_square > 0.0, mean_square, 1.0), 0.0)
+        information = np.einsum("j,jpq->pq", weights, equations.A)
+    seen = excitation(information)
+    weak = np.flatnonzero(seen < MIN_EXCITATION)
+    if len(weak):
+        names = ", ".join(f"{LINK_PARAMETERS[k]} ({PARAMETER_MEANINGS[k]})" for k in weak)
+        raise RecordingError(
+            path,
+            f"the motion does not excite the payload's {names}: record `excitation --payload` (wrist motion)",
+        )
+
+
+def _nearest_physical(estimate: Estimate) -> tuple[np.ndarray, float]:
+    """The physical phi closest to phi_hat in the metric of its covariance, and the misfit."""
+    phi_hat = estimate.beta
+    root = np.linalg.cholesky(estimate.information())
+    mass = max(abs(phi_hat[0]), 1e-3)
+    length = max(float(np.linalg.norm(phi_hat[1:4])) / mass, 0.05)
+    spread = np.array([mass, *[mass * length] * 3, *[mass * length**2] * 6])
+    J = pseudo_inertia(phi_hat)
+    if np.linalg.eigvalsh(J)[0] > 0.0:
+        return phi_hat.copy(), 0.0
+    theta0 = log_cholesky_of(_positive(J, spread))
+
+    def residuals(theta):
+        return root.T @ (parameters_and_jacobian(theta)[0] - phi_hat)
+
+    def jacobian(theta):
+        return root.T @ parameters_and_jacobian(theta)[1]
+
+    result = least_squares(residuals, theta0, jac=jacobian, method="trf", x_scale="jac", max_nfev=500)
+    phi = parameters_and_jacobian(result.x)[0]
+    return phi, float(np.sum(residuals(result.x) ** 2))
+
+
+def _described(phi: np.ndarray) -> np.ndarray:
+    """[m, c_x, c_y, c_z, Ixx, Iyy, Izz, Ixy, Ixz, Iyz] (inertia about the CoM) of phi."""
+    m = phi[0]
+    c = phi[1:4] / m
+    xx, xy, yy, xz, yz, zz = phi[4:]
+    I = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]) - m * (c @ c * np.eye(3) - np.outer(c, c))
+    return np.array([m, *c, I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]])
+
+
+def _standard_deviations(phi: np.ndarray, covariance: np.ndarray) -> dict:
+    """Standard deviations of mass, CoM and inertia about the CoM, by the delta method."""
+    steps = 1e-6 * np.maximum(np.sqrt(np.diag(covariance)), 1e-9)
+    G = np.column_stack(
+        [(_described(phi + s * e) - _described(phi - s * e)) / (2.0 * s) for s, e in zip(steps, np.eye(10))]
+    )
+    std = np.sqrt(np.maximum(np.diag(G @ covariance @ G.T), 0.0))
+    return {"mass": float(std[0]), "com": std[1:4], "inertia": std[4:]}
