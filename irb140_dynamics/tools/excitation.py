@@ -3,6 +3,7 @@
     irb140-excitation --out FILE [--params-file F | --urdf FILE [--base L] [--tip L]]
                       [-p NAME:=VALUE] [--rate HZ] [--period S]
                       [--harmonics K] [--periods P] [--seed N] [--iterations N]
+                      [--payload [--pose Q1,...,Qn]]
     (or: ros2 run irb140_dynamics excitation ..., python -m irb140_dynamics.tools.excitation ...)
 
 Writes FILE, a trajectory_msgs/JointTrajectory in YAML (the form `ros2 topic pub` takes),
@@ -11,6 +12,11 @@ The trajectory stays within the model's position (less a margin), velocity and
 acceleration limits, starts and ends at rest at its first point, and repeats seamlessly.
 Every argument and FILE's folder are checked before the work; FILE is written whole or
 not at all. Exit status 0; 1 with one line; 2 for a bad argument; 130 after Ctrl-C.
+
+With --payload, a load identification motion for `identify --payload-only`: the last three
+joints move (each over more than 0.1 rad), the others hold --pose (default: the middle of
+their ranges), at most 30 s in all; the condition number is the payload's ten-column
+regressor's (see docs/load.md).
 """
 
 from __future__ import annotations
@@ -65,8 +71,31 @@ def parser() -> Parser:
     p.add_argument(
         "--iterations", type=number(0, 10_000, integer=True), default=40, help="optimiser iterations (default 40)"
     )
+    p.add_argument(
+        "--payload",
+        action="store_true",
+        help="a wrist motion that excites a payload's mass, CoM and inertia (identify --payload-only)",
+    )
+    p.add_argument(
+        "--pose",
+        type=_pose,
+        metavar="Q1,...,Qn",
+        help="with --payload: the pose [rad] the joints before the wrist hold (default: mid-range)",
+    )
     add_model_arguments(p, "the model and its limits (default: the package's IRB-140)")
     return p
+
+
+def _pose(text: str) -> list[float]:
+    import math
+
+    try:
+        values = [float(x) for x in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
+    if not all(math.isfinite(x) for x in values):
+        raise argparse.ArgumentTypeError(f"expected finite numbers, got {text!r}")
+    return values
 
 
 def main(argv=None) -> int:
@@ -78,6 +107,15 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
     points = args.rate * args.period * args.periods
     if points > MAX_POINTS:
         raise ToolError(f"--rate x --period x --periods gives {points:.3g} points, more than {MAX_POINTS:,}")
+    if args.pose is not None and not args.payload:
+        raise ToolError("--pose: only with --payload")
+    from irb140_dynamics.identification.payload_excitation import MAX_PAYLOAD_DURATION
+
+    if args.payload and args.period * args.periods > MAX_PAYLOAD_DURATION:
+        raise ToolError(
+            f"--period x --periods: a payload motion lasts at most {MAX_PAYLOAD_DURATION:g} s, "
+            f"got {args.period * args.periods:g} s"
+        )
     check_model_paths(args)
     out = output_file(args.out)
 
@@ -91,11 +129,15 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
 
     source = model_of(args)
     model, path = source.model, source.origin
-    base = find_base_parameters(model)
-    print(f"model: {path}; {base.count} base parameters; optimising ({args.iterations} iterations)...", flush=True)
-    result = optimise_excitation(
-        model, args.period, args.harmonics, args.seed, args.iterations, margin=args.margin, base=base
-    )
+    if args.payload:
+        result, regressor = _payload_excitation(model, path, args), "the payload's regressor"
+    else:
+        base = find_base_parameters(model)
+        print(f"model: {path}; {base.count} base parameters; optimising ({args.iterations} iterations)...", flush=True)
+        result = optimise_excitation(
+            model, args.period, args.harmonics, args.seed, args.iterations, margin=args.margin, base=base
+        )
+        regressor = "the base regressor"
     trajectory = result.trajectory
     problems = check_limits(model, trajectory, args.rate)
     if problems:  # cannot happen by construction; refuse rather than write a bad file
@@ -104,8 +146,9 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
     Q, QD, QDD = trajectory.evaluate(times)
     QD[np.abs(QD) < 1e-12], QDD[np.abs(QDD) < 1e-12] = 0.0, 0.0
     comments = [
-        f"Excitation trajectory for `identify` (irb140_dynamics), model {path}",
-        f"condition number of the base regressor: {result.condition_number:.2f} (random start: "
+        f"Excitation trajectory for `identify{' --payload-only' if args.payload else ''}` (irb140_dynamics), "
+        f"model {path}",
+        f"condition number of {regressor}: {result.condition_number:.2f} (random start: "
         f"{result.start_condition_number:.2f})",
         f"{args.periods} x {args.period:g} s period, {args.harmonics} harmonics, {args.rate:g} Hz, "
         f"{len(times)} points; starts and ends at rest at the first point",
@@ -129,6 +172,22 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
             "publish it with --yaml-file, or lower --rate"
         )
     return 0
+
+
+def _payload_excitation(model, path: str, args: argparse.Namespace):
+    from irb140_dynamics.identification.payload_excitation import optimise_payload_excitation, wrist
+
+    if args.pose is not None and len(args.pose) != model.n:
+        raise ToolError(f"--pose: expected {model.n} joint positions, got {len(args.pose)}")
+    moving = ", ".join(model.joint_names[j] for j in wrist(model))
+    print(f"model: {path}; payload motion of {moving}; optimising ({args.iterations} iterations)...", flush=True)
+    try:
+        return optimise_payload_excitation(
+            model, args.period, args.harmonics, args.seed, args.iterations, margin=args.margin, pose=args.pose
+        )
+    except ValueError as error:
+        message = str(error)
+        raise ToolError(f"--{message}" if message.startswith("pose:") else message) from None
 
 
 if __name__ == "__main__":

@@ -3,6 +3,7 @@
     irb140-identify BAG --out IDENTIFIED.yaml [--topic /joint_states]
         [--params-file PRIOR.yaml | --urdf PRIOR.urdf [--base LINK] [--tip LINK]] [-p NAME:=VALUE]
         [--urdf-out IDENTIFIED.urdf] [--plots DIR] [--validate BAG2] [--offsets]
+    irb140-identify --payload-only --params-file ARM.yaml BAG --out LOAD.yaml
     (or: ros2 run irb140_dynamics identify ..., python -m irb140_dynamics.tools.identify ...)
 
 BAG: a ROS 2 bag (directory, .mcap or .db3) with sensor_msgs/JointState including effort,
@@ -20,6 +21,11 @@ limits, the identified inertials and friction), and, with --plots, DIR/torques.p
 DIR/residuals.png: all of them or none (each written to a temporary file beside it,
 renamed at the end). Exit status 0; 1 with one line naming the file and the problem; 2
 for a bad argument; 130 after Ctrl-C, nothing written.
+
+With --payload-only, only the payload is fitted (mass, CoM in the flange frame, inertia
+about its CoM), the arm's own parameters taken from ARM.yaml (or --urdf) as they are; a
+recording of `excitation --payload` (see docs/load.md). LOAD.yaml is ARM.yaml's model with
+payload.* identified.
 """
 
 from __future__ import annotations
@@ -90,6 +96,11 @@ def parser() -> Parser:
         help="the identified arm as URDF (default with a URDF prior: IDENTIFIED.urdf beside --out)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument(
+        "--payload-only",
+        action="store_true",
+        help="fit only the payload (mass, CoM, inertia), the arm's parameters as the model gives them",
+    )
     add_model_arguments(
         p, "the prior model: kinematics, limits and starting inertials (default: the package's IRB-140)"
     )
@@ -103,6 +114,10 @@ def main(argv=None) -> int:
 
 def _identify(argv: list[str], interrupts) -> int:
     args = parser().parse_args(argv)
+    if args.payload_only:
+        from irb140_dynamics.tools.identify_payload import identify_payload
+
+        return identify_payload(args, argv, interrupts)
     if not args.held_out < 1.0:
         raise ToolError(f"--held-out: must be < 1, got {args.held_out:g}")
     recording = input_path(args.recording)
