@@ -24,7 +24,7 @@ as it is.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -59,19 +59,13 @@ from irb140_dynamics.identification.pipeline import (
 from irb140_dynamics.identification.recording import Recording, RecordingError
 from irb140_dynamics.identification.selection import rows_used, select
 
-MIN_EXCITATION = 0.01  # sine of the angle between a parameter's column and the others' span
-PARAMETER_MEANINGS = (
-    "mass",
-    "first moment m c_x",
-    "first moment m c_y",
-    "first moment m c_z",
-    "inertia Ixx about the flange origin",
-    "inertia Ixy about the flange origin",
-    "inertia Iyy about the flange origin",
-    "inertia Ixz about the flange origin",
-    "inertia Iyz about the flange origin",
-    "inertia Izz about the flange origin",
-)
+MIN_EXCITATION = 1e-6  # sine of the angle between a parameter's column and the others' span: rounding
+WEAK_EXCITATION = 1e-3  # named (with the least excited) when the regressor is singular
+MAX_RELATIVE_STD = 0.05  # of the payload's own scale (see _check_excitation)
+MIN_MASS = 0.1  # kg
+MIN_LENGTH = 0.1  # m
+UNIT_SCALE = np.array([1.0, 0.1, 0.1, 0.1, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01])  # 1 kg, 0.1 m out
+PARAMETER_LABELS = ("mass", "m*cx", "m*cy", "m*cz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")  # phi's, as printed
 _ALL_INDEPENDENT = BaseParameters(tuple(LINK_PARAMETERS), np.arange(10), np.arange(0), np.zeros((10, 0)), np.arange(0))
 
 
@@ -116,9 +110,10 @@ def payload_of(phi) -> RigidBody:
 
 def excitation(information: np.ndarray) -> np.ndarray:
     """Per parameter, the sine of the angle between its (weighted) regressor column and the
-    span of the others': 1 / sqrt(N_jj (N^-1)_jj) of the normal matrix N; 0 when unseen."""
+    span of the others': 1 / sqrt(N_jj (N^-1)_jj) of the normal matrix N; 0 when unseen
+    (its column's norm below MIN_EXCITATION of the largest: rounding)."""
     diagonal = np.diag(information).copy()
-    seen = diagonal > 0.0
+    seen = diagonal > MIN_EXCITATION**2 * max(float(diagonal.max()), 0.0)
     out = np.zeros(len(diagonal))
     if not seen.any():
         return out
@@ -170,9 +165,8 @@ def fit_payload(
         batch = points.take(slice(start, start + FIT_BATCH))
         Y, tau_arm = payload_regressor(arm, batch.q, batch.qd, batch.qdd)
         equations.add(Y, batch.tau - tau_arm, use[start : start + FIT_BATCH])
-    _check_excitation(tally.path, equations)
-    estimate = weighted_least_squares(equations, _ALL_INDEPENDENT, tally.design.noise_correlation())
-    _check_excitation(tally.path, equations, estimate.information())
+    estimate = _estimate(tally.path, equations, tally.design.noise_correlation())
+    _check_excitation(tally.path, estimate)
     phi, misfit = _nearest_physical(estimate)
     return PayloadFit(
         payload_of(phi),
@@ -188,20 +182,52 @@ def fit_payload(
     )
 
 
-def _check_excitation(path, equations: NormalEquations, information: np.ndarray | None = None) -> None:
-    """RecordingError naming the parameters the rows do not excite (rows weighted by their
-    joint's mean square torque until the fit's own weights are known)."""
-    if information is None:
-        mean_square = equations.c / np.maximum(equations.rows, 1)
-        weights = np.where(mean_square > 0.0, 1.0 / np.where(mean_square > 0.0, mean_square, 1.0), 0.0)
-        information = np.einsum("j,jpq->pq", weights, equations.A)
-    seen = excitation(information)
-    weak = np.flatnonzero(seen < MIN_EXCITATION)
+def _scaled(equations: NormalEquations) -> NormalEquations:
+    """The sums for phi / UNIT_SCALE: regressor columns of like size."""
+    scaled = NormalEquations(*equations.b.shape)
+    scaled.A = equations.A * np.outer(UNIT_SCALE, UNIT_SCALE)
+    scaled.b = equations.b * UNIT_SCALE
+    scaled.c, scaled.rows, scaled.peak = equations.c, equations.rows, equations.peak
+    return scaled
+
+
+def _estimate(path, equations: NormalEquations, correlation: float) -> Estimate:
+    """Weighted least squares of phi (solved for phi / UNIT_SCALE); RecordingError naming the
+    parameters least told apart from the others when the regressor is singular."""
+    scaled = _scaled(equations)
+    seen = excitation(scaled.A.sum(axis=0))
+    _refuse(path, np.flatnonzero(seen < MIN_EXCITATION), None)
+    try:
+        estimate = weighted_least_squares(scaled, _ALL_INDEPENDENT, correlation)
+    except ValueError:
+        weak = np.flatnonzero(seen <= max(WEAK_EXCITATION, float(seen.min())))
+        _refuse(path, weak, None)
+        raise
+    covariance = estimate.covariance * np.outer(UNIT_SCALE, UNIT_SCALE)
+    return replace(estimate, beta=estimate.beta * UNIT_SCALE, covariance=covariance)
+
+
+def _check_excitation(path, estimate: Estimate) -> None:
+    """RecordingError naming the parameters whose standard deviation exceeds MAX_RELATIVE_STD
+    of the payload's own scale: m_ref = max(m, MIN_MASS) for the mass, m_ref L for the first
+    moments and m_ref L^2 for the inertia, L = max(|c|, MIN_LENGTH)."""
+    phi = estimate.beta
+    mass = max(abs(phi[0]), MIN_MASS)
+    length = max(float(np.linalg.norm(phi[1:4])) / mass, MIN_LENGTH)
+    scale = mass * np.array([1.0, *[length] * 3, *[length**2] * 6])
+    std = estimate.std
+    weak = np.flatnonzero(~(std <= MAX_RELATIVE_STD * scale))
+    units = ["kg"] + ["kg m"] * 3 + ["kg m^2"] * 6
+    _refuse(path, weak, [f" (+- {std[k]:.2g} {units[k]})" for k in range(10)])
+
+
+def _refuse(path, weak, notes: list[str] | None) -> None:
     if len(weak):
-        names = ", ".join(f"{LINK_PARAMETERS[k]} ({PARAMETER_MEANINGS[k]})" for k in weak)
+        names = ", ".join(f"{PARAMETER_LABELS[k]}{notes[k] if notes else ''}" for k in weak)
         raise RecordingError(
             path,
-            f"the motion does not excite the payload's {names}: record `excitation --payload` (wrist motion)",
+            f"the motion does not excite the payload's {names} (flange frame, inertia about its origin): "
+            "record `excitation --payload` (wrist motion)",
         )
 
 
