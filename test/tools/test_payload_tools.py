@@ -1,0 +1,183 @@
+"""The load identification commands: `excitation --payload` -> a recording -> `identify
+--payload-only` -> a params file whose payload.inertia `retime` and the trajectory check use.
+
+The recording is the IRB-140 of config/true_arm.yaml (friction, rotor inertia) carrying a
+payload along the points the command wrote, its torques by our RNEA with 1 % noise of each
+joint's peak (the MuJoCo-simulated arms: test/identification/test_payload_identification.py).
+"""
+
+import numpy as np
+import pytest
+import yaml
+
+from irb140_dynamics.core import RigidBody, rnea_batch
+from irb140_dynamics.core.io.params_file import load_model, read_parameter_file
+from irb140_dynamics.core.trajectories import Trajectory, check_trajectory
+from irb140_dynamics.tools import excitation as excitation_tool
+from irb140_dynamics.tools import identify as identify_tool
+from irb140_dynamics.tools import retime as retime_tool
+
+from ..support.paths import ROOT
+from ..support.simulated_ur5 import write_csv
+
+pytestmark = pytest.mark.slow  # optimises an excitation and identifies a payload
+ARM = ROOT / "config" / "true_arm.yaml"
+PAYLOAD = RigidBody(3.0, (0.05, 0.03, 0.08), (0.02, 0.03, 0.015, 0.004, -0.002, 0.003))
+
+
+def points_of(path):
+    document = yaml.safe_load(path.read_text())
+    t = np.array([p["time_from_start"]["sec"] + 1e-9 * p["time_from_start"]["nanosec"] for p in document["points"]])
+    fields = ("positions", "velocities", "accelerations")
+    return document, t, *(np.array([p[f] for p in document["points"]]) for f in fields)
+
+
+@pytest.fixture(scope="module")
+def workflow(tmp_path_factory):
+    work = tmp_path_factory.mktemp("load")
+    motion = work / "payload_motion.yaml"
+    arguments = ["--payload", "--params-file", str(ARM), "--out", str(motion), "--iterations", "5"]
+    assert excitation_tool.main([*arguments, "--periods", "2", "--rate", "100"]) == 0
+    document, t, Q, QD, QDD = points_of(motion)
+    arm = load_model(ARM)
+    tau = rnea_batch(arm.with_payload(PAYLOAD), Q, QD, QDD)
+    measured = tau + np.random.default_rng(4).normal(size=tau.shape) * 0.01 * np.abs(tau).max(axis=0)
+    recording = write_csv(work / "recording.csv", arm.joint_names, t, Q, QD, measured)
+    load = work / "load.yaml"
+    return work, motion, (t, Q, QD, QDD), recording, load
+
+
+@pytest.fixture(scope="module")
+def identified(workflow):
+    work, _, _, recording, load = workflow
+    assert identify_tool.main(["--payload-only", "--params-file", str(ARM), str(recording), "--out", str(load)]) == 0
+    return load_model(load)
+
+
+def test_the_payload_motion_is_the_wrist_within_limits_and_30_s(workflow):
+    _, motion, (t, Q, QD, QDD), _, _ = workflow
+    text = motion.read_text()
+    assert "condition number of the payload's regressor" in text and "identify --payload-only" in text
+    assert t[-1] <= 30.0 and t[-1] == pytest.approx(20.0)
+    assert np.all(np.ptp(Q[:, 3:], axis=0) > 0.1) and np.all(np.ptp(Q[:, :3], axis=0) <= 0.02)
+    arm = load_model(ARM)
+    lower, upper = np.array([j.position_limits for j in arm.joints]).T
+    assert np.all((lower <= Q) & (upper >= Q))
+    assert np.all(np.abs(QD) <= [j.velocity_limit for j in arm.joints])
+    assert np.all(np.abs(QDD) <= [j.acceleration_limit for j in arm.joints])
+    assert np.all(QD[0] == 0) and np.all(QD[-1] == 0)
+
+
+def test_identify_payload_only_prints_values_with_deviations_and_writes_the_arm_with_them(workflow, identified, capsys):
+    _, _, _, _, load = workflow
+    payload = identified.payload
+    assert payload.mass == pytest.approx(PAYLOAD.mass, rel=0.02)
+    assert np.linalg.norm(np.subtract(payload.com, PAYLOAD.com)) < 0.005
+    assert payload.inertia == pytest.approx(PAYLOAD.inertia, abs=0.002)
+    arm = load_model(ARM)
+    assert identified.joints == arm.joints  # the arm's own parameters as they were
+    text = load.read_text()
+    for label in ("mass", "com.x", "com.y", "com.z", "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz"):
+        assert any(line.startswith(f"#   {label} ") and "+-" in line for line in text.splitlines()), label
+
+
+def test_retime_and_the_trajectory_check_use_the_identified_inertia(workflow, identified, capsys):
+    """`retime --check-only --params-file LOAD.yaml` prints the torques of the identified
+    payload, inertia included (not those of the same mass and CoM without it), and the
+    trajectory check node's settings take the file's payload whole."""
+    from irb140_dynamics.nodes.trajectory_check_node.node import check_settings
+
+    _, motion, _, _, load = workflow
+    trajectory = Trajectory.from_message(yaml.safe_load(motion.read_text()), identified.joint_names)
+    point_mass = identified.with_payload(RigidBody(identified.payload.mass, identified.payload.com))
+    torques = [p for p in check_trajectory(identified, trajectory).peaks if p.quantity == "torque"]
+    without = [p for p in check_trajectory(point_mass, trajectory).peaks if p.quantity == "torque"]
+    assert any(abs(a.value - b.value) > 1e-3 * abs(a.value) for a, b in zip(torques, without))
+    capsys.readouterr()
+    assert retime_tool.main(["--check-only", "--params-file", str(load), str(motion)]) in (0, 3)
+    printed = capsys.readouterr().out
+    assert all(peak.line() in printed for peak in torques), printed
+    assert not all(peak.line() in printed for peak in without)
+    values = {**read_parameter_file(load), "retime.grid": 1000, "diagnostics.warn_use": 80.0}
+    assert check_settings(values).model.payload == identified.payload  # the node reads payload.inertia
+
+
+def _without_efforts(path, work):
+    lines = path.read_text().splitlines()
+    header = lines[0].split(",")
+    keep = [k for k, name in enumerate(header) if not name.startswith("effort_")]
+    out = work / "no_effort.csv"
+    out.write_text("\n".join(",".join(line.split(",")[k] for k in keep) for line in lines) + "\n")
+    return out
+
+
+def _last_joint_only(path, work):
+    data = np.loadtxt(path, delimiter=",", skiprows=1)
+    t, Q, QD = data[:, 0], data[:, 1:7], data[:, 7:13]
+    Q[:, :5], QD[:, :5] = Q[0, :5], 0.0
+    QDD = np.gradient(QD, t, axis=0)
+    tau = rnea_batch(load_model(ARM).with_payload(PAYLOAD), Q, QD, QDD)
+    return write_csv(work / "last_joint.csv", load_model(ARM).joint_names, t, Q, QD, tau)
+
+
+def _not_a_recording(path, work):
+    out = work / "bad.csv"
+    out.write_text("hello\n1,2\n")
+    return out
+
+
+BAD = {
+    "missing recording": (lambda rec, work: work / "nowhere.csv", "nowhere.csv"),
+    "not a recording": (_not_a_recording, "bad.csv"),
+    "no efforts": (_without_efforts, "effort"),
+    "not exciting": (_last_joint_only, "does not excite the payload's Ixx, Ixy, Iyy"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_bad_recordings_are_refused_in_one_line_and_nothing_is_written(workflow, tmp_path, capsys, case):
+    _, _, _, recording, _ = workflow
+    make, problem = BAD[case]
+    bad = make(recording, tmp_path)
+    out = tmp_path / "load.yaml"
+    capsys.readouterr()
+    assert (
+        identify_tool.main(["--payload-only", "--quiet", "--params-file", str(ARM), str(bad), "--out", str(out)]) == 1
+    )
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("identify: error: ") and problem in err[0], err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "arguments, problem",
+    [
+        (["--params-file", "nowhere.yaml"], "nowhere.yaml"),
+        ([], "--payload-only: give the arm's model"),
+        (["--params-file", str(ARM), "--plots", "plots"], "--plots: not with --payload-only"),
+        (["--params-file", "BADFILE"], "BADFILE"),
+    ],
+)
+def test_bad_model_arguments_are_refused_in_one_line(workflow, tmp_path, capsys, arguments, problem):
+    _, _, _, recording, _ = workflow
+    bad_params = tmp_path / "bad.yaml"
+    bad_params.write_text("/**:\n  ros__parameters:\n    payload: {mass: -1.0}\n")
+    arguments = [str(bad_params) if a == "BADFILE" else a for a in arguments]
+    problem = "bad.yaml" if problem == "BADFILE" else problem
+    out = tmp_path / "load.yaml"
+    capsys.readouterr()
+    assert identify_tool.main(["--payload-only", "--quiet", *arguments, str(recording), "--out", str(out)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and problem in err[0], err
+    assert not out.exists()
+
+
+def test_excitation_payload_refuses_more_than_30_s_and_a_bad_pose(tmp_path, capsys):
+    out = tmp_path / "motion.yaml"
+    assert excitation_tool.main(["--payload", "--out", str(out), "--period", "20", "--periods", "2"]) == 1
+    assert "at most 30 s, got 40 s" in capsys.readouterr().err
+    assert excitation_tool.main(["--payload", "--out", str(out), "--pose", "0,3,0,0,0,0", "--iterations", "0"]) == 1
+    assert "--pose: joint_2 at 3 rad is outside" in capsys.readouterr().err
+    assert excitation_tool.main(["--out", str(out), "--pose", "0,0,0,0,0,0"]) == 1
+    assert "--pose: only with --payload" in capsys.readouterr().err
+    assert not out.exists()
