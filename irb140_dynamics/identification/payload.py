@@ -13,13 +13,14 @@ from the flange frame to the last joint's frame (``flange_map``). Every fit poin
 are summed into normal equations (``least_squares``): a moving joint's row where it is fast
 enough for the Coulomb model (as ``identify`` uses rows), and every row of a joint held
 still throughout (it carries the payload's static load). Weighted least squares gives
-phi_hat and its covariance; a parameter the motion does not tell from the others (the sine
-of the angle between its column and the others' span below ``MIN_EXCITATION``, rows
-weighted as in the fit) refuses the recording, naming it. The payload is then the physical
-body closest to phi_hat in its covariance's metric: phi = phi(theta) through the
-log-Cholesky pseudo-inertia of ``consistent`` (mass > 0, inertia about the CoM positive
-definite, triangle inequality hold for any theta), so a phi_hat that is physical is kept
-as it is.
+phi_hat and its covariance. The recording is refused, naming the parameters, when it does
+not excite one: its column (in units of a 1 kg body 0.1 m out) vanishes to rounding or
+lies in the others' span (``excitation``), or its standard deviation exceeds
+MAX_RELATIVE_STD of the payload's own scale (m, m L, m L^2; see ``_check_excitation``).
+The payload is then the physical body closest to phi_hat in its covariance's metric:
+phi = phi(theta) through the log-Cholesky pseudo-inertia of ``consistent`` (mass > 0,
+inertia about the CoM positive definite, triangle inequality hold for any theta), so a
+phi_hat that is physical is kept as it is.
 """
 
 from __future__ import annotations

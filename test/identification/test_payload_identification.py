@@ -148,3 +148,25 @@ def test_an_unphysical_estimate_becomes_the_nearest_physical_payload():
     moments = np.linalg.eigvalsh(inertia_matrix(body.inertia))
     assert body.mass > 0 and moments.min() > 0 and moments[0] + moments[1] >= moments[2]
     assert nearest[0] == pytest.approx(unphysical[0], rel=0.05)  # moved mostly where it was cheap
+
+
+def test_a_wrist_motion_too_small_for_the_noise_is_refused_with_the_deviations(tmp_path):
+    """The same motion at a tenth of its size: its accelerations leave the inertia about the
+    flange's x and y axes to the noise (standard deviations above 5 % of m |c|^2)."""
+    from dataclasses import replace
+
+    arm = load_model(ROOT / "config" / "true_arm.yaml")
+    payload = tool(3.0, (0.05, 0.03, 0.08), (0.012, 0.02, 0.03), (0.4, -0.3, 0.7))
+    trajectory = optimise_payload_excitation(arm, iterations=0).trajectory
+    t = np.arange(0.0, trajectory.period, 0.004)
+
+    def recording(size):
+        motion = replace(trajectory, a=trajectory.a * size, b=trajectory.b * size)
+        Q, QD, QDD = motion.evaluate(t)
+        tau = rnea_batch(arm.with_payload(payload), Q, QD, QDD)
+        tau += np.random.default_rng(0).normal(size=tau.shape) * NOISE * np.abs(tau).max(axis=0)
+        return write_csv(tmp_path / f"size_{size}.csv", arm.joint_names, t, Q, QD, tau)
+
+    assert fit_payload(arm, recording(1.0)).payload.mass == pytest.approx(payload.mass, rel=0.02)
+    with pytest.raises(RecordingError, match=r"does not excite the payload's Ixx \(\+- [0-9.e-]+ kg m\^2\)"):
+        fit_payload(arm, recording(0.1))
