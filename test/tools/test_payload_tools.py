@@ -102,6 +102,39 @@ def test_retime_and_the_trajectory_check_use_the_identified_inertia(workflow, id
     assert check_settings(values).model.payload == identified.payload  # the node reads payload.inertia
 
 
+def test_a_bag_gives_the_same_payload_and_a_previous_payload_in_the_arm_file_is_replaced(
+    workflow, identified, tmp_path
+):
+    """REC as an .mcap bag (positions only: velocities differentiated) and ARM.yaml carrying
+    another payload (-p): the same payload within its tolerances."""
+    from rosbags.typesys import Stores, get_typestore
+
+    from ..support.synthetic_arm import Samples, joint_state_messages, write_bag
+
+    _, _, _, recording, _ = workflow
+    data = np.loadtxt(recording, delimiter=",", skiprows=1)
+    t, Q, QD, TAU = data[:, 0], data[:, 1:7], data[:, 7:13], data[:, 13:19]
+    names = load_model(ARM).joint_names
+    typestore = get_typestore(Stores.ROS2_JAZZY)
+    messages = joint_state_messages(Samples(t, Q, QD, TAU, TAU), names, with_velocity=False, typestore=typestore)
+    bag = write_bag(tmp_path / "bag", messages)
+    out = tmp_path / "load.yaml"
+    arguments = ["--payload-only", "--quiet", "--params-file", str(ARM), "-p", "payload.mass:=7.0"]
+    assert identify_tool.main([*arguments, str(bag), "--out", str(out)]) == 0
+    payload = load_model(out).payload
+    assert payload.mass == pytest.approx(PAYLOAD.mass, rel=0.02)
+    assert np.linalg.norm(np.subtract(payload.com, PAYLOAD.com)) < 0.005
+    assert payload.inertia == pytest.approx(identified.payload.inertia, abs=0.002)
+
+
+def _at_rest(path, work):
+    data = np.loadtxt(path, delimiter=",", skiprows=1)
+    data[:, 1:13] = np.r_[data[0, 1:7], np.zeros(6)]
+    out = work / "rest.csv"
+    np.savetxt(out, data, delimiter=",", header=path.read_text().splitlines()[0], comments="")
+    return out
+
+
 def _without_efforts(path, work):
     lines = path.read_text().splitlines()
     header = lines[0].split(",")
@@ -131,6 +164,7 @@ BAD = {
     "not a recording": (_not_a_recording, "bad.csv"),
     "no efforts": (_without_efforts, "effort"),
     "not exciting": (_last_joint_only, "does not excite the payload's Ixx, Ixy, Iyy"),
+    "at rest": (_at_rest, "nothing moves"),
 }
 
 
