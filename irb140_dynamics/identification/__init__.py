@@ -11,7 +11,9 @@ May import: ``core``. Never ``ros``, ``nodes``, ``tools``.
     consistent  the physically consistent full set closest to the data (log-Cholesky);
                 whether a physical arm is within the estimate's uncertainty
     pipeline    all of it over a recording; report, plots, files: its outputs
+    payload     load identification: a payload's ten parameters, the arm known
+                (payload_excitation: the wrist motion for it; payload_report: its outputs)
 
 The command-line tools (``irb140_dynamics.tools``) are thin wrappers; see
-docs/identification.md for the workflow.
+docs/identification.md and docs/load.md for the workflows.
 """
