@@ -15,6 +15,11 @@ not at all. Exit status 0; 1 with one line; 2 for a bad argument; 130 after Ctrl
 
 from __future__ import annotations
 
+if __name__ == "__main__":  # python -m: the entry first, before the heavy imports
+    from irb140_dynamics.entry import TOOL, start
+
+    start("excitation", TOOL)
+
 import argparse
 import sys
 
@@ -132,4 +137,6 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from irb140_dynamics.entry import finish
+
+    finish(main)

@@ -24,6 +24,11 @@ for a bad argument; 130 after Ctrl-C, nothing written.
 
 from __future__ import annotations
 
+if __name__ == "__main__":  # python -m: the entry first, before the heavy imports
+    from irb140_dynamics.entry import TOOL, start
+
+    start("identify", TOOL)
+
 import argparse
 import sys
 from pathlib import Path
@@ -159,4 +164,6 @@ def _identify(argv: list[str], interrupts) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from irb140_dynamics.entry import finish
+
+    finish(main)

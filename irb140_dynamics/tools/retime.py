@@ -20,6 +20,11 @@ written both or neither).
 
 from __future__ import annotations
 
+if __name__ == "__main__":  # python -m: the entry first, before the heavy imports
+    from irb140_dynamics.entry import TOOL, start
+
+    start("retime", TOOL)
+
 import argparse
 import math
 import sys
@@ -159,4 +164,6 @@ def _plot(model, limits, before, after) -> bytes:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from irb140_dynamics.entry import finish
+
+    finish(main)
