@@ -1,14 +1,13 @@
 """What every command-line tool does alike: bad input in one line, arguments and output
 paths checked before any work, Ctrl-C at any moment one line and exit 130.
 
-Light on purpose (no NumPy, no rclpy): a tool imports this first and installs its signal
-handlers before the heavy imports, so that a Ctrl-C during them is handled too.
+A Ctrl-C while the tool starts (its imports) is noted by the entry (irb140_dynamics.entry)
+and acted on here, when ``run`` begins.
 """
 
 from __future__ import annotations
 
 import argparse
-import contextlib
 import math
 import os
 import signal
@@ -17,8 +16,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 from irb140_dynamics.core.errors import LINE_LIMIT, one_line  # noqa: F401 (the tools import them from here)
+from irb140_dynamics.entry import take_noted_signals
 
-INTERRUPTED = 130  # exit status after Ctrl-C (128 + SIGINT), 143 after SIGTERM
 open_line = [False]  # a progress bar's line on stderr is unfinished: end it before an error
 
 
@@ -186,12 +185,10 @@ class Interrupts:
             self._previous[s] = signal.signal(s, self._on_signal)
 
     def restore(self) -> None:
-        """The handlers from before; when the tool is the program, SIG_IGN instead: Python
-        resets its handlers to the default as it exits, and a late Ctrl-C would kill it."""
-        from irb140_dynamics.tools import AS_PROGRAM
-
+        """The handlers from before (the entry's, when the tool is the program: it ignores
+        the signals once main() has returned)."""
         for s, handler in self._previous.items():
-            signal.signal(s, signal.SIG_IGN if AS_PROGRAM else handler)
+            signal.signal(s, handler)
         self._previous = {}
 
     @property
@@ -210,13 +207,12 @@ def run(tool: str, body: Callable[[Interrupts], int]) -> int:
     'tool: error: ...' and status 1; Ctrl-C (or SIGTERM) one line 'tool: interrupted' and
     130 (143); a closed standard output (``tool | head``) nothing, and 141 as for SIGPIPE;
     the body's ``Outputs`` leave nothing behind in each case."""
-    from irb140_dynamics.tools import EARLY_SIGNALS
-
     interrupts = Interrupts()
     interrupts.install()
     try:
-        if EARLY_SIGNALS:  # Ctrl-C while the tool was starting: nothing done yet
-            interrupts.received = EARLY_SIGNALS[0]
+        early = take_noted_signals()
+        if early:  # Ctrl-C while the tool was starting: nothing done yet
+            interrupts.received = early[0]
             raise KeyboardInterrupt
         return body(interrupts)
     except SystemExit as stop:  # argparse: --help (0), a bad argument (2, its line printed)
@@ -236,7 +232,6 @@ def _failed(tool: str, error: BaseException, interrupts: Interrupts) -> int:
         # Ctrl-C, or what it became on its way up (NumPy's "initialization failed" ImportError)
         interrupts.received = interrupts.received or signal.SIGINT
         _say(f"{tool}: interrupted")
-        _exit_now_if_the_program(interrupts.status)
         return interrupts.status
     if isinstance(error, BrokenPipeError):  # `tool | head`: the reader has gone, as with SIGPIPE
         _quiet_stdout()
@@ -262,20 +257,6 @@ def _quiet_stdout() -> None:
         os.dup2(devnull, sys.stdout.fileno())
     except (OSError, ValueError, AttributeError):  # no real stdout (a test's capture)
         pass
-
-
-def _exit_now_if_the_program(status: int) -> None:
-    """Exit with ``status`` at once when the tool is the program. A KeyboardInterrupt that
-    passed through code run by PyRun_* (an extension module's start-up) leaves a flag by
-    which the interpreter, at its end, kills itself with SIGINT (status -2) however the
-    exception was handled; nothing is left to clean up here (the outputs are discarded)."""
-    from irb140_dynamics.tools import AS_PROGRAM
-
-    if AS_PROGRAM:
-        for stream in (sys.stdout, sys.stderr):
-            with contextlib.suppress(OSError, ValueError):
-                stream.flush()
-        os._exit(status)
 
 
 def _describe(error: BaseException) -> str:

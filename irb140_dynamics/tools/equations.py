@@ -11,6 +11,11 @@ in it are replaced, nothing else is touched; on any error nothing is written the
 
 from __future__ import annotations
 
+if __name__ == "__main__":  # python -m: the entry first, before the heavy imports
+    from irb140_dynamics.entry import TOOL, start
+
+    start("equations", TOOL)
+
 import argparse
 import os
 import re
@@ -186,4 +191,6 @@ class _Progress:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from irb140_dynamics.entry import finish
+
+    finish(main)

@@ -21,6 +21,11 @@ regressor's (see docs/load.md).
 
 from __future__ import annotations
 
+if __name__ == "__main__":  # python -m: the entry first, before the heavy imports
+    from irb140_dynamics.entry import TOOL, start
+
+    start("excitation", TOOL)
+
 import argparse
 import sys
 
@@ -191,4 +196,6 @@ def _payload_excitation(model, path: str, args: argparse.Namespace):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from irb140_dynamics.entry import finish
+
+    finish(main)

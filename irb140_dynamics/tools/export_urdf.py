@@ -23,6 +23,11 @@ argument; 130 after Ctrl-C, nothing written.
 
 from __future__ import annotations
 
+if __name__ == "__main__":  # python -m: the entry first, before the heavy imports
+    from irb140_dynamics.entry import TOOL, start
+
+    start("export_urdf", TOOL)
+
 import math
 import sys
 
@@ -149,4 +154,6 @@ def _export(args: list[str], interrupts) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from irb140_dynamics.entry import finish
+
+    finish(main)

@@ -30,6 +30,11 @@ payload.* identified.
 
 from __future__ import annotations
 
+if __name__ == "__main__":  # python -m: the entry first, before the heavy imports
+    from irb140_dynamics.entry import TOOL, start
+
+    start("identify", TOOL)
+
 import argparse
 import sys
 from pathlib import Path
@@ -174,4 +179,6 @@ def _identify(argv: list[str], interrupts) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from irb140_dynamics.entry import finish
+
+    finish(main)

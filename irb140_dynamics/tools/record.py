@@ -20,11 +20,17 @@ exists or cannot be made, a bad topic name); 2 for a bad argument.
 
 from __future__ import annotations
 
+if __name__ == "__main__":  # python -m: the entry first, before the heavy imports
+    from irb140_dynamics.entry import RECORDER, start
+
+    start("record", RECORDER)
+
 import argparse
 import signal
 import sys
 import time
 
+from irb140_dynamics.entry import take_noted_signals
 from irb140_dynamics.tools.cli import Parser, ToolError, number, one_line, output_directory
 
 DEFAULT_TOPIC = "/joint_states"  # as identification.recording's
@@ -63,18 +69,15 @@ class Stop:
     SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
     def __init__(self):
-        from irb140_dynamics.tools import EARLY_SIGNALS
-
-        self.signals: list[int] = EARLY_SIGNALS  # those that came while the tool was starting
+        self.signals: list[int] = []
         self.previous = {s: signal.signal(s, self._on_signal) for s in self.SIGNALS}
+        self.signals[:0] = take_noted_signals()  # those that came while the tool was starting
 
     def restore(self) -> None:
-        """The handlers from before (main() called in a process that goes on); SIG_IGN when
-        the tool is the program (Python restores the default ones as it exits)."""
-        from irb140_dynamics.tools import AS_PROGRAM
-
+        """The handlers from before (the entry's, when the tool is the program: it ignores
+        the signals once main() has returned)."""
         for s, handler in self.previous.items():
-            signal.signal(s, signal.SIG_IGN if AS_PROGRAM else handler)
+            signal.signal(s, handler)
 
     def _on_signal(self, signum, _frame) -> None:
         self.signals.append(signum)
@@ -157,4 +160,6 @@ def _say(text: str) -> None:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from irb140_dynamics.entry import finish
+
+    finish(main)

@@ -20,6 +20,11 @@ written both or neither).
 
 from __future__ import annotations
 
+if __name__ == "__main__":  # python -m: the entry first, before the heavy imports
+    from irb140_dynamics.entry import TOOL, start
+
+    start("retime", TOOL)
+
 import argparse
 import math
 import sys
@@ -113,43 +118,42 @@ def report_text(title: str, report) -> str:
 
 
 def main(argv=None) -> int:
-    args = parser().parse_args(sys.argv[1:] if argv is None else argv)
+    return run(NAME, lambda interrupts: _retime(parser().parse_args(sys.argv[1:] if argv is None else argv)))
 
-    def body() -> int:
-        if not args.check_only and not args.output:
-            raise ToolError("OUT.yaml: missing (or give --check-only)")
-        model = model_of(args.params_file, args.urdf, args.payload_mass, (args.base_link, args.tip_link))
-        tr = read_trajectory(args.input, model)
-        limits = trajectory_limits(model)
-        notes = list(torque_limit_notes(model, limits))
-        before = check_trajectory(model, tr, limits)
-        if args.check_only:
-            files = {args.plot: _plot(model, limits, tr, None)} if args.plot else {}
-            write_all(files)
-            print("\n".join([*notes, report_text("input", before)]))
-            return 0 if before.ok else OVER_LIMIT
-        try:
-            result = retime(model, tr, limits, grid=args.grid, accelerations=args.accelerations)
-        except TrajectoryError as error:
-            raise ToolError(f"{args.input}: {error}") from None
-        after = check_trajectory(model, result.trajectory, limits)
-        files = {args.output: joint_trajectory_yaml(result.trajectory.to_message()).encode()}
-        if args.plot:
-            files[args.plot] = _plot(model, limits, tr, result.trajectory)
+
+def _retime(args: argparse.Namespace) -> int:
+    if not args.check_only and not args.output:
+        raise ToolError("OUT.yaml: missing (or give --check-only)")
+    model = model_of(args.params_file, args.urdf, args.payload_mass, (args.base_link, args.tip_link))
+    tr = read_trajectory(args.input, model)
+    limits = trajectory_limits(model)
+    notes = list(torque_limit_notes(model, limits))
+    before = check_trajectory(model, tr, limits)
+    if args.check_only:
+        files = {args.plot: _plot(model, limits, tr, None)} if args.plot else {}
         write_all(files)
-        print(
-            "\n".join(
-                [
-                    *notes,
-                    report_text("input", before),
-                    report_text("re-timed", after),
-                    f"{len(result.trajectory.t)} points, {result.rounds} round(s); wrote {', '.join(files)}",
-                ]
-            )
+        print("\n".join([*notes, report_text("input", before)]))
+        return 0 if before.ok else OVER_LIMIT
+    try:
+        result = retime(model, tr, limits, grid=args.grid, accelerations=args.accelerations)
+    except TrajectoryError as error:
+        raise ToolError(f"{args.input}: {error}") from None
+    after = check_trajectory(model, result.trajectory, limits)
+    files = {args.output: joint_trajectory_yaml(result.trajectory.to_message()).encode()}
+    if args.plot:
+        files[args.plot] = _plot(model, limits, tr, result.trajectory)
+    write_all(files)
+    print(
+        "\n".join(
+            [
+                *notes,
+                report_text("input", before),
+                report_text("re-timed", after),
+                f"{len(result.trajectory.t)} points, {result.rounds} round(s); wrote {', '.join(files)}",
+            ]
         )
-        return 0
-
-    return run(NAME, lambda interrupts: body())
+    )
+    return 0
 
 
 def _plot(model, limits, before, after) -> bytes:
@@ -159,4 +163,6 @@ def _plot(model, limits, before, after) -> bytes:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from irb140_dynamics.entry import finish
+
+    finish(main)

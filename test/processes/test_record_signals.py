@@ -17,18 +17,11 @@ from sensor_msgs.msg import JointState
 from irb140_dynamics.identification.recording import Recording
 
 from ..support.common import sweep
-from ..support.node_process import TIMEOUT, start, wait_for_line
+from ..support.node_process import TIMEOUT, handles_sigterm, start, wait_for_line
 
 NAMES = [f"joint_{i}" for i in range(1, 7)]
 PERIOD = 1 / 200.0  # s between messages
 SETTLED = 0.5  # s: a message published this long before the first signal has surely arrived
-
-
-def handles_sigterm(pid: int) -> bool:
-    """Has the process a handler of SIGTERM (the tool's, installed as it starts)?"""
-    with open(f"/proc/{pid}/status") as status:
-        caught = next(line for line in status if line.startswith("SigCgt:"))
-    return bool(int(caught.split()[1], 16) >> (signal.SIGTERM - 1) & 1)
 
 
 def cases(seed: int = 23, count: int = sweep(4, 32)):

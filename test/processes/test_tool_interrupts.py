@@ -18,15 +18,9 @@ from irb140_dynamics.core import irb140, rnea_batch
 from irb140_dynamics.identification.excitation import optimise_excitation
 
 from ..support.common import sweep
-from ..support.node_process import TIMEOUT
+from ..support.node_process import TIMEOUT, handles_sigterm
 from ..support.paths import ROOT
 from ..support.synthetic_arm import Samples, true_arm, write_csv
-
-
-def handles_sigterm(pid: int) -> bool:
-    with open(f"/proc/{pid}/status") as status:
-        caught = next(line for line in status if line.startswith("SigCgt:"))
-    return bool(int(caught.split()[1], 16) >> (signal.SIGTERM - 1) & 1)
 
 
 @pytest.fixture(scope="module")

@@ -89,3 +89,11 @@ def one_fatal_line(code: int, output: str) -> str:
     fatal = [line for line in output.splitlines() if "[FATAL]" in line]
     assert len(fatal) == 1, output
     return fatal[0]
+
+
+def handles_sigterm(pid: int) -> bool:
+    """Has the process a handler of SIGTERM (an executable's, from irb140_dynamics.entry.start
+    on: the moment its own code runs)?"""
+    with open(f"/proc/{pid}/status") as status:
+        caught = next(line for line in status if line.startswith("SigCgt:"))
+    return bool(int(caught.split()[1], 16) >> (signal.SIGTERM - 1) & 1)

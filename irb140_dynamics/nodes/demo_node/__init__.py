@@ -1,10 +1,12 @@
 """demo_node: a first look at the closed loop (a reference motion, the tracking error)."""
 
-from irb140_dynamics.nodes import quiet_ctrl_c
+from irb140_dynamics.entry import NODE, finish, start
 
 
 def main() -> None:
-    """The console script ``demo_node`` (``ros2 run irb140_dynamics demo_node``)."""
-    with quiet_ctrl_c():
-        from irb140_dynamics.nodes.demo_node.node import main as node_main
-    node_main()
+    """``demo_node`` as ``ros2 run`` and ``python -m irb140_dynamics.nodes.demo_node`` start it:
+    the node's main() through the entry (irb140_dynamics.entry)."""
+    start("demo_node", NODE)
+    from irb140_dynamics.nodes.demo_node.node import main as node_main
+
+    finish(node_main)

@@ -5,11 +5,13 @@ the report as a DiagnosticStatus.
 May import: ``core``, ``ros``; never another node.
 """
 
-from irb140_dynamics.nodes import quiet_ctrl_c
+from irb140_dynamics.entry import NODE, finish, start
 
 
 def main() -> None:
-    """The console script ``trajectory_check_node`` (``ros2 run irb140_dynamics trajectory_check_node``)."""
-    with quiet_ctrl_c():
-        from irb140_dynamics.nodes.trajectory_check_node.node import main as node_main
-    node_main()
+    """``trajectory_check_node`` as ``ros2 run`` and ``python -m irb140_dynamics.nodes.trajectory_check_node`` start it:
+    the node's main() through the entry (irb140_dynamics.entry)."""
+    start("trajectory_check_node", NODE)
+    from irb140_dynamics.nodes.trajectory_check_node.node import main as node_main
+
+    finish(node_main)

@@ -1,5 +1,6 @@
-"""python -m irb140_dynamics.nodes.trajectory_check_node"""
+"""``python -m irb140_dynamics.nodes.trajectory_check_node``: the node, as its console script starts it."""
 
-from irb140_dynamics.nodes.trajectory_check_node import main
+if __name__ == "__main__":
+    from irb140_dynamics.nodes.trajectory_check_node import main
 
-main()
+    main()

@@ -1,0 +1,86 @@
+"""Every executable is reachable in one line and starts through the entry
+(irb140_dynamics.entry): the console scripts of setup.py (a tool's plain name for ``ros2
+run`` and its ``irb140-<name>`` for a PyPI install; a node's name), ``python -m`` of each
+tool and node; and every tool answers --help / -h with its usage (exit 0), called here
+in-process as its console script calls it. test/processes/test_tool_command_lines.py
+starts two of them as processes."""
+
+import ast
+import importlib
+import re
+
+import pytest
+
+from irb140_dynamics.tools import programs
+
+from ..support.paths import ROOT
+
+TOOLS = {
+    "identify": "identify",
+    "record": "record",
+    "excitation": "excitation",
+    "export_urdf": "export-urdf",
+    "equations": "equations",
+    "retime": "retime",
+}
+NODES = ("id_node", "payload_check_node", "sim_node", "demo_node", "trajectory_check_node")
+FULL_ARGV = {"record", "export_urdf"}  # their main() takes argv with the program first (ROS arguments)
+
+
+def entry_points() -> dict[str, str]:
+    text = (ROOT / "setup.py").read_text()
+    return dict(re.findall(r'"([\w-]+) = ([\w.]+:\w+)"', text))
+
+
+def test_every_tool_has_both_console_scripts_through_the_entry():
+    scripts = entry_points()
+    for module, name in TOOLS.items():
+        target = f"irb140_dynamics.tools.programs:{module}"
+        assert scripts.get(module) == target and scripts.get(f"irb140-{name}") == target, scripts
+        assert callable(getattr(programs, module))
+    for node in NODES:
+        assert scripts.get(node) == f"irb140_dynamics.nodes.{node}:main", scripts
+    targets = {target for target in scripts.values()}
+    assert len(scripts) == 2 * len(TOOLS) + len(NODES) and len(targets) == len(TOOLS) + len(NODES), scripts
+
+
+def main_guards(path) -> list[str]:
+    """The source of each ``if __name__ == "__main__":`` block of a module, in order."""
+    source = path.read_text()
+    tree = ast.parse(source)
+    return [
+        ast.get_source_segment(source, node)
+        for node in tree.body
+        if isinstance(node, ast.If) and ast.unparse(node.test) == "__name__ == '__main__'"
+    ]
+
+
+@pytest.mark.parametrize("module", sorted(TOOLS))
+def test_python_m_of_a_tool_starts_the_entry_before_its_imports(module):
+    """First statement after the docstring: the entry started; last: finish(main)."""
+    path = ROOT / "irb140_dynamics" / "tools" / f"{module}.py"
+    tree = ast.parse(path.read_text())
+    body = [n for n in tree.body if not (isinstance(n, ast.Expr) and isinstance(n.value, ast.Constant))]
+    body = [n for n in body if not (isinstance(n, ast.ImportFrom) and n.module == "__future__")]
+    first, last = main_guards(path)[0], main_guards(path)[-1]
+    kind = "RECORDER" if module == "record" else "TOOL"
+    assert isinstance(body[0], ast.If) and f'start("{module}", {kind})' in first, first
+    assert body[-1] is tree.body[-1] and "finish(main)" in last, last
+
+
+@pytest.mark.parametrize("node", NODES)
+def test_python_m_of_a_node_is_its_console_script(node):
+    (guard,) = main_guards(ROOT / "irb140_dynamics" / "nodes" / node / "__main__.py")
+    assert f"from irb140_dynamics.nodes.{node} import main" in guard and guard.rstrip().endswith("main()"), guard
+    init = (ROOT / "irb140_dynamics" / "nodes" / node / "__init__.py").read_text()
+    assert f'start("{node}", NODE)' in init and "finish(node_main)" in init, init
+
+
+@pytest.mark.parametrize("module", sorted(TOOLS))
+@pytest.mark.parametrize("flag", ["--help", "-h"])
+def test_help_prints_usage_and_exits_0(capsys, module, flag):
+    main = importlib.import_module(f"irb140_dynamics.tools.{module}").main
+    argv = [module, flag] if module in FULL_ARGV else [flag]
+    assert main(argv) == 0
+    out, err = capsys.readouterr()
+    assert out.startswith(f"usage: {module}") and err == "", (out, err)
