@@ -7,7 +7,8 @@ Publishes    ~/markers   visualization_msgs/MarkerArray, at most ``markers.rate`
 
 Each marker keeps its namespace and id (RViz updates it in place):
 
-- ``joint_load`` j: a sphere at joint j's origin coloured by |tau_j| / limit_j (the measured
+- ``joint_load`` j: a sphere at joint j's origin (nested in those of earlier joints at the same
+  place, e.g. a wrist's, its label stacked above theirs) coloured by |tau_j| / limit_j (the measured
   effort when the joint state has efforts, else the feed-forward torque; the limit the
   payload check uses), green 0, yellow 0.7, red 1 and above, grey without a limit;
   ``joint_label`` j: its text, e.g. ``joint_3 81 % (85.2 N m)`` (core.monitoring.display);
@@ -40,7 +41,9 @@ from irb140_dynamics.ros.runtime.guard import guarded
 MAX_RATE = 100.0  # Hz
 LIFETIME_PERIODS = 3.0  # a marker lives this many periods (at least MIN_LIFETIME): a stopped stream's go
 MIN_LIFETIME = 0.5  # s
-JOINT_DIAMETER = 0.06  # m
+JOINT_DIAMETER = 0.06  # m; a joint at the same place as earlier ones (SAME_PLACE) nests inside them, 0.7x each
+JOINT_ALPHA = 0.6
+SAME_PLACE = 0.01  # m
 TEXT_HEIGHT = 0.04  # m
 LABEL_RISE = 0.06  # m: a label above its sphere
 WHITE, COLLISION_RED, FORCE, PAYLOAD = (1.0, 1.0, 1.0), (1.0, 0.0, 0.0), (1.0, 0.0, 1.0), (0.2, 0.4, 1.0)
@@ -73,9 +76,12 @@ def build_markers(model, limits, frame_id: str, stamp, q, tau, external=None, co
     origins = joint_origins(model, q)
     loads = display.joint_loads(tau, limits)
     for j, (name, origin, torque, load) in enumerate(zip(model.joint_names, origins, tau, loads)):
-        markers.markers.append(new("joint_load", j, Marker.SPHERE, origin, JOINT_DIAMETER, display.load_colour(load)))
+        below = sum(float(np.linalg.norm(origins[i] - origin)) < SAME_PLACE for i in range(j))  # joints here before j
+        size = JOINT_DIAMETER * 0.7**below  # nested, each seen through the one around it
+        colour = display.load_colour(load)
+        markers.markers.append(new("joint_load", j, Marker.SPHERE, origin, size, colour, alpha=JOINT_ALPHA))
         label = display.load_label(name, float(torque), load)
-        above = origin + (0.0, 0.0, LABEL_RISE)
+        above = origin + (0.0, 0.0, LABEL_RISE * (1 + below))  # stacked where joints share a place
         markers.markers.append(new("joint_label", j, Marker.TEXT_VIEW_FACING, above, TEXT_HEIGHT, WHITE, label))
     pose = flange_pose(model, q)
     payload = model.payload
