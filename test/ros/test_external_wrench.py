@@ -132,3 +132,15 @@ def test_at_a_singular_pose_the_wrench_is_finite_and_flagged():
         assert harness.spin_until(warned, timeout=30.0), [s.message for s in wrench_statuses(harness)]
         status = warned()[0]
     assert status.message.startswith("near a singularity") and f"< {SINGULAR_THRESHOLD:g}" in status.message
+
+
+def test_the_frame_can_be_changed_while_running_and_a_bad_one_is_refused():
+    with running(IdNode, parameter_overrides=overrides("irb140", "tip")) as harness:
+        started(harness)
+        q, F_true = regular_pose(harness.node.settings.model, seed=5), np.array([10.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+        refused = harness.set_parameters([Parameter("external_wrench.frame", value="world")])[0]
+        assert not refused.successful and "external_wrench.frame" in refused.reason
+        assert harness.set_parameters([Parameter("external_wrench.frame", value="base")])[0].successful
+        msg = hold(harness, q, held_efforts("irb140", q, F_true, "base"), 3.0, SETTLED)
+    assert msg.header.frame_id == "base_link"
+    assert abs(msg.wrench.force.x - 10.0) <= 0.2 and abs(msg.wrench.force.y) <= 0.2

@@ -169,6 +169,10 @@ class MarkerPublisher:
         if rate > 0.0:
             node.create_timer(1.0 / rate, self.publish)
 
+    def forget(self) -> None:
+        """A model of other joints: the last joint state was of the one before."""
+        self._last, self._observed, self._fresh = None, None, False
+
     def note(self, stamp, q, tau) -> None:
         """A joint state: its stamp, positions and the torques shown."""
         self._last, self._observed, self._fresh = (stamp, q, tau), None, True

@@ -128,6 +128,7 @@ class IdNode(Node):
             self.tracker.clear()
             self._differentiator = None
             self.wrench.forget()
+            self.markers.forget()
         if self._differentiator is None or settings.cutoff_frequency != self.settings.cutoff_frequency:
             self._differentiator = VelocityDifferentiator(settings.model.n, settings.cutoff_frequency)
         self.collision.use(settings.model, settings.collision)
