@@ -136,3 +136,23 @@ def test_the_node_publishes_markers_after_joint_states_only():
     assert last[("collision", 0)].text == "collision: joint_2"
     assert last[("external_force", 0)].action == Marker.ADD
     assert {m.header.frame_id for m in last.values()} == {"base_link"}
+
+
+def test_a_urdf_arm_s_markers_are_in_its_base_link():
+    from ..support.urdf_support import ARMS, arm_text
+
+    overrides = [
+        Parameter("model.source", value="robot_description"),
+        Parameter("model.tip_link", value=ARMS["ur5"][1]),
+        Parameter("robot_description", value=arm_text("ur5")),
+        Parameter("markers.rate", value=20.0),
+    ]
+    with running(IdNode, parameter_overrides=overrides) as harness:
+        markers = harness.listen(MarkerArray, "/id_node/markers")
+        states = harness.publisher(JointState, "joint_states")
+        names = list(harness.node.settings.model.joint_names)
+        states.publish(JointState(name=names, position=[0.1] * 6, velocity=[0.0] * 6))
+        assert harness.spin_until(lambda: markers)
+    assert {m.header.frame_id for m in markers[-1].markers} == {"world"}  # the UR5 URDF's root link
+    labels = [m.text for m in markers[-1].markers if m.ns == "joint_label"]
+    assert [label.split()[0] for label in labels] == names and all("%" in label for label in labels)  # given limits
