@@ -73,6 +73,7 @@ def build_markers(model, limits, frame_id: str, stamp, q, tau, external=None, co
     is not finite (the core's refusal, or here)."""
     markers = MarkerArray()
     new = _maker(frame_id, stamp, life)
+    limits = np.full(model.n, np.inf) if limits is None else limits  # none known (yet): grey
     origins = joint_origins(model, q)
     loads = display.joint_loads(tau, limits)
     for j, (name, origin, torque, load) in enumerate(zip(model.joint_names, origins, tau, loads)):

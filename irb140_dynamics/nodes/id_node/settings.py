@@ -7,6 +7,7 @@ from dataclasses import dataclass, replace
 from irb140_dynamics.core import RobotModel
 from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.payload.limits import derive_torque_limits
+from irb140_dynamics.core.payload.stop import stopping
 from irb140_dynamics.nodes.id_node.collision import (
     COLLISION_PARAMETERS,
     CollisionSettings,
@@ -114,10 +115,14 @@ def finish_settings(settings: IdNodeSettings, previous: IdNodeSettings | None) -
     return replace(settings, torque_limits=torque_limits(settings.model))
 
 
+LIMITS_TIME = 5.0  # s: the search for derived limits stops by then (what it found stands)
+
+
 def torque_limits(model: RobotModel) -> tuple[float, ...]:
     """The limits the markers colour the joints by: the payload check's (given, else derived
-    from its default rated payload; inf: none)."""
-    return derive_torque_limits(model).values
+    from its default rated payload, searched for at most LIMITS_TIME; inf: none)."""
+    with stopping(seconds=LIMITS_TIME):
+        return derive_torque_limits(model).values
 
 
 def compiled(settings: IdNodeSettings, previous: IdNodeSettings | None) -> bool:
