@@ -57,8 +57,9 @@ def test_the_recording_is_what_id_node_publishes():
     assert [(m["ns"], m["id"], m["action"], m["text"]) for m in recorded] == [
         (m["ns"], m["id"], m["action"], m["text"]) for m in published
     ]
-    for old, new in zip(recorded, published):
+    for old, new in zip(recorded, published):  # 0.1 mm: 0.01 N of arrow (a joint state lost on a busy machine)
         for field in ("position", "scale", "color"):
-            np.testing.assert_allclose(old[field], new[field], atol=2e-6)
+            np.testing.assert_allclose(old[field], new[field], atol=1e-4)
+        np.testing.assert_allclose(old["points"], new["points"], atol=1e-4)
     shown = {m["ns"] for m in recorded if m["action"] == Marker.ADD}
     assert shown == {"joint_load", "joint_label", "payload", "external_force", "collision"}
