@@ -91,6 +91,9 @@ def _die_with_parent() -> None:
         pass
 
 
+MARKERS_OFF = "id_node_markers_off"  # a kind: id_node with markers.rate 0 (bench_markers.py)
+
+
 def node_command(kind: str, executor: str, namespace: str, lean: bool = False, depth: int = QOS_DEPTH) -> list[str]:
     """id_node as `ros2 run` starts it (its main(): the events executor), or through
     relay_node.py (the relay, or id_node under another executor or without QoS event
@@ -104,8 +107,10 @@ def node_command(kind: str, executor: str, namespace: str, lean: bool = False, d
         "-p",
         f"qos.depth:={depth}",
     ]
-    if kind == "id_node":
+    if kind in ("id_node", MARKERS_OFF):
         ros_args += ["-p", "acceleration.mode:=differentiate"]
+        if kind == MARKERS_OFF:
+            ros_args += ["-p", "markers.rate:=0"]
         if executor == "events" and not lean:
             return [sys.executable, "-m", "irb140_dynamics.nodes.id_node.node", *ros_args]
     lean_flag = ["--no-event-handlers"] if lean else []

@@ -4,6 +4,9 @@ Launch arguments (all with defaults, so that no argument is needed):
   params_file     the model's parameters (default: the installed config/irb140.yaml)
   payload_mass    kg, on the flange (default 0.0)
   payload_com     m, in the flange frame (default [0.0, 0.0, 0.0])
+  rviz            true: start rviz2 with share/irb140_dynamics/rviz/dynamics.rviz (the
+                  arm, TF, id_node's ~/markers; docs/visualization.md), where RViz is installed
+                  (default false)
 """
 
 from launch.actions import DeclareLaunchArgument
@@ -12,6 +15,7 @@ from launch_ros.actions import Node
 from launch_ros.parameter_descriptions import ParameterValue
 from launch_ros.substitutions import FindPackageShare
 
+from irb140_dynamics.ros.rviz_launch import rviz_entities
 from launch import LaunchDescription
 
 PACKAGE = "irb140_dynamics"
@@ -44,5 +48,6 @@ def generate_launch_description():
                     },
                 ],
             ),
+            *rviz_entities(),
         ]
     )

@@ -9,6 +9,9 @@ Launch arguments (all with defaults):
   plot_file       where demo_node writes its plot at the end (default demo_tracking.png,
                   in the directory ros2 launch was started from)
   duration        s, demo_node stops after this long; 0 = until Ctrl-C (default 0.0)
+  rviz            true: start rviz2 with share/irb140_dynamics/rviz/dynamics.rviz (the
+                  arm, TF, id_node's ~/markers; docs/visualization.md), where RViz is installed
+                  (default false)
 """
 
 from launch.actions import DeclareLaunchArgument
@@ -17,6 +20,7 @@ from launch_ros.actions import Node
 from launch_ros.parameter_descriptions import ParameterValue
 from launch_ros.substitutions import FindPackageShare
 
+from irb140_dynamics.ros.rviz_launch import rviz_entities
 from launch import LaunchDescription
 
 PACKAGE = "irb140_dynamics"
@@ -70,5 +74,6 @@ def generate_launch_description():
                     }
                 ],
             ),
+            *rviz_entities(),
         ]
     )

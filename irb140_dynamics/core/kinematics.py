@@ -32,9 +32,51 @@ def dh_transform(dh: DH, q: float) -> np.ndarray:
 def link_frames(model: RobotModel, q) -> np.ndarray:
     """The poses of the base and the link frames 0..n in the base frame, (n + 1, 4, 4)."""
     frames = [np.eye(4)]
-    for joint, q_i in zip(model.joints, state(q, model.n, "q")):
-        frames.append(frames[-1] @ joint.transform(float(q_i)))
+    for (pre, post, axis, offset, prismatic), q_i in zip(_placements(model), state(q, model.n, "q")):
+        # as Joint.transform, its constant matrices kept with the model
+        move = _slide(axis, q_i) if prismatic else _turn(axis, q_i + offset)
+        frames.append(frames[-1] @ (pre @ move @ post))
     return np.array(frames)
+
+
+def _turn(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rot(axis, angle) as a 4x4 transform (Rodrigues, as joints.axis_rotation, on floats)."""
+    x, y, z = axis.tolist()
+    c, s = math.cos(angle), math.sin(angle)
+    v = 1.0 - c
+    return np.array(
+        [
+            [c + v * x * x, v * x * y - s * z, v * x * z + s * y, 0.0],
+            [v * x * y + s * z, c + v * y * y, v * y * z - s * x, 0.0],
+            [v * x * z - s * y, v * y * z + s * x, c + v * z * z, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
+
+
+def _slide(axis: np.ndarray, distance: float) -> np.ndarray:
+    move = np.eye(4)
+    move[:3, 3] = axis * distance
+    return move
+
+
+def _placements(model: RobotModel) -> list[tuple]:
+    """Per joint (pre, post as 4x4, axis, offset, prismatic), made on first use and kept with
+    the model (models are immutable: see codegen.kernels_of)."""
+    try:
+        return model.__dict__["_placements"]
+    except KeyError:
+        placements = model.__dict__["_placements"] = [
+            (
+                joint.pre.matrix(),
+                joint.post.matrix(),
+                np.asarray(joint.axis if joint.prismatic else joint.turning_axis, dtype=float),
+                float(joint.offset),
+                joint.prismatic,
+            )
+            for joint in model.joints
+        ]
+        return placements
 
 
 def flange_pose(model: RobotModel, q) -> np.ndarray:
@@ -42,18 +84,36 @@ def flange_pose(model: RobotModel, q) -> np.ndarray:
     return link_frames(model, q)[-1] @ model.flange.matrix()
 
 
+def joint_origins(model: RobotModel, q) -> np.ndarray:
+    """Where each joint's axis is placed, (n, 3) m in the base frame: the origin of joint i's
+    frame (link frame i-1 placed by pre_i), which is URDF joint i's origin and URDF link i's."""
+    frames = link_frames(model, q)
+    return np.array([(frame @ placed[0])[:3, 3] for frame, placed in zip(frames[:-1], _placements(model))])
+
+
 def flange_jacobian(model: RobotModel, q) -> np.ndarray:
     """The 6 x n geometric Jacobian of the flange, rows (v; w), in the base frame (a
     prismatic joint's column: its axis in v, zero in w)."""
+    return _flange_jacobian(model, link_frames(model, q))
+
+
+def flange_pose_and_jacobian(model: RobotModel, q) -> tuple[np.ndarray, np.ndarray]:
+    """``flange_pose`` and ``flange_jacobian`` from one pass of forward kinematics."""
     frames = link_frames(model, q)
-    flange = (frames[-1] @ model.flange.matrix())[:3, 3]
+    pose = frames[-1] @ model.flange.matrix()
+    return pose, _flange_jacobian(model, frames, pose)
+
+
+def _flange_jacobian(model: RobotModel, frames: np.ndarray, pose: np.ndarray | None = None) -> np.ndarray:
+    flange = (frames[-1] @ model.flange.matrix() if pose is None else pose)[:3, 3]
     J = np.empty((6, model.n))
-    for i, (frame, joint) in enumerate(zip(frames[:-1], model.joints)):
-        joint_frame = frame @ joint.pre.matrix()  # joint i+1's axis passes through its origin
-        axis, origin = joint_frame[:3, :3] @ np.array(joint.turning_axis), joint_frame[:3, 3]
-        if joint.prismatic:  # sliding: the flange moves along the axis, does not turn
+    for i, (frame, (pre, _, turning_axis, _, prismatic)) in enumerate(zip(frames[:-1], _placements(model))):
+        joint_frame = frame @ pre  # joint i+1's axis passes through its origin
+        axis, origin = joint_frame[:3, :3] @ turning_axis, joint_frame[:3, 3]
+        if prismatic:  # sliding: the flange moves along the axis, does not turn
             J[:3, i], J[3:, i] = axis, 0.0
             continue
-        J[:3, i] = np.cross(axis, flange - origin)
+        (ax, ay, az), (rx, ry, rz) = axis.tolist(), (flange - origin).tolist()
+        J[:3, i] = (ay * rz - az * ry, az * rx - ax * rz, ax * ry - ay * rx)  # axis x r (np.cross: 10x slower)
         J[3:, i] = axis
     return J

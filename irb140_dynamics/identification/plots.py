@@ -9,6 +9,7 @@ from typing import BinaryIO
 import numpy as np
 
 from irb140_dynamics.core.regressor import inertial_parameters, regressor_batch
+from irb140_dynamics.figures import fit_text
 from irb140_dynamics.identification.pipeline import Result
 
 Save = Callable[[str, Callable[[BinaryIO], None]], None]  # (file name, writer of its bytes)
@@ -73,7 +74,7 @@ def write_plots(result: Result, directory) -> list[str]:
         axes[0, 0].legend(loc="upper right", fontsize="small", ncol=3)
         axes[0, 0].set_title(f"{kind.capitalize()} on held-out data: {result.held_out_source}")
         axes[-1, 0].set_xlabel("time [s] (held-out fit points)")
-        figure.tight_layout()
+        fit_text(figure)  # the title names the held-out recording's path: wrapped, never cut
         try:
             save(f"{kind}.png", lambda stream, figure=figure: figure.savefig(stream, format="png", dpi=110))
         finally:

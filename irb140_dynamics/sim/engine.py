@@ -5,6 +5,11 @@ The physics is MuJoCo's (see ``mjcf``): the model's inertials, armature, viscous
 (soft stops). A step holds the applied torques for one period, integrated in ``substeps``
 MuJoCo steps. Torques beyond a joint's torque_limit (when it has one, > 0) are clipped to
 it: the drives saturate, and ``applied`` says what was applied.
+
+A wrench on the flange (force [N]; torque [N m] about the flange origin, in the base's axes
+or the flange's) can be applied with a step: MuJoCo's ``xfrc_applied`` takes the force and
+the torque about the body's centre of mass (``xipos``) in world axes, so the torque is
+moved there, m_com = m + (p_flange - p_com) x f, at the pose of each sub-step.
 """
 
 from __future__ import annotations
@@ -47,6 +52,8 @@ class SimulatedArm:
         limits = np.array(model.torque_limits, dtype=float)
         self.torque_limits = np.where(limits > 0.0, limits, np.inf)
         self.applied = np.zeros(model.n)
+        self._flange_body = mujoco.mj_name2id(self.mj_model, mujoco.mjtObj.mjOBJ_BODY, model.joints[-1].name)
+        self._flange = model.flange.matrix()  # the flange in the last link's frame
         self._reset_state = (np.zeros(model.n), np.zeros(model.n))
         self.reset(np.zeros(model.n))
 
@@ -83,20 +90,46 @@ class SimulatedArm:
         self.applied = other.applied.copy()
         self._reset_state = other._reset_state
 
-    def step(self, tau) -> None:
-        """Apply tau [N m] (clipped to the torque limits) for one period.
+    def step(self, tau, wrench=None, frame: str = "base") -> None:
+        """Apply tau [N m] (clipped to the torque limits) for one period, and ``wrench`` (6
+        finite numbers: force; torque about the flange origin, in the axes of ``frame``,
+        ``base`` or ``tip``) on the flange if given.
 
         Raises SimulationError, with the arm reset to where it was last reset, if the state
         stops being finite (torques far beyond anything the arm can take).
         """
         self.applied = np.clip(self._checked("tau", tau), -self.torque_limits, self.torque_limits)
+        if wrench is not None:
+            wrench = np.asarray(wrench, dtype=float)
+            if wrench.shape != (6,) or not np.isfinite(wrench).all() or frame not in ("base", "tip"):
+                raise ValueError(f"wrench: expected 6 finite numbers in 'base' or 'tip' axes, got {wrench}, {frame!r}")
         data = self.data
         data.qfrc_applied[:] = self.applied
         for _ in range(self.substeps):
+            data.xfrc_applied[self._flange_body] = 0.0 if wrench is None else self._at_com(wrench, frame)
             mujoco.mj_step(self.mj_model, data)
+        data.xfrc_applied[self._flange_body] = 0.0
         if not (np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()) or self._diverged():
             self.reset(*self._reset_state)
             raise SimulationError("the simulation diverged (non-finite state); the arm was reset")
+
+    def flange_pose(self) -> np.ndarray:
+        """The flange's pose in the base frame as MuJoCo has it at the current state, 4x4."""
+        body = np.eye(4)
+        body[:3, :3] = self.data.xmat[self._flange_body].reshape(3, 3)
+        body[:3, 3] = self.data.xpos[self._flange_body]
+        return body @ self._flange
+
+    def _at_com(self, wrench: np.ndarray, frame: str) -> np.ndarray:
+        """The flange wrench as xfrc_applied wants it: world axes, torque about the body's
+        centre of mass, at the current pose (kinematics computed first)."""
+        mujoco.mj_kinematics(self.mj_model, self.data)
+        pose = self.flange_pose()
+        force, torque = wrench[:3], wrench[3:]
+        if frame == "tip":
+            force, torque = pose[:3, :3] @ force, pose[:3, :3] @ torque
+        lever = pose[:3, 3] - self.data.xipos[self._flange_body]
+        return np.concatenate([force, torque + np.cross(lever, force)])
 
     def _diverged(self) -> bool:
         return data_warning(self.data, mujoco.mjtWarning.mjWARN_BADQACC) > 0

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..core.trajectories.check import QUANTITIES, profiles
 from ..core.trajectories.interpolation import sample_times, spline
+from ..figures import fit_text
 
 COLORS = ("tab:green", "tab:blue", "tab:orange")  # torque, velocity, acceleration
 
@@ -41,7 +42,7 @@ def limit_use_png(model, limits, before, after=None) -> bytes:
         axes[-1, c].set_xlabel("t [s]")
     handles = [matplotlib.lines.Line2D([], [], color=c, label=q) for q, c in zip(QUANTITIES, COLORS)]
     fig.legend(handles=handles, loc="upper center", ncol=3, fontsize="small")
-    fig.tight_layout(rect=(0, 0, 1, 0.97))
+    fit_text(fig, rect=(0, 0, 1, 0.97))
     out = io.BytesIO()
     fig.savefig(out, format="png", dpi=80)
     plt.close(fig)

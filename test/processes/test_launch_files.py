@@ -63,7 +63,7 @@ def test_runs_with_no_argument_on_installed_files_and_executables(launch_file, m
     arguments = arguments_of(description, {}, SHARE)
     assert all(value is not None for value in arguments.values()), arguments  # every argument has a default
     paths = installed(monkeypatch)
-    for node in nodes_of(description):
+    for node in nodes_of(description, arguments, SHARE):
         assert node.package == "irb140_dynamics" and node.executable in SCRIPTS, node
         for item in resolve(node.parameters, arguments, SHARE):
             if isinstance(item, str):  # a params file: one the package installs
@@ -101,7 +101,7 @@ def test_its_nodes_start_with_its_parameters_and_stop_on_ctrl_c(launch_file, giv
     arguments = arguments_of(description, given, SHARE)
     processes = []
     try:
-        for node in nodes_of(description):
+        for node in nodes_of(description, arguments, SHARE):
             lines: list[str] = []
             process = start(node_command(node, arguments))
             processes.append((process, lines))
@@ -112,3 +112,35 @@ def test_its_nodes_start_with_its_parameters_and_stop_on_ctrl_c(launch_file, giv
     assert all(code == 0 for code, _ in stopped), output
     assert "Traceback" not in output and "FATAL" not in output and "unknown parameter" not in output, output
     assert expected in output, output
+
+
+@pytest.mark.parametrize("launch_file", LAUNCH_FILES, ids=lambda path: path.name)
+@pytest.mark.parametrize("installed_rviz", [True, False], ids=["rviz_installed", "no_rviz"])
+def test_rviz_true_starts_rviz_with_the_installed_config_where_installed(launch_file, installed_rviz, monkeypatch):
+    from irb140_dynamics.ros import rviz_launch
+
+    monkeypatch.setattr(rviz_launch, "rviz_installed", lambda: installed_rviz)
+    description = load_description(launch_file, monkeypatch)
+    assert all(node.package != "rviz2" for node in nodes_of(description, arguments_of(description, {}, SHARE), SHARE))
+    arguments = arguments_of(description, {"rviz": "true"}, SHARE)
+    rviz = [node for node in nodes_of(description, arguments, SHARE) if node.package == "rviz2"]
+    if not installed_rviz:
+        assert rviz == []
+        notes = [e for e in description.entities if type(e).__name__ == "LogInfo"]
+        assert len(notes) == 1 and "not installed" in notes[0].msg
+        return
+    assert len(rviz) == 1 and rviz[0].executable == "rviz2"
+    option, config = resolve(rviz[0].arguments, arguments, SHARE)
+    assert option == "-d" and config == str(SHARE / "rviz" / "dynamics.rviz")
+    assert "share/irb140_dynamics/rviz/dynamics.rviz" in installed(monkeypatch) and in_source(config).is_file()
+
+
+def test_the_rviz_config_shows_the_markers_in_the_base_link():
+    config = yaml.safe_load((ROOT / "rviz" / "dynamics.rviz").read_text())
+    manager = config["Visualization Manager"]
+    displays = {display["Class"]: display for display in manager["Displays"]}
+    assert {"rviz_default_plugins/RobotModel", "rviz_default_plugins/TF", "rviz_default_plugins/MarkerArray"} <= set(
+        displays
+    )
+    assert displays["rviz_default_plugins/MarkerArray"]["Topic"]["Value"] == "/id_node/markers"
+    assert manager["Global Options"]["Fixed Frame"] == "base_link"  # export_urdf's base link, the markers' frame

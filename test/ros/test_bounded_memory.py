@@ -81,8 +81,8 @@ def test_id_node_holds_no_more_memory_after_warming_up(monkeypatch):
         assert len(node._order._cache) <= 16
         assert len(node.counts) <= 30 and all(key.count(".") == 1 for key in node.counts), dict(node.counts)
         assert len(node.tally._next_warning) <= 3
-        timers = list(node.timers)  # diagnostics, and the builder's poll timer: made once, cancelled once idle
-        assert len(timers) == 2 and sum(timer.is_canceled() for timer in timers) == 1
+        timers = list(node.timers)  # diagnostics, markers, and the builder's poll timer: made once, cancelled once idle
+        assert len(timers) == 3 and sum(timer.is_canceled() for timer in timers) == 1
         assert threading.active_count() == threads
         assert not any(key.endswith(".errors") for key in node.counts)
 

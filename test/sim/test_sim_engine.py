@@ -227,3 +227,33 @@ def test_the_loop_runs_under_sched_fifo_when_asked_and_allowed():
             assert os.sched_getscheduler(loop._thread.native_id) == os.SCHED_OTHER
     finally:
         loop.stop()
+
+
+@pytest.mark.parametrize("frame", ["base", "tip"])
+def test_a_flange_wrench_is_balanced_by_the_jacobian_transpose(frame):
+    """Drives giving g(q) - J(q)^T F hold the arm still under a wrench F on the flange (our
+    J, MuJoCo's mapping of xfrc_applied): the torque about the flange origin was moved to
+    the body's centre of mass right. Without the wrench the same torques move it."""
+    from irb140_dynamics.core.monitoring.wrench import flange_jacobian_in
+
+    model = loaded_irb140()
+    F = np.array([15.0, -20.0, 10.0, 2.0, -3.0, 1.5])  # N, N m about the flange origin
+    tau = gravity(model, POSE) - flange_jacobian_in(model, POSE, frame).T @ F
+    arm = SimulatedArm(model)
+    arm.reset(POSE)
+    for _ in range(100):
+        arm.step(tau, F, frame)
+    assert np.abs(arm.q - POSE).max() < 1e-9 and np.abs(arm.qd).max() < 1e-7
+    arm.reset(POSE)
+    for _ in range(100):
+        arm.step(tau)
+    assert np.abs(arm.q - POSE).max() > 1e-3
+
+
+def test_a_bad_wrench_is_refused():
+    arm = SimulatedArm(irb140())
+    arm.reset(POSE)
+    for wrench, frame in (([np.nan] * 6, "base"), ([1.0] * 5, "base"), ([1.0] * 6, "world")):
+        with pytest.raises(ValueError, match="wrench"):
+            arm.step(np.zeros(6), wrench, frame)
+    assert (arm.q == POSE).all()

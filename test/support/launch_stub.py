@@ -49,6 +49,17 @@ class ParameterValue:
 
 
 @dataclass
+class IfCondition:
+    predicate_expression: Any
+
+
+@dataclass
+class LogInfo:
+    msg: Any
+    condition: IfCondition | None = None
+
+
+@dataclass
 class Node:
     package: str = ""
     executable: str = ""
@@ -57,11 +68,13 @@ class Node:
     parameters: list = field(default_factory=list)
     arguments: list = field(default_factory=list)
     remappings: list = field(default_factory=list)
+    condition: IfCondition | None = None
 
 
 MODULES = {
     "launch": {"LaunchDescription": LaunchDescription},
-    "launch.actions": {"DeclareLaunchArgument": DeclareLaunchArgument},
+    "launch.actions": {"DeclareLaunchArgument": DeclareLaunchArgument, "LogInfo": LogInfo},
+    "launch.conditions": {"IfCondition": IfCondition},
     "launch.substitutions": {"LaunchConfiguration": LaunchConfiguration, "PathJoinSubstitution": PathJoinSubstitution},
     "launch_ros": {},
     "launch_ros.actions": {"Node": Node},
@@ -118,5 +131,14 @@ def arguments_of(description: LaunchDescription, given: dict[str, str], share: P
     return values
 
 
-def nodes_of(description: LaunchDescription) -> list[Node]:
-    return [entity for entity in description.entities if isinstance(entity, Node)]
+def nodes_of(description: LaunchDescription, arguments: dict[str, str] | None = None, share: Path = Path("/")) -> list:
+    """The nodes launched with ``arguments`` (None: the defaults): those without a condition
+    or whose condition holds (as launch reads it: 'true' or '1', any case)."""
+    arguments = arguments_of(description, {}, share) if arguments is None else arguments
+    return [entity for entity in description.entities if isinstance(entity, Node) and holds(entity, arguments, share)]
+
+
+def holds(entity, arguments: dict[str, str], share: Path) -> bool:
+    if getattr(entity, "condition", None) is None:
+        return True
+    return str(resolve(entity.condition.predicate_expression, arguments, share)).strip().lower() in ("true", "1")

@@ -1,6 +1,7 @@
 """What measured signals say beyond the model: joint accelerations estimated from velocities
-(``filters``) and external joint torques from efforts (``observer``: the generalized momentum
-observer behind id_node's collision detection).
+(``filters``), external joint torques from efforts (``observer``: the generalized momentum
+observer behind id_node's collision detection), the wrench on the flange they come from
+(``wrench``: a virtual force sensor) and the scales the markers draw loads with (``display``).
 
 May import: ``core.model``, ``core.algorithms``, ``core.codegen``, ``core.dynamics``.
 """

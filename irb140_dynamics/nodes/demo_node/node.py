@@ -161,6 +161,8 @@ class DemoNode(Node):
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
+        from irb140_dynamics.figures import fit_text
+
         t = np.array([h[0] for h in self._history])
         reference, actual = np.array([h[1] for h in self._history]), np.array([h[2] for h in self._history])
         figure, axes = plt.subplots(3, 2, figsize=(11, 8), sharex=True)
@@ -175,7 +177,7 @@ class DemoNode(Node):
         figure.suptitle(f"demo_node: reference and actual joint positions ({self.label})")
         for axis in axes[-1]:
             axis.set_xlabel("t [s]")
-        figure.tight_layout()
+        fit_text(figure)  # the label can be long (a config path): wrapped, never cut
         figure.savefig(self.plot_file)
         plt.close(figure)
         print(f"plot written: {self.plot_file}", flush=True)

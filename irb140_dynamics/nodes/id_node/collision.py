@@ -107,6 +107,11 @@ class CollisionMonitor:
     def reset(self) -> None:
         self._observer.reset()
 
+    @property
+    def residual(self) -> list[float] | None:
+        """The external torques of the last joint state with efforts [N m], None before one."""
+        return self._residual
+
     def update(self, t: float, q, qd, effort, g, stamp, terms=None) -> str | None:
         """One joint state with efforts: publish the residual, and the flag when it changes
         (``terms``: see MomentumObserver.advance). What restarted the observer at this

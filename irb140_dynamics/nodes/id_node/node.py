@@ -13,6 +13,10 @@ Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, q
              external_torques      sensor_msgs/JointState, effort = external torques by the momentum
                                    observer (for joint states that carry efforts; see ros.collision)
              collision             std_msgs/Bool (transient local), any over its collision_threshold
+             external_wrench       geometry_msgs/WrenchStamped: the wrench on the flange the external
+                                   torques come from (see id_node.wrench)
+             ~/markers             visualization_msgs/MarkerArray at markers.rate: loads, payload,
+                                   external force, collision (see id_node.markers)
              /diagnostics          diagnostic_msgs/DiagnosticArray, message counts and collision, 1 Hz
              (an empty ~/reference trajectory lets the held reference go)
 
@@ -39,6 +43,7 @@ from irb140_dynamics.core.io.stamps import seconds
 from irb140_dynamics.core.monitoring.filters import VelocityDifferentiator
 from irb140_dynamics.core.monitoring.observer import monitor_terms
 from irb140_dynamics.nodes.id_node.collision import RESTARTS, CollisionMonitor
+from irb140_dynamics.nodes.id_node.markers import MarkerPublisher
 from irb140_dynamics.nodes.id_node.settings import (  # noqa: F401 (finish_settings, compiled: looked up here, tests patch them)
     NODE_PARAMETERS,
     PER_JOINT_PARAMETERS,
@@ -48,6 +53,7 @@ from irb140_dynamics.nodes.id_node.settings import (  # noqa: F401 (finish_setti
     finish_settings,
 )
 from irb140_dynamics.nodes.id_node.tracking import ReferenceTracker
+from irb140_dynamics.nodes.id_node.wrench import WrenchSensor
 from irb140_dynamics.ros.messages.joint_messages import (
     BadMessage,
     JointOrder,
@@ -60,6 +66,7 @@ from irb140_dynamics.ros.messages.joint_messages import (
     read_trajectory,
 )
 from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage, read_joint_state_cdr
+from irb140_dynamics.ros.messages.wrench import chain_links
 from irb140_dynamics.ros.parameters.model_source import declare_model_source
 from irb140_dynamics.ros.parameters.specs import joint_states_qos
 from irb140_dynamics.ros.parameters.usage import JOINT, model_sections, per_joint_section
@@ -87,6 +94,8 @@ class IdNode(Node):
         )
         self.parameters.on_change(self._use)
         self.collision = CollisionMonitor(self, [], self.get_parameter("qos.depth").value)  # joints: by _use
+        self.wrench = WrenchSensor(self, self.get_parameter("qos.depth").value)
+        self.markers = MarkerPublisher(self, self.get_parameter("markers.rate").value)
         self._command_msg = Float64MultiArray()
         if self.parameters.current is not None:
             self._use(self.parameters.current)
@@ -118,6 +127,8 @@ class IdNode(Node):
             self._tracking_msg = JointState(name=names)
             self.tracker.clear()
             self._differentiator = None
+            self.wrench.forget()
+            self.markers.forget()
         if self._differentiator is None or settings.cutoff_frequency != self.settings.cutoff_frequency:
             self._differentiator = VelocityDifferentiator(settings.model.n, settings.cutoff_frequency)
         self.collision.use(settings.model, settings.collision)
@@ -162,6 +173,7 @@ class IdNode(Node):
         self.counts["torques.published"] += 1
         if reference is not None and self._tracking_pub.subscribers:
             self._publish_tracking_error(stamp, q, qd, reference)
+        self.markers.note(stamp, q, tau)
         self._observe(msg, t, q, qd, g, terms)
 
     def _publish_tracking_error(self, stamp, q, qd, reference) -> None:
@@ -229,6 +241,18 @@ class IdNode(Node):
         if restarted is not None:
             self.counts[f"collision.restart_{restarted}"] += 1
             self.tally.warn("collision", f"observer restarted at r = 0 ({RESTARTS[restarted]})")
+        self._estimate_wrench(msg.header.stamp, q, effort)
+
+    def _estimate_wrench(self, stamp, q, effort) -> None:
+        """The observer's external torques as the flange wrench (external_wrench) and markers."""
+        settings, r = self.settings, self.collision.residual
+        colliding = [settings.model.joint_names[j] for j in self.collision.colliding]
+        self.markers.observed(effort, r, colliding)
+        try:
+            self.wrench.update(settings.model, settings.wrench_frame, chain_links(self.parameters), stamp, q, r)
+        except ValueError as error:
+            self.counts["external_wrench.not_finite"] += 1
+            self.tally.warn("external_wrench", f"no wrench for a joint state ({error})")
 
     def _estimated_acceleration(self, t: float, qd, settings: IdNodeSettings):
         if settings.acceleration_mode == "zero":
@@ -270,7 +294,8 @@ class IdNode(Node):
         self._reported = self.counts.copy()
         name, hardware_id = self.get_name(), self.parameters.robot_name or self.get_fully_qualified_name()
         status = message_status(name, hardware_id, self.counts, recent, self.parameters, self.settings is None)
-        msg = DiagnosticArray(status=[status, self.collision.status(name, hardware_id)])
+        statuses = [status, self.collision.status(name, hardware_id), self.wrench.status(name, hardware_id)]
+        msg = DiagnosticArray(status=statuses)
         msg.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(msg)
 

@@ -6,13 +6,17 @@ from dataclasses import dataclass, replace
 
 from irb140_dynamics.core import RobotModel
 from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.payload.limits import derive_torque_limits
+from irb140_dynamics.core.payload.stop import stopping
 from irb140_dynamics.nodes.id_node.collision import (
     COLLISION_PARAMETERS,
     CollisionSettings,
     build_collision_settings,
     collision_threshold_specs,
 )
+from irb140_dynamics.nodes.id_node.markers import MARKER_PARAMETERS
 from irb140_dynamics.nodes.id_node.tracking import Gains, build_gains, gain_specs
+from irb140_dynamics.nodes.id_node.wrench import WRENCH_PARAMETERS, check_wrench_frame
 from irb140_dynamics.ros.parameters.specs import QOS_PARAMETERS, Spec, check_choice, check_number, check_qos
 
 ACCELERATION_MODES = ("zero", "differentiate")
@@ -53,6 +57,8 @@ NODE_PARAMETERS = [
         "which torques go to effort_commands: 'feedforward', 'gravity' or 'computed_torque'",
     ),
     *COLLISION_PARAMETERS,
+    *WRENCH_PARAMETERS,
+    *MARKER_PARAMETERS,
     *QOS_PARAMETERS,
 ]
 
@@ -72,6 +78,8 @@ class IdNodeSettings:
     effort_source: str
     collision: CollisionSettings
     gains: Gains
+    wrench_frame: str  # external_wrench.frame: "tip" or "base"
+    torque_limits: tuple[float, ...] | None = None  # N m (inf: none), the payload check's; set by finish_settings
 
 
 def check_settings(values: dict) -> IdNodeSettings:
@@ -90,6 +98,7 @@ def check_settings(values: dict) -> IdNodeSettings:
         values["effort_commands.source"],
         build_collision_settings(values, model.joint_names),
         build_gains(values, model.joint_names),
+        check_wrench_frame(values),
     )
 
 
@@ -100,10 +109,20 @@ def finish_settings(settings: IdNodeSettings, previous: IdNodeSettings | None) -
     """Compile the kernels the messages use, here and not on a message (off the executor
     unless they exist already: a payload or gravity change shares the arm's code)."""
     if previous is not None and previous.model == settings.model:
-        return replace(settings, model=previous.model)
+        return replace(settings, model=previous.model, torque_limits=previous.torque_limits)
     for name in KERNELS:
         getattr(kernels_of(settings.model), name)  # compiles it
-    return settings
+    return replace(settings, torque_limits=torque_limits(settings.model))
+
+
+LIMITS_TIME = 5.0  # s: the search for derived limits stops by then (what it found stands)
+
+
+def torque_limits(model: RobotModel) -> tuple[float, ...]:
+    """The limits the markers colour the joints by: the payload check's (given, else derived
+    from its default rated payload, searched for at most LIMITS_TIME; inf: none)."""
+    with stopping(seconds=LIMITS_TIME):
+        return derive_torque_limits(model).values
 
 
 def compiled(settings: IdNodeSettings, previous: IdNodeSettings | None) -> bool:

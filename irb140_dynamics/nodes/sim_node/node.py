@@ -2,6 +2,8 @@
 
 Subscribes   effort_commands   std_msgs/Float64MultiArray: joint torques [N m], model joint
                                order (as ros2_control's JointGroupEffortController ~/commands)
+             ~/external_wrench geometry_msgs/WrenchStamped: a push on the flange, held (see
+                               sim_node.push)
 Publishes    joint_states      sensor_msgs/JointState every step: position, velocity, effort =
                                the torque applied, named, stamped
              /clock            rosgraph_msgs/Clock, in lockstep only: the simulated time, every step
@@ -27,6 +29,7 @@ from collections import Counter
 
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import WrenchStamped
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -35,8 +38,10 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 
+from irb140_dynamics.nodes.sim_node.push import HeldWrench
 from irb140_dynamics.nodes.sim_node.settings import NODE_PARAMETERS, SimNodeSettings, build_settings, read_command  # noqa: F401 (NODE_PARAMETERS: read by ros.overrides)
 from irb140_dynamics.ros.messages.joint_messages import BadMessage
+from irb140_dynamics.ros.messages.wrench import chain_links
 from irb140_dynamics.ros.parameters.model_source import declare_model_source
 from irb140_dynamics.ros.parameters.usage import model_sections
 from irb140_dynamics.ros.runtime.command_line import Usage
@@ -80,6 +85,8 @@ class SimNode(Node):
         self._state_pub = self.create_publisher(JointState, "joint_states", depth)
         commands_qos = QoSProfile(depth=depth, reliability=ReliabilityPolicy.BEST_EFFORT)
         self.create_subscription(Float64MultiArray, "effort_commands", self._on_command, commands_qos)
+        self.push = HeldWrench()
+        self.create_subscription(WrenchStamped, "~/external_wrench", self._on_wrench, depth)
         self.create_service(Trigger, "~/reset", self._on_reset)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self.create_timer(1.0, self._publish_diagnostics)
@@ -118,6 +125,7 @@ class SimNode(Node):
             if new_joints:
                 self._state_msg = JointState(name=names)
                 self._command = None
+                self.push.clear()
                 self._reset()
         if not first:
             return
@@ -186,6 +194,19 @@ class SimNode(Node):
             self.lockstep.step(tau)
         self._publish_lockstep()
 
+    @guarded("external_wrench")
+    def _on_wrench(self, msg: WrenchStamped) -> None:
+        """Hold the push from the next step on (see sim_node.push)."""
+        self.tally.add("external_wrench", "received")
+        if self.arm is None:
+            self.tally.add("external_wrench", "no_model_yet")
+            return
+        try:
+            with self._lock:
+                self.push.receive(msg, chain_links(self.parameters), self._now())
+        except BadMessage as error:
+            self.tally.drop("external_wrench", error)
+
     def _held_command(self, now: float) -> np.ndarray:
         """The last command while it is fresh, else zero torque."""
         if self._command is None:
@@ -207,7 +228,7 @@ class SimNode(Node):
             arm.applied = np.zeros(arm.n)
             return
         try:
-            arm.step(tau)
+            arm.step(tau, *self.push.current(self._now(), self.settings.command_timeout))
         except SimulationError as error:
             self.counts["diverged"] += 1
             self.tally.warn("simulation", str(error))
@@ -267,6 +288,8 @@ class SimNode(Node):
         if self.lockstep:
             self.counts["steps"], self.counts["republished"] = self.lockstep.steps, self.lockstep.republished
             self.counts["duplicates_dropped"] = self.lockstep.duplicates
+        if self.push.timed_out:
+            self.counts["external_wrench.timeouts"] = self.push.timed_out
         else:
             self.counts["steps"], self.counts["late_steps"] = self.schedule.steps, self.schedule.late
             self.counts["skipped_steps"] = self.schedule.skipped

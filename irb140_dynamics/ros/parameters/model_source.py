@@ -131,6 +131,7 @@ class RobotDescription:
 
     def _announce(self, origin: str) -> None:
         self.parameters.robot_name = self.urdf.robot_name or "robot"
+        self.parameters.chain_links = (self.urdf.base_link, self.urdf.tip_link)  # frames of markers and wrenches
         names, held = list(self.urdf.model.joint_names), self.urdf.held_joints
         held = f"; held at zero: {', '.join(held)}" if held else ""
         logger = self._node.get_logger()

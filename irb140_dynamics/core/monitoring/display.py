@@ -1,0 +1,69 @@
+"""How the arm's loads are drawn (RViz markers, previews): the numbers behind the pictures.
+
+- A joint's load is |tau_j| / limit_j, limit_j the torque limit the payload check uses
+  (``payload.limits.derive_torque_limits``: the given torque_limit, else the rated
+  payload's worst static torque). Its colour runs green (0) to yellow (YELLOW_AT = 0.7)
+  to red (1 and above), linearly in between; a joint without a limit is grey.
+- The payload is a sphere of PAYLOAD_DENSITY (aluminium, 2700 kg/m^3) of its mass: 6 kg
+  gives 0.162 m across; never less than MIN_PAYLOAD_DIAMETER, so that a light payload shows.
+- A force is an arrow of ARROW_PER_NEWTON (0.01 m/N: 20 N draws 0.2 m), at most
+  MAX_ARROW long (the length saturates; the label keeps the number).
+
+Units: N m, kg, m, N. Colours are (red, green, blue) in 0..1.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+YELLOW_AT = 0.7  # load where the colour is yellow
+GREEN, YELLOW, RED, GREY = (0.0, 1.0, 0.0), (1.0, 1.0, 0.0), (1.0, 0.0, 0.0), (0.5, 0.5, 0.5)
+PAYLOAD_DENSITY = 2700.0  # kg/m^3
+MIN_PAYLOAD_DIAMETER = 0.02  # m
+ARROW_PER_NEWTON = 0.01  # m/N
+MAX_ARROW = 2.0  # m
+
+
+def joint_loads(tau, limits) -> list[float | None]:
+    """|tau_j| / limit_j per joint; None where the limit is none (inf or 0) or tau not finite."""
+    return [
+        abs(t) / limit if 0.0 < limit < math.inf and math.isfinite(t) else None
+        for t, limit in zip(np.asarray(tau, dtype=float).tolist(), np.asarray(limits, dtype=float).tolist())
+    ]
+
+
+def load_colour(load: float | None) -> tuple[float, float, float]:
+    """The colour of a load (see the module): green, yellow at YELLOW_AT, red from 1; grey for None."""
+    if load is None or not math.isfinite(load):
+        return GREY
+    if load <= YELLOW_AT:
+        return _mix(GREEN, YELLOW, max(load, 0.0) / YELLOW_AT)
+    return _mix(YELLOW, RED, min((load - YELLOW_AT) / (1.0 - YELLOW_AT), 1.0))
+
+
+def load_label(name: str, tau: float, load: float | None) -> str:
+    """E.g. ``joint_3 81 % (85.2 N m)``; without a limit ``joint_1 (85.2 N m, no limit)``."""
+    if load is None:
+        return f"{name} ({tau:.1f} N m, no limit)"
+    return f"{name} {100.0 * load:.0f} % ({tau:.1f} N m)"
+
+
+def payload_diameter(mass: float) -> float:
+    """The payload sphere's diameter [m]: a ball of PAYLOAD_DENSITY of ``mass`` [kg]."""
+    mass = mass if math.isfinite(mass) and mass > 0.0 else 0.0
+    return max(2.0 * (3.0 * mass / (4.0 * math.pi * PAYLOAD_DENSITY)) ** (1.0 / 3.0), MIN_PAYLOAD_DIAMETER)
+
+
+def arrow_end(start, force) -> np.ndarray:
+    """Where a force's arrow from ``start`` ends [m]: ARROW_PER_NEWTON per newton along it,
+    at most MAX_ARROW."""
+    force = np.asarray(force, dtype=float)
+    length = ARROW_PER_NEWTON * float(np.linalg.norm(force))
+    scale = ARROW_PER_NEWTON if length <= MAX_ARROW else MAX_ARROW / float(np.linalg.norm(force))
+    return np.asarray(start, dtype=float) + scale * force
+
+
+def _mix(a, b, share: float) -> tuple[float, float, float]:
+    return tuple(x + share * (y - x) for x, y in zip(a, b))
