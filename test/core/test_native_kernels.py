@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import Friction, RigidBody, gravity, irb140, mass_matrix, rnea
-from irb140_dynamics.core.codegen import native
-from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.codegen import c_code, native
+from irb140_dynamics.core.codegen.kernels import WITH_FRICTION, kernels_of
 from irb140_dynamics.core.urdf import load_urdf
 
 from ..support.common import OFFSET_PAYLOAD
@@ -129,14 +129,14 @@ def test_non_finite_inputs_and_results_are_refused_as_by_the_python_form():
         rnea(model, q, np.full(6, 1e200), q)
 
 
-def test_friction_is_added_to_native_torques_and_a_flange_wrench_takes_the_python_form():
+def test_friction_is_inside_the_native_torques_and_a_flange_wrench_takes_the_python_form():
     def with_friction():
         model = irb140(payload=OFFSET_PAYLOAD)
         return replace(model, joints=tuple(replace(j, friction=Friction(0.5, 2.0)) for j in model.joints))
 
-    model, python_model = promoted(with_friction()), with_friction()
+    model, python_model = promoted(with_friction(), (WITH_FRICTION,)), with_friction()
     assert model.friction is not None
-    kernel = kernels_of(model).rnea
+    kernel = kernels_of(model).rnea_with_friction
     for q, qd, qdd in zip(*states(model, count=50, seed=8)):
         calls = kernel._calls
         np.testing.assert_array_equal(rnea(model, q, qd, qdd), rnea(python_model, q, qd, qdd))
@@ -172,7 +172,7 @@ def test_a_compile_that_fails_leaves_the_python_form(monkeypatch):
 
 
 def test_a_library_is_compiled_once_and_then_loaded_from_the_cache():
-    source, _, _ = native.c_source(kernels_of(irb140()).gravity_torques.native_recipe()[0])
+    source, _, _ = c_code.kernel_source(kernels_of(irb140()).gravity_torques.program)
     path = native.library(source)
     stamp = path.stat().st_mtime_ns
     assert native.library(source) == path and path.stat().st_mtime_ns == stamp
@@ -185,13 +185,14 @@ def test_waiting_with_nothing_asked_for_returns_at_once():
 
 def test_the_check_before_use_compares_bits():
     python = lambda q, k=(): [0.0, 1.0]  # noqa: E731
-    native_form = lambda inputs: (native.ctypes.c_double * 2)(-0.0, 1.0)  # noqa: E731
-    assert not native.same_as_python(native_form, python, 1, [1], 0)
+    native_form = lambda q: np.array([-0.0, 1.0])  # noqa: E731
+    assert not native.same_as_python(native_form, python, [1], 0)
+    assert native.same_as_python(lambda q: np.array([0.0, 1.0]), python, [1], 0)
 
 
 @pytest.mark.parametrize("damage", ["truncated", "emptied", "garbage"])
 def test_a_damaged_library_in_the_cache_is_compiled_again(damage):
-    source, _, _ = native.c_source(kernels_of(irb140(payload=OFFSET_PAYLOAD)).gravity_torques.native_recipe()[0])
+    source, _, _ = c_code.kernel_source(kernels_of(irb140(payload=OFFSET_PAYLOAD)).gravity_torques.program)
     path = native.library(source)
     whole = path.read_bytes()
     path.unlink()  # a new file: this process may have the library loaded, and writing into it would crash it
@@ -209,7 +210,7 @@ def test_stale_working_folders_are_removed_by_a_compile(monkeypatch):
         (work / "kernel.c").write_text("")
     os.utime(old, (0, time.time() - native.STALE_AFTER - 10.0))
     monkeypatch.setattr(native, "FLAGS", (*native.FLAGS, "-DSTALE_TEST"))  # not cached: compiled
-    native.library(native.c_source(kernels_of(irb140()).gravity_torques.native_recipe()[0])[0])
+    native.library(c_code.kernel_source(kernels_of(irb140()).gravity_torques.program)[0])
     assert not old.exists() and recent.exists()
     shutil.rmtree(recent)
 
@@ -275,7 +276,19 @@ def test_a_cache_folder_others_can_write_to_is_not_used(tmp_path, monkeypatch):
     (shared / "irb140_dynamics" / "kernels").mkdir(parents=True)
     (shared / "irb140_dynamics" / "kernels").chmod(0o777)
     monkeypatch.setenv("IRB140_CACHE", str(shared))
-    source, _, _ = native.c_source(kernels_of(irb140()).gravity_torques.native_recipe()[0])
+    source, _, _ = c_code.kernel_source(kernels_of(irb140()).gravity_torques.program)
     with pytest.raises(OSError, match="not private to this user"):
         native.library(source)
     assert list((shared / "irb140_dynamics" / "kernels").iterdir()) == []
+
+
+def test_without_python_headers_the_kernels_are_called_through_ctypes(monkeypatch):
+    monkeypatch.setattr(native, "headers", lambda: None)
+    monkeypatch.setattr(native, "COMPILER", native._Compiler())  # nothing built by this process yet
+    model = promoted(frictionless(irb140(payload=OFFSET_PAYLOAD)))
+    assert isinstance(kernels_of(model).rnea.native, native.CtypesKernel)
+    python_model = frictionless(irb140(payload=OFFSET_PAYLOAD))
+    for q, qd, qdd in zip(*states(model, count=50)):
+        np.testing.assert_array_equal(rnea(model, q, qd, qdd), rnea(python_model, q, qd, qdd))
+        np.testing.assert_array_equal(mass_matrix(model, q), mass_matrix(python_model, q))
+    assert kernels_of(model).rnea.native(q.tolist(), qd, qdd) is None  # not arrays: the Python form's
