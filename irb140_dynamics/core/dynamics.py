@@ -6,7 +6,9 @@ M includes the joints' armature (rotor inertia); tau_f is joint friction (see ``
 
 Single-state functions take sequences of n numbers and return NumPy arrays; the
 ``*_batch`` forms take arrays shaped (N, n) and give the same numbers for N states at once.
-All run the model's generated kernels (see ``codegen``), compiled on first use. What a
+All run the model's generated kernels (see ``codegen``), traced on first use; the
+single-state ``rnea``, ``gravity`` and ``mass_matrix`` run them as C once compiled: in the
+background after PROMOTE_AFTER calls, or at once with ``prepare(model, timeout)``. What a
 state is, and the checks of each argument, are in ``states``: anything else raises
 ValueError naming the argument (the kernels fold constants: a NaN times a zero constant
 would vanish). A result is never silently non-finite: where velocities, accelerations,
@@ -22,7 +24,23 @@ from math import isfinite
 
 import numpy as np
 
-from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.codegen.kernels import Preparation, kernels_of, prepare
+
+__all__ = [  # prepare, Preparation: compile a model's kernels now (see codegen.kernels)
+    "Preparation",
+    "coriolis",
+    "coriolis_batch",
+    "coriolis_matrix",
+    "forward_dynamics",
+    "forward_dynamics_batch",
+    "gravity",
+    "gravity_batch",
+    "mass_matrix",
+    "mass_matrix_batch",
+    "prepare",
+    "rnea",
+    "rnea_batch",
+]
 from irb140_dynamics.core.codegen.layout import upper_to_full
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.model.states import finite_result, finite_results, state, states

@@ -3,6 +3,7 @@ numbers bit for bit, refuses what the Python form refuses, and is only ever an
 acceleration: without a compiler, with IRB140_NATIVE=0, or when compiling fails, the
 Python form answers. The session's cache is its own (test/conftest.py)."""
 
+import contextlib
 import os
 import shutil
 import subprocess
@@ -14,9 +15,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from irb140_dynamics.core import Friction, RigidBody, gravity, irb140, mass_matrix, rnea
+from irb140_dynamics.core import Friction, RigidBody, gravity, irb140, mass_matrix, prepare, rnea
 from irb140_dynamics.core.codegen import c_code, native
-from irb140_dynamics.core.codegen.kernels import WITH_FRICTION, kernels_of
+from irb140_dynamics.core.codegen.kernels import NATIVE_KERNELS, WITH_FRICTION, kernels_of
 from irb140_dynamics.core.urdf import load_urdf
 
 from ..support.common import OFFSET_PAYLOAD
@@ -292,3 +293,49 @@ def test_without_python_headers_the_kernels_are_called_through_ctypes(monkeypatc
         np.testing.assert_array_equal(rnea(model, q, qd, qdd), rnea(python_model, q, qd, qdd))
         np.testing.assert_array_equal(mass_matrix(model, q), mass_matrix(python_model, q))
     assert kernels_of(model).rnea.native(q.tolist(), qd, qdd) is None  # not arrays: the Python form's
+
+
+def test_prepare_compiles_now_and_the_verbs_then_answer_natively():
+    model = irb140(payload=RigidBody(2.5, (0.01, 0.0, 0.05)))
+    done = prepare(model, timeout=120.0)
+    assert done.native and not done.compiling and done.seconds > 0.0
+    kernels = kernels_of(model)
+    calls = [kernels.kernel(name)._calls for name in NATIVE_KERNELS]
+    q = np.full(6, 0.4)
+    python_model = irb140(payload=RigidBody(2.5, (0.01, 0.0, 0.05)))
+    with native_off():
+        want = rnea(python_model, q, q, q), gravity(python_model, q), mass_matrix(python_model, q)
+    for got, expected in zip((rnea(model, q, q, q), gravity(model, q), mass_matrix(model, q)), want):
+        np.testing.assert_array_equal(got, expected)
+    assert [kernels.kernel(name)._calls for name in NATIVE_KERNELS] == calls  # native answered
+    assert prepare(model).native  # already: at once
+
+
+def test_prepare_without_native_code_says_so(monkeypatch):
+    monkeypatch.setenv("IRB140_NATIVE", "0")
+    done = prepare(irb140().with_gravity((0.0, 0.2, -9.8)), timeout=60.0)
+    assert not done.native and not done.compiling
+
+
+def test_prepare_past_its_timeout_leaves_the_compile_running_and_python_answering(tmp_path, monkeypatch):
+    slow = tmp_path / "slow-cc"  # a compiler that takes its time
+    slow.write_text(f'#!/bin/sh\nsleep 3\nexec {native.compiler()} "$@"\n')
+    slow.chmod(0o755)
+    monkeypatch.setenv("CC", str(slow))
+    model = irb140().with_gravity((0.1, -0.2, -9.8))  # a pattern of zeros no other test compiles
+    done = prepare(model, timeout=0.5, names=("gravity_torques",))
+    assert not done.native and done.compiling and done.seconds < 3.0
+    q = np.full(6, 0.1)
+    np.testing.assert_array_equal(gravity(model, q), np.array(kernels_of(model).gravity_torques.scalar(q.tolist())))
+    assert native.COMPILER.wait(timeout=120.0)
+    assert kernels_of(model).gravity_torques.native is not None  # in the background, done
+
+
+@contextlib.contextmanager
+def native_off():
+    before = os.environ.get("IRB140_NATIVE")
+    os.environ["IRB140_NATIVE"] = "0"
+    try:
+        yield
+    finally:
+        os.environ.pop("IRB140_NATIVE") if before is None else os.environ.__setitem__("IRB140_NATIVE", before)

@@ -10,6 +10,7 @@ it along the flange axis, compiles nothing; the code is as short as a fully fold
 
 from __future__ import annotations
 
+import time
 import types
 from dataclasses import dataclass, replace
 from functools import cached_property, lru_cache
@@ -208,6 +209,39 @@ class Kernels:
         if self._friction is None:
             return "rnea"
         return "rnea_coulomb" if self._friction.coulomb.any() else "rnea_viscous"
+
+
+NATIVE_KERNELS = (WITH_FRICTION, "gravity_torques", "mass_matrix")  # what rnea, gravity, mass_matrix call
+
+
+@dataclass(frozen=True)
+class Preparation:
+    """What ``prepare`` did: ``native``, whether the kernels asked for are native now;
+    ``seconds``, how long it took (tracing, compiling or loading from the cache, checking);
+    ``compiling``, whether a compile goes on in the background after the timeout (the
+    Python form answers meanwhile, the native one from when it is ready)."""
+
+    native: bool
+    seconds: float
+    compiling: bool = False
+
+
+def prepare(model, timeout: float | None = None, names: tuple[str, ...] = NATIVE_KERNELS) -> Preparation:
+    """Make ``model``'s kernels ``names`` native now: trace them, compile them as C (or load
+    them from the cache) and check them, waiting at most ``timeout`` seconds (None: until
+    done). After the timeout the compile goes on in the background. Without a compiler, or
+    with IRB140_NATIVE=0, the kernels are traced (their Python form ready) and native is
+    False. Safe from any thread; a kernel native already costs nothing."""
+    start = time.monotonic()
+    kernels = kernels_of(model)
+    wanted = [kernels.kernel(name) for name in names]
+    missing = [kernel for kernel in wanted if kernel.native is None]
+    compiling = False
+    if missing and native.enabled():
+        left = None if timeout is None else max(0.0, timeout - (time.monotonic() - start))
+        compiling = not native.COMPILER.compile_now(missing, left)
+    done = all(kernel.native is not None for kernel in wanted)
+    return Preparation(done, time.monotonic() - start, compiling and not done)
 
 
 def kernels_of(model) -> Kernels:

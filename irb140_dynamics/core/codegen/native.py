@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import array
 import atexit
+import collections
 import contextlib
 import ctypes
 import hashlib
@@ -33,7 +34,6 @@ import importlib.machinery
 import importlib.util
 import os
 import platform
-import queue
 import random
 import shutil
 import signal
@@ -306,31 +306,47 @@ class _Compiler:
         os.register_at_fork(after_in_child=self._restart)
 
     def _restart(self) -> None:
-        self._lock = threading.Lock()
-        self._requests: queue.Queue = queue.Queue()
+        self._ready = threading.Condition(threading.Lock())
+        self._requests: collections.deque = collections.deque()  # kernels and Events, the next first
         self._thread: threading.Thread | None = None
 
-    def _started(self) -> queue.Queue:
-        """The queue of requests, with the worker thread started to take them."""
-        with self._lock:
+    def _put(self, items: list, first: bool = False) -> None:
+        """Queue ``items`` (at the front, in their order, with ``first``), the worker thread
+        started to take them."""
+        with self._ready:
             if self._thread is None:
                 self._thread = threading.Thread(target=self._run, name="irb140-native", daemon=True)
                 self._thread.start()
-            return self._requests
+            if first:
+                self._requests.extendleft(reversed(items))
+            else:
+                self._requests.extend(items)
+            self._ready.notify()
 
     def request(self, kernel) -> None:
-        self._started().put(kernel)
+        self._put([kernel])
 
     def wait(self, timeout: float | None = None) -> bool:
         """Until every kernel asked for so far (in this process) is compiled or given up:
         True if so in time. Nothing asked for: True at once."""
         done = threading.Event()
-        self._started().put(done)
+        self._put([done])
+        return done.wait(timeout)
+
+    def compile_now(self, kernels: list, timeout: float | None = None) -> bool:
+        """Compile ``kernels`` before anything asked for earlier and wait until they are
+        compiled or given up, at most ``timeout`` s: True if so in time (else they are
+        compiled in the background)."""
+        done = threading.Event()
+        self._put([*kernels, done], first=True)
         return done.wait(timeout)
 
     def _run(self) -> None:
         while True:
-            kernel = self._requests.get()
+            with self._ready:
+                while not self._requests:
+                    self._ready.wait()
+                kernel = self._requests.popleft()
             if isinstance(kernel, threading.Event):
                 kernel.set()
                 continue
