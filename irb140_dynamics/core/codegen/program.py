@@ -123,3 +123,23 @@ def with_friction(program: Program, qd_group: str, coulomb: bool) -> Program:
         (g, length + (2 * n + 1 if coulomb else n)) if g == "k" else (g, length) for g, length in program.groups
     )
     return Program(f"{program.name}_friction", groups, tuple(builder.ops), tuple(outputs))
+
+
+def with_constants(program: Program, group: str, values: tuple) -> Program:
+    """``program`` with the inputs of ``group`` replaced by ``values`` (the same floats: the
+    same arithmetic), the group dropped from its arguments."""
+    index: list = []
+    ops: list[tuple[str, tuple]] = []
+    for op, args in program.ops:
+        if op == "in" and args[0].startswith(group) and args[0][len(group) :].isdigit():
+            index.append(float(values[int(args[0][len(group) :])]))
+            continue
+        if op != "in":
+            args = tuple(index[a] if isinstance(a, int) else a for a in (args[:1] if op in ANGLES else args)) + (
+                args[1:] if op in ANGLES else ()
+            )
+        ops.append((op, args))
+        index.append(len(ops) - 1)
+    outputs = tuple(index[out] if isinstance(out, int) else out for out in program.outputs)
+    groups = tuple((g, length) for g, length in program.groups if g != group)
+    return Program(program.name, groups, tuple(ops), outputs)

@@ -33,9 +33,11 @@ def _run(kernel, shape, *arrays):
 '''
 
 
-def render(eq: Equations, reduced: dict, prefix: str, source: str) -> dict[str, str]:
-    """{file name: text} of the module."""
-    doc = "\n".join(header_lines(eq, source))
+def render(eq: Equations, reduced: dict, prefix: str, source: str, bodies: dict | None = None) -> dict[str, str]:
+    """{file name: text} of the module; a quantity in ``bodies`` (see traced) written from
+    its program, the others from ``reduced``."""
+    bodies = bodies or {}
+    doc = "\n".join(header_lines(eq, source, traced=bool(bodies)))
     lines = [f'"""{doc}\n\nFunctions of one state (arrays (n,)) or N states ((N, n)).\n"""', _PRELUDE]
     lines.append(f"N_JOINTS = {eq.n}")
     lines.append(f"JOINT_NAMES = {tuple(eq.joint_names)!r}")
@@ -45,11 +47,11 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str) -> dict[str, 
     if eq.regressor_columns:
         lines.append(f"REGRESSOR_COLUMNS = {eq.regressor_columns!r}")
     for name, (replacements, outputs) in reduced.items():
-        lines += ["", ""] + _function(eq, name, replacements, outputs)
+        lines += ["", ""] + _function(eq, name, replacements, outputs, bodies.get(name))
     return {f"{prefix}_eom.py": "\n".join(lines) + "\n"}
 
 
-def _function(eq: Equations, name: str, replacements, outputs) -> list[str]:
+def _function(eq: Equations, name: str, replacements, outputs, body=None) -> list[str]:
     printer = PythonPrinter()
     args = list(eq.arguments[name])
     shape = {"M": (eq.n, eq.n), "regressor": (eq.n, 13 * eq.n)}.get(name, (eq.n,))
@@ -65,6 +67,8 @@ def _function(eq: Equations, name: str, replacements, outputs) -> list[str]:
     else:
         lines.append(f"    return _run(_{name}, {shape!r}, {', '.join(args)})")
     lines += ["", "", f"def _{name}({', '.join(kernel_args)}):"]
+    if body is not None:
+        return lines + _traced_lines(eq, args, body)
     for arg in args:
         names = [f"{arg}{i + 1}" for i in range(eq.n)]
         if any(v in used for v in names):
@@ -78,3 +82,13 @@ def _function(eq: Equations, name: str, replacements, outputs) -> list[str]:
     lines += [f"        {printer.doprint(expr)}," for expr in outputs]
     lines.append("    )")
     return lines
+
+
+def _traced_lines(eq: Equations, args: list[str], body) -> list[str]:
+    lines = []
+    for arg in args:
+        used = dict(body.inputs.get(arg, []))
+        if used:
+            lines.append(f"    {', '.join(used.get(i, '_') for i in range(eq.n))} = {arg}")
+    lines += [f"    {var} = {expr}" for var, expr in body.assignments]
+    return lines + ["    return (", *(f"        {expr}," for expr in body.outputs), "    )"]
