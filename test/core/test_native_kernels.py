@@ -339,3 +339,21 @@ def native_off():
         yield
     finally:
         os.environ.pop("IRB140_NATIVE") if before is None else os.environ.__setitem__("IRB140_NATIVE", before)
+
+
+def test_the_extension_takes_any_float64_vector_and_leaves_the_rest_to_the_python_form():
+    model = promoted(frictionless(irb140(payload=OFFSET_PAYLOAD)))
+    python_model = frictionless(irb140(payload=OFFSET_PAYLOAD))
+    Q = np.random.default_rng(4).uniform(-2.0, 2.0, (6, 3))
+    column = Q[:, 1]  # strided
+    readonly = Q[:, 2].copy()
+    readonly.flags.writeable = False
+    swapped = Q[:, 0].astype(">f8")
+    for q in (column, readonly, swapped, Q[:, 0].astype(np.float32), Q[:, 0].tolist()):
+        want = rnea(python_model, np.array(q, dtype=float), column, readonly)
+        np.testing.assert_array_equal(rnea(model, q, column, readonly), want)
+        np.testing.assert_array_equal(mass_matrix(model, q), mass_matrix(python_model, np.array(q, dtype=float)))
+    native_rnea = kernels_of(model).rnea.native
+    assert native_rnea(swapped, column, readonly) is None  # byte-swapped: the Python form converts it
+    assert native_rnea(column, column) is None and native_rnea(Q, Q, Q) is None
+    assert native_rnea(column, column, column) is not None
