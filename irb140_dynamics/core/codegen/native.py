@@ -8,9 +8,10 @@ never used. It is built as a CPython extension module (Python.h and NumPy's head
 functions take NumPy arrays directly; where Python.h is missing, as a plain library called
 through ctypes (slower per call, same numbers).
 
-Compiling takes a C compiler (``$CC``, ``cc`` or ``gcc``), so no call waits for it: a
-kernel whose Python form has run ``PROMOTE_AFTER`` times is compiled by one background
-thread (the compiler at the lowest CPU priority), and calls use the native code once it is
+Compiling takes a C compiler (``$CC``, ``cc`` or ``gcc``), so no call of a kernel waits
+for it: one background thread compiles the kernels asked for (the compiler at the lowest
+CPU priority), a kernel whose Python form has run ``PROMOTE_AFTER`` times, or those that
+``kernels.prepare`` asks for first and waits for, and calls use the native code once it is
 ready. Without a compiler, or with ``IRB140_NATIVE=0``, everything stays in Python; so does
 a kernel whose compile fails in any way (no usable cache folder, a ``$CC`` that is not a
 compiler): the caller never sees it. Libraries are kept in ``$IRB140_CACHE`` (else
@@ -53,7 +54,7 @@ from irb140_dynamics.core.codegen.layout import whole_matrix
 PROMOTE_AFTER = 1000  # calls of a kernel's Python form before it is compiled
 CHECKS = 20  # random inputs on which the native code must equal the Python code exactly
 FLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math", "-fno-builtin")
-COMPILE_TIMEOUT = 120.0  # s
+COMPILE_TIMEOUT = 600.0  # s: a long chain's mass matrix on a busy machine, at the lowest priority
 NICENESS = 19  # of the compiler: the lowest CPU priority, so that a node's loop comes first
 STALE_AFTER = 3600.0  # s: a working folder this old is no running compile's (see library)
 WORKING_PREFIX = "build-"  # a compile's working folder in the cache folder
@@ -361,6 +362,8 @@ class _Compiler:
         if key not in self._built:
             try:
                 built = build(program, full_matrix)
+            except subprocess.TimeoutExpired:
+                return None  # not kept: asked for again, it is compiled again
             except (OSError, ImportError, subprocess.SubprocessError):
                 built = None
             if len(self._built) >= FUNCTIONS_KEPT:
