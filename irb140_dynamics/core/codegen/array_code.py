@@ -48,6 +48,15 @@ def compile_into(program: Program, scalars: Sequence[str] = ()) -> tuple[str, Ca
     in ``written`` (the others, folded to constants, are not touched), and the argument
     groups as arrays of shape (length, N) (the groups named in ``scalars`` as floats).
     """
+    source, written = into_source(program, scalars)
+    namespace = dict(_NAMESPACE)
+    exec(compile(source, f"<{program.name}_into>", "exec"), namespace)
+    return source, namespace[f"{program.name}_into"], written
+
+
+def into_source(program: Program, scalars: Sequence[str] = ()) -> tuple[str, list[int]]:
+    """(the source of ``<name>_into``, see compile_into; the outputs it writes). Its names:
+    cos, sin, tanh, mul, add, sub, div, neg (NumPy's ufuncs) and empty (np.empty)."""
     scalar_vars = {f"{group}{i}" for group in scalars for i in range(program.group(group))}
     body, first_array, registers = _emit_into(program, scalar_vars)
     written = [j for j, out in enumerate(program.outputs) if isinstance(out, int)]
@@ -57,10 +66,7 @@ def compile_into(program: Program, scalars: Sequence[str] = ()) -> tuple[str, Ca
     if registers:
         lines.append(f"    {''.join(f'r{i}, ' for i in range(registers))}= empty(({registers}, len({first_array})))")
     lines += body
-    source = "\n".join(lines) + "\n"
-    namespace = dict(_NAMESPACE)
-    exec(compile(source, f"<{program.name}_into>", "exec"), namespace)
-    return source, namespace[f"{program.name}_into"], written
+    return "\n".join(lines) + "\n", written
 
 
 def _emit_into(program: Program, scalar_vars: set[str]):

@@ -12,7 +12,8 @@ from .symbolic import Equations
 
 _PRELUDE = '''
 import numpy as np
-from numpy import cos, sin, tanh  # noqa: F401 (used by the generated expressions)
+from numpy import add, cos, empty, sin, tanh  # noqa: F401 (used by the generated code)
+from numpy import divide as div, multiply as mul, negative as neg, subtract as sub  # noqa: F401
 
 CHUNK = 4096  # states per pass
 
@@ -68,7 +69,7 @@ def _function(eq: Equations, name: str, replacements, outputs, body=None) -> lis
         lines.append(f"    return _run(_{name}, {shape!r}, {', '.join(args)})")
     lines += ["", "", f"def _{name}({', '.join(kernel_args)}):"]
     if body is not None:
-        return lines + _traced_lines(eq, args, body)
+        return lines[:-3] + _traced_lines(name, args, body)
     for arg in args:
         names = [f"{arg}{i + 1}" for i in range(eq.n)]
         if any(v in used for v in names):
@@ -84,11 +85,13 @@ def _function(eq: Equations, name: str, replacements, outputs, body=None) -> lis
     return lines
 
 
-def _traced_lines(eq: Equations, args: list[str], body) -> list[str]:
-    lines = []
-    for arg in args:
-        used = dict(body.inputs.get(arg, []))
-        if used:
-            lines.append(f"    {', '.join(used.get(i, '_') for i in range(eq.n))} = {arg}")
-    lines += [f"    {var} = {expr}" for var, expr in body.assignments]
-    return lines + ["    return (", *(f"        {expr}," for expr in body.outputs), "    )"]
+def _traced_lines(name: str, args: list[str], body) -> list[str]:
+    """``_<name>``: the rows of the entries, written by ``_<name>_into`` (the code
+    generator's program as NumPy ufunc calls into reused buffers)."""
+    rows = len(body.constants) + len(body.written)
+    lines = ["", "", f"def _{name}({', '.join(args)}):", f"    out = empty(({rows}, {args[0]}.shape[1]))"]
+    lines.append(f"    _{name}_into(out, {', '.join(args)})")
+    lines += [f"    out[{j}] = {value!r}" for j, value in body.constants.items()]
+    ordered = body.entries != list(range(rows))
+    lines.append(f"    return out[{body.entries!r}]" if ordered else "    return out")
+    return [*lines, "", "", *body.into.rstrip("\n").split("\n")]

@@ -9,10 +9,11 @@ from the SymPy derivation (``symbolic``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+from ..codegen.array_code import into_source
 from ..codegen.kernels import WITH_FRICTION, kernels_of
-from ..codegen.layout import whole_matrix
+from ..codegen.layout import upper_to_full, whole_matrix
 from ..codegen.program import with_constants
 from ..codegen.python_code import statements
 
@@ -22,11 +23,19 @@ KERNEL_OF = {"tau": WITH_FRICTION, "M": "mass_matrix", "Cqd": "coriolis", "g": "
 @dataclass(frozen=True)
 class Body:
     """A quantity as straight-line code: the inputs it reads by group ({"q": [(0, "q0"),
-    ...]}), its assignments (variable, expression) and its entries' expressions."""
+    ...]}), its assignments (variable, expression) and its entries' expressions; and as
+    NumPy code writing into given rows (``into``: the source of ``_<name>_into(out, ...)``,
+    see codegen.array_code), with the rows it writes (``written``), the constant ones
+    ({row: value}) and the entries' rows in order (``entries``: M whole from its upper
+    triangle)."""
 
     inputs: dict[str, list[tuple[int, str]]]
     assignments: list[tuple[str, str]]
     outputs: list[str]
+    into: str
+    written: list[int]
+    constants: dict[int, float]
+    entries: list[int]
 
 
 def traced_bodies(model, names) -> dict[str, Body]:
@@ -39,12 +48,16 @@ def traced_bodies(model, names) -> dict[str, Body]:
         kernel = kernels.kernel(KERNEL_OF[name])
         program = with_constants(kernel.program, "k", kernel.constants)
         assignments, outputs = statements(program)
+        into, written = into_source(replace(program, name=f"_{name}"))
+        constants = {j: out for j, out in enumerate(program.outputs) if not isinstance(out, int)}
+        entries = list(range(len(outputs)))
         if name == "M":
             outputs = whole_matrix(outputs, model.n)
+            entries = upper_to_full(model.n).ravel().tolist()
         used = program.inputs_used()
         inputs = {
             group: [(i, f"{group}{i}") for i in range(length) if f"{group}{i}" in used]
             for group, length in program.groups
         }
-        bodies[name] = Body(inputs, assignments, outputs)
+        bodies[name] = Body(inputs, assignments, outputs, into, written, constants, entries)
     return bodies
