@@ -10,6 +10,7 @@ it along the flange axis, compiles nothing; the code is as short as a fully fold
 
 from __future__ import annotations
 
+import threading
 import time
 import types
 from dataclasses import dataclass, replace
@@ -173,6 +174,7 @@ class Kernels:
         arm = links[:-1] + (replace(last, m=0.0, h=ZERO3, I=ZERO6),)
         self._arm = _arm(arm, model.flange, tuple(x != 0.0 for x in constants))
         self._friction = model.friction
+        self._lock = threading.Lock()  # one kernel of a name, also when threads ask at once
 
     @property
     def angles(self) -> list[float]:
@@ -187,11 +189,16 @@ class Kernels:
     def kernel(self, name: str) -> Kernel:
         """The kernel ``name``, made on first use and kept (also as the attribute ``name``)."""
         kernel = vars(self).get(name)
-        if kernel is None:
-            if name not in RECIPES and name != WITH_FRICTION:
-                raise AttributeError(f"no kernel {name!r}: one of {', '.join([*RECIPES, WITH_FRICTION])}")
-            if name == WITH_FRICTION and self._friction is None:
-                kernel = vars(self)[name] = self.kernel("rnea")  # the same kernel: one native form
+        if kernel is not None:
+            return kernel
+        if name not in RECIPES and name != WITH_FRICTION:
+            raise AttributeError(f"no kernel {name!r}: one of {', '.join([*RECIPES, WITH_FRICTION])}")
+        if name == WITH_FRICTION and self._friction is None:
+            kernel = vars(self)[name] = self.kernel("rnea")  # the same kernel: one native form
+            return kernel
+        with self._lock:
+            kernel = vars(self).get(name)
+            if kernel is not None:
                 return kernel
             constants = self.constants
             if name == WITH_FRICTION:
@@ -278,6 +285,7 @@ class ArmKernels:
         self.nonzero = nonzero
         self.angles = [None if link.prismatic else link.theta_offset for link in links]
         self._kernels: dict[str, Kernel] = {}
+        self._lock = threading.RLock()  # one trace of a kernel, also when threads ask at once
 
     def has(self, name: str) -> bool:
         return name in self._kernels
@@ -286,7 +294,12 @@ class ArmKernels:
         """The kernel ``name`` of RECIPES, or ``rnea_viscous`` / ``rnea_coulomb`` (rnea with
         friction, see program.with_friction), traced and compiled on first use."""
         kernel = self._kernels.get(name)
-        if kernel is None:
+        if kernel is not None:
+            return kernel
+        with self._lock:
+            kernel = self._kernels.get(name)
+            if kernel is not None:
+                return kernel
             if name in ("rnea_viscous", "rnea_coulomb"):
                 program = with_friction(self.kernel("rnea").program, "qd", coulomb=name == "rnea_coulomb")
                 kernel = Kernel(program)

@@ -10,7 +10,7 @@ from irb140_dynamics.core import Friction, coriolis, gravity, irb140, mass_matri
 from irb140_dynamics.core.equations import generate
 
 from ...support.common import OFFSET_PAYLOAD
-from .support import c_function, compile_c, compiler, random_states
+from .support import arms, c_function, compile_c, compiler, random_states
 
 pytestmark = pytest.mark.skipif(compiler() is None, reason="no C compiler (cc or gcc) on this machine")
 
@@ -22,8 +22,10 @@ def with_friction():
     )
 
 
-def test_the_written_c_is_the_cores_arithmetic(tmp_path):
-    model = with_friction()
+@pytest.mark.parametrize("arm", ["irb140 with friction and an offset payload", "panda (URDF damping)"])
+def test_the_written_c_is_the_cores_arithmetic(tmp_path, arm):
+    model = with_friction() if arm.startswith("irb140") else arms()["panda"]
+    assert model.friction is not None
     for file, text in generate(model, ("c",), prefix="arm").items():
         (tmp_path / file).write_text(text)
     library = compile_c(tmp_path, "arm")
