@@ -28,6 +28,7 @@ import time
 import timeit
 from contextlib import contextmanager
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -42,19 +43,19 @@ from common import (
     shown,
     write_results,
 )
+from prepare_section import preparation
 
 from irb140_dynamics.core import (
-    Friction,
     gravity,
     gravity_batch,
     irb140,
     mass_matrix,
     mass_matrix_batch,
+    prepare,
     rnea,
     rnea_batch,
 )
 from irb140_dynamics.core.codegen import kernels as kernel_cache  # noqa: E402
-from irb140_dynamics.core.codegen import native
 from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.io.urdf import load_urdf  # noqa: E402
 from irb140_dynamics.core.model.rigid_body import RigidBody, inertia_matrix  # noqa: E402
@@ -69,6 +70,7 @@ KERNELS = ("rnea", "rnea_wrench", "gravity_torques", "coriolis", "mass_matrix", 
 TOLERANCE = dict(rtol=1e-9, atol=1e-9)
 SEED = 140
 PAIRED_BLOCKS = 800  # alternating blocks of the URDF arms' timings
+NATIVE_TARGET = 0.7  # ours / Pinocchio's per call, native, each arm and verb
 
 
 # -- the baselines ----------------------------------------------------------------------
@@ -118,15 +120,10 @@ class TextbookRnea:
 
 
 def with_native(model):
-    """``model`` with its single-state kernels compiled as C (core.codegen.native), as a
-    program that calls them often has them: PROMOTE_AFTER calls each, then the compiler's
-    background work waited for. Says so when there is no native code (no compiler)."""
-    q = np.zeros(model.n)
-    for _ in range(native.PROMOTE_AFTER):
-        rnea(model, q, q, q), gravity(model, q), mass_matrix(model, q)
-    native.COMPILER.wait(timeout=300.0)
-    kernels = kernels_of(model)
-    if any(getattr(kernels, k).native is None for k in ("rnea", "gravity_torques", "mass_matrix")):
+    """``model`` with its single-state kernels compiled as C (core.codegen.native), as
+    ``prepare`` makes them (a node at startup, or a program after PROMOTE_AFTER calls).
+    Says so when there is no native code (no compiler)."""
+    if not prepare(model, timeout=300.0).native:
         print("note: no native kernels (no C compiler, or IRB140_NATIVE=0): the Python forms are timed")
     return model
 
@@ -180,17 +177,17 @@ def single_state(model, pm, data) -> list[Row]:
     pin_crba = lambda: pin.crba(pm, data, q)  # noqa: E731
     ours_rnea = lambda: rnea(model, q, qd, qdd)  # noqa: E731
     cases = [  # name, ours, baseline, target
-        ("rnea vs pin.rnea", ours_rnea, pin_rnea, Target(8)),
+        ("rnea vs pin.rnea", ours_rnea, pin_rnea, Target(0.7)),
         ("rnea kernel, Python form (lists) vs pin.rnea", lambda: kernels.rnea.scalar(*lists), pin_rnea, None),
         ("rnea vs textbook NumPy RNEA", ours_rnea, lambda: textbook(q, qd, qdd), None),
-        ("gravity vs computeGeneralizedGravity", lambda: gravity(model, q), pin_gravity, Target(8)),
+        ("gravity vs computeGeneralizedGravity", lambda: gravity(model, q), pin_gravity, Target(0.7)),
         (
             "gravity kernel, Python form (list) vs computeGeneralizedGravity",
             lambda: kernels.gravity_torques.scalar(lists[0]),
             pin_gravity,
             None,
         ),
-        ("mass_matrix vs pin.crba", lambda: mass_matrix(model, q), pin_crba, Target(15)),
+        ("mass_matrix vs pin.crba", lambda: mass_matrix(model, q), pin_crba, Target(0.7)),
         (
             "mass_matrix kernel, Python form (list) vs pin.crba",
             lambda: kernels.mass_matrix.scalar(lists[0]),
@@ -250,8 +247,8 @@ def batch(model, pm, data) -> list[Row]:
     ]
     group = f"batch of {BATCH_STATES:,} states"
     rows = []
-    for name, ours, call, shape, prepare, target in cases:
-        check_same(name, ours()[:BATCH_CHECKED], prepare(loop(call, shape, BATCH_CHECKED)()))
+    for name, ours, call, shape, arrange, target in cases:
+        check_same(name, ours()[:BATCH_CHECKED], arrange(loop(call, shape, BATCH_CHECKED)()))
         ours_rate, loop_rate = (
             Figure.rate(seconds_per_call(fn, blocks=BATCH_REPEATS, number=1), BATCH_STATES)
             for fn in (ours, loop(call, shape))
@@ -263,49 +260,49 @@ def batch(model, pm, data) -> list[Row]:
 def urdf_arms() -> list[Row]:
     """Per-call cost on the UR5 and the Panda of example-robot-data, as our loader and
     Pinocchio's parser read the same file (Pinocchio's Panda with its fingers locked), and
-    on the DH IRB-140 the same way (no target: no slower than before). The joints'
-    friction (the Panda's damping) is left out of our model: pin.rnea has none. Ours with
-    native kernels (the default where a C compiler is), then in their Python form."""
+    on the DH IRB-140 the same way. Ours with the friction the model carries (the Panda's
+    URDF damping: inside our native call; pin.rnea has none, so the check takes it out).
+    Ours with native kernels (the default where a C compiler is), then in their Python form."""
     rows = []
     arms = {"IRB-140 (DH)": (irb140(), None), **URDF_ARMS}
     for name, (text, tip) in arms.items():
         model, pm = _paired_models(text, tip)
         data = pm.createData()
         q, qd, qdd = (x[0] for x in random_states(model, 1, np.random.default_rng(SEED + 2)))
-        check_same(f"{name} rnea", rnea(model, q, qd, qdd), pin.rnea(pm, data, q, qd, qdd))
+        friction = model.friction.torques(qd) if model.friction is not None else 0.0
+        check_same(f"{name} rnea", rnea(model, q, qd, qdd) - friction, pin.rnea(pm, data, q, qd, qdd))
         check_same(f"{name} gravity", gravity(model, q), pin.computeGeneralizedGravity(pm, data, q))
         check_same(f"{name} mass_matrix", mass_matrix(model, q), symmetric_from_upper(pin.crba(pm, data, q)))
-        urdf = tip is not None
+        label = f"{name}{' (with its friction)' if model.friction is not None else ''}"
         for form in ("native", "Python"):
             ours = with_native(model) if form == "native" else replace(model)  # a fresh model: no kernels yet
             cases = [
-                ("rnea vs pin.rnea", lambda m=ours: rnea(m, q, qd, qdd), lambda: pin.rnea(pm, data, q, qd, qdd), 5),
+                ("rnea vs pin.rnea", lambda m=ours: rnea(m, q, qd, qdd), lambda: pin.rnea(pm, data, q, qd, qdd)),
                 (
                     "gravity vs computeGeneralizedGravity",
                     lambda m=ours: gravity(m, q),
                     lambda: pin.computeGeneralizedGravity(pm, data, q),
-                    5,
                 ),
-                ("mass_matrix vs pin.crba", lambda m=ours: mass_matrix(m, q), lambda: pin.crba(pm, data, q), 6),
+                ("mass_matrix vs pin.crba", lambda m=ours: mass_matrix(m, q), lambda: pin.crba(pm, data, q)),
             ]
             group = f"arms, ours {form}, alternating blocks (URDF: load_urdf vs buildModelFromXML), per call"
-            for label, call, baseline, limit in cases:
+            for case, call, baseline in cases:
                 if form == "native":
                     timed = paired_seconds_per_call(call, baseline)
                 else:
                     with python_form():
                         timed = paired_seconds_per_call(call, baseline)
-                target = Target(limit) if urdf and form == "native" else None
-                rows.append(Row(group, f"{name} {label}", *(Figure.cost(t) for t in timed), target))
+                target = Target(NATIVE_TARGET) if form == "native" else None
+                rows.append(Row(group, f"{label} {case}", *(Figure.cost(t) for t in timed), target))
     return rows
 
 
 def _paired_models(text, tip):
-    """(our model without friction, Pinocchio's) of a URDF's chain to ``tip``, or of a model."""
+    """(our model, Pinocchio's) of a URDF's chain to ``tip``, or of a model."""
     if tip is None:
         return text, pinocchio_model(text)
     loaded = load_urdf(text, tip_link=tip)
-    model = replace(loaded.model, joints=tuple(replace(j, friction=Friction()) for j in loaded.model.joints))
+    model = loaded.model
     pm = pin.buildModelFromXML(text)
     held = [pm.getJointId(joint) for joint in loaded.held_joints]
     pm = pin.buildReducedModel(pm, held, pin.neutral(pm)) if held else pm
@@ -326,18 +323,19 @@ def paired_seconds_per_call(ours, baseline, blocks: int = PAIRED_BLOCKS, calls: 
     return times
 
 
-def _urdf_arms() -> dict[str, tuple[str, str]]:
-    """name -> (URDF text, tip link) of example-robot-data's UR5 and Panda."""
+def _urdf_paths() -> dict[str, tuple[Path, str]]:
+    """name -> (URDF file, tip link) of example-robot-data's UR5 and Panda."""
     files = importlib.metadata.distribution("example-robot-data").files or ()
     paths = {str(f).split("robots/")[-1]: f for f in files}
     arms = {
         "UR5": ("ur_description/urdf/ur5_robot.urdf", "tool0"),
         "Panda": ("panda_description/urdf/panda.urdf", "panda_hand"),
     }
-    return {name: (paths[path].locate().read_text(), tip) for name, (path, tip) in arms.items()}
+    return {name: (Path(paths[path].locate()), tip) for name, (path, tip) in arms.items()}
 
 
-URDF_ARMS = _urdf_arms()
+URDF_PATHS = _urdf_paths()
+URDF_ARMS = {name: (path.read_text(), tip) for name, (path, tip) in URDF_PATHS.items()}
 
 
 def kernel_generation() -> tuple[list[Row], dict]:
@@ -375,7 +373,7 @@ def main() -> None:
     pm = pinocchio_model(model)  # the builder the tests check against our core
     data = pm.createData()
     generation, source_lines = kernel_generation()  # first: on fresh models, before any warm-up
-    rows = single_state(model, pm, data) + batch(model, pm, data) + generation + urdf_arms()
+    rows = single_state(model, pm, data) + batch(model, pm, data) + generation + preparation(URDF_PATHS) + urdf_arms()
     print_table(rows, "irb140_dynamics core vs Pinocchio (ratio = ours / baseline)")
     path = write_results(
         "core",

@@ -6,6 +6,7 @@ array([  0.   , 243.382,  79.156,  -0.   ,   2.43 ,   0.   ])
 """
 
 from irb140_dynamics.core.dynamics import (
+    Preparation,
     coriolis,
     coriolis_batch,
     coriolis_matrix,
@@ -15,6 +16,7 @@ from irb140_dynamics.core.dynamics import (
     gravity_batch,
     mass_matrix,
     mass_matrix_batch,
+    prepare,
     rnea,
     rnea_batch,
 )
@@ -38,6 +40,7 @@ from irb140_dynamics.core.payload import (
 
 __all__ = [
     "DH",
+    "Preparation",
     "Friction",
     "Joint",
     "MaxPayload",
@@ -68,6 +71,7 @@ __all__ = [
     "mass_matrix_batch",
     "max_payload_at",
     "read_parameter_file",
+    "prepare",
     "rnea",
     "rnea_batch",
     "workspace_load",

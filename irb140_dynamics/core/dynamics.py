@@ -6,7 +6,9 @@ M includes the joints' armature (rotor inertia); tau_f is joint friction (see ``
 
 Single-state functions take sequences of n numbers and return NumPy arrays; the
 ``*_batch`` forms take arrays shaped (N, n) and give the same numbers for N states at once.
-All run the model's generated kernels (see ``codegen``), compiled on first use. What a
+All run the model's generated kernels (see ``codegen``), traced on first use; the
+single-state ``rnea``, ``gravity`` and ``mass_matrix`` run them as C once compiled: in the
+background after PROMOTE_AFTER calls, or at once with ``prepare(model, timeout)``. What a
 state is, and the checks of each argument, are in ``states``: anything else raises
 ValueError naming the argument (the kernels fold constants: a NaN times a zero constant
 would vanish). A result is never silently non-finite: where velocities, accelerations,
@@ -22,14 +24,29 @@ from math import isfinite
 
 import numpy as np
 
-from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.codegen.kernels import Preparation, kernels_of, prepare
+
+__all__ = [  # prepare, Preparation: compile a model's kernels now (see codegen.kernels)
+    "Preparation",
+    "coriolis",
+    "coriolis_batch",
+    "coriolis_matrix",
+    "forward_dynamics",
+    "forward_dynamics_batch",
+    "gravity",
+    "gravity_batch",
+    "mass_matrix",
+    "mass_matrix_batch",
+    "prepare",
+    "rnea",
+    "rnea_batch",
+]
 from irb140_dynamics.core.codegen.layout import upper_to_full
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.model.states import finite_result, finite_results, state, states
 
 ArrayLike = Sequence[float] | np.ndarray
 _ARRAY, _FLOAT64 = np.ndarray, np.dtype(float)
-_frombuffer = np.frombuffer  # a native kernel's ctypes array as a NumPy array, without a copy
 
 
 def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=None) -> np.ndarray:
@@ -41,6 +58,13 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
     it: tau = ID(q, qd, qdd) - J(q)^T f_ext, with J the flange Jacobian in the flange frame.
     """
     kernels = kernels_of(model)
+    if f_ext is None:
+        kernel = kernels.rnea_with_friction
+        if kernel.native is not None:  # checks the arrays itself: None unless (n,) float64, finite
+            tau = kernel.native(q, qd, qdd)
+            if tau is not None:
+                return tau
+        kernel.used()
     shape = kernels.shape
     if (  # the common case checked at once, inline: rnea is the hot path
         type(q) is _ARRAY
@@ -53,42 +77,38 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
         and qd.shape == shape
         and qdd.shape == shape
     ):
-        kernel = kernels.rnea
-        if f_ext is None and kernel.native is not None:
-            tau = kernel.native(q.tobytes() + qd.tobytes() + qdd.tobytes())
-            if tau is not None:  # else not finite: the Python form below says which
-                friction = model.friction  # added as the Python form adds it: the same floats
-                return _frombuffer(tau) if friction is None else np.array(friction.added(tau, qd.tolist()))
-        kernel.used()
         args = q.tolist(), qd.tolist(), qdd.tolist()
         if not isfinite(sum(args[2], sum(args[1], sum(args[0])))):  # a finite sum: all finite
             args = (state(q, kernels.n, "q"), state(qd, kernels.n, "qd"), state(qdd, kernels.n, "qdd"))
     else:
         args = (state(q, kernels.n, "q"), state(qd, kernels.n, "qd"), state(qdd, kernels.n, "qdd"))
-    tau = kernels.rnea.scalar(*args) if f_ext is None else kernels.rnea_wrench.scalar(*args, state(f_ext, 6, "f_ext"))
+    if f_ext is None:  # friction inside
+        tau = kernels.rnea_with_friction.scalar(*args)
+    else:
+        tau = kernels.rnea_wrench.scalar(*args, state(f_ext, 6, "f_ext"))
+        if model.friction is not None:
+            tau = model.friction.added(tau, args[1])
     if not isfinite(sum(tau)):  # inline: rnea is the hot path
         finite_result(tau, "rnea", q=q, qd=qd, qdd=qdd, **({} if f_ext is None else {"f_ext": f_ext}))
-    if model.friction is None:
-        return np.array(tau)
-    return np.array(model.friction.added(tau, args[1]))
+    return np.array(tau)
 
 
 def gravity(model: RobotModel, q: ArrayLike) -> np.ndarray:
     """Gravity torques g(q) [N m]: what holds the arm (and payload) still at q."""
     kernels = kernels_of(model)
+    kernel = kernels.gravity_torques
+    if kernel.native is not None:
+        g = kernel.native(q)
+        if g is not None:
+            return g
+    kernel.used()
     if type(q) is _ARRAY and q.dtype is _FLOAT64 and q.shape == kernels.shape:  # the common case, inline
-        kernel = kernels.gravity_torques
-        if kernel.native is not None:
-            g = kernel.native(q.tobytes())
-            if g is not None:
-                return _frombuffer(g)
-        kernel.used()
         q_list = q.tolist()
         if not isfinite(sum(q_list)):
             q_list = state(q, kernels.n, "q")
     else:
         q_list = state(q, kernels.n, "q")
-    return np.array(kernels.gravity_torques.scalar(q_list))
+    return np.array(kernel.scalar(q_list))
 
 
 def coriolis(model: RobotModel, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
@@ -106,14 +126,13 @@ def coriolis_matrix(model: RobotModel, q: ArrayLike, qd: ArrayLike) -> np.ndarra
 
 def mass_matrix(model: RobotModel, q: ArrayLike) -> np.ndarray:
     """The joint-space mass matrix M(q) [kg m^2], symmetric positive definite."""
-    kernels = kernels_of(model)
-    kernel, n = kernels.mass_matrix, kernels.n
-    if type(q) is _ARRAY and q.dtype is _FLOAT64 and q.shape == kernels.shape:
-        if kernel.native is not None:
-            M = kernel.native(q.tobytes())  # the whole matrix, row by row
-            if M is not None:
-                return _frombuffer(M).reshape(n, n)
-        kernel.used()
+    kernel = kernels_of(model).mass_matrix
+    if kernel.native is not None:
+        M = kernel.native(q)  # the whole matrix
+        if M is not None:
+            return M
+    kernel.used()
+    n = model.n
     upper = kernel.scalar(state(q, n, "q"))
     return np.fromiter(upper, float, len(upper))[upper_to_full(n)]
 

@@ -40,7 +40,7 @@ from irb140_dynamics.identification.correlation import residual_correlation
 from irb140_dynamics.identification.least_squares import Estimate, NormalEquations, weighted_least_squares
 from irb140_dynamics.identification.recording import CHUNK_SIZE, DEFAULT_TOPIC, Recording, RecordingError
 from irb140_dynamics.identification.selection import Selection, rows_used, select
-from irb140_dynamics.identification.signals import DEFAULT_CUTOFF, Differentiator, FilterDesign, FitPoints, _joined
+from irb140_dynamics.identification.signals import DEFAULT_CUTOFF, Differentiator, FilterDesign, FitPoints, joined
 
 SLOW_SPEEDS = 3.0  # min_speed in smoothing velocities
 FIT_BATCH = 8192  # fit points gathered before the regressor and the sums run: few, large array operations
@@ -206,7 +206,7 @@ def read_fit_points(prior, recording, settings, progress) -> tuple[SampleTally, 
     tally.skipped = recording.skipped
     if times:
         tally.start, tally.end = min(times), max(times)
-    points = _joined(parts)
+    points = joined(parts)
     tally.fit_points = 0 if points is None else len(points)
     return tally, points
 

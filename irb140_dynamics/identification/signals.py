@@ -127,7 +127,7 @@ class Differentiator:
                 self._close()
             self._extend(index[a:b], time[a:b], values[a:b])
             outputs.append(self._emit())
-        return _joined([p for p in outputs if p is not None])
+        return joined([p for p in outputs if p is not None])
 
     def finish(self) -> None:
         """End of the recording: the open segment's last half window is left out."""
@@ -171,7 +171,7 @@ class Differentiator:
         self._segment, self._length = None, 0
 
 
-def _joined(parts: list[FitPoints]) -> FitPoints | None:
+def joined(parts: list[FitPoints]) -> FitPoints | None:
     if not parts:
         return None
     if len(parts) == 1:

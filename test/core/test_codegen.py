@@ -2,11 +2,12 @@
 
 import ast
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from irb140_dynamics.core import coriolis, coriolis_matrix, gravity, irb140, mass_matrix, rnea
+from irb140_dynamics.core import Friction, coriolis, coriolis_matrix, gravity, irb140, mass_matrix, rnea
 from irb140_dynamics.core.algorithms import recursions as algorithms
 from irb140_dynamics.core.codegen.kernels import kernels_of
 
@@ -126,3 +127,16 @@ def test_irb140_gravity_kernel_has_no_trivial_operations():
 @pytest.mark.parametrize("kernel", ["rnea", "rnea_wrench", "coriolis", "mass_matrix", "coriolis_matrix"])
 def test_other_irb140_kernels_have_no_trivial_operations(kernel):
     assert trivial_operations(getattr(kernels_of(loaded_irb140()), kernel).source) == []
+
+
+@pytest.mark.parametrize("coulomb", [0.0, 1.5])
+def test_rnea_with_friction_adds_it_as_the_friction_model_does(coulomb):
+    model = loaded_irb140()
+    model = replace(
+        model, joints=tuple(replace(j, friction=Friction(0.3 * i, coulomb)) for i, j in enumerate(model.joints))
+    )
+    kernels = kernels_of(model)
+    for q, qd, qdd in zip(*random_states(np.random.default_rng(34), model.n, 100)):
+        q, qd, qdd = q.tolist(), qd.tolist(), qdd.tolist()
+        want = model.friction.added(kernels.rnea.scalar(q, qd, qdd), qd)
+        assert list(kernels.rnea_with_friction.scalar(q, qd, qdd)) == want

@@ -1,6 +1,8 @@
 """Models that differ only in payload or gravity share their compiled kernels (the payload
 and gravity are an argument, only their zeros folded), with the same numbers as ever."""
 
+import threading
+
 import numpy as np
 
 from irb140_dynamics.core import RigidBody, RobotModel, gravity, irb140, mass_matrix, rnea
@@ -55,3 +57,20 @@ def test_shared_code_gives_each_model_its_own_torques():
             assert gravity(fresh, q).tolist() == g.tolist()
             assert mass_matrix(fresh, q).tolist() == M.tolist()
         kernel_module._arm.cache_clear()
+
+
+def test_threads_asking_at_once_get_one_kernel():
+    kernel_module._arm.cache_clear()
+    model = irb140(payload=RigidBody(1.25, (0.0, 0.0, 0.02)))
+    start, got = threading.Barrier(4), []
+
+    def ask():
+        start.wait()
+        got.append(kernels_of(model).kernel("mass_matrix"))
+
+    threads = [threading.Thread(target=ask) for _ in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(timeout=60.0)
+    assert len(got) == 4 and all(kernel is got[0] for kernel in got)

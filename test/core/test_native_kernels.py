@@ -3,6 +3,7 @@ numbers bit for bit, refuses what the Python form refuses, and is only ever an
 acceleration: without a compiler, with IRB140_NATIVE=0, or when compiling fails, the
 Python form answers. The session's cache is its own (test/conftest.py)."""
 
+import contextlib
 import os
 import shutil
 import subprocess
@@ -14,9 +15,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from irb140_dynamics.core import Friction, RigidBody, gravity, irb140, mass_matrix, rnea
-from irb140_dynamics.core.codegen import native
-from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core import Friction, RigidBody, gravity, irb140, mass_matrix, prepare, rnea
+from irb140_dynamics.core.codegen import c_code, native
+from irb140_dynamics.core.codegen.kernels import NATIVE_KERNELS, WITH_FRICTION, kernels_of
 from irb140_dynamics.core.urdf import load_urdf
 
 from ..support.common import OFFSET_PAYLOAD
@@ -129,14 +130,14 @@ def test_non_finite_inputs_and_results_are_refused_as_by_the_python_form():
         rnea(model, q, np.full(6, 1e200), q)
 
 
-def test_friction_is_added_to_native_torques_and_a_flange_wrench_takes_the_python_form():
+def test_friction_is_inside_the_native_torques_and_a_flange_wrench_takes_the_python_form():
     def with_friction():
         model = irb140(payload=OFFSET_PAYLOAD)
         return replace(model, joints=tuple(replace(j, friction=Friction(0.5, 2.0)) for j in model.joints))
 
-    model, python_model = promoted(with_friction()), with_friction()
+    model, python_model = promoted(with_friction(), (WITH_FRICTION,)), with_friction()
     assert model.friction is not None
-    kernel = kernels_of(model).rnea
+    kernel = kernels_of(model).rnea_with_friction
     for q, qd, qdd in zip(*states(model, count=50, seed=8)):
         calls = kernel._calls
         np.testing.assert_array_equal(rnea(model, q, qd, qdd), rnea(python_model, q, qd, qdd))
@@ -172,7 +173,7 @@ def test_a_compile_that_fails_leaves_the_python_form(monkeypatch):
 
 
 def test_a_library_is_compiled_once_and_then_loaded_from_the_cache():
-    source, _, _ = native.c_source(kernels_of(irb140()).gravity_torques.native_recipe()[0])
+    source, _, _ = c_code.kernel_source(kernels_of(irb140()).gravity_torques.program)
     path = native.library(source)
     stamp = path.stat().st_mtime_ns
     assert native.library(source) == path and path.stat().st_mtime_ns == stamp
@@ -185,13 +186,14 @@ def test_waiting_with_nothing_asked_for_returns_at_once():
 
 def test_the_check_before_use_compares_bits():
     python = lambda q, k=(): [0.0, 1.0]  # noqa: E731
-    native_form = lambda inputs: (native.ctypes.c_double * 2)(-0.0, 1.0)  # noqa: E731
-    assert not native.same_as_python(native_form, python, 1, [1], 0)
+    native_form = lambda q: np.array([-0.0, 1.0])  # noqa: E731
+    assert not native.same_as_python(native_form, python, [1], 0)
+    assert native.same_as_python(lambda q: np.array([0.0, 1.0]), python, [1], 0)
 
 
 @pytest.mark.parametrize("damage", ["truncated", "emptied", "garbage"])
 def test_a_damaged_library_in_the_cache_is_compiled_again(damage):
-    source, _, _ = native.c_source(kernels_of(irb140(payload=OFFSET_PAYLOAD)).gravity_torques.native_recipe()[0])
+    source, _, _ = c_code.kernel_source(kernels_of(irb140(payload=OFFSET_PAYLOAD)).gravity_torques.program)
     path = native.library(source)
     whole = path.read_bytes()
     path.unlink()  # a new file: this process may have the library loaded, and writing into it would crash it
@@ -209,7 +211,7 @@ def test_stale_working_folders_are_removed_by_a_compile(monkeypatch):
         (work / "kernel.c").write_text("")
     os.utime(old, (0, time.time() - native.STALE_AFTER - 10.0))
     monkeypatch.setattr(native, "FLAGS", (*native.FLAGS, "-DSTALE_TEST"))  # not cached: compiled
-    native.library(native.c_source(kernels_of(irb140()).gravity_torques.native_recipe()[0])[0])
+    native.library(c_code.kernel_source(kernels_of(irb140()).gravity_torques.program)[0])
     assert not old.exists() and recent.exists()
     shutil.rmtree(recent)
 
@@ -275,7 +277,83 @@ def test_a_cache_folder_others_can_write_to_is_not_used(tmp_path, monkeypatch):
     (shared / "irb140_dynamics" / "kernels").mkdir(parents=True)
     (shared / "irb140_dynamics" / "kernels").chmod(0o777)
     monkeypatch.setenv("IRB140_CACHE", str(shared))
-    source, _, _ = native.c_source(kernels_of(irb140()).gravity_torques.native_recipe()[0])
+    source, _, _ = c_code.kernel_source(kernels_of(irb140()).gravity_torques.program)
     with pytest.raises(OSError, match="not private to this user"):
         native.library(source)
     assert list((shared / "irb140_dynamics" / "kernels").iterdir()) == []
+
+
+def test_without_python_headers_the_kernels_are_called_through_ctypes(monkeypatch):
+    monkeypatch.setattr(native, "headers", lambda: None)
+    monkeypatch.setattr(native, "COMPILER", native._Compiler())  # nothing built by this process yet
+    model = promoted(frictionless(irb140(payload=OFFSET_PAYLOAD)))
+    assert isinstance(kernels_of(model).rnea.native, native.CtypesKernel)
+    python_model = frictionless(irb140(payload=OFFSET_PAYLOAD))
+    for q, qd, qdd in zip(*states(model, count=50)):
+        np.testing.assert_array_equal(rnea(model, q, qd, qdd), rnea(python_model, q, qd, qdd))
+        np.testing.assert_array_equal(mass_matrix(model, q), mass_matrix(python_model, q))
+    assert kernels_of(model).rnea.native(q.tolist(), qd, qdd) is None  # not arrays: the Python form's
+
+
+def test_prepare_compiles_now_and_the_verbs_then_answer_natively():
+    model = irb140(payload=RigidBody(2.5, (0.01, 0.0, 0.05)))
+    done = prepare(model, timeout=120.0)
+    assert done.native and not done.compiling and done.seconds > 0.0
+    kernels = kernels_of(model)
+    calls = [kernels.kernel(name)._calls for name in NATIVE_KERNELS]
+    q = np.full(6, 0.4)
+    python_model = irb140(payload=RigidBody(2.5, (0.01, 0.0, 0.05)))
+    with native_off():
+        want = rnea(python_model, q, q, q), gravity(python_model, q), mass_matrix(python_model, q)
+    for got, expected in zip((rnea(model, q, q, q), gravity(model, q), mass_matrix(model, q)), want):
+        np.testing.assert_array_equal(got, expected)
+    assert [kernels.kernel(name)._calls for name in NATIVE_KERNELS] == calls  # native answered
+    assert prepare(model).native  # already: at once
+
+
+def test_prepare_without_native_code_says_so(monkeypatch):
+    monkeypatch.setenv("IRB140_NATIVE", "0")
+    done = prepare(irb140().with_gravity((0.0, 0.2, -9.8)), timeout=60.0)
+    assert not done.native and not done.compiling
+
+
+def test_prepare_past_its_timeout_leaves_the_compile_running_and_python_answering(tmp_path, monkeypatch):
+    slow = tmp_path / "slow-cc"  # a compiler that takes its time
+    slow.write_text(f'#!/bin/sh\nsleep 3\nexec {native.compiler()} "$@"\n')
+    slow.chmod(0o755)
+    monkeypatch.setenv("CC", str(slow))
+    model = irb140().with_gravity((0.1, -0.2, -9.8))  # a pattern of zeros no other test compiles
+    done = prepare(model, timeout=0.5, names=("gravity_torques",))
+    assert not done.native and done.compiling and done.seconds < 3.0
+    q = np.full(6, 0.1)
+    np.testing.assert_array_equal(gravity(model, q), np.array(kernels_of(model).gravity_torques.scalar(q.tolist())))
+    assert native.COMPILER.wait(timeout=120.0)
+    assert kernels_of(model).gravity_torques.native is not None  # in the background, done
+
+
+@contextlib.contextmanager
+def native_off():
+    before = os.environ.get("IRB140_NATIVE")
+    os.environ["IRB140_NATIVE"] = "0"
+    try:
+        yield
+    finally:
+        os.environ.pop("IRB140_NATIVE") if before is None else os.environ.__setitem__("IRB140_NATIVE", before)
+
+
+def test_the_extension_takes_any_float64_vector_and_leaves_the_rest_to_the_python_form():
+    model = promoted(frictionless(irb140(payload=OFFSET_PAYLOAD)))
+    python_model = frictionless(irb140(payload=OFFSET_PAYLOAD))
+    Q = np.random.default_rng(4).uniform(-2.0, 2.0, (6, 3))
+    column = Q[:, 1]  # strided
+    readonly = Q[:, 2].copy()
+    readonly.flags.writeable = False
+    swapped = Q[:, 0].astype(">f8")
+    for q in (column, readonly, swapped, Q[:, 0].astype(np.float32), Q[:, 0].tolist()):
+        want = rnea(python_model, np.array(q, dtype=float), column, readonly)
+        np.testing.assert_array_equal(rnea(model, q, column, readonly), want)
+        np.testing.assert_array_equal(mass_matrix(model, q), mass_matrix(python_model, np.array(q, dtype=float)))
+    native_rnea = kernels_of(model).rnea.native
+    assert native_rnea(swapped, column, readonly) is None  # byte-swapped: the Python form converts it
+    assert native_rnea(column, column) is None and native_rnea(Q, Q, Q) is None
+    assert native_rnea(column, column, column) is not None

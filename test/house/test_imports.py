@@ -17,6 +17,7 @@ PACKAGE = "irb140_dynamics"
 # importlib used on purpose, and what it loads: never a module of this package.
 IMPORTLIB_ALLOWED = {
     "irb140_dynamics/ros/recorder.py": "message classes of a recorded topic's type (sensor_msgs.msg, ...)",
+    "irb140_dynamics/core/codegen/native.py": "a kernel's extension module, compiled from generated C into the cache",
 }
 
 
@@ -97,3 +98,13 @@ def test_a_cycle_inside_a_function_is_found(package_copy):
     model = package_copy / PACKAGE / "core" / "model" / "robot_model.py"
     model.write_text(model.read_text() + "\n\ndef _late():\n    from irb140_dynamics.core import dynamics  # noqa\n")
     assert any("irb140_dynamics.core.model.robot_model" in cycle for cycle in import_cycles(package_copy))
+
+
+def test_no_module_imports_another_modules_private_names():
+    found = []
+    for path in sorted((ROOT / PACKAGE).rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module != "__future__":
+                private = [a.name for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
+                found += [f"{path.relative_to(ROOT)}:{node.lineno} {name}" for name in private]
+    assert found == []

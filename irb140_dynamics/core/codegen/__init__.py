@@ -1,8 +1,10 @@
-"""Generated code: an algorithm of ``core.algorithms`` traced into straight-line Python for
-one model (``trace``), an array form writing into given buffers (``array_code``), and the
-compiled kernels of a model, cached per arm (``kernels``: ``kernels_of(model)``), and the
-same code compiled as C for the single-state verbs (``native``). Models do not import this
-room; the public verbs (``core.dynamics``) call ``kernels_of``.
+"""Generated code: an algorithm of ``core.algorithms`` traced once per model (``trace``)
+into one intermediate form (``program``: single assignments), which three emitters read:
+straight-line Python on floats or NumPy arrays (``python_code``), a NumPy form writing into
+given buffers (``array_code``) and C (``c_code``), compiled as a CPython extension for the
+single-state verbs (``native``). ``kernels`` keeps each model's kernels, found by name in
+one table and shared per arm (``kernels_of(model)``). Models do not import this room; the
+public verbs (``core.dynamics``) call ``kernels_of``.
 
 May import: ``core.algorithms``, ``core.model``, ``core.scalars``.
 """

@@ -24,98 +24,107 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from irb140_dynamics.core.codegen.trace import Sym, angle_lines, input_lines, merged, operand, operands_first, trace
+from irb140_dynamics.core.codegen.program import ANGLES, Program
+from irb140_dynamics.core.codegen.python_code import constant, unpacked
 
-_UFUNCS = {"*": "mul", "+": "add", "-": "sub"}
+_UFUNCS = {"*": "mul", "+": "add", "-": "sub", "/": "div", "neg": "neg", "tanh": "tanh"}
 _NAMESPACE = {
     "cos": np.cos,
     "sin": np.sin,
     "mul": np.multiply,
     "add": np.add,
     "sub": np.subtract,
+    "div": np.divide,
     "neg": np.negative,
+    "tanh": np.tanh,
     "empty": np.empty,
 }
 
 
-def compile_into(
-    name: str,
-    algorithm: Callable[..., Sequence],
-    inputs: dict[str, int],
-    angles: Sequence[float] | None = None,
-    scalars: Sequence[str] = (),
-) -> tuple[str, Callable, list[int]]:
-    """Trace ``algorithm`` like ``codegen.compile_kernel`` and compile its writing array form.
+def compile_into(program: Program, scalars: Sequence[str] = ()) -> tuple[str, Callable, list[int]]:
+    """The writing array form of ``program``: (source, fn, written).
 
-    Returns (source, fn, written): ``fn(out, *groups)`` takes ``out``, a sequence with a
-    writable (N,) array at each index in ``written`` (the others are not touched), and the
-    input groups as arrays of shape (length, N) (the groups named in ``scalars`` as floats).
+    ``fn(out, *groups)`` takes ``out``, a sequence with a writable (N,) array at each index
+    in ``written`` (the others, folded to constants, are not touched), and the argument
+    groups as arrays of shape (length, N) (the groups named in ``scalars`` as floats).
     """
-    params, outputs = trace(algorithm, inputs, angles)
-    scalar_vars = {f"{group}{i}" for group in scalars for i in range(inputs[group])}
-    body, used, first_array, registers = _emit_into(outputs, scalar_vars)
-    written = [j for j, out in enumerate(outputs) if isinstance(out, Sym)]
-    lines = [f"def {name}_into({', '.join(['out', *params])}):"]
-    lines += input_lines(inputs, angles)
-    lines += angle_lines(angles, used)
+    source, written = into_source(program, scalars)
+    namespace = dict(_NAMESPACE)
+    exec(compile(source, f"<{program.name}_into>", "exec"), namespace)
+    return source, namespace[f"{program.name}_into"], written
+
+
+def into_source(program: Program, scalars: Sequence[str] = ()) -> tuple[str, list[int]]:
+    """(the source of ``<name>_into``, see compile_into; the outputs it writes). Its names:
+    cos, sin, tanh, mul, add, sub, div, neg (NumPy's ufuncs) and empty (np.empty)."""
+    scalar_vars = {f"{group}{i}" for group in scalars for i in range(program.group(group))}
+    body, first_array, registers = _emit_into(program, scalar_vars)
+    written = [j for j, out in enumerate(program.outputs) if isinstance(out, int)]
+    lines = [f"def {program.name}_into({', '.join(['out', *(group for group, _ in program.groups)])}):"]
+    lines += unpacked(program)
     lines += [f"    o{j} = out[{j}]" for j in written]
     if registers:
         lines.append(f"    {''.join(f'r{i}, ' for i in range(registers))}= empty(({registers}, len({first_array})))")
     lines += body
-    source = "\n".join(lines) + "\n"
-    namespace = dict(_NAMESPACE)
-    exec(compile(source, f"<{name}_into>", "exec"), namespace)
-    return source, namespace[f"{name}_into"], written
+    return "\n".join(lines) + "\n", written
 
 
-def _emit_into(outputs: list, scalar_vars: set[str]):
-    """(body lines, the input variables used, an array input's name, buffers needed)."""
-    outputs = merged(outputs)
-    order = operands_first(outputs)
-    scalar = set()  # ids of the nodes that depend on scalar inputs only
+def _emit_into(program: Program, scalar_vars: set[str]):
+    """(body lines, an array input's name, buffers needed)."""
+    ops, outputs = program.ops, program.outputs
+    scalar = set()  # indices of the operations that depend on scalar inputs only
     last_use = {}
-    for k, x in enumerate(order):
-        if (x.name in scalar_vars) if x.op == "var" else all(id(a) in scalar for a in x.args if isinstance(a, Sym)):
-            scalar.add(id(x))
-        for a in x.args:
-            if isinstance(a, Sym):
-                last_use[id(a)] = k
-    destination = {}  # an output's node -> the output it is computed into
+    for k, (op, args) in enumerate(ops):
+        operands = () if op == "in" else [a for a in (args[:1] if op in ANGLES else args) if isinstance(a, int)]
+        if (args[0] in scalar_vars) if op == "in" else all(a in scalar for a in operands):
+            scalar.add(k)
+        for a in operands:
+            last_use[a] = k
+    destination = {}  # an output's operation -> the output it is computed into
     for j, out in enumerate(outputs):
-        if isinstance(out, Sym) and out.op != "var" and id(out) not in scalar:
-            destination.setdefault(id(out), f"o{j}")
+        if isinstance(out, int) and ops[out][0] not in ("in", *ANGLES) and out not in scalar:
+            destination.setdefault(out, f"o{j}")
 
     names: dict[int, str] = {}
     lines: list[str] = []
     buffers: set[str] = set()
     free: list[str] = []  # buffers whose values are dead, the most recently freed last
-    for k, x in enumerate(order):
-        if x.op == "var":
-            names[id(x)] = x.name
+    for k, (op, args) in enumerate(ops):
+        if op == "in":
+            names[k] = args[0]
             continue
-        operands = [names[id(a)] if isinstance(a, Sym) else operand(a, None) for a in x.args]
-        if id(x) in scalar:
-            expr = f"-{operands[0]}" if x.op == "neg" else f"{operands[0]} {x.op} {operands[1]}"
-            names[id(x)] = f"t{k}"
+        if op in ANGLES:  # an array of its own, computed as the Python form does
+            q = names[args[0]]
+            names[k] = f"{op[0]}{q[1:]}"
+            lines.append(f"    {names[k]} = {op}({q if args[1] == 0.0 else f'{q} + {args[1]!r}'})")
+            continue
+        operands = [names[a] if isinstance(a, int) else constant(a) for a in args]
+        if k in scalar:
+            expr = (
+                f"{op}({operands[0]})"
+                if op == "tanh"
+                else f"-{operands[0]}"
+                if op == "neg"
+                else f"{operands[0]} {op} {operands[1]}"
+            )
+            names[k] = f"t{k}"
             lines.append(f"    t{k} = {expr}")
             continue
-        for a in {id(a): a for a in x.args if isinstance(a, Sym)}.values():
-            name = names[id(a)]
-            if last_use[id(a)] == k and name in buffers:
+        for a in {a for a in args if isinstance(a, int)}:
+            name = names[a]
+            if last_use[a] == k and name in buffers:
                 free.append(name)
-        if id(x) in destination:
-            target = destination[id(x)]
+        if k in destination:
+            target = destination[k]
         elif free:
             target = free.pop()
         else:
             target = f"r{len(buffers)}"
             buffers.add(target)
-        call = "neg" if x.op == "neg" else _UFUNCS[x.op]
-        lines.append(f"    {call}({', '.join(operands)}, {target})")
-        names[id(x)] = target
+        lines.append(f"    {_UFUNCS[op]}({', '.join(operands)}, {target})")
+        names[k] = target
     for j, out in enumerate(outputs):
-        if isinstance(out, Sym) and destination.get(id(out)) != f"o{j}":
-            lines.append(f"    o{j}[...] = {names[id(out)]}")
-    used = {x.name for x in order if x.op == "var"}
-    first_array = next((x.name for x in order if x.op == "var" and x.name not in scalar_vars), None)
-    return lines, used, first_array, len(buffers)
+        if isinstance(out, int) and destination.get(out) != f"o{j}":
+            lines.append(f"    o{j}[...] = {names[out]}")
+    first_array = next((args[0] for op, args in ops if op == "in" and args[0] not in scalar_vars), None)
+    return lines, first_array, len(buffers)

@@ -1,15 +1,17 @@
-"""A kernel's straight-line code compiled as C, for the single-state public functions.
+"""A kernel's program compiled as C (see ``c_code``), for the single-state public functions.
 
-The traced code of a kernel (see ``trace``) is plain arithmetic on doubles, cos and sin: the
-same text is C. Compiled without contraction or fast-math (``-ffp-contract=off``: no fused
-multiply-add) and with cos and sin left to libm, the C performs the very operations of the
-Python code in the same order, so its results are the same, bit for bit. That is checked
-before a native kernel is used: on random inputs it must equal the Python kernel exactly,
-else it is never used.
+Compiled without contraction or fast-math (``-ffp-contract=off``: no fused multiply-add)
+and with cos, sin and tanh left to libm, the C performs the very operations of the Python
+form in the same order, so its results are the same, bit for bit. That is checked before a
+native kernel is used: on random inputs it must equal the Python kernel exactly, else it is
+never used. It is built as a CPython extension module (Python.h and NumPy's headers) whose
+functions take NumPy arrays directly; where Python.h is missing, as a plain library called
+through ctypes (slower per call, same numbers).
 
-Compiling takes a C compiler (``$CC``, ``cc`` or ``gcc``), so no call waits for it: a
-kernel whose Python form has run ``PROMOTE_AFTER`` times is compiled by one background
-thread (the compiler at the lowest CPU priority), and calls use the native code once it is
+Compiling takes a C compiler (``$CC``, ``cc`` or ``gcc``), so no call of a kernel waits
+for it: one background thread compiles the kernels asked for (the compiler at the lowest
+CPU priority), a kernel whose Python form has run ``PROMOTE_AFTER`` times, or those that
+``kernels.prepare`` asks for first and waits for, and calls use the native code once it is
 ready. Without a compiler, or with ``IRB140_NATIVE=0``, everything stays in Python; so does
 a kernel whose compile fails in any way (no usable cache folder, a ``$CC`` that is not a
 compiler): the caller never sees it. Libraries are kept in ``$IRB140_CACHE`` (else
@@ -25,34 +27,39 @@ from __future__ import annotations
 
 import array
 import atexit
+import collections
 import contextlib
 import ctypes
 import hashlib
+import importlib.machinery
+import importlib.util
 import os
 import platform
-import queue
 import random
 import shutil
 import signal
 import subprocess
 import sys
+import sysconfig
 import tempfile
 import threading
 import time
 from pathlib import Path
 
+import numpy as np
+
+from irb140_dynamics.core.codegen import c_code
 from irb140_dynamics.core.codegen.layout import whole_matrix
-from irb140_dynamics.core.codegen.trace import _emit, angle_lines, merged, trace
 
 PROMOTE_AFTER = 1000  # calls of a kernel's Python form before it is compiled
 CHECKS = 20  # random inputs on which the native code must equal the Python code exactly
 FLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-fast-math", "-fno-builtin")
-COMPILE_TIMEOUT = 120.0  # s
+COMPILE_TIMEOUT = 600.0  # s: a long chain's mass matrix on a busy machine, at the lowest priority
 NICENESS = 19  # of the compiler: the lowest CPU priority, so that a node's loop comes first
 STALE_AFTER = 3600.0  # s: a working folder this old is no running compile's (see library)
 WORKING_PREFIX = "build-"  # a compile's working folder in the cache folder
 FUNCTIONS_KEPT = 64  # compiled kernels kept for the next model of the same arm
-INPUT_NOT_FINITE, OUTPUT_NOT_FINITE = 1, 2  # what a native kernel returns instead of 0
+_FLOAT64 = np.dtype(float)
 
 
 def enabled() -> bool:
@@ -68,41 +75,7 @@ def cache_dir() -> Path:
     return Path(base) / "irb140_dynamics" / "kernels"
 
 
-def c_source(recipe, full_matrix: int = 0) -> tuple[str, int, int]:
-    """(C source, number of input doubles, number of outputs) of a kernel's recipe (see
-    ``kernels.Kernel``): ``int kernel(const double *x, const double *k, double *out)`` with x
-    the inputs (q, then the other groups but k, in order). It returns 0, or
-    INPUT_NOT_FINITE / OUTPUT_NOT_FINITE (then ``out`` is not to be used). With
-    ``full_matrix`` n, the outputs (an upper triangle row by row) are written as the whole
-    n x n matrix. The checks are on the sum of the inputs, then of the outputs: finite
-    values whose sum overflows are sent to the Python form too, which tells them apart."""
-    name, algorithm, inputs, angles = recipe
-    params, outputs = trace(algorithm, inputs, angles)
-    body, results, used = _emit(merged(outputs))
-    if full_matrix:
-        results = whole_matrix(results, full_matrix)
-    lines = ["#include <math.h>", "", "int kernel(const double *x, const double *k, double *out) {"]
-    count = 0
-    for group in params:
-        length = len(angles) if group == "q" else inputs[group]
-        for i in range(length):
-            if group == "k":
-                lines.append(f"    const double k{i} = k[{i}];")
-            else:
-                lines.append(f"    const double {group}{i} = x[{count}];")
-                count += 1
-    lines.append("    double check = 0.0;")
-    lines.append(f"    for (int i = 0; i < {count}; ++i) check += x[i];")
-    lines.append(f"    if (!isfinite(check)) return {INPUT_NOT_FINITE};")
-    lines += [f"    const double {line.strip()};" for line in angle_lines(angles, used) + body]
-    lines += [f"    out[{j}] = {expression};" for j, expression in enumerate(results)]
-    lines.append("    check = 0.0;")
-    lines.append(f"    for (int i = 0; i < {len(results)}; ++i) check += out[i];")
-    lines.append(f"    return isfinite(check) ? 0 : {OUTPUT_NOT_FINITE};")
-    return "\n".join(lines) + "\n}\n", count, len(results)
-
-
-def library(source: str) -> Path:
+def library(source: str, flags: list[str] = ()) -> Path:
     """The shared library of ``source``, compiled unless cached; OSError or
     subprocess.SubprocessError when it cannot be.
 
@@ -116,7 +89,7 @@ def library(source: str) -> Path:
     cc = compiler()
     if cc is None:
         raise OSError("no C compiler")
-    parts = [source, cc, *FLAGS, sys.platform, platform.machine()]
+    parts = [source, cc, *FLAGS, *flags, sys.platform, platform.machine()]
     key = hashlib.sha256("\0".join(parts).encode()).hexdigest()[:32]
     folder = cache_dir()
     folder.mkdir(parents=True, exist_ok=True, mode=0o700)
@@ -130,7 +103,7 @@ def library(source: str) -> Path:
     try:
         (work / "kernel.c").write_text(source)
         built = work / "kernel.so"
-        process = _BUILDS.start([cc, *FLAGS, "kernel.c", "-o", built.name, "-lm"], work)
+        process = _BUILDS.start([cc, *FLAGS, *flags, "kernel.c", "-o", built.name, "-lm"], work)
         try:
             _, error = process.communicate(timeout=COMPILE_TIMEOUT)
         except subprocess.TimeoutExpired:
@@ -247,42 +220,79 @@ class _Builds:
 _BUILDS = _Builds()
 
 
-class NativeKernel:
-    """A compiled kernel with one model's constants: ``(inputs: bytes) -> ctypes array or
-    None`` (None: an input or output not finite; the Python path then says which)."""
+class CtypesKernel:
+    """A kernel loaded with ctypes, where no extension can be built (no Python.h): the
+    extension's call (see c_code) in Python, with one model's constants."""
 
-    def __init__(self, function, constants, outputs: int):
-        self._function = function
-        self._constants = (ctypes.c_double * max(len(constants), 1))(*constants)
-        self._out = ctypes.c_double * outputs
+    def __init__(self, function, constants: bytes, lengths: list[int], shape: tuple[int, ...]):
+        self._function, self._constants = function, constants
+        self._lengths, self._shape = [(length,) for length in lengths], shape
+        self._size = 1
+        for extent in shape:
+            self._size *= extent
 
-    def __call__(self, inputs: bytes):
-        out = self._out()
-        return out if self._function(inputs, self._constants, out) == 0 else None
+    def __call__(self, *arrays):
+        if len(arrays) != len(self._lengths) or not all(
+            type(a) is np.ndarray and a.dtype is _FLOAT64 and a.shape == length
+            for a, length in zip(arrays, self._lengths)
+        ):
+            return None
+        out = np.empty(self._shape)
+        inputs = b"".join(a.tobytes() for a in arrays)
+        return out if self._function(inputs, self._constants, out.ctypes.data) == 0 else None
+
+
+def headers() -> list[str] | None:
+    """The include folders an extension is built with (Python's, NumPy's), or None when
+    Python.h is missing (a Python without its development files)."""
+    include = sysconfig.get_paths()["include"]
+    if not (Path(include) / "Python.h").is_file():
+        return None
+    return [include, np.get_include()]
+
+
+def build(program, full_matrix: int = 0):
+    """The compiled form of ``program`` (compiled or loaded from the cache): (bind, lengths,
+    shape) with ``bind(constants: bytes)`` the kernel with those constants, a function of
+    the argument groups but k (1-D float64 arrays of ``lengths``) -> an array shaped
+    ``shape``, or None (anything else, or not finite)."""
+    lengths = [length for group, length in program.groups if group != "k"]
+    source, _, outputs = c_code.kernel_source(program, full_matrix)
+    shape = (full_matrix, full_matrix) if full_matrix else (outputs,)
+    include = headers()
+    if include is None:
+        function = load(source)
+        return (lambda constants: CtypesKernel(function, constants, lengths, shape)), lengths, shape
+    versions = "\0".join([source, sys.version, np.__version__, *include])
+    name = "k" + hashlib.sha256(versions.encode()).hexdigest()[:24]
+    extension = c_code.extension_source(program, name, full_matrix)
+    path = library(extension, [f"-I{folder}" for folder in include])
+    module = importlib.util.module_from_spec(
+        importlib.util.spec_from_loader(name, importlib.machinery.ExtensionFileLoader(name, str(path)))
+    )
+    module.__spec__.loader.exec_module(module)
+    return module.bind, lengths, shape
 
 
 def load(source: str):
-    """The C function of ``source`` (compiled or loaded from the cache)."""
+    """The C function ``kernel`` of ``source`` through ctypes (compiled or loaded from the cache)."""
     function = ctypes.PyDLL(str(library(source))).kernel  # the GIL stays held: a call is short
     function.restype = ctypes.c_int
-    function.argtypes = (ctypes.c_char_p, ctypes.c_void_p, ctypes.c_void_p)
+    function.argtypes = (ctypes.c_char_p, ctypes.c_char_p, ctypes.c_void_p)
     return function
 
 
-def same_as_python(native: NativeKernel, python, inputs: int, groups: list[int], full_matrix: int) -> bool:
-    """Does ``native`` give exactly the Python kernel's numbers (bound: k defaulted)?"""
+def same_as_python(native, python, lengths: list[int], full_matrix: int) -> bool:
+    """Does ``native`` (arrays -> array or None) give exactly the Python kernel's numbers
+    (bound: k defaulted)?"""
     rng = random.Random(140)
     for _ in range(CHECKS):
-        x = [rng.uniform(-4.0, 4.0) for _ in range(inputs)]
-        args, start = [], 0
-        for length in groups:
-            args.append(x[start : start + length])
-            start += length
+        args = [[rng.uniform(-4.0, 4.0) for _ in range(length)] for length in lengths]
         want = list(python(*args))
         if full_matrix:
             want = whole_matrix(want, full_matrix)
-        got = native(array.array("d", x).tobytes())
-        if got is None or bytes(got) != array.array("d", want).tobytes():  # bits: -0.0 is not 0.0
+        got = native(*(np.array(a) for a in args))
+        if got is None or got.tobytes() != array.array("d", want).tobytes():  # bits: -0.0 is not 0.0
             return False
     return True
 
@@ -291,37 +301,53 @@ class _Compiler:
     """One background thread compiling the kernels asked for, one at a time."""
 
     def __init__(self):
-        self._functions: dict[str, object] = {}  # source -> C function (None: failed), the newest last
+        self._built: dict[tuple, tuple | None] = {}  # (program, full_matrix) -> build() (None: failed), the newest last
         self._restart()
         # a forked child has no worker thread, and its lock may have been held by another thread
         os.register_at_fork(after_in_child=self._restart)
 
     def _restart(self) -> None:
-        self._lock = threading.Lock()
-        self._requests: queue.Queue = queue.Queue()
+        self._ready = threading.Condition(threading.Lock())
+        self._requests: collections.deque = collections.deque()  # kernels and Events, the next first
         self._thread: threading.Thread | None = None
 
-    def _started(self) -> queue.Queue:
-        """The queue of requests, with the worker thread started to take them."""
-        with self._lock:
+    def _put(self, items: list, first: bool = False) -> None:
+        """Queue ``items`` (at the front, in their order, with ``first``), the worker thread
+        started to take them."""
+        with self._ready:
             if self._thread is None:
                 self._thread = threading.Thread(target=self._run, name="irb140-native", daemon=True)
                 self._thread.start()
-            return self._requests
+            if first:
+                self._requests.extendleft(reversed(items))
+            else:
+                self._requests.extend(items)
+            self._ready.notify()
 
     def request(self, kernel) -> None:
-        self._started().put(kernel)
+        self._put([kernel])
 
     def wait(self, timeout: float | None = None) -> bool:
         """Until every kernel asked for so far (in this process) is compiled or given up:
         True if so in time. Nothing asked for: True at once."""
         done = threading.Event()
-        self._started().put(done)
+        self._put([done])
+        return done.wait(timeout)
+
+    def compile_now(self, kernels: list, timeout: float | None = None) -> bool:
+        """Compile ``kernels`` before anything asked for earlier and wait until they are
+        compiled or given up, at most ``timeout`` s: True if so in time (else they are
+        compiled in the background)."""
+        done = threading.Event()
+        self._put([*kernels, done], first=True)
         return done.wait(timeout)
 
     def _run(self) -> None:
         while True:
-            kernel = self._requests.get()
+            with self._ready:
+                while not self._requests:
+                    self._ready.wait()
+                kernel = self._requests.popleft()
             if isinstance(kernel, threading.Event):
                 kernel.set()
                 continue
@@ -331,23 +357,25 @@ class _Compiler:
                 kernel.native = None
 
     def _native(self, kernel):
-        recipe, full_matrix = kernel.native_recipe()
-        source, inputs, outputs = c_source(recipe, full_matrix)
-        if source not in self._functions:
+        program, full_matrix = kernel.program, kernel.full_matrix
+        key = (program, full_matrix)
+        if key not in self._built:
             try:
-                function = load(source)
-            except (OSError, subprocess.SubprocessError):
-                function = None
-            if len(self._functions) >= FUNCTIONS_KEPT:
-                del self._functions[next(iter(self._functions))]
+                built = build(program, full_matrix)
+            except subprocess.TimeoutExpired:
+                return None  # not kept: asked for again, it is compiled again
+            except (OSError, ImportError, subprocess.SubprocessError):
+                built = None
+            if len(self._built) >= FUNCTIONS_KEPT:
+                del self._built[next(iter(self._built))]
         else:
-            function = self._functions.pop(source)
-        self._functions[source] = function
-        if function is None:
+            built = self._built.pop(key)
+        self._built[key] = built
+        if built is None:
             return None
-        native = NativeKernel(function, kernel.constants, outputs)
-        groups = [len(recipe[3])] + [length for group, length in recipe[2].items() if group != "k"]
-        return native if same_as_python(native, kernel.scalar, inputs, groups, full_matrix) else None
+        bind, lengths, _ = built
+        native = bind(array.array("d", kernel.constants).tobytes())
+        return native if same_as_python(native, kernel.scalar, lengths, full_matrix) else None
 
 
 COMPILER = _Compiler()

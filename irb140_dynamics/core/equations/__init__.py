@@ -1,8 +1,10 @@
 """The equations of motion in closed form: LaTeX, SymPy, C99 and NumPy Python.
 
 The core's own scalar recursions (``algorithms``) run on SymPy symbols (``symbolic``), the
-common subexpressions are shared, and one emitter per form writes the files. Imports the
-core (algorithms, regressor, rigid_body) and SymPy; nothing of ROS.
+common subexpressions are shared, and one emitter per form writes the files. The C and
+Python forms of a model with numbers write tau, M, Cqd and g from the code generator's
+programs instead (``traced``): the same arithmetic as the kernels the package compiles.
+Imports the core (algorithms, codegen, regressor, rigid_body) and SymPy; nothing of ROS.
 
     files = generate(model, ("c",), prefix="irb140")      # {file name: text}
 """
@@ -14,9 +16,10 @@ from collections.abc import Callable
 from . import c_code, latex, python_code, sympy_code
 from .printing import reduced_quantities
 from .symbolic import DEFAULT_QUANTITIES, QUANTITIES, Equations, derive
+from .traced import traced_bodies
 
 FORMS = ("latex", "sympy", "c", "python")
-_EMITTERS = {"c": c_code.render, "python": python_code.render, "sympy": sympy_code.render}
+_TRACED_EMITTERS = {"c": c_code.render, "python": python_code.render}  # numbers: the programs' bodies
 
 __all__ = ["DEFAULT_QUANTITIES", "Equations", "FORMS", "QUANTITIES", "derive", "generate"]
 
@@ -47,6 +50,9 @@ def generate(
         if form == "latex":
             expanded = {} if symbolic else latex.series(model, set(reduced) & {"M", "Cqd", "g"})
             files.update(latex.render(equations, reduced, prefix, source, expanded))
+        elif form == "sympy":
+            files.update(sympy_code.render(equations, reduced, prefix, source))
         else:
-            files.update(_EMITTERS[form](equations, reduced, prefix, source))
+            bodies = {} if symbolic else traced_bodies(model, reduced)
+            files.update(_TRACED_EMITTERS[form](equations, reduced, prefix, source, bodies))
     return files

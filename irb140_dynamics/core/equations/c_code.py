@@ -11,10 +11,12 @@ from .printing import DESCRIPTIONS, CPrinter, header_lines, used_names
 from .symbolic import Equations
 
 
-def render(eq: Equations, reduced: dict, prefix: str, source: str) -> dict[str, str]:
-    """{file name: text} of the .h and .c pair."""
+def render(eq: Equations, reduced: dict, prefix: str, source: str, bodies: dict | None = None) -> dict[str, str]:
+    """{file name: text} of the .h and .c pair; a quantity in ``bodies`` (see traced)
+    written from its program, the others from ``reduced``."""
+    bodies = bodies or {}
     guard = f"{prefix.upper()}_EOM_H"
-    comment = _comment(header_lines(eq, source))
+    comment = _comment(header_lines(eq, source, traced=bool(bodies)))
     h = [comment, f"#ifndef {guard}", f"#define {guard}", "", f"#define {prefix.upper()}_N {eq.n}"]
     if eq.parameters:
         h.append(f"#define {prefix.upper()}_N_PARAMETERS {len(eq.parameters)}")
@@ -26,7 +28,8 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str) -> dict[str, 
     for name, (replacements, outputs) in reduced.items():
         signature = _signature(eq, name, prefix)
         h += [f"/* {DESCRIPTIONS[name]} */", f"{signature};", ""]
-        c += [signature, "{", *_body(eq, name, replacements, outputs), "}", ""]
+        body = _traced_body(eq, name, bodies[name]) if name in bodies else _body(eq, name, replacements, outputs)
+        c += [signature, "{", *body, "}", ""]
     h += ["#ifdef __cplusplus", "}", "#endif", "", f"#endif /* {guard} */", ""]
     return {f"{prefix}_eom.h": "\n".join(h), f"{prefix}_eom.c": "\n".join(c)}
 
@@ -61,3 +64,13 @@ def _body(eq: Equations, name: str, replacements, outputs) -> list[str]:
     out = name if name != "regressor" else "Y"
     lines += [f"    {out}[{k}] = {printer.doprint(expr)};" for k, expr in enumerate(outputs)]
     return lines
+
+
+def _traced_body(eq: Equations, name: str, body) -> list[str]:
+    lines = []
+    for arg in eq.arguments[name]:
+        taken = [f"    const double {var} = {arg}[{i}];" for i, var in body.inputs.get(arg, [])]
+        lines += taken or [f"    (void){arg};"]
+    lines += [f"    const double {var} = {expr};" for var, expr in body.assignments]
+    out = name if name != "regressor" else "Y"
+    return lines + [f"    {out}[{k}] = {expr};" for k, expr in enumerate(body.outputs)]

@@ -12,7 +12,8 @@ from .symbolic import Equations
 
 _PRELUDE = '''
 import numpy as np
-from numpy import cos, sin, tanh  # noqa: F401 (used by the generated expressions)
+from numpy import add, cos, empty, sin, tanh  # noqa: F401 (used by the generated code)
+from numpy import divide as div, multiply as mul, negative as neg, subtract as sub  # noqa: F401
 
 CHUNK = 4096  # states per pass
 
@@ -33,9 +34,11 @@ def _run(kernel, shape, *arrays):
 '''
 
 
-def render(eq: Equations, reduced: dict, prefix: str, source: str) -> dict[str, str]:
-    """{file name: text} of the module."""
-    doc = "\n".join(header_lines(eq, source))
+def render(eq: Equations, reduced: dict, prefix: str, source: str, bodies: dict | None = None) -> dict[str, str]:
+    """{file name: text} of the module; a quantity in ``bodies`` (see traced) written from
+    its program, the others from ``reduced``."""
+    bodies = bodies or {}
+    doc = "\n".join(header_lines(eq, source, traced=bool(bodies)))
     lines = [f'"""{doc}\n\nFunctions of one state (arrays (n,)) or N states ((N, n)).\n"""', _PRELUDE]
     lines.append(f"N_JOINTS = {eq.n}")
     lines.append(f"JOINT_NAMES = {tuple(eq.joint_names)!r}")
@@ -45,11 +48,11 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str) -> dict[str, 
     if eq.regressor_columns:
         lines.append(f"REGRESSOR_COLUMNS = {eq.regressor_columns!r}")
     for name, (replacements, outputs) in reduced.items():
-        lines += ["", ""] + _function(eq, name, replacements, outputs)
+        lines += ["", ""] + _function(eq, name, replacements, outputs, bodies.get(name))
     return {f"{prefix}_eom.py": "\n".join(lines) + "\n"}
 
 
-def _function(eq: Equations, name: str, replacements, outputs) -> list[str]:
+def _function(eq: Equations, name: str, replacements, outputs, body=None) -> list[str]:
     printer = PythonPrinter()
     args = list(eq.arguments[name])
     shape = {"M": (eq.n, eq.n), "regressor": (eq.n, 13 * eq.n)}.get(name, (eq.n,))
@@ -65,6 +68,8 @@ def _function(eq: Equations, name: str, replacements, outputs) -> list[str]:
     else:
         lines.append(f"    return _run(_{name}, {shape!r}, {', '.join(args)})")
     lines += ["", "", f"def _{name}({', '.join(kernel_args)}):"]
+    if body is not None:
+        return lines[:-3] + _traced_lines(name, args, body)
     for arg in args:
         names = [f"{arg}{i + 1}" for i in range(eq.n)]
         if any(v in used for v in names):
@@ -78,3 +83,15 @@ def _function(eq: Equations, name: str, replacements, outputs) -> list[str]:
     lines += [f"        {printer.doprint(expr)}," for expr in outputs]
     lines.append("    )")
     return lines
+
+
+def _traced_lines(name: str, args: list[str], body) -> list[str]:
+    """``_<name>``: the rows of the entries, written by ``_<name>_into`` (the code
+    generator's program as NumPy ufunc calls into reused buffers)."""
+    rows = len(body.constants) + len(body.written)
+    lines = ["", "", f"def _{name}({', '.join(args)}):", f"    out = empty(({rows}, {args[0]}.shape[1]))"]
+    lines.append(f"    _{name}_into(out, {', '.join(args)})")
+    lines += [f"    out[{j}] = {value!r}" for j, value in body.constants.items()]
+    ordered = body.entries != list(range(rows))
+    lines.append(f"    return out[{body.entries!r}]" if ordered else "    return out")
+    return [*lines, "", "", *body.into.rstrip("\n").split("\n")]

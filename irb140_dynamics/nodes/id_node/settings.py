@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from irb140_dynamics.core import RobotModel
-from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.codegen.kernels import WITH_FRICTION, kernels_of
 from irb140_dynamics.core.payload.limits import derive_torque_limits
 from irb140_dynamics.core.payload.stop import stopping
 from irb140_dynamics.nodes.id_node.collision import (
@@ -102,7 +102,7 @@ def check_settings(values: dict) -> IdNodeSettings:
     )
 
 
-KERNELS = ("rnea", "gravity_torques", "momentum", "monitor")  # what a message uses (the last two: the observer)
+KERNELS = (WITH_FRICTION, "gravity_torques", "momentum", "monitor")  # what a message uses (rnea, gravity; the observer)
 
 
 def finish_settings(settings: IdNodeSettings, previous: IdNodeSettings | None) -> IdNodeSettings:

@@ -32,7 +32,8 @@ from irb140_dynamics.core import Joint, RigidBody, RobotModel
 from irb140_dynamics.core.errors import one_line
 from irb140_dynamics.core.io.urdf import LoadedUrdf, UrdfError, load_urdf, read_urdf
 from irb140_dynamics.ros.parameters.live import LiveParameters
-from irb140_dynamics.ros.parameters.specs import Spec, _declare, check_choice, declare_model, model_specs
+from irb140_dynamics.ros.parameters.spec import declare
+from irb140_dynamics.ros.parameters.specs import Spec, check_choice, declare_model, model_specs
 
 PerJoint = Callable[[list[str]], list[Spec]]  # a node's parameters for each joint of a model
 SOURCES = ("parameters", "robot_description")
@@ -83,7 +84,7 @@ def declare_model_source(
     ``finish``, ``startup_wait`` and ``quick`` as for LiveParameters. With the
     robot_description topic the returned parameters' ``current`` is None until a model
     arrives, and the per-joint specs are declared as models come."""
-    source = _declare(node, SOURCE)
+    source = declare(node, SOURCE)
     check_choice("model.source", source, SOURCES)
     if source == "parameters":
         return declare_model(node, extra, check, per_joint, finish, startup_wait, quick)
@@ -104,7 +105,7 @@ class RobotDescription:
     ):
         """``later``: LiveParameters' finish, startup_wait and quick."""
         self._node, self._build_node, self._per_joint = node, check, per_joint
-        text, path, base, tip = (_declare(node, spec) for spec in DESCRIPTION_PARAMETERS)
+        text, path, base, tip = (declare(node, spec) for spec in DESCRIPTION_PARAMETERS)
         self._chain_ends = (base or None, tip or None)
         self.urdf: LoadedUrdf | None = None  # the URDF's chain of the model in use
         self.refused, self.last_refusal = 0, ""  # URDFs refused on the topic, and why the last one was

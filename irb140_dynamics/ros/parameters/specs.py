@@ -31,9 +31,6 @@ from irb140_dynamics.ros.parameters.live import LiveParameters
 from irb140_dynamics.ros.parameters.spec import Spec, declare
 from irb140_dynamics.ros.runtime.command_line import params_files_given
 
-_declare = declare  # the name model_source imports
-
-
 # The finite ranges of the model's numbers (ParameterDescriptor ranges, `ros2 param describe`):
 # wide, to keep inf, nan and 1e308 out, not to judge the robot.
 # Masses and friction: the core's own caps (core.model), so that the descriptor and the

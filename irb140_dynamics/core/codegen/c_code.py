@@ -1,0 +1,126 @@
+"""A Program (see ``program``) as C: the kernel function, and a CPython extension calling it.
+
+The body is the infix text of ``python_code.statements``, the very operations of the
+Python form in the same order. Compiled without contraction or fast-math (no fused
+multiply-add) and with cos, sin and tanh left to libm, its results are the Python form's,
+bit for bit (``native`` checks that before use).
+
+``kernel_source`` is ``int kernel(const double *x, const double *k, double *out)``;
+``extension_source`` adds a module ``<name>`` whose ``bind(k: bytes)`` returns the kernel
+with constants ``k`` as a Python function of NumPy arrays, called with METH_FASTCALL: it
+takes the argument groups but ``k`` (1-D float64 arrays of their lengths, any stride) and
+returns a new array, or None for anything else or a result that is not finite (the caller
+then takes the Python form, which says why).
+"""
+
+from __future__ import annotations
+
+from irb140_dynamics.core.codegen.layout import whole_matrix
+from irb140_dynamics.core.codegen.program import Program
+from irb140_dynamics.core.codegen.python_code import statements
+
+INPUT_NOT_FINITE, OUTPUT_NOT_FINITE = 1, 2  # what a kernel returns instead of 0
+
+
+def kernel_source(program: Program, full_matrix: int = 0) -> tuple[str, int, int]:
+    """(C source, number of input doubles, number of outputs) of ``program``:
+    ``int kernel(const double *x, const double *k, double *out)`` with x the inputs (the
+    groups but k, in order). It returns 0, or INPUT_NOT_FINITE / OUTPUT_NOT_FINITE (then
+    ``out`` is not to be used). With ``full_matrix`` n, the outputs (an upper triangle row
+    by row) are written as the whole n x n matrix. The checks are on the sum of the inputs,
+    then of the outputs: finite values whose sum overflows are sent to the Python form too,
+    which tells them apart."""
+    body, results = statements(program)
+    if full_matrix:
+        results = whole_matrix(results, full_matrix)
+    lines = ["#include <math.h>", "", "int kernel(const double *x, const double *k, double *out) {"]
+    count = 0
+    for group, length in program.groups:
+        for i in range(length):
+            if group == "k":
+                lines.append(f"    const double k{i} = k[{i}];")
+            else:
+                lines.append(f"    const double {group}{i} = x[{count}];")
+                count += 1
+    lines.append("    double check = 0.0;")
+    lines.append(f"    for (int i = 0; i < {count}; ++i) check += x[i];")
+    lines.append(f"    if (!isfinite(check)) return {INPUT_NOT_FINITE};")
+    lines += [f"    const double {var} = {expr};" for var, expr in body]
+    lines += [f"    out[{j}] = {expression};" for j, expression in enumerate(results)]
+    lines.append("    check = 0.0;")
+    lines.append(f"    for (int i = 0; i < {len(results)}; ++i) check += out[i];")
+    lines.append(f"    return isfinite(check) ? 0 : {OUTPUT_NOT_FINITE};")
+    return "\n".join(lines) + "\n}\n", count, len(results)
+
+
+def extension_source(program: Program, module: str, full_matrix: int = 0) -> str:
+    """The kernel and the CPython module ``module`` around it (see the module's doc)."""
+    kernel, inputs, outputs = kernel_source(program, full_matrix)
+    lengths = [length for group, length in program.groups if group != "k"]
+    shape = f"{{{full_matrix}, {full_matrix}}}" if full_matrix else f"{{{outputs}}}"
+    takes = []
+    start = 0
+    for i, length in enumerate(lengths):
+        takes.append(f"!take(args[{i}], x + {start}, {length})")
+        start += length
+    return _EXTENSION.format(
+        kernel=kernel,
+        module=module,
+        inputs=max(inputs, 1),
+        groups=len(lengths),
+        takes=" || ".join(takes) or "0",
+        ndim=2 if full_matrix else 1,
+        shape=shape,
+    )
+
+
+_EXTENSION = """#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
+#include <numpy/arrayobject.h>
+
+{kernel}
+/* x[0:n] from a 1-D native float64 array of n entries; 0 for anything else */
+static int take(PyObject *o, double *x, npy_intp n) {{
+    if (!PyArray_CheckExact(o)) return 0;
+    PyArrayObject *a = (PyArrayObject *)o;
+    if (PyArray_TYPE(a) != NPY_DOUBLE || PyArray_NDIM(a) != 1 || PyArray_DIM(a, 0) != n
+        || !PyArray_ISNOTSWAPPED(a) || !PyArray_ISALIGNED(a)) return 0;
+    const char *p = PyArray_BYTES(a);
+    const npy_intp stride = PyArray_STRIDE(a, 0);
+    for (npy_intp i = 0; i < n; ++i) x[i] = *(const double *)(p + i * stride);
+    return 1;
+}}
+
+static PyObject *call(PyObject *k, PyObject *const *args, Py_ssize_t nargs) {{
+    double x[{inputs}];
+    if (nargs != {groups} || {takes}) Py_RETURN_NONE;
+    npy_intp shape[] = {shape};
+    PyObject *result = PyArray_SimpleNew({ndim}, shape, NPY_DOUBLE);
+    if (result == NULL) return NULL;
+    if (kernel(x, (const double *)PyBytes_AS_STRING(k), (double *)PyArray_DATA((PyArrayObject *)result)) != 0) {{
+        Py_DECREF(result);
+        Py_RETURN_NONE;
+    }}
+    return result;
+}}
+
+static PyMethodDef call_method = {{"kernel", (PyCFunction)(void (*)(void))call, METH_FASTCALL, NULL}};
+
+static PyObject *bind(PyObject *module, PyObject *k) {{
+    (void)module;
+    if (!PyBytes_CheckExact(k)) {{
+        PyErr_SetString(PyExc_TypeError, "bind: the constants as bytes of doubles");
+        return NULL;
+    }}
+    return PyCFunction_NewEx(&call_method, k, NULL);
+}}
+
+static PyMethodDef methods[] = {{{{"bind", bind, METH_O, NULL}}, {{NULL, NULL, 0, NULL}}}};
+static struct PyModuleDef definition = {{PyModuleDef_HEAD_INIT, "{module}", NULL, -1, methods}};
+
+PyMODINIT_FUNC PyInit_{module}(void) {{
+    import_array();
+    return PyModule_Create(&definition);
+}}
+"""

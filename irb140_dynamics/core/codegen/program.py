@@ -1,0 +1,145 @@
+"""The one intermediate form of a traced algorithm: a list of single assignments.
+
+An algorithm is traced once per model (``trace``); the traced graph is lowered here into a
+``Program``: its argument groups, its operations in an order where each comes after its
+operands, and its outputs. The emitters read nothing else: straight-line Python
+(``python_code``), the NumPy form writing into given arrays (``array_code``) and C
+(``c_code``). They write the same operations on the same operands in the same order, so
+every form gives the same floating-point numbers.
+
+An operation is ``(op, args)``:
+
+- ``("in", (name,))``: an input, ``name`` = group and index, e.g. ``qd2``;
+- ``("+" | "-" | "*" | "/", (a, b))``, ``("neg", (a,))``, ``("tanh", (a,))``;
+- ``("cos" | "sin", (a, offset))``: cos or sin of input ``a`` plus the float ``offset``
+  (a joint angle: theta_i = q_i + theta_offset_i; offset 0.0 adds nothing).
+
+An operand is an int (the index of an earlier operation) or a float (a constant).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from irb140_dynamics.core.codegen.trace import Sym, merged, operands_first, trace
+
+BINARY = ("+", "-", "*", "/")
+UNARY = ("neg", "tanh")
+ANGLES = ("cos", "sin")
+
+
+@dataclass(frozen=True)
+class Program:
+    """A traced algorithm: ``groups`` the arguments ((name, length), q first when the joints
+    are angles), ``ops`` the single assignments, ``outputs`` their values (an index into
+    ``ops``, or a float folded at tracing)."""
+
+    name: str
+    groups: tuple[tuple[str, int], ...]
+    ops: tuple[tuple[str, tuple], ...]
+    outputs: tuple
+
+    def group(self, name: str) -> int:
+        """The length of the argument group ``name``."""
+        return dict(self.groups)[name]
+
+    def inputs_used(self) -> set[str]:
+        return {args[0] for op, args in self.ops if op == "in"}
+
+    def uses(self) -> list[int]:
+        """How many operations read each operation's value (outputs not counted)."""
+        counts = [0] * len(self.ops)
+        for op, args in self.ops:
+            if op == "in":
+                continue
+            for a in args[:1] if op in ANGLES else args:
+                if isinstance(a, int):
+                    counts[a] += 1
+        return counts
+
+
+def traced(
+    name: str, algorithm: Callable[..., Sequence], inputs: dict[str, int], angles: Sequence[float] | None = None
+) -> Program:
+    """``algorithm`` traced (see ``trace.trace``) and lowered to a Program: each operation
+    once, the joint angles' cos and sin as operations on q."""
+    _, outputs = trace(algorithm, inputs, angles)
+    outputs = merged(outputs)
+    groups = ((("q", len(angles)),) if angles is not None else ()) + tuple(inputs.items())
+    builder = _Builder()
+    index: dict[int, int] = {}
+    for x in operands_first(outputs):
+        if x.op == "var":
+            index[id(x)] = builder.variable(x.name, angles)
+        else:
+            args = tuple(index[id(a)] if isinstance(a, Sym) else float(a) for a in x.args)
+            index[id(x)] = builder.add(x.op, args)
+    results = tuple(index[id(out)] if isinstance(out, Sym) else float(out) for out in outputs)
+    return Program(name, groups, tuple(builder.ops), results)
+
+
+class _Builder:
+    def __init__(self):
+        self.ops: list[tuple[str, tuple]] = []
+        self.inputs: dict[str, int] = {}
+
+    def add(self, op: str, args: tuple) -> int:
+        self.ops.append((op, args))
+        return len(self.ops) - 1
+
+    def input(self, name: str) -> int:
+        if name not in self.inputs:
+            self.inputs[name] = self.add("in", (name,))
+        return self.inputs[name]
+
+    def variable(self, name: str, angles) -> int:
+        """A traced variable: an input, or c_i / s_i, the cos / sin of joint i's angle."""
+        if name[0] in "cs" and name[1:].isdigit():
+            i = int(name[1:])
+            return self.add("cos" if name[0] == "c" else "sin", (self.input(f"q{i}"), float(angles[i])))
+        return self.input(name)
+
+
+def with_friction(program: Program, qd_group: str, coulomb: bool) -> Program:
+    """``program`` with joint friction added to its outputs (one per joint), as
+    ``JointFriction.added`` adds it: out_i + (v_i qd_i [+ c_i tanh(qd_i / s)]), the
+    coefficients (v, then c and s with Coulomb friction) appended to the group ``k``."""
+    n = program.group(qd_group)
+    k = program.group("k")
+    builder = _Builder()
+    builder.ops = list(program.ops)
+    builder.inputs = {args[0]: i for i, (op, args) in enumerate(program.ops) if op == "in"}
+    s = builder.input(f"k{k + 2 * n}") if coulomb else None
+    outputs = []
+    for i, out in enumerate(program.outputs):
+        qd = builder.input(f"{qd_group}{i}")
+        f = builder.add("*", (builder.input(f"k{k + i}"), qd))
+        if coulomb:
+            shape = builder.add("tanh", (builder.add("/", (qd, s)),))
+            f = builder.add("+", (f, builder.add("*", (builder.input(f"k{k + n + i}"), shape))))
+        outputs.append(builder.add("+", (out, f)))  # a folded output too: 0.0 + -0.0 is 0.0
+    groups = tuple(
+        (g, length + (2 * n + 1 if coulomb else n)) if g == "k" else (g, length) for g, length in program.groups
+    )
+    return Program(f"{program.name}_friction", groups, tuple(builder.ops), tuple(outputs))
+
+
+def with_constants(program: Program, group: str, values: tuple) -> Program:
+    """``program`` with the inputs of ``group`` replaced by ``values`` (the same floats: the
+    same arithmetic), the group dropped from its arguments."""
+    index: list = []
+    ops: list[tuple[str, tuple]] = []
+    for op, args in program.ops:
+        if op == "in" and args[0].startswith(group) and args[0][len(group) :].isdigit():
+            index.append(float(values[int(args[0][len(group) :])]))
+            continue
+        if op != "in":
+            args = tuple(index[a] if isinstance(a, int) else a for a in (args[:1] if op in ANGLES else args)) + (
+                args[1:] if op in ANGLES else ()
+            )
+        ops.append((op, args))
+        index.append(len(ops) - 1)
+    outputs = tuple(index[out] if isinstance(out, int) else out for out in program.outputs)
+    groups = tuple((g, length) for g, length in program.groups if g != group)
+    return Program(program.name, groups, tuple(ops), outputs)

@@ -1,0 +1,99 @@
+"""A Program (see ``program``) as straight-line Python, and the infix text it shares with C.
+
+``statements`` writes each operation as an infix expression: a value used once is written
+inline into its user (up to a nesting depth), any other into a variable (``t<k>``, the
+joint angles' ``c<i>``, ``s<i>``). That text is valid Python and valid C: ``python_source``
+wraps it into a function of floats (compiled with math's cos and sin, or NumPy's to
+evaluate many states at once), ``c_code`` into a C function.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from irb140_dynamics.core.codegen.program import ANGLES, Program
+
+MAX_INLINE_DEPTH = 12  # of an expression written inline: deeper ones get a variable
+
+
+def constant(x: float) -> str:
+    """A float as exact source text (a negative one in parentheses)."""
+    return f"({float(x)!r})" if x < 0 else repr(float(x))
+
+
+def statements(program: Program) -> tuple[list[tuple[str, str]], list[str]]:
+    """(assignments (variable, expression) in order, the outputs' expressions)."""
+    uses = program.uses()
+    for out in program.outputs:
+        if isinstance(out, int):
+            uses[out] += 2  # an output is always stored in a variable
+    exprs: list[str] = []
+    depth: list[int] = []
+    lines: list[tuple[str, str]] = []
+
+    def operand(a) -> str:
+        return exprs[a] if isinstance(a, int) else constant(a)
+
+    for k, (op, args) in enumerate(program.ops):
+        if op == "in":
+            exprs.append(args[0])
+            depth.append(0)
+            continue
+        if op in ANGLES:
+            q = exprs[args[0]]
+            theta = q if args[1] == 0.0 else f"{q} + {args[1]!r}"
+            name = f"{op[0]}{q[1:]}"
+            lines.append((name, f"{op}({theta})"))
+            exprs.append(name)
+            depth.append(0)
+            continue
+        operands = [operand(a) for a in args]
+        if op == "neg":
+            expr = f"-{operands[0]}"
+        elif op == "tanh":
+            expr = f"tanh({operands[0]})"
+        else:
+            expr = f"{operands[0]} {op} {operands[1]}"
+        d = 1 + max((depth[a] for a in args if isinstance(a, int)), default=0)
+        if uses[k] == 1 and d < MAX_INLINE_DEPTH:
+            exprs.append(f"({expr})")
+            depth.append(d)
+        else:
+            lines.append((f"t{k}", expr))
+            exprs.append(f"t{k}")
+            depth.append(0)
+    return lines, [operand(out) for out in program.outputs]
+
+
+def unpacked(program: Program) -> list[str]:
+    """The lines unpacking the argument groups into variables q0, q1, ..., qd0, ... (none for
+    an empty group: ``k`` of a model whose payload, last link and gravity are all zero)."""
+    return [f"    {_names(group, length)} = {group}" for group, length in program.groups if length]
+
+
+def python_source(program: Program) -> str:
+    """``def <name>(q, qd, ...): return (outputs,)``: the program on floats."""
+    lines, results = statements(program)
+    text = [f"def {program.name}({', '.join(group for group, _ in program.groups)}):", *unpacked(program)]
+    text += [f"    {var} = {expr}" for var, expr in lines]
+    text.append(f"    return ({', '.join(results)},)")
+    return "\n".join(text) + "\n"
+
+
+def compile_python(program: Program) -> tuple[str, Callable, Callable]:
+    """(source, scalar_fn, array_fn): the same code on floats, and on NumPy arrays."""
+    source = python_source(program)
+    code = compile(source, f"<{program.name}>", "exec")
+    scalar_ns = {"cos": math.cos, "sin": math.sin, "tanh": math.tanh}
+    array_ns = {"cos": np.cos, "sin": np.sin, "tanh": np.tanh}
+    exec(code, scalar_ns)
+    exec(code, array_ns)
+    return source, scalar_ns[program.name], array_ns[program.name]
+
+
+def _names(group: str, length: int) -> str:
+    names = ", ".join(f"{group}{i}" for i in range(length))
+    return names + ("," if length == 1 else "")
