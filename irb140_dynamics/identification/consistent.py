@@ -179,7 +179,9 @@ def consistent_parameters(
     else:
         unconstrained = np.asarray(start, dtype=float)
     start = [
-        log_cholesky_of(_positive(pseudo_inertia(unconstrained[10 * i : 10 * i + 10]), spread[10 * i : 10 * i + 10]))
+        log_cholesky_of(
+            nearest_positive(pseudo_inertia(unconstrained[10 * i : 10 * i + 10]), spread[10 * i : 10 * i + 10])
+        )
         for i in range(n)
     ]
     x0 = np.concatenate([*start, np.maximum(unconstrained[10 * n :], 0.0)])
@@ -236,7 +238,7 @@ def physical_check(prior: RobotModel, base: BaseParameters, estimate: Estimate, 
     return PhysicalCheck(chi2, float(2.0 * gammaincinv(r / 2.0, PHYSICAL_CONFIDENCE)), r)
 
 
-def _positive(J: np.ndarray, spread10: np.ndarray) -> np.ndarray:
+def nearest_positive(J: np.ndarray, spread10: np.ndarray) -> np.ndarray:
     """J with its eigenvalues raised to at least those of a small body at the origin
     (1e-3 of the spread's mass, of its length scale)."""
     mass, length2 = spread10[0] * 1e-3, spread10[4] / spread10[0]

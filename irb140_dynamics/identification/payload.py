@@ -42,8 +42,8 @@ from irb140_dynamics.core.regressor import (
 )
 from irb140_dynamics.identification.base import BaseParameters
 from irb140_dynamics.identification.consistent import (
-    _positive,
     log_cholesky_of,
+    nearest_positive,
     parameters_and_jacobian,
     pseudo_inertia,
 )
@@ -242,7 +242,7 @@ def _nearest_physical(estimate: Estimate) -> tuple[np.ndarray, float]:
     J = pseudo_inertia(phi_hat)
     if np.linalg.eigvalsh(J)[0] > 0.0:
         return phi_hat.copy(), 0.0
-    theta0 = log_cholesky_of(_positive(J, spread))
+    theta0 = log_cholesky_of(nearest_positive(J, spread))
 
     def residuals(theta):
         return root.T @ (parameters_and_jacobian(theta)[0] - phi_hat)
