@@ -4,8 +4,8 @@
 exact, leaving out the ROS 2 wheels and colcon (the run needs no ROS) and what cannot be
 installed beside the oldest NumPy (``WITHOUT``).
 
-``oldest.py unimportable TEST_DIR`` prints, one per line, ``--ignore=PATH`` for each test
-module that imports, at module level and directly or through another module of the test
+``oldest.py unimportable TEST_DIR [--ignore=PATH ...]`` prints, one per line, the given
+``--ignore=PATH`` and one for each other test module that imports, at module level and directly or through another module of the test
 package, a package this interpreter does not have (rclpy, Pinocchio, ...), and says on stderr
 which package keeps each one out.
 """
@@ -76,9 +76,13 @@ def missing_package(path: Path, seen: set[Path]) -> str | None:
     return None
 
 
-def unimportable(test_dir: str) -> list[str]:
-    ignores = []
+def unimportable(test_dir: str, ignores: list[str]) -> list[str]:
+    """``ignores`` (pytest's --ignore=PATH), then one for each module that cannot be imported."""
+    ignored = [Path.cwd() / argument.removeprefix("--ignore=") for argument in ignores]
+    ignores = list(ignores)
     for path in sorted((Path.cwd() / test_dir).rglob("test_*.py")):
+        if any(path.is_relative_to(folder) for folder in ignored):
+            continue
         found = missing_package(path, set())
         if found:
             relative = path.relative_to(Path.cwd())
@@ -92,6 +96,6 @@ if __name__ == "__main__":
     if command == "requirements":
         print("\n".join(oldest_requirements(arguments)))
     elif command == "unimportable":
-        print("\n".join(unimportable(arguments[0])))
+        print("\n".join(unimportable(arguments[0], arguments[1:])))
     else:
         sys.exit(f"oldest.py: unknown command {command!r}")

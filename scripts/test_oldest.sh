@@ -28,7 +28,8 @@ source "$venv/bin/activate"
 python -m pip list --format=freeze 2>/dev/null \
     | grep -i -E '^(numpy|scipy|matplotlib|sympy|pyyaml|mujoco|rosbags)==' | tr '\n' ' ' >&2
 echo >&2
-# The test modules that import ROS (or Pinocchio) at import time, directly or through
-# test/support, are left out: named on stderr.
-mapfile -t ignores < <(python scripts/oldest.py unimportable test)
+# test/ros and test/processes (every test there is marked ros or process; their conftests
+# import rclpy) are left out, and so is each other test module that imports ROS (or
+# Pinocchio) when it is imported, directly or through test/support: named on stderr.
+mapfile -t ignores < <(python scripts/oldest.py unimportable test --ignore=test/ros --ignore=test/processes)
 exec python -m pytest -m "not ros and not process" -p no:cacheprovider "${ignores[@]}" "$@"
