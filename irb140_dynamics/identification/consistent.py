@@ -141,7 +141,6 @@ class ConsistentFit:
     model: RobotModel
     deviation: np.ndarray  # (K pi - beta_hat) / std, per base parameter
     consistent: bool
-    solver_message: str
     misfit: float = 0.0  # | L^T (K pi - beta_hat) |^2: the data's chi-square of pi
 
 
@@ -210,7 +209,7 @@ def consistent_parameters(
     deviation = (K @ pi - estimate.beta) / estimate.std
     misfit = float(np.sum((data_map @ pi - data_target) ** 2))
     model = with_inertial_parameters(prior, pi)
-    return ConsistentFit(pi, model, deviation, is_consistent(pi, n), result.message, misfit)
+    return ConsistentFit(pi, model, deviation, is_consistent(pi, n), misfit)
 
 
 @dataclass(frozen=True)
