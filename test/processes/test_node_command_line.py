@@ -1,6 +1,6 @@
 """Every node's command line as a user types it: --help, ROS arguments without --ros-args,
 integers for doubles, the startup log, params files refused in one line, Ctrl-C at any
-moment (issue 21 items 5 and 6, issue 23 item 6)."""
+moment."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ from ..support.paths import CONFIG
 
 NODES = ("id_node", "payload_check_node", "sim_node", "demo_node")
 MODEL_NODES = ("id_node", "payload_check_node", "sim_node")
-START_LIMIT = 10.0  # s: a node that cannot start says so within this (issue 21 item 5)
+START_LIMIT = 10.0  # s: a node that cannot start says so within this
 
 
 def command(node: str, *arguments: str) -> list[str]:
