@@ -18,9 +18,9 @@ PACKAGE = "irb140_dynamics"
 RUN_TIME_FOLDERS = ("irb140_dynamics", "launch")
 
 # Import name -> rosdep key. ROS 2 packages are keys of their own (rosdistro's
-# jazzy/distribution.yaml); the others are keys of ros/rosdistro's rosdep/python.yaml: the
-# system package where Debian and Ubuntu have one, its "-pip" key (installed from PyPI) where
-# they do not (MuJoCo, rosbags).
+# jazzy/distribution.yaml); the others are keys of ros/rosdistro's rosdep/python.yaml (read
+# at its commit 8468e88 of 2026-08-22): the system package where Debian and Ubuntu have one,
+# its "-pip" key (installed from PyPI) where they do not (MuJoCo, rosbags).
 ROSDEP_KEYS = {
     "rclpy": "rclpy",
     "ament_index_python": "ament_index_python",
