@@ -5,9 +5,9 @@ exact, leaving out the ROS 2 wheels and colcon (the run needs no ROS) and what c
 installed beside the oldest NumPy (``WITHOUT``).
 
 ``oldest.py unimportable TEST_DIR [--ignore=PATH ...]`` prints, one per line, the given
-``--ignore=PATH`` and one for each other test module that imports, at module level and directly or through another module of the test
-package, a package this interpreter does not have (rclpy, Pinocchio, ...), and says on stderr
-which package keeps each one out.
+``--ignore=PATH`` and one for each other test module that imports, when it is imported
+(directly or through another module of the repository), a package this interpreter does
+not have (rclpy, Pinocchio, ...), and says on stderr which package keeps each one out.
 """
 
 import ast
@@ -39,8 +39,7 @@ def oldest_requirements(files: list[str]) -> list[str]:
 
 def imports_at_import_time(path: Path) -> set[str]:
     """Absolute names a module imports when it is imported (function bodies excepted)."""
-    parts = path.relative_to(Path.cwd()).with_suffix("").parts
-    package = parts[:-1] if parts[-1] != "__init__" else parts[:-1]
+    package = path.relative_to(Path.cwd()).parent.parts  # (of a module and of an __init__.py)
     names, pending = set(), list(ast.parse(path.read_text()).body)
     while pending:
         node = pending.pop()
