@@ -35,6 +35,7 @@ JOINT_PARAMETERS = ("viscous", "coulomb", "armature")
 # pi's layout (the module's docstring): INERTIAL_PARAMETERS per link, then JOINT_TERMS per joint
 JOINT_TERMS = len(JOINT_PARAMETERS)
 PARAMETERS_PER_JOINT = INERTIAL_PARAMETERS + JOINT_TERMS
+
 # -- public functions ---------------------------------------------------------------------
 
 
