@@ -17,7 +17,7 @@ stamp="$venv/.requirements-oldest"
 wanted=$(cat requirements/*.txt | sha256sum)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$wanted" ]; then
     "$venv/bin/python" scripts/oldest.py requirements requirements/run.txt requirements/test.txt >"$venv/oldest.txt"
-    echo "installing the oldest versions into $venv:" $(tr '\n' ' ' <"$venv/oldest.txt") >&2
+    echo "installing the oldest versions into $venv: $(tr '\n' ' ' <"$venv/oldest.txt")" >&2
     # pip warns "Location ... is ignored" for every package of this machine's local indexes: filtered.
     { "$venv/bin/python" -m pip install -q --disable-pip-version-check -r "$venv/oldest.txt"; } 2>&1 \
         | { grep -v "is ignored" || true; } >&2
