@@ -1,5 +1,5 @@
 """payload_check_node's ~/check after a model change, with the analysis of a slow model under
-way (issue 23: it answered "pending" for minutes): the time from the new model's URDF to
+way (it must wait for the new model's analysis, not answer "pending"): the time from the new model's URDF to
 ~/check's answer, against the same with no analysis before (the baseline). Target: the
 ratio at most 1.5x (the old analysis cancelled at its next check).
 

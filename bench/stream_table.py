@@ -36,7 +36,7 @@ def stream_rows(runs: list[dict]) -> list[Row]:
             f"id_node end to end, {rate:g} Hz for {ours[0]['duration_s']:g} s{changes}{repeats}, "
             f"executor {executor}{lean} (baseline: relay" + (", the same parameter calls)" if changes else ")")
         )
-        p99_target = P99_TARGET if change_period is None else None  # with changes the target is 0 lost (issue 8)
+        p99_target = P99_TARGET if change_period is None else None  # with changes the target is 0 lost
         for stat, target in (("p50", None), ("p99", p99_target), ("max", None)):
             rows.append(Row(group, f"delay {stat}", _delay(ours, stat), _delay(base, stat), target))
         sent = sum(run["sent"] for run in ours)

@@ -1,7 +1,15 @@
-# Sourced by run.sh and test.sh: make .venv and install requirements/$1.txt into it
-# (again only when the requirement files change), then activate it.
-venv=.venv
-python=${PYTHON:-$(command -v python3.11 || command -v python3)}
+# Sourced by run.sh and test.sh: make .venv and install requirements/$1.txt into it (at the
+# versions of requirements/pinned.txt; again only when the requirement files change), then
+# activate it. PYTHON=python3.12 ./scripts/test.sh does the same with that interpreter, in a
+# venv of its own (.venv-python3.12).
+# shellcheck source=scripts/python.sh
+source scripts/python.sh
+venv=$(venv_dir)
+if [ -n "${PYTHON:-}" ]; then
+    python=$(find_python "$PYTHON") || exit 1
+else
+    python=$(command -v python3.11 || command -v python3)
+fi
 if [ ! -x "$venv/bin/python" ]; then
     if ! "$python" -m venv "$venv" >/dev/null 2>&1; then
         rm -rf "$venv"
@@ -22,7 +30,8 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$wanted" ] \
     && ! { [ "$1" = run ] && [ "$(cat "$venv/.requirements-test" 2>/dev/null)" = "$wanted" ]; }; then
     echo "installing requirements/$1.txt into $venv ..." >&2
     # pip warns "Location ... is ignored" for every ROS wheel: harmless, filtered.
-    { "$venv/bin/python" -m pip install -q --disable-pip-version-check -r "requirements/$1.txt"; } 2>&1 \
+    { "$venv/bin/python" -m pip install -q --disable-pip-version-check -r "requirements/$1.txt" \
+        -c requirements/pinned.txt; } 2>&1 \
         | { grep -v "is ignored" || true; } >&2
     echo "$wanted" >"$stamp"
 fi

@@ -60,7 +60,7 @@ done
     colcon --log-base build/log build --paths . --build-base build --install-base install >build.log 2>&1 \
         || { cat build.log >&2; echo "run.sh: the build failed (build.log above)" >&2; exit 1; }
 ) || exit 1
-source "$repo/.venv/bin/activate"
+source "$repo/$(source "$repo/scripts/python.sh" && venv_dir)/bin/activate"
 set +u  # colcon's setup scripts read unset variables
 # shellcheck disable=SC1091
 source "$repo/install/setup.bash"

@@ -12,7 +12,9 @@ fi
 runs=$1
 shift
 cd "$(dirname "$0")/.."
-python=.venv/bin/python
+# shellcheck source=scripts/python.sh
+source scripts/python.sh
+python=$(venv_dir)/bin/python  # .venv, or PYTHON=python3.12's venv
 "$python" -c "while True: pass" &
 busy1=$!
 "$python" -c "while True: pass" &

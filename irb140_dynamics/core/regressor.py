@@ -18,7 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from irb140_dynamics.core.algorithms.regressor import rigid_body_regressor  # noqa: F401 (part of this module's interface)
+from irb140_dynamics.core.algorithms.regressor import (  # noqa: F401 (part of this module's interface)
+    INERTIAL_PARAMETERS,
+    rigid_body_regressor,
+)
 from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.model.joints import Friction
 from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, inertia_matrix
@@ -29,6 +32,10 @@ _CHUNK = 4096  # states per pass of the kernel (its buffers then stay in the CPU
 
 LINK_PARAMETERS = ("m", "mcx", "mcy", "mcz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
 JOINT_PARAMETERS = ("viscous", "coulomb", "armature")
+# pi's layout (the module's docstring): INERTIAL_PARAMETERS per link, then JOINT_TERMS per joint
+JOINT_TERMS = len(JOINT_PARAMETERS)
+PARAMETERS_PER_JOINT = INERTIAL_PARAMETERS + JOINT_TERMS
+
 # -- public functions ---------------------------------------------------------------------
 
 
@@ -36,8 +43,9 @@ def regressor(model: RobotModel, q, qd, qdd) -> np.ndarray:
     """Y(q, qd, qdd), n x 13n: rnea(model, q, qd, qdd) == Y @ inertial_parameters(model)."""
     n = model.n
     q, qd, qdd = state(q, n, "q"), state(qd, n, "qd"), state(qdd, n, "qdd")
-    Y = np.zeros((n, 13 * n))
-    Y[:, : 10 * n] = np.reshape(kernels_of(model).regressor.scalar(q, qd, qdd), (10 * n, n)).T
+    Y = np.zeros((n, PARAMETERS_PER_JOINT * n))
+    rigid = kernels_of(model).regressor.scalar(q, qd, qdd)
+    Y[:, : INERTIAL_PARAMETERS * n] = np.reshape(rigid, (INERTIAL_PARAMETERS * n, n)).T
     _joint_columns(model, Y, np.array(qd), np.array(qdd))
     return Y
 
@@ -52,29 +60,31 @@ def regressor_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
     # written with a stride of 13 n^2 numbers, four times slower). Output c * n + i is
     # Y[:, i, c]; the constant zeros (about half: link k moves no joint after k) are left
     # as they are, their pages never touched.
-    rows = np.zeros((n * 13 * n, N))
+    width = PARAMETERS_PER_JOINT * n
+    rows = np.zeros((n * width, N))
     kernel = kernels_of(model).regressor
-    where = [(j, (j % n) * 13 * n + j // n) for j in kernel.written]
-    out = [None] * (10 * n * n)
+    where = [(j, (j % n) * width + j // n) for j in kernel.written]
+    out = [None] * (INERTIAL_PARAMETERS * n * n)
     for start in range(0, N, _CHUNK):
         chunk = slice(start, start + _CHUNK)
         for j, row in where:
             out[j] = rows[row, chunk]
         kernel.into(out, q[:, chunk], qd[:, chunk], qdd[:, chunk])
-    joints = np.arange(n) * 13 * n + 10 * n + 3 * np.arange(n)
+    joints = np.arange(n) * width + INERTIAL_PARAMETERS * n + JOINT_TERMS * np.arange(n)
     rows[joints] = qd
     rows[joints + 1] = np.tanh(qd / model.smoothing_velocity)
     rows[joints + 2] = qdd
-    return rows.T.reshape(N, n, 13 * n)
+    return rows.T.reshape(N, n, width)
 
 
 def _joint_columns(model: RobotModel, Y: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> None:
     """Fill the friction and armature columns of one state's Y (n, 13n)."""
     n = model.n
     rows = np.arange(n)
-    Y[rows, 10 * n + 3 * rows] = qd
-    Y[rows, 10 * n + 3 * rows + 1] = np.tanh(qd / model.smoothing_velocity)
-    Y[rows, 10 * n + 3 * rows + 2] = qdd
+    columns = INERTIAL_PARAMETERS * n + JOINT_TERMS * rows
+    Y[rows, columns] = qd
+    Y[rows, columns + 1] = np.tanh(qd / model.smoothing_velocity)
+    Y[rows, columns + 2] = qdd
 
 
 def parameter_names(model: RobotModel) -> list[str]:
@@ -97,12 +107,13 @@ def with_inertial_parameters(model: RobotModel, pi) -> RobotModel:
 
     n = model.n
     pi = np.asarray(pi, dtype=float)
-    if pi.shape != (13 * n,):
-        raise ValueError(f"pi: expected {13 * n} parameters, got shape {pi.shape}")
+    if pi.shape != (PARAMETERS_PER_JOINT * n,):
+        raise ValueError(f"pi: expected {PARAMETERS_PER_JOINT * n} parameters, got shape {pi.shape}")
+    links = np.reshape(pi[: INERTIAL_PARAMETERS * n], (n, INERTIAL_PARAMETERS))
+    terms = np.reshape(pi[INERTIAL_PARAMETERS * n :], (n, JOINT_TERMS))
     joints = []
-    for i, joint in enumerate(model.joints):
-        link = parameters_body(f"{joint.name}.link", pi[10 * i : 10 * i + 10], joint.post)
-        viscous, coulomb, armature = pi[10 * n + 3 * i : 10 * n + 3 * i + 3]
+    for joint, link_parameters, (viscous, coulomb, armature) in zip(model.joints, links, terms):
+        link = parameters_body(f"{joint.name}.link", link_parameters, joint.post)
         joints.append(replace(joint, link=link, friction=Friction(viscous, coulomb), armature=armature))
     return replace(model, joints=tuple(joints), payload=RigidBody())
 

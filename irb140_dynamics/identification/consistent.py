@@ -34,7 +34,13 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from irb140_dynamics.core.model.robot_model import RobotModel
-from irb140_dynamics.core.regressor import inertial_parameters, with_inertial_parameters
+from irb140_dynamics.core.regressor import (
+    INERTIAL_PARAMETERS,
+    JOINT_TERMS,
+    PARAMETERS_PER_JOINT,
+    inertial_parameters,
+    with_inertial_parameters,
+)
 from irb140_dynamics.identification.base import BaseParameters
 from irb140_dynamics.identification.least_squares import Estimate
 
@@ -105,17 +111,22 @@ def log_cholesky_of(J: np.ndarray) -> np.ndarray:
 def is_consistent(pi: np.ndarray, n: int, tolerance: float = 1e-9) -> bool:
     """Every link's pseudo-inertia positive semidefinite, friction and armature >= 0."""
     for i in range(n):
-        J = pseudo_inertia(pi[10 * i : 10 * i + 10])
+        J = pseudo_inertia(pi[_link(i)])
         eigenvalues = np.linalg.eigvalsh(J)
         if eigenvalues[0] < -tolerance * max(1.0, eigenvalues[-1]):
             return False
-    return bool(np.all(pi[10 * n :] >= 0.0))
+    return bool(np.all(pi[INERTIAL_PARAMETERS * n :] >= 0.0))
+
+
+def _link(i: int) -> slice:
+    """Link i's inertial parameters in pi."""
+    return slice(INERTIAL_PARAMETERS * i, INERTIAL_PARAMETERS * (i + 1))
 
 
 def prior_spread(model: RobotModel, pi_prior: np.ndarray) -> np.ndarray:
     """s of the module's docstring, (13 n,)."""
     n = model.n
-    masses = pi_prior[0 : 10 * n : 10]
+    masses = pi_prior[0 : INERTIAL_PARAMETERS * n : INERTIAL_PARAMETERS]
     reference = np.maximum(masses, 0.1 * max(masses.mean(), 1e-3))
     distances = [np.linalg.norm(np.add(j.pre.xyz, j.post.xyz)) for j in model.joints]
     length = max(0.1, float(np.mean(distances)))
@@ -130,7 +141,6 @@ class ConsistentFit:
     model: RobotModel
     deviation: np.ndarray  # (K pi - beta_hat) / std, per base parameter
     consistent: bool
-    solver_message: str
     misfit: float = 0.0  # | L^T (K pi - beta_hat) |^2: the data's chi-square of pi
 
 
@@ -154,12 +164,13 @@ def consistent_parameters(
 
     def evaluate(x):
         """pi(x) and d pi / d x (block diagonal: links, then the identity for friction)."""
-        pi, jacobian = np.empty(13 * n), np.zeros((13 * n, 13 * n))
+        size, joints = PARAMETERS_PER_JOINT * n, INERTIAL_PARAMETERS * n
+        pi, jacobian = np.empty(size), np.zeros((size, size))
         for i in range(n):
-            block = slice(10 * i, 10 * i + 10)
+            block = _link(i)
             pi[block], jacobian[block, block] = parameters_and_jacobian(x[block])
-        pi[10 * n :] = x[10 * n :]
-        jacobian[10 * n :, 10 * n :] = np.eye(3 * n)
+        pi[joints:] = x[joints:]
+        jacobian[joints:, joints:] = np.eye(JOINT_TERMS * n)
         return pi, jacobian
 
     def residuals(x):
@@ -179,14 +190,11 @@ def consistent_parameters(
     else:
         unconstrained = np.asarray(start, dtype=float)
     start = [
-        log_cholesky_of(
-            nearest_positive(pseudo_inertia(unconstrained[10 * i : 10 * i + 10]), spread[10 * i : 10 * i + 10])
-        )
-        for i in range(n)
+        log_cholesky_of(nearest_positive(pseudo_inertia(unconstrained[_link(i)]), spread[_link(i)])) for i in range(n)
     ]
-    x0 = np.concatenate([*start, np.maximum(unconstrained[10 * n :], 0.0)])
-    lower = np.concatenate([np.tile(THETA_LOWER, n), np.zeros(3 * n)])
-    upper = np.concatenate([np.tile(THETA_UPPER, n), np.full(3 * n, np.inf)])
+    x0 = np.concatenate([*start, np.maximum(unconstrained[INERTIAL_PARAMETERS * n :], 0.0)])
+    lower = np.concatenate([np.tile(THETA_LOWER, n), np.zeros(JOINT_TERMS * n)])
+    upper = np.concatenate([np.tile(THETA_UPPER, n), np.full(JOINT_TERMS * n, np.inf)])
     x0 = np.clip(x0, lower, upper)
     result = least_squares(
         residuals,
@@ -199,11 +207,11 @@ def consistent_parameters(
         ftol=1e-4,
     )
     pi, _ = evaluate(result.x)
-    pi[10 * n :] = np.maximum(pi[10 * n :], 0.0)
+    pi[INERTIAL_PARAMETERS * n :] = np.maximum(pi[INERTIAL_PARAMETERS * n :], 0.0)
     deviation = (K @ pi - estimate.beta) / estimate.std
     misfit = float(np.sum((data_map @ pi - data_target) ** 2))
     model = with_inertial_parameters(prior, pi)
-    return ConsistentFit(pi, model, deviation, is_consistent(pi, n), result.message, misfit)
+    return ConsistentFit(pi, model, deviation, is_consistent(pi, n), misfit)
 
 
 @dataclass(frozen=True)

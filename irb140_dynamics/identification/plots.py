@@ -15,7 +15,7 @@ from irb140_dynamics.identification.pipeline import Result
 Save = Callable[[str, Callable[[BinaryIO], None]], None]  # (file name, writer of its bytes)
 
 
-def write_plots(result: Result, directory) -> list[str]:
+def write_plots(result: Result, directory: str | Path | Save) -> list[str]:
     """torques.png and residuals.png of the held-out fit points, in ``directory`` or, when it
     is a ``Save`` function, through it (the tools stage them: all outputs or none); their names."""
     import matplotlib

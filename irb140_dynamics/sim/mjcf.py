@@ -111,7 +111,14 @@ def _placement(T: np.ndarray) -> str:
 
 
 def _inertial(body: RigidBody) -> str:
-    return f'<inertial pos="{_numbers(body.com)}" mass="{_number(body.mass)}" fullinertia="{_numbers(body.inertia)}"/>'
+    xx, yy, zz, *products = body.inertia
+    # A diagonal inertia as diaginertia: older MuJoCo releases refuse a singular fullinertia
+    # (a point mass, a payload given by its mass alone) but takes zeros there.
+    if any(products):
+        inertia = f'fullinertia="{_numbers(body.inertia)}"'
+    else:
+        inertia = f'diaginertia="{_numbers((xx, yy, zz))}"'
+    return f'<inertial pos="{_numbers(body.com)}" mass="{_number(body.mass)}" {inertia}/>'
 
 
 def _number(x: float) -> str:

@@ -160,7 +160,7 @@ class _Progress:
         self._thread.start()
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *_exception):
         self._done.set()
         self._thread.join()
         if self.shown:

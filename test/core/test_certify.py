@@ -1,6 +1,6 @@
-"""The worst static torques are proven, not only searched (issue 8, item 6): Interval
+"""The worst static torques are proven, not only searched: Interval
 numbers, the exact harmonic form of the static torques, the box bounds, and the branch
-and bound against brute force; the issue's reproduction."""
+and bound against brute force; narrowed joint ranges with a small payload."""
 
 import math
 from dataclasses import replace
@@ -21,16 +21,17 @@ from irb140_dynamics.core.scalars.interval import Interval
 
 from ..support.common import random_model
 
-# issue 8, item 6: narrowed ranges (q2..q6) and a 1.0646 kg payload
-ISSUE_RANGES = {
+# Narrowed ranges (q2..q6) and a 1.0646 kg payload, where a local search stops short of the
+# worst joint-5 torque; FAR_POSE is beyond the search's maximum.
+NARROWED_RANGES = {
     1: (-0.5791, -0.0241),
     2: (1.9343, 3.7139),
     3: (0.2400, 2.5213),
     4: (1.6978, 1.9185),
     5: (-5.9204, -4.2777),
 }
-ISSUE_PAYLOAD = RigidBody(1.0646, (0.02498, 0.00324, -0.00464))
-ISSUE_POSE = [0.0, -0.56047, 1.93432, 0.23997, 1.69778, -5.92038]  # rounded: clipped into the ranges below
+NARROWED_PAYLOAD = RigidBody(1.0646, (0.02498, 0.00324, -0.00464))
+FAR_POSE = [0.0, -0.56047, 1.93432, 0.23997, 1.69778, -5.92038]  # rounded: clipped into the ranges below
 
 
 NO_PAYLOAD = RigidBody()
@@ -180,33 +181,33 @@ def test_long_chains_get_plain_interval_bounds():
     assert np.all(np.isfinite(extremes.bounds)) and np.all(extremes.bounds >= dense - 1e-9)
 
 
-# -- the issue's reproduction and the verdicts ---------------------------------------------------------
+# -- narrowed ranges and the verdicts ------------------------------------------------------------------
 
 
 @pytest.fixture(scope="module")
-def issue_model():
-    return with_ranges(irb140(), ISSUE_RANGES, ISSUE_PAYLOAD)
+def narrowed_model():
+    return with_ranges(irb140(), NARROWED_RANGES, NARROWED_PAYLOAD)
 
 
-def test_the_issue_reproduction_finds_the_true_worst_joint_5_torque(issue_model):
-    model = issue_model
+def test_narrowed_ranges_find_the_true_worst_joint_5_torque(narrowed_model):
+    model = narrowed_model
     limits = derive_torque_limits(model)
-    pose = np.clip(ISSUE_POSE, *np.array([j.position_limits for j in model.joints]).T)
+    pose = np.clip(FAR_POSE, *np.array([j.position_limits for j in model.joints]).T)
     there = gravity(model, pose)[4]
     assert there < -3.0656
-    load = workspace_load(model, ISSUE_PAYLOAD, limits)
-    assert load.torque[4] <= there  # the true worst: at least as far as the issue's pose
+    load = workspace_load(model, NARROWED_PAYLOAD, limits)
+    assert load.torque[4] <= there  # the true worst: at least as far as FAR_POSE
     assert gravity(model, load.pose[4])[4] == pytest.approx(load.torque[4], rel=1e-12)
     assert load.gap[4] <= 2 * CERTIFY_RTOL * abs(load.torque[4])
 
 
-def test_check_payload_no_longer_calls_an_over_payload_fine(issue_model):
+def test_check_payload_calls_a_payload_over_a_limit_past_the_local_maximum(narrowed_model):
     """A joint-5 limit between the search's local maximum (3.0631 N m) and the true worst
     (3.0657 N m): the payload is over it there, and the check says so."""
-    params = issue_model.to_params()
+    params = narrowed_model.to_params()
     params["joint_5.torque_limit"] = 3.0645
     model = RobotModel.from_params(params)
-    check = check_payload(model, ISSUE_PAYLOAD)
+    check = check_payload(model, NARROWED_PAYLOAD)
     assert not check.ok and check.over == ["joint_5"]
     assert check.workspace.bound[4] > 3.0645
 
@@ -224,7 +225,7 @@ def test_the_default_model_is_proven_to_the_tolerance():
 def test_a_spent_budget_leaves_a_gap_and_the_verdict_says_unproven(monkeypatch):
     """With almost no budget the proof stops early: the bounds are loose but still bounds,
     the gap is reported, and a limit between the torque found and the bound is neither
-    passed nor failed: UNPROVEN (issue 23: a bound is never a torque)."""
+    passed nor failed: UNPROVEN (a bound is never a torque)."""
     model, payload = irb140(), RigidBody(3.0, (0.05, 0.01, 0.1))  # a shape of its own: no proof remembered
     limits = derive_torque_limits(model)
     monkeypatch.setattr(certify, "EVALUATIONS", 0)  # one bound of the whole box per objective

@@ -7,6 +7,7 @@ import pytest
 
 from irb140_dynamics.core import irb140
 from irb140_dynamics.core.model.irb140 import (
+    IRB140_MOVING_MASS,
     box_inertia,
     cylinder_inertia,
     irb140_volumes,
@@ -35,7 +36,7 @@ def test_solve_density_reproduces_figure_5(row):
         link4=(a2, 0.38, a2),
         link6=dict(radius=a3, height=0.065),
     )
-    rho = solve_density(78.0, volumes)
+    rho = solve_density(IRB140_MOVING_MASS, volumes)
     assert abs(rho - rho_printed) <= PRINTED
     for volume, mass_printed in zip(volumes, masses_printed):
         assert abs(rho * volume - mass_printed) <= PRINTED

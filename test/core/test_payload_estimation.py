@@ -196,7 +196,7 @@ def test_rest_detector_counts_the_poses_of_rests_without_effort():
     for pose, states in ((0.0, 200), (0.1, 200), (0.2, 50), (0.0, 200)):  # 0.2: too short; 0.0 twice
         assert not rest(pose, states)
     assert detector.samples == [] and poses_without_effort() == [0.1, 0.0]
-    assert rest(0.0, effort=np.ones(6))  # pose 0 again, with effort: a sample, no longer without
+    assert rest(0.0, effort=np.ones(6))  # pose 0 again, with effort: a sample, and no longer a pose without
     assert len(detector.samples) == 1 and poses_without_effort() == [0.1]
     for pose in (0.3, 0.4, 0.5):  # at most max_samples poses, the latest kept
         rest(pose)

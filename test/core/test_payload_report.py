@@ -88,7 +88,7 @@ def test_a_payload_loading_a_joint_without_limit_gets_a_note(model, limits):
 
 def test_report_columns_stay_apart_at_any_use(model, limits):
     """Uses of 1,000 % and more keep at least two spaces between the columns, aligned
-    (issue 8: "243.382        1.00024338.2%")."""
+    (never run together as in "243.382        1.00024338.2%")."""
     check = check_payload(model, RigidBody(600.0), limits, q=STRETCHED)
     rows = check.report().splitlines()[2:9]
     for j, line in enumerate(rows[1:]):

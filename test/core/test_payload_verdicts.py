@@ -1,4 +1,4 @@
-"""A verdict is proven or says it is not (issue 23, item 1): OK and OVER-LIMIT only from a
+"""A verdict is proven or says it is not: OK and OVER-LIMIT only from a
 finished computation (a bound within the limit; a real torque over it), UNPROVEN with the
 best bound and the reason where a proof ran out of budget or the analysis out of time; a
 cancelled analysis stops at its next check. The chains here are beyond the harmonic proofs

@@ -6,6 +6,11 @@ import pytest
 
 from irb140_dynamics.core import Friction, ModelError, RigidBody, irb140, rnea, rnea_batch
 from irb140_dynamics.core.regressor import (
+    INERTIAL_PARAMETERS,
+    JOINT_PARAMETERS,
+    JOINT_TERMS,
+    LINK_PARAMETERS,
+    PARAMETERS_PER_JOINT,
     inertial_parameters,
     parameter_names,
     regressor,
@@ -158,3 +163,17 @@ def test_inconsistent_parameters_are_refused(change, field):
 def test_wrong_length_is_refused():
     with pytest.raises(ValueError, match="expected 78 parameters"):
         with_inertial_parameters(irb140(), np.zeros(77))
+
+
+def test_the_layout_names_count_pi_and_its_columns():
+    """pi: INERTIAL_PARAMETERS per link (Pinocchio's ten), then JOINT_TERMS per joint."""
+    model = with_friction(irb140(), np.random.default_rng(3))
+    n = model.n
+    assert (INERTIAL_PARAMETERS, JOINT_TERMS, PARAMETERS_PER_JOINT) == (10, 3, 13)
+    assert len(LINK_PARAMETERS) == INERTIAL_PARAMETERS and len(JOINT_PARAMETERS) == JOINT_TERMS
+    names = parameter_names(model)
+    pi = inertial_parameters(model)
+    assert len(names) == pi.size == PARAMETERS_PER_JOINT * n
+    assert names[INERTIAL_PARAMETERS * n] == f"{model.joints[0].name}.viscous"
+    assert pi[INERTIAL_PARAMETERS * n + JOINT_TERMS * 2] == model.joints[2].friction.viscous
+    assert regressor(model, np.zeros(n), np.zeros(n), np.zeros(n)).shape == (n, PARAMETERS_PER_JOINT * n)

@@ -1,4 +1,4 @@
-"""The core's public API refuses what it should (issue 8, item 7): a state is n finite real
+"""The core's public API refuses what it should: a state is n finite real
 numbers; anything else, and any result that would not be finite, is a ValueError naming
 the argument; payload functions check their bodies and limits too."""
 

@@ -52,3 +52,21 @@ def _in_docstring(path: Path, number: int, _cache={}) -> bool:  # noqa: B006 (a 
                     spans.append((value.lineno, value.end_lineno))
         _cache[path] = spans
     return any(start <= number <= end for start, end in _cache[path])
+
+
+ISSUE_NUMBER = re.compile(r"\bissues? #?\d+", re.IGNORECASE)
+
+
+def test_no_issue_numbers_in_docstrings_comments_or_docs():
+    """Tests, code and docs describe behaviour; which issue asked for it belongs in git."""
+    from .test_named_references import prose
+
+    texts = [path for folder in ("irb140_dynamics", "test", "bench") for path in sorted((ROOT / folder).rglob("*.py"))]
+    texts += [*sorted((ROOT / "docs").glob("*.md")), ROOT / "README.md", ROOT / "bench" / "README.md"]
+    found = []
+    for path in texts:
+        if not ISSUE_NUMBER.search(path.read_text()):
+            continue  # (most files: only the others' docstrings and comments are read)
+        for match in ISSUE_NUMBER.finditer(prose(path)):
+            found.append(f"{path.relative_to(ROOT)}: {match.group()}")
+    assert found == []

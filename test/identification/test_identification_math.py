@@ -245,6 +245,7 @@ def as_joint_trajectory(document: dict):
     return JointTrajectory(joint_names=document["joint_names"], points=points)
 
 
+@pytest.mark.ros  # builds trajectory_msgs messages
 def test_trajectory_text_is_a_joint_trajectory_message():
     t = np.array([0.0, 0.05, 1.25, 2.0000000001])
     Q = np.arange(8.0).reshape(4, 2) * 0.1

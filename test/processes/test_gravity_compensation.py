@@ -4,7 +4,7 @@ still where it falls without commands.
 
 The loop runs in lockstep on simulated time (sim_node `lockstep:=true`, id_node
 `use_sim_time:=true`, docs/sim.md, Lockstep): each state k+1 is one engine step with the
-command id_node computed from state k, so what the arm does no longer depends on the
+command id_node computed from state k, so the arm's motion does not depend on the
 machine's load (in real time, on two busy cores, commands came late and the arm drifted
 0.029 rad). The probe sees every state; each after the hold is checked to carry as its
 effort g of the state before it (to 1e-12): no step went without its command or took a

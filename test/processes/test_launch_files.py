@@ -1,7 +1,7 @@
 """The launch files (launch/*.launch.py, installed under share/irb140_dynamics/launch/), tested
 without ros2 launch (not on PyPI): each runs with no argument, names executables the
 package installs and files it installs, and its nodes start with the parameters it gives
-them, as ros2 launch would start them (issue 21 item 9)."""
+them, as ros2 launch would start them."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """payload_check_node as its own process (the EventsExecutor main() uses): ~/check held while
 the analysis of new parameters runs, then answered for them; an analysis out of time
-answers UNPROVEN (issue 21, item 7; issue 23, item 1)."""
+answers UNPROVEN."""
 
 import pytest
 from rclpy.parameter import Parameter

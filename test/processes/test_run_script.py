@@ -1,4 +1,4 @@
-"""scripts/run.sh as a user types it, from a directory of their own (issue 21 item 5):
+"""scripts/run.sh as a user types it, from a directory of their own:
 --help, relative paths from the caller's directory, a node that fails stops the rest and is
 named, Ctrl-C stops everything with exit 0, the demo's plot where it says."""
 

@@ -19,9 +19,9 @@ def test_starts_with_the_default_model_and_stops_cleanly_on_ctrl_c():
 
 
 def test_ctrl_c_inside_a_callback_stops_cleanly():
-    """Ctrl-C while a callback runs and messages wait: exit 0, no FATAL, no traceback (it
-    used to cut the callback, logged FATAL, or failed in rclpy's C++ building the next
-    message: "RuntimeError: Unable to convert call argument '0'")."""
+    """Ctrl-C while a callback runs and messages wait: exit 0, no FATAL, no traceback
+    (neither the callback cut short nor rclpy's C++ failing to build the next message:
+    "RuntimeError: Unable to convert call argument '0'")."""
     code, output = run_to_exit(module_command("test.support.interrupting_node"), timeout=30.0)
     assert code == 0, output
     assert "FATAL" not in output and "Traceback" not in output, output

@@ -1,5 +1,4 @@
-"""Starting the nodes with bad values, unknown names or Ctrl-C: one clear line, no traceback
-(issue 8, items 3, 4 and 9)."""
+"""Starting the nodes with bad values, unknown names or Ctrl-C: one clear line, no traceback."""
 
 import os
 import re

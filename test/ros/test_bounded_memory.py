@@ -1,4 +1,4 @@
-"""Nothing of ours grows with the inputs (issue 8, item 8): counters, caches, warning keys,
+"""Nothing of ours grows with the inputs: counters, caches, warning keys,
 timers and threads stay bounded, and the Python memory allocated by our code stops growing
 after a warm-up, under ever-new joint names, bad messages, references, parameter changes
 (models compiled anew) and checks. Growth below the Python allocator (rclpy, DDS) is for

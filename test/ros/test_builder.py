@@ -41,7 +41,7 @@ def test_builds_reuse_one_timer_and_leave_no_thread():
 
 
 def test_a_newer_job_cancels_the_build_under_way():
-    """Issue 23: a build that checks core.payload.stop (the payload analysis does) stops at
+    """A build that checks core.payload.stop (the payload analysis does) stops at
     its next check once a newer job comes, and is not delivered; the newer one is."""
     with running(lambda **kw: Node("builder_test", **kw)) as harness:
         delivered, survived = [], []

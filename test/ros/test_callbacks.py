@@ -1,5 +1,5 @@
 """No input leaves a callback with an exception: what cannot give finite torques is dropped,
-counted per topic, and the node goes on (issue 8, item 1)."""
+counted per topic, and the node goes on."""
 
 import math
 

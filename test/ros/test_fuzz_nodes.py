@@ -43,7 +43,7 @@ class Recorder:
             msg = deserialize_message(msg, JointState)
         self.efforts.append(list(msg.effort))
 
-    subscribers = 1  # a subscriber listens: id_node publishes only then (see ros.listened)
+    subscribers = 1  # a subscriber listens: id_node publishes only then (see ros.runtime.listened)
 
 
 def held_point(node):

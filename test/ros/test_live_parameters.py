@@ -1,5 +1,5 @@
 """Parameter changes: checked whole within the call, built off the executor, the message flow
-never waiting for a build (issue 8, item 2); undeclared names refused by name (item 5)."""
+never waiting for a build; undeclared names refused by name."""
 
 import threading
 
@@ -126,8 +126,8 @@ def check(harness):
 
 
 def test_check_right_after_a_change_waits_and_answers_for_the_new_parameters(gated_payload_node):
-    """Issue 21, item 7 (it answered "pending" at once): the request is held until the
-    analysis is in force, and the executor goes on serving the rest meanwhile."""
+    """~/check is not answered "pending": the request is held until the analysis is in
+    force, and the executor goes on serving the rest meanwhile."""
     node = gated_payload_node
     node.gate.close()
     assert [r.successful for r in unsettled_set(node, [Parameter("payload.mass", value=7.0)])] == [True]

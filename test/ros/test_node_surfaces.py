@@ -1,4 +1,4 @@
-"""What a user sees of the nodes besides their topics (issue 21 items 6 and 10): an integer
+"""What a user sees of the nodes besides their topics: an integer
 for a double at run time (`ros2 param set /id_node joint_1.torque_limit 100`), and the
 robot's name as the hardware_id of /diagnostics (model.name, or the URDF's <robot name>)."""
 

@@ -1,5 +1,5 @@
-"""payload_check_node's ~/check on models beyond the proofs' budget and after a model change
-(issue 23, item 1; issue 21, item 7): a long chain answers UNPROVEN with its best bound,
+"""payload_check_node's ~/check on models beyond the proofs' budget and after a model change: a
+long chain answers UNPROVEN with its best bound,
 never OVER-LIMIT; an analysis out of time answers UNPROVEN and says so; a model change
 cancels the analysis of the model before at its next check, and ~/check answers for the
 new model."""

@@ -17,6 +17,8 @@ from irb140_dynamics.core.algorithms.recursions import (
     steps,
 )
 
+INERTIAL_PARAMETERS = 10  # per link: m, the first moment m c (3), the inertia's 6 entries
+
 # Pinocchio's inertia order as entries (xx, yy, zz, xy, xz, yz) of our inertia 6-tuples
 _UNIT_INERTIAS = tuple(tuple(1.0 if k == position else 0.0 for k in range(6)) for position in (0, 3, 1, 4, 5, 2))
 _UNIT_VECTORS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
@@ -27,14 +29,14 @@ def rigid_body_regressor(links, cs, qd, qdd, gravity):
     moves = steps(links, cs)
     motion = forward_motion(links, moves, qd, qdd, gravity, at_joints=True)
     n = len(links)
-    Y = [[0.0] * (10 * n) for _ in range(n)]
+    Y = [[0.0] * (INERTIAL_PARAMETERS * n) for _ in range(n)]
     for k in range(n):
         w, dw, a = _in_joint_frame(links[k], *motion[k])
         for column, (f, moment) in enumerate(_unit_wrenches(w, dw, a)):
             for i in reversed(range(k + 1)):
                 if i < k:
                     f, moment = _to_parent_joint_frame(links[i + 1], moves[i + 1], links[i], f, moment)
-                Y[i][10 * k + column] = dot(links[i].u, f if links[i].prismatic else moment)
+                Y[i][INERTIAL_PARAMETERS * k + column] = dot(links[i].u, f if links[i].prismatic else moment)
     return Y
 
 

@@ -7,6 +7,7 @@ qdd, Y)``; with symbolic parameters each takes ``p`` (the parameters) last.
 
 from __future__ import annotations
 
+from ..regressor import PARAMETERS_PER_JOINT
 from .printing import DESCRIPTIONS, CPrinter, header_lines, used_names
 from .symbolic import Equations
 
@@ -40,7 +41,9 @@ def _comment(lines: list[str]) -> str:
 
 def _signature(eq: Equations, name: str, prefix: str) -> str:
     n = eq.n
-    size = {"tau": f"{n}", "M": f"{n * n}", "Cqd": f"{n}", "g": f"{n}", "regressor": f"{n * 13 * n}"}[name]
+    size = {"tau": f"{n}", "M": f"{n * n}", "Cqd": f"{n}", "g": f"{n}", "regressor": f"{n * PARAMETERS_PER_JOINT * n}"}[
+        name
+    ]
     args = [f"const double {arg}[{n}]" for arg in eq.arguments[name]]
     args.append(f"double {name if name != 'regressor' else 'Y'}[{size}]")
     if eq.parameters:

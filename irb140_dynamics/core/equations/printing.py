@@ -9,7 +9,6 @@ from sympy.printing.str import StrPrinter
 
 from .symbolic import Equations, reduced
 
-FUNCTIONS = {"tau": "tau", "M": "M", "Cqd": "Cqd", "g": "g", "regressor": "regressor"}
 DESCRIPTIONS = {
     "tau": "joint torques tau = M(q) qdd + C(q, qd) qd + g(q) + friction(qd) [N m]",
     "M": "mass matrix M(q) [kg m^2] (armature on the diagonal)",

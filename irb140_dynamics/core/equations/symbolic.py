@@ -28,7 +28,7 @@ from sympy.core.parameters import distribute
 from ..algorithms import recursions as algorithms
 from ..algorithms.regressor import rigid_body_regressor
 from ..model.rigid_body import shift_inertia
-from ..regressor import LINK_PARAMETERS
+from ..regressor import JOINT_TERMS, LINK_PARAMETERS, PARAMETERS_PER_JOINT
 
 QUANTITIES = ("tau", "M", "C", "g", "regressor")
 DEFAULT_QUANTITIES = ("tau", "M", "C", "g")
@@ -122,7 +122,7 @@ def derive(model, what=DEFAULT_QUANTITIES, symbolic: bool = False, progress: Cal
             progress("the regressor")
             Y = rigid_body_regressor(links, cs, qd, qdd, _exact(model.gravity))
             quantities["regressor"] = _with_joint_columns(Y, qd, qdd, model.smoothing_velocity)
-            shapes["regressor"], arguments["regressor"] = (n, 13 * n), ("q", "qd", "qdd")
+            shapes["regressor"], arguments["regressor"] = (n, PARAMETERS_PER_JOINT * n), ("q", "qd", "qdd")
     columns = _regressor_columns(n) if "regressor" in what else ()
     return Equations(
         n,
@@ -258,8 +258,8 @@ def _with_joint_columns(Y, qd, qdd, smoothing):
     n = len(Y)
     rows = []
     for i in range(n):
-        joint = [0] * (3 * n)
-        joint[3 * i : 3 * i + 3] = [qd[i], sp.tanh(qd[i] / sp.Float(smoothing)), qdd[i]]
+        joint = [0] * (JOINT_TERMS * n)
+        joint[JOINT_TERMS * i : JOINT_TERMS * (i + 1)] = [qd[i], sp.tanh(qd[i] / sp.Float(smoothing)), qdd[i]]
         rows += list(Y[i]) + joint
     return rows
 

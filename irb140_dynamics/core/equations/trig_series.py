@@ -67,19 +67,6 @@ class Series:
 
     # -- reading -----------------------------------------------------------------------
 
-    def real_terms(self, tolerance: float = 0.0):
-        """[(parameter, velocities, k, cos coefficient, sin coefficient)] with k canonical
-        (its first nonzero entry positive), sorted; the term is (a cos(k.q) + b sin(k.q))."""
-        out = {}
-        for (p, v, k), c in self.terms.items():
-            sign = next((1 if x > 0 else -1 for x in k if x), 0)
-            if sign < 0:
-                continue  # folded in with its conjugate at -k
-            a, b = (c.real, 0.0) if sign == 0 else (2.0 * c.real, -2.0 * c.imag)
-            if abs(a) > tolerance or abs(b) > tolerance:
-                out[(v, k, p)] = (a if abs(a) > tolerance else 0.0, b if abs(b) > tolerance else 0.0)
-        return [(p, v, k, a, b) for (v, k, p), (a, b) in sorted(out.items(), key=_order)]
-
     def value(self, q, velocities, parameters=()) -> float:
         """The series at angles q, velocities (qd then qdd, one list) and parameter values."""
         total = 0.0
@@ -90,11 +77,6 @@ class Series:
                 term *= velocities[j]
             total += term * (parameters[p] if p >= 0 else 1.0)
         return total.real
-
-
-def _order(item):
-    (v, k, p), _ = item
-    return (len(v), v, sum(map(abs, k)), tuple(-abs(x) for x in k), k, p)
 
 
 def _pruned(terms: dict):

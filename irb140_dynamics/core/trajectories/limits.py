@@ -24,9 +24,6 @@ class Limits:
     acceleration: np.ndarray
     torque_source: tuple[str, ...]  # per joint: "given", "derived" or "none"
 
-    def scaled(self, factor: float) -> Limits:
-        return Limits(self.torque * factor, self.velocity * factor, self.acceleration * factor, self.torque_source)
-
 
 def trajectory_limits(model: RobotModel) -> Limits:
     """The model's limits; torque limits of 0 derived as the payload check derives them."""
