@@ -227,9 +227,6 @@ class CtypesKernel:
     def __init__(self, function, constants: bytes, lengths: list[int], shape: tuple[int, ...]):
         self._function, self._constants = function, constants
         self._lengths, self._shape = [(length,) for length in lengths], shape
-        self._size = 1
-        for extent in shape:
-            self._size *= extent
 
     def __call__(self, *arrays):
         if len(arrays) != len(self._lengths) or not all(

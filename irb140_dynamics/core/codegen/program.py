@@ -24,8 +24,6 @@ from dataclasses import dataclass
 
 from irb140_dynamics.core.codegen.trace import Sym, merged, operands_first, trace
 
-BINARY = ("+", "-", "*", "/")
-UNARY = ("neg", "tanh")
 ANGLES = ("cos", "sin")
 
 
