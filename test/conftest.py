@@ -1,6 +1,10 @@
 """Test session setup: DDS isolated to this machine and to this session's own domain, a
 cache of native kernels of its own, Ctrl-C as from a terminal, and the markers of the test
-folders: test/ros/ spins nodes (``ros``), test/processes/ starts executables (``process``)."""
+folders: test/ros/ spins nodes (``ros``), test/processes/ starts executables (``process``).
+
+Under pytest-xdist (``-n 2``) each worker is a session of its own: a domain of its own (the
+run's first domain plus the worker's number, the run's drawn once by the process that starts
+the workers, which they inherit) and a kernel cache of its own."""
 
 import os
 import random
@@ -9,7 +13,13 @@ import tempfile
 from pathlib import Path
 
 # Set before rclpy is imported anywhere: a domain of our own, discovery on localhost only.
-os.environ["ROS_DOMAIN_ID"] = str(random.SystemRandom().randint(1, 100))
+WORKERS_AT_MOST = 8  # pytest-xdist workers: domains FIRST_DOMAIN to FIRST_DOMAIN + 7
+FIRST_DOMAIN = int(
+    os.environ.setdefault("IRB140_TEST_DOMAIN", str(random.SystemRandom().randint(1, 101 - WORKERS_AT_MOST)))
+)
+WORKER = int(os.environ.get("PYTEST_XDIST_WORKER", "gw0").removeprefix("gw"))
+assert WORKER < WORKERS_AT_MOST, f"at most {WORKERS_AT_MOST} pytest-xdist workers (a DDS domain each)"
+os.environ["ROS_DOMAIN_ID"] = str(FIRST_DOMAIN + WORKER)
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ.pop("ROS_STATIC_PEERS", None)
 # Native kernels (core.codegen.native) compiled by this session into a folder of its own,

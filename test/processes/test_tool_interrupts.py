@@ -17,7 +17,7 @@ import pytest
 from irb140_dynamics.core import irb140, rnea_batch
 from irb140_dynamics.identification.excitation import optimise_excitation
 
-from ..support.common import sweep
+from ..support.common import spread
 from ..support.node_process import TIMEOUT, handles_sigterm
 from ..support.paths import ROOT
 from ..support.synthetic_arm import Samples, true_arm, write_csv
@@ -33,11 +33,15 @@ def recording(tmp_path_factory):
     return write_csv(folder / "run.csv", Samples(t, Q, QD, tau, tau), irb140().joint_names)
 
 
-def moments(seed: int, count: int, longest: float):
+def moments(seed: int, longest: float, count: int = 12) -> list:
+    """``count`` seeded (delay, signals) cases, delays up to ``longest`` s; in the suite the
+    earliest, a middle and the latest of them (support.common.spread)."""
     rng = np.random.default_rng(seed)
+    cases = []
     for k in range(count):
         signals = [int(rng.choice([signal.SIGINT, signal.SIGTERM])) for _ in range(int(rng.integers(1, 4)))]
-        yield pytest.param(float(rng.uniform(0.0, longest)), signals, id=f"case{k}")
+        cases.append(pytest.param(float(rng.uniform(0.0, longest)), signals, id=f"case{k}"))
+    return spread(cases, 3, key=lambda case: case.values[0])
 
 
 def interrupted(command, folder, delay, signals):
@@ -62,7 +66,7 @@ def interrupted(command, folder, delay, signals):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("delay, signals", list(moments(7, sweep(3, 12), 8.0)))
+@pytest.mark.parametrize("delay, signals", moments(7, 8.0))
 def test_identify_interrupted_at_any_moment(recording, tmp_path, delay, signals):
     (tmp_path / "run.csv").write_bytes(recording.read_bytes())
     command = [
@@ -96,7 +100,7 @@ def test_identify_interrupted_at_any_moment(recording, tmp_path, delay, signals)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("delay, signals", list(moments(8, sweep(3, 12), 3.0)))
+@pytest.mark.parametrize("delay, signals", moments(8, 3.0))
 def test_excitation_interrupted_at_any_moment(tmp_path, delay, signals):
     command = [
         sys.executable,
@@ -120,7 +124,7 @@ def test_excitation_interrupted_at_any_moment(tmp_path, delay, signals):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("delay, signals", list(moments(9, sweep(3, 12), 3.0)))
+@pytest.mark.parametrize("delay, signals", moments(9, 3.0))
 def test_export_urdf_interrupted_at_any_moment(tmp_path, delay, signals):
     command = [sys.executable, "-m", "irb140_dynamics.tools.export_urdf", "--out", "arm.urdf"]
     code, output = interrupted(command, tmp_path, delay, signals)

@@ -22,10 +22,13 @@ from irb140_dynamics.core import RobotModel, check_payload, gravity, rnea
 from irb140_dynamics.nodes.id_node.node import IdNode
 from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
 
+from ..support.common import full_sweep
 from ..support.fuzz_inputs import Fuzzer, parameter_set
 from ..support.ros_harness import running
 
 BUDGET = 2.5  # s of fuzzing per node and mode, at most, once MIN_MESSAGES are done
+# id_node's: MIN_MESSAGES and a short while more in the suite, BUDGET with IRB140_SWEEP=full
+ID_NODE_BUDGET = BUDGET if full_sweep() else 1.0
 MIN_MESSAGES = 400  # per node and mode, at least, however slow the machine: the counts below hold
 MESSAGES = 800  # per node and mode, at most
 PARAMETER_EVERY = 30  # messages between two parameter sets
@@ -97,7 +100,7 @@ def test_fuzz_id_node(mode):
         direct_ff, direct_g = Recorder(), Recorder()
         real = node._feedforward_pub, node._gravity_pub
         held = None  # the reference the node must hold: (q, qd, qdd or None)
-        deadline = time.monotonic() + BUDGET
+        deadline = time.monotonic() + ID_NODE_BUDGET
         counts = {"valid": 0, "dropped": 0, "dds": 0, "accepted": 0, "refused": 0}
         for k in range(MESSAGES):
             if k >= MIN_MESSAGES and time.monotonic() > deadline:

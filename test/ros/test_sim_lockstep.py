@@ -27,7 +27,9 @@ PERIOD_NS = 10_000_000
 
 @pytest.fixture
 def lockstep(request):
-    overrides = {"lockstep": True, "rate": RATE, "lockstep_timeout": 5.0, **getattr(request, "param", {})}
+    # the first state goes out as the node starts, before the probe listens: the test takes
+    # it as published again after lockstep_timeout, long beside the 0.3 s it spins idle
+    overrides = {"lockstep": True, "rate": RATE, "lockstep_timeout": 2.0, **getattr(request, "param", {})}
     with running(SimNode, parameter_overrides=make(**overrides)) as harness:
         harness.states = harness.listen(JointState, "joint_states", 1000)
         harness.clock = harness.listen(Clock, "/clock", 1000)
@@ -50,8 +52,10 @@ def step(sim, tau) -> JointState:
 
 
 def first_step(sim) -> JointState:
-    """The first command may reach sim_node before its subscription has matched ours: send
-    zero torque until a step is taken (each given long enough that a late one is not sent twice)."""
+    """The first command may reach sim_node before its subscription has matched ours: wait
+    until our publisher sees it, then send zero torque until a step is taken (each given long
+    enough that a late one is not sent twice)."""
+    assert sim.spin_until(lambda: sim.commands.get_subscription_count() > 0)
     for _ in range(10):
         sim.commands.publish(Float64MultiArray(data=[0.0] * 6))
         if sim.spin_until(lambda: sim.states and stamp(sim.states[-1]) > 0, timeout=3.0):
@@ -122,7 +126,7 @@ def test_each_command_is_one_step_of_the_engine_and_one_period_of_clock(lockstep
         np.testing.assert_array_equal(state.position, arm.q)  # exactly: no step more, none less
         np.testing.assert_array_equal(state.velocity, arm.qd)
     count = len(sim.states)
-    sim.spin_for(0.3)  # no command: no step (and the timeout, 5 s, is not up)
+    sim.spin_for(0.3)  # no command: no step (and the timeout, 2 s, is not up)
     assert len(sim.states) == count and sim.node.lockstep.steps == 21
     assert [clock_ns(msg) for msg in sim.clock] == sorted(clock_ns(msg) for msg in sim.clock)
 

@@ -28,6 +28,17 @@ def sweep(quick: int, full: int) -> int:
     return full if full_sweep() else quick
 
 
+def spread(cases: list, quick: int, key) -> list:
+    """The cases a sweep test runs: all of ``cases`` with IRB140_SWEEP=full; in the suite,
+    ``quick`` of them spread evenly over the range of ``key(case)`` (its least, its
+    greatest and between: an early and a late moment, say), in the order of ``cases``."""
+    if full_sweep() or len(cases) <= quick:
+        return list(cases)
+    order = sorted(range(len(cases)), key=lambda k: key(cases[k]))
+    chosen = {order[round(i * (len(cases) - 1) / (quick - 1))] for i in range(quick)}
+    return [case for k, case in enumerate(cases) if k in chosen]
+
+
 def loaded_irb140() -> RobotModel:
     return irb140(payload=OFFSET_PAYLOAD)
 

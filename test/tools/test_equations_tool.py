@@ -119,20 +119,28 @@ def test_progress_line_after_the_quiet_time(tmp_path, capsys, monkeypatch):
 @pytest.mark.slow
 @pytest.mark.process
 def test_same_input_same_bytes(tmp_path):
-    """Two runs as processes (python -m), with different hash seeds: the same files, byte for
-    byte. The two seeds' runs go side by side (one per core)."""
+    """Two runs as processes, with different hash seeds: the same files, byte for byte. Each
+    process writes both forms (the C of tau, M, C, g; the LaTeX of M, g) through the tool's
+    main, one after the other; the two seeds' processes go side by side (one per core)."""
 
-    def start(seed: str, form: str, what: str):
+    def start(seed: str):
         env = {**os.environ, "PYTHONHASHSEED": seed, "PYTHONPATH": str(ROOT)}
-        command = [sys.executable, "-m", "irb140_dynamics.tools.equations", "--params-file", str(CONFIG)]
-        command += ["--form", form, "--what", what, "--out", str(tmp_path / seed)]
-        return subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        runs = [
+            ["--params-file", str(CONFIG), "--form", form, "--what", what, "--out", str(tmp_path / seed)]
+            for form, what in (("c", "tau,M,C,g"), ("latex", "M,g"))
+        ]
+        script = (
+            "import sys\nfrom irb140_dynamics.tools import equations\n"
+            f"sys.exit(max(equations.main(arguments) for arguments in {runs!r}))"
+        )
+        return subprocess.Popen(
+            [sys.executable, "-c", script], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+        )
 
-    for form, what in (("c", "tau,M,C,g"), ("latex", "M,g")):
-        processes = [start(seed, form, what) for seed in ("1", "2")]
-        for process in processes:
-            _, err = process.communicate(timeout=300)
-            assert process.returncode == 0, err
+    processes = [start(seed) for seed in ("1", "2")]
+    for process in processes:
+        _, err = process.communicate(timeout=300)
+        assert process.returncode == 0, err
     outputs = [{p.name: p.read_bytes() for p in sorted((tmp_path / seed).iterdir())} for seed in ("1", "2")]
     assert outputs[0] and outputs[0] == outputs[1]
     assert sorted(outputs[0]) == ["irb140_eom.c", "irb140_eom.h", "irb140_eom.tex"]

@@ -19,8 +19,10 @@ from rosbags.typesys import Stores, get_typestore
 from irb140_dynamics.core import RobotModel, irb140, rnea, rnea_batch
 from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.core.regressor import inertial_parameters
+from irb140_dynamics.identification import pipeline
 from irb140_dynamics.identification.base import find_base_parameters
 from irb140_dynamics.identification.consistent import is_consistent
+from irb140_dynamics.identification.pipeline import identify
 from irb140_dynamics.tools import excitation as excitation_tool
 from irb140_dynamics.tools import identify as identify_tool
 
@@ -81,12 +83,20 @@ def workflow(tmp_path_factory):
     bag = write_bag(work / "bag", joint_state_messages(samples, NAMES, with_velocity=False, typestore=typestore))
     out, plots = work / "identified.yaml", work / "plots"
     printed = io.StringIO()
-    with contextlib.redirect_stdout(printed):
+    results = []  # identify's result, kept for the tests of what the tool does with one
+
+    def kept(*args, **kwargs):
+        results.append(identify(*args, **kwargs))
+        return results[-1]
+
+    with pytest.MonkeyPatch.context() as patch, contextlib.redirect_stdout(printed):
+        patch.setattr(pipeline, "identify", kept)
         status = identify_tool.main([str(bag), "--out", str(out), "--plots", str(plots), "--quiet"])
     return dict(
         work=work,
         trajectory=trajectory_file,
         document=document,
+        trajectory_arrays=(t, Q, QD, QDD),
         samples=samples,
         arm=arm,
         QDD=QDD,
@@ -95,6 +105,7 @@ def workflow(tmp_path_factory):
         plots=plots,
         status=status,
         printed=printed.getvalue(),
+        result=results[0] if results else None,
     )
 
 
@@ -117,7 +128,7 @@ def test_the_excitation_file_is_a_trajectory_within_the_limits(workflow):
     assert 1.0 < condition < 1000.0
     document = workflow["document"]
     assert document["joint_names"] == list(NAMES) and len(document["points"]) == RATE * PERIOD * PERIODS + 1
-    _, t, Q, QD, QDD = load_trajectory(workflow["trajectory"])
+    _, Q, QD, QDD = workflow["trajectory_arrays"]  # the file as load_trajectory read it
     for j, joint in enumerate(irb140().joints):
         lower, upper = joint.position_limits
         assert lower <= Q[:, j].min() and Q[:, j].max() <= upper
@@ -291,8 +302,12 @@ def test_progress_bar_ends_at_100_percent_on_its_own_line():
 
 def test_plots_and_result_are_written_together_or_not_at_all(workflow, tmp_path, monkeypatch, capsys):
     """A plot that cannot be written (here: the second fails) leaves neither the result nor
-    the first plot, nor a temporary file or the plots folder made for them."""
+    the first plot, nor a temporary file or the plots folder made for them. The fit is the
+    workflow's own (the recording read and fitted once for the module)."""
     import irb140_dynamics.identification.plots as plots
+
+    assert workflow["result"] is not None
+    monkeypatch.setattr(pipeline, "identify", lambda *a, **k: workflow["result"])
 
     real = plots.write_plots
 
@@ -316,8 +331,6 @@ def test_plots_and_result_are_written_together_or_not_at_all(workflow, tmp_path,
 
 
 def test_arguments_and_outputs_are_checked_before_the_recording_is_read(workflow, tmp_path, monkeypatch, capsys):
-    import irb140_dynamics.identification.pipeline as pipeline
-
     monkeypatch.setattr(pipeline, "identify", lambda *a, **k: pytest.fail("the recording was read"))
     afile = tmp_path / "afile"
     afile.write_text("")
