@@ -34,6 +34,7 @@ setup(
             "record = irb140_dynamics.tools.record:main",
             "equations = irb140_dynamics.tools.equations:main",
             "retime = irb140_dynamics.tools.retime:main",
+            "load_diagram = irb140_dynamics.tools.load_diagram:main",
             "trajectory_check_node = irb140_dynamics.nodes.trajectory_check_node:main",
             # the tools under names of their own, for an install without the ros2 CLI (pip)
             "irb140-export-urdf = irb140_dynamics.tools.export_urdf:main",
@@ -42,6 +43,7 @@ setup(
             "irb140-record = irb140_dynamics.tools.record:main",
             "irb140-equations = irb140_dynamics.tools.equations:main",
             "irb140-retime = irb140_dynamics.tools.retime:main",
+            "irb140-load-diagram = irb140_dynamics.tools.load_diagram:main",
         ],
     },
 )

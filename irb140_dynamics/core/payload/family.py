@@ -69,6 +69,7 @@ class PayloadFamily:
 
     empty: RobotModel  # the payload at 0 kg
     unit: RobotModel  # the payload at 1 kg
+    given_forms: tuple[StaticForms, StaticForms] | None = None  # the forms, if already known
 
     def torques(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
         """(tau0, dtau) [N m, N m/kg] that hold the motion (q, qd) with qdd = 0."""
@@ -96,18 +97,30 @@ class PayloadFamily:
         return ranges.maximize(self.static_torque(m), np.vstack([np.eye(n), -np.eye(n)]), sample_torques, warm)
 
     def extremes(
-        self, m: float, ranges: JointRanges, sample_torques=None, warm=None, rows=None, share: float = 1.0, found=None
+        self,
+        m: float,
+        ranges: JointRanges,
+        sample_torques=None,
+        warm=None,
+        rows=None,
+        share: float = 1.0,
+        found=None,
+        ceiling=None,
     ) -> Extremes:
         """The worst static torques at m kg, searched and proven (remembered per m and
         ranges): all 2n of them, or only ``rows`` proven (the others' bounds inf), within
-        ``share`` of the proof's budget; ``found``: (values, poses) of a search at m done."""
+        ``share`` of the proof's budget; ``found``: (values, poses) of a search at m done.
+        ``ceiling`` (2n,): a row's proof may stop once its bound is below it (a limit to
+        prove, not the maximum itself: far cheaper where the maximum is well below it)."""
         rows = np.arange(2 * self.empty.n) if rows is None else np.asarray(rows, dtype=int)
+        ceiling = None if ceiling is None else np.asarray(ceiling, dtype=float)
         key = (float(m), ranges.lower.tobytes(), ranges.upper.tobytes(), rows.tobytes())
+        key += (None if ceiling is None else ceiling.tobytes(),)
         proven = self._proven.get(key)  # (a family may serve several threads: no check-then-get)
         if proven is not None:
             return proven
         values, poses = self.search(m, ranges, sample_torques, warm) if found is None else found
-        proven = self._prove(m, ranges, values, poses, rows, share)
+        proven = self._prove(m, ranges, values, poses, rows, share, ceiling)
         if not ran_out():  # cut short by the deadline: not the proof the budget would give
             if len(self._proven) >= 8:
                 self._proven.pop(next(iter(self._proven)))
@@ -121,16 +134,20 @@ class PayloadFamily:
     @cached_property
     def forms(self) -> tuple[StaticForms, StaticForms] | None:
         """The harmonic forms of the payload at 0 and 1 kg (None for too many joints)."""
+        if self.given_forms is not None:
+            return self.given_forms
         empty = StaticForms.of(self.empty)
         return None if empty is None else (empty, StaticForms.of(self.unit))
 
-    def _prove(self, m, ranges, values, poses, rows, share) -> Extremes:
+    def _prove(self, m, ranges, values, poses, rows, share, ceiling=None) -> Extremes:
         n, torque = self.empty.n, self.static_torque(m)
         bounds = np.full(2 * n, np.inf)
         weights = np.vstack([np.eye(n), -np.eye(n)])
         offsets = np.array(kernels_of(self.empty).angles)
         scale = max(1.0, float(np.max(np.abs(values))))
         tol = CERTIFY_RTOL * np.maximum(np.abs(values), 1e-3 * scale)
+        if ceiling is not None:
+            tol = np.maximum(tol, np.nan_to_num(ceiling - values, posinf=np.inf, neginf=0.0))
         lower, upper = ranges.lower + offsets, ranges.upper + offsets
         joints, signs = rows % n, np.where(rows < n, 1.0, -1.0)
         if self.forms is None:
