@@ -14,11 +14,12 @@ a wrist whose last joint turns about the flange axis the two merge into one angl
 
 At each point the payload's torques are affine in its mass (see ``family``). Dinkelbach's
 iteration over searched poses gives the mass m* at which a real pose reaches a limit (an
-upper bound of the true maximum); the proof then shows that (1 - MARGIN) m* holds in every
+upper bound of the true maximum); the proof then shows that (1 - margin) m* holds in every
 pose: every limited joint's worst static torque there is proven below its limit (a
 decision, far cheaper than the exact maximum). A proof that finds a worse pose than the
-search hands it back to Dinkelbach (ROUNDS times at most). Where it still fails the point
-is unproven, and its mass the one the search found: no more can hold.
+search hands it back to Dinkelbach; one whose budget runs out is tried again with the next
+of MARGINS (ROUNDS proofs at most). Where it still fails the point is unproven, and its
+mass the one the search found: no more can hold.
 
 The forms of the proof are linear in the payload's mass and first moment, so they are
 made once per arm (at 0 kg, and 1 kg at the origin, at x = 1 m and at z = 1 m) and mixed
@@ -42,8 +43,9 @@ from irb140_dynamics.core.payload.limits import limit_values, smallest_max_paylo
 from irb140_dynamics.core.payload.proof.harmonic import StaticForms
 from irb140_dynamics.core.payload.workspace import JointRanges
 
-MARGIN = 0.005  # the proof aims at (1 - MARGIN) of the mass the search finds
-ROUNDS = 3  # proofs per point (each after Dinkelbach from the worse poses the last one found)
+MARGINS = (0.005, 0.015)  # the proof aims at (1 - margin) of the mass the search finds; the next if it fails
+ROUNDS = 4  # proofs per point (each after Dinkelbach from the worse poses the last one found, or with the next margin)
+PROOF_SHARE = 4.0  # of ``certify.EVALUATIONS`` per proof: a heavy arm's own torques leave a payload little room
 DIRECTION = "load_direction"  # the name of the joint that turns the CoM about the flange axis
 
 
@@ -193,6 +195,8 @@ def _point(family: PayloadFamily, ranges: JointRanges, L: np.ndarray, warm, z: f
     if poses is not None:
         from_warm = smallest_max_payload(family, poses, L)
         best = from_warm if _below(from_warm.mass, best.mass) else best
+    margin = iter(MARGINS)
+    m, fraction = math.nan, 1 - next(margin)
     for _ in range(ROUNDS):
         while math.isfinite(best.mass):  # Dinkelbach, on the limited joints' torques only
             torque = _static_torque(family, min(best.mass, MAX_MASS))
@@ -205,18 +209,21 @@ def _point(family: PayloadFamily, ranges: JointRanges, L: np.ndarray, warm, z: f
             return DiagramPoint(z, l, math.nan, False, best.joint, "a pose exceeds a limit without any payload"), poses
         if math.isinf(best.mass):
             return DiagramPoint(z, l, math.inf, False, None, "no limited joint is loaded"), poses
-        m = min(best.mass, MAX_MASS) * (1 - MARGIN)
+        m = min(best.mass, MAX_MASS) * fraction
         ceiling = np.tile(L, 2)
         every = np.repeat(poses[:1], 2 * n, axis=0)  # rows not proven: a real pose's torque
         every[limited] = poses
         found = (np.einsum("kn,kn->k", _static_torque(family, m)(every), np.vstack([np.eye(n), -np.eye(n)])), every)
-        proof = family.extremes(m, ranges, rows=limited, found=found, ceiling=ceiling)
+        proof = family.extremes(m, ranges, rows=limited, found=found, ceiling=ceiling, share=PROOF_SHARE)
         if np.all(proof.bounds[limited] <= ceiling[limited]):
             return DiagramPoint(z, l, m, True, best.joint), poses
         candidate = smallest_max_payload(family, proof.poses[limited], L)
-        if not _below(candidate.mass, best.mass * (1 - 1e-12)):
-            break  # no worse pose found: the bounds did not close
-        best, poses = candidate, proof.poses[limited]
+        if _below(candidate.mass, best.mass * (1 - 1e-12)):
+            best, poses = candidate, proof.poses[limited]  # the search missed a worse pose
+            continue
+        fraction = 1 - next(margin, math.nan)  # the bounds did not close: aim lower
+        if math.isnan(fraction):
+            break
     reason = f"the proof's budget ran out at {m:.4g} kg (no more than {best.mass:.4g} kg holds)"
     return DiagramPoint(z, l, best.mass, False, best.joint, reason), poses
 
