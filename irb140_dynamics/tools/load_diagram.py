@@ -84,13 +84,13 @@ def _diagram(argv: list[str], interrupts) -> int:
     from irb140_dynamics.tools.outputs import Outputs
 
     try:
-        model = model_of(args).model
+        source = model_of(args)
     except ValueError as error:
         raise ToolError(str(error).splitlines()[0]) from None
-    rated = RigidBody(args.rated_mass)
+    model, rated = source.model, RigidBody(args.rated_mass)
     limits = derive_torque_limits(model, rated)
     diagram = load_diagram(model, limits.values, z, l, workers=_workers(z.size))
-    csv, png = diagram_csv(diagram).encode(), diagram_png(diagram, rated.mass)
+    csv, png = diagram_csv(diagram).encode(), diagram_png(diagram, rated.mass, os.path.basename(source.origin))
     with Outputs(interrupts) as outputs:
         outputs.directory(out, args.out)
         for name, data in zip(FILES, (csv, png)):

@@ -33,9 +33,10 @@ def diagram_csv(diagram) -> str:
     return "\n".join(lines) + "\n"
 
 
-def diagram_png(diagram, rated_mass: float) -> bytes:
+def diagram_png(diagram, rated_mass: float, arm: str) -> bytes:
     """PNG bytes: filled mass contours over L (across) and Z (up), labelled lines, the rated
-    mass's curve in bold, unproven points crossed."""
+    mass's curve in bold (or, where no point holds it, the note of where it does), unproven
+    points crossed; ``arm`` names the arm in the title."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -54,6 +55,10 @@ def diagram_png(diagram, rated_mass: float) -> bytes:
         if finite.min() <= rated_mass <= finite.max():
             rated = ax.contour(L, Z, masses, levels=[rated_mass], colors="tab:red", linewidths=2.5)
             ax.clabel(rated, fmt=f"rated {rated_mass:g} kg", fontsize=8)
+    if not (finite.size and finite.min() <= rated_mass <= finite.max()):
+        where = "above every point's" if finite.size and rated_mass > finite.max() else "within every point's"
+        ax.plot([0], [0], "o", color="tab:red", label=f"rated {rated_mass:g} kg: {where} mass")
+        ax.legend(loc="upper right", fontsize="small")
     else:
         points = ax.scatter(L, Z, c=masses, cmap="viridis_r")
         fig.colorbar(points, ax=ax, label="largest payload [kg]", shrink=0.8)
@@ -65,7 +70,7 @@ def diagram_png(diagram, rated_mass: float) -> bytes:
     ax.set_ylabel("Z: CoM along the flange axis [m]")
     ax.set_aspect("equal", adjustable="box")
     ax.set_title(
-        f"Load diagram: {len(diagram.joint_names)}-joint arm, static, every pose\n"
+        f"Load diagram: {arm} ({len(diagram.joint_names)} joints), at rest in every pose\n"
         f"largest payload [kg], {100 * diagram.proven_share:.0f} % proven",
         fontsize=10,
     )

@@ -107,7 +107,8 @@ class _Shapes:
         if self.forms is not None:
             empty, origin, x, up = self.forms
             given = (empty, _mixed(origin, [(x, l), (up, z)]))
-        return PayloadFamily(self.arm.with_payload(RigidBody(0.0)), self.arm.with_payload(shape), given)
+        direction = (self.arm.n - 1,)  # a whole turn: its shear is exact
+        return PayloadFamily(self.arm.with_payload(RigidBody(0.0)), self.arm.with_payload(shape), given, direction)
 
 
 def _mixed(origin: StaticForms, steps) -> StaticForms:

@@ -70,6 +70,7 @@ class PayloadFamily:
     empty: RobotModel  # the payload at 0 kg
     unit: RobotModel  # the payload at 1 kg
     given_forms: tuple[StaticForms, StaticForms] | None = None  # the forms, if already known
+    shear: tuple[int, ...] = ()  # joints whose angle the proof may shear (see harmonic.shear_parallel)
 
     def torques(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
         """(tau0, dtau) [N m, N m/kg] that hold the motion (q, qd) with qdd = 0."""
@@ -157,7 +158,11 @@ class PayloadFamily:
             return Extremes(values, poses, bounds)
         forms = self.forms[0].affine(self.forms[1], m)
         objectives = [
-            Objective((forms.torque[j] * sign).reduced(merge=True), forms.omega[j].reduced(), forms.gravity_norm)
+            Objective(
+                (forms.torque[j] * sign).reduced(merge=True, shear=self.shear),
+                forms.omega[j].reduced(),
+                forms.gravity_norm,
+            )
             for j, sign in zip(joints, signs)
         ]
         boxes = [objective.value.box(lower, upper) for objective in objectives]
