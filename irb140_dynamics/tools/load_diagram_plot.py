@@ -56,16 +56,19 @@ def diagram_png(diagram, rated_mass: float, arm: str) -> bytes:
             rated = ax.contour(L, Z, masses, levels=[rated_mass], colors="tab:red", linewidths=2.5)
             ax.clabel(rated, fmt=f"rated {rated_mass:g} kg", fontsize=8)
     if not (finite.size and finite.min() <= rated_mass <= finite.max()):
-        where = "above every point's" if finite.size and rated_mass > finite.max() else "within every point's"
-        ax.plot([0], [0], "o", color="tab:red", label=f"rated {rated_mass:g} kg: {where} mass")
-        ax.legend(loc="upper right", fontsize="small")
+        if finite.size and rated_mass > finite.max():
+            where = f"more than any point holds (at most {finite.max():.3f} kg)"
+        else:
+            where = "less than every point holds"
+        ax.plot([0], [0], "o", color="tab:red", label=f"rated {rated_mass:g} kg: {where}")
     else:
         points = ax.scatter(L, Z, c=masses, cmap="viridis_r")
         fig.colorbar(points, ax=ax, label="largest payload [kg]", shrink=0.8)
     unproven = np.array([not p.proven for p in diagram.points]).reshape(masses.shape)
     if unproven.any():
         ax.plot(L[unproven], Z[unproven], "x", color="tab:red", label="unproven")
-        ax.legend(loc="upper right", fontsize="small")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), fontsize="small")
     ax.set_xlabel("L: CoM off the flange axis, any direction [m]")
     ax.set_ylabel("Z: CoM along the flange axis [m]")
     ax.set_aspect("equal", adjustable="box")
@@ -81,8 +84,10 @@ def diagram_png(diagram, rated_mass: float, arm: str) -> bytes:
 
 
 def _levels(low: float, high: float) -> np.ndarray:
-    """About ten round contour levels over [low, high]."""
-    step = (high - low) / 10
-    magnitude = 10 ** math.floor(math.log10(step))
-    step = min((k * magnitude for k in (1, 2, 2.5, 5, 10) if k * magnitude >= step), default=step)
-    return np.arange(math.floor(low / step) * step, high + step, step)
+    """Round masses spread evenly on a log scale over [low, high], at most a dozen (as a
+    vendor labels the curves: dense where the masses are small)."""
+    ladder = np.array([k * 10.0**e for e in range(-3, 7) for k in (1, 1.25, 1.5, 2, 2.5, 3, 4, 5, 6, 8)])
+    inside = ladder[(ladder >= low) & (ladder <= high)]
+    if inside.size < 3:
+        return np.linspace(low, high, 6)
+    return inside[np.unique(np.linspace(0, inside.size - 1, min(12, inside.size)).round().astype(int))]

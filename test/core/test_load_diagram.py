@@ -17,6 +17,7 @@ from irb140_dynamics.core.payload import diagram as diagram_module
 from irb140_dynamics.core.payload.diagram import load_diagram, pivoted
 from irb140_dynamics.core.payload.proof.harmonic import StaticForms
 
+from ..support.paths import URDF_DATA
 from ..support.pinocchio_model import build
 from ..support.urdf_support import ARMS, arm_text, pinocchio_of
 
@@ -81,8 +82,29 @@ def urdf_case(name):
     return loaded.model, loaded.model.torque_limits, models
 
 
-CASES = {"irb140": irb140_case, "ur5": lambda: urdf_case("ur5"), "panda": lambda: urdf_case("panda")}
-GRIDS = {"irb140": ([0.0, 0.12], [0.0, 0.08]), "ur5": ([0.0, 0.15], [0.0, 0.1]), "panda": ([0.0, 0.1], [0.0])}
+WALL = (0.0, -9.81 * math.sin(0.6), -9.81 * math.cos(0.6))  # mounted on a tilted wall: every joint is loaded
+
+
+def prismatic_case():
+    """The corpus's revolute-prismatic-revolute arm (to its tip ``hand``), its URDF efforts."""
+    text = (URDF_DATA / "prismatic_arm.urdf").read_text()
+    model = load_urdf(text).model.with_gravity(WALL)
+    models = payload_models(lambda body: pinocchio_of(text, (), "hand", body, WALL))
+    return model, model.torque_limits, models
+
+
+CASES = {
+    "irb140": irb140_case,
+    "ur5": lambda: urdf_case("ur5"),
+    "panda": lambda: urdf_case("panda"),
+    "prismatic_arm": prismatic_case,
+}
+GRIDS = {
+    "irb140": ([0.0, 0.12], [0.0, 0.08]),
+    "ur5": ([0.0, 0.15], [0.0, 0.1]),
+    "panda": ([0.0, 0.1], [0.0]),
+    "prismatic_arm": ([0.0, 0.2], [0.0, 0.1]),
+}
 
 
 def test_the_pivot_turns_the_payload_about_the_flange_axis():

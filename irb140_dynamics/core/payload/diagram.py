@@ -140,13 +140,18 @@ def load_diagram(
         import multiprocessing
 
         _JOBS[0] = job  # the forked workers find it here (a model's compiled kernels do not pickle)
+        pool = multiprocessing.get_context("fork").Pool(min(workers, z.size), _quiet)
         try:
-            with multiprocessing.get_context("fork").Pool(min(workers, z.size), _quiet) as pool:
-                for done, (i, row) in enumerate(pool.imap_unordered(_row, list(enumerate(z))), 1):
-                    rows[i] = row
-                    if progress is not None:
-                        progress(done, z.size)
+            for done, (i, row) in enumerate(pool.imap_unordered(_row, list(enumerate(z))), 1):
+                rows[i] = row
+                if progress is not None:
+                    progress(done, z.size)
+            pool.close()
+        except BaseException:
+            pool.terminate()
+            raise
         finally:
+            pool.join()
             _JOBS[0] = None
     else:
         for i, zi in enumerate(z):
@@ -157,10 +162,12 @@ def load_diagram(
 
 
 def _quiet() -> None:
-    """A worker leaves Ctrl-C to its parent, which ends the pool."""
+    """A worker leaves Ctrl-C to its parent, which ends the pool, and ends at once when
+    told to (not by a handler the parent had installed)."""
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 _JOBS: list = [None]

@@ -165,6 +165,7 @@ class StaticForms:
     torque: HarmonicSum
     omega: tuple[HarmonicSum, ...]
     gravity_norm: float
+    sliding: tuple[tuple[float, float] | None, ...] = ()  # per joint: a prismatic one's (c, r), see ``slide``
 
     @classmethod
     def of(cls, model) -> StaticForms | None:
@@ -172,37 +173,76 @@ class StaticForms:
         if model.n > MAX_JOINTS:
             return None
         kernels = kernels_of(model)
-        return _forms(kernels.links, tuple(kernels.gravity))
+        sliding = tuple(slide(j.position_limits) if j.prismatic else None for j in model.joints)
+        return _forms(kernels.links, tuple(kernels.gravity), sliding)
 
     def affine(self, other: StaticForms, k: float) -> StaticForms:
         """self + k (other - self): the forms of a payload at k kg from those at 0 and 1 kg."""
         torque = self.torque + (other.torque - self.torque) * k
         omega = tuple(a + (b - a) * k for a, b in zip(self.omega, other.omega))
-        return StaticForms(torque, omega, self.gravity_norm)
+        return StaticForms(torque, omega, self.gravity_norm, self.sliding)
+
+    def angles_of(self, q) -> np.ndarray:
+        """A prismatic joint's displacements q [m] (..., n) as the angles of ``slide`` (rad),
+        the revolute joints' values unchanged."""
+        theta = np.array(q, dtype=float)
+        for k, cr in enumerate(self.sliding):
+            if cr is not None:
+                c, r = cr
+                theta[..., k] = np.arcsin(np.clip((theta[..., k] - c) / r, -1.0, 1.0)) if r > 0 else 0.0
+        return theta
+
+    def joints_of(self, theta) -> np.ndarray:
+        """The inverse of ``angles_of``: d = c + r sin(theta) for the prismatic joints."""
+        q = np.array(theta, dtype=float)
+        for k, cr in enumerate(self.sliding):
+            if cr is not None:
+                q[..., k] = cr[0] + cr[1] * np.sin(q[..., k])
+        return q
 
 
-def _forms(links, gravity) -> StaticForms:
+def slide(limits) -> tuple[float, float]:
+    """A prismatic joint's range [lo, hi] as d = c + r sin(theta), theta in [-pi/2, pi/2]:
+    (c, r) with [c - r, c + r] holding [lo, hi] (r rounded up). Static torques are affine
+    in each displacement (a weight's lever arm is), so in theta they are A + C sin(theta):
+    a harmonic sum like a revolute joint's, fitted from theta = 0, pi/2, pi as those are."""
+    lo, hi = (float(x) for x in limits)
+    c = 0.5 * (lo + hi)
+    r = np.nextafter(np.nextafter(max(hi - c, c - lo, 0.0), np.inf), np.inf)
+    return c, float(r)
+
+
+def _forms(links, gravity, sliding) -> StaticForms:
     n = len(links)
     zeros = [0.0] * n
-    values = algorithms.rnea(links, _circle_points(n), zeros, zeros, gravity)
+    values = algorithms.rnea(links, _circle_points(n, sliding=sliding), zeros, zeros, gravity)
     torque = _fit(_stack(values, 3**n), n)
     omega = []
     for j in range(n):
         rest = n - j - 1
-        cs = [(1.0, 0.0)] + _circle_points(rest, copies=3)
+        own = (sliding[j][0],) if sliding[j] is not None else (1.0, 0.0)  # (omega_j does not depend on it)
+        cs = [own] + _circle_points(rest, copies=3, sliding=sliding[j + 1 :])
         unit_gravity = tuple(Interval(np.repeat(np.eye(3)[axis], 3**rest)) for axis in range(3))
         per_axis = algorithms.rnea(links[j:], cs, zeros[j:], zeros[j:], unit_gravity)[0]
         lo, hi = bounds_of(per_axis, 3 * 3**rest)
         omega.append(_fit(Interval(lo.reshape(3, -1), hi.reshape(3, -1)), rest, first=j + 1))
     norm = math.hypot(*gravity)
-    return StaticForms(torque, tuple(omega), float(np.nextafter(norm * (1 + 4e-16), np.inf)))
+    return StaticForms(torque, tuple(omega), float(np.nextafter(norm * (1 + 4e-16), np.inf)), tuple(sliding))
 
 
-def _circle_points(d: int, copies: int = 1) -> list:
+def _circle_points(d: int, copies: int = 1, sliding=()) -> list:
     """(cos, sin) pairs for d joints over the 3^d combinations of theta in {0, pi/2, pi},
-    the first joint slowest; ``copies`` times over."""
+    the first joint slowest; ``copies`` times over; a prismatic joint's (c + r sin theta,)."""
     digits = np.tile(np.array(list(itertools.product(range(3), repeat=d)), dtype=int), (copies, 1))
-    return [(Interval(_COS[column]), Interval(_SIN[column])) for column in digits.T]
+    points = []
+    for k, column in enumerate(digits.T):
+        cr = sliding[k] if k < len(sliding) else None
+        points.append(
+            (Interval(_COS[column]), Interval(_SIN[column]))
+            if cr is None
+            else (Interval(_SIN[column]) * cr[1] + cr[0],)
+        )
+    return points
 
 
 def _stack(values, size: int) -> Interval:
