@@ -11,7 +11,7 @@ import pinocchio as pin
 import pytest
 from scipy.optimize import minimize
 
-from irb140_dynamics.core import RigidBody, derive_torque_limits, gravity, irb140
+from irb140_dynamics.core import RigidBody, derive_torque_limits, gravity, gravity_batch, irb140
 from irb140_dynamics.core.io.urdf import load_urdf
 from irb140_dynamics.core.payload import diagram as diagram_module
 from irb140_dynamics.core.payload.diagram import load_diagram, pivoted
@@ -175,3 +175,17 @@ def test_full_irb140_sweep_is_proven_and_below_the_independent_search():
     for p in diagram.points[::7]:
         found = independent.search(p.z, p.l, rng, poses=1500, climbs=3)
         assert p.mass <= found * (1 + 1e-9) and (not p.proven or p.mass >= 0.98 * found), (p.z, p.l, p.mass, found)
+
+
+def test_a_prismatic_joint_is_an_angle_of_the_proof():
+    """The proof's sums of an arm with a prismatic joint, at d = c + r sin(theta), are its
+    static torques; and the angles map back to the displacements."""
+    text = (URDF_DATA / "prismatic_arm.urdf").read_text()
+    model = load_urdf(text).model.with_gravity(WALL).with_payload(RigidBody(2.0, (0.05, 0.02, 0.1)))
+    forms = StaticForms.of(model)
+    lower, upper = np.array([j.position_limits for j in model.joints]).T
+    q = lower + np.random.default_rng(4).random((50, model.n)) * (upper - lower)
+    theta = forms.angles_of(q)  # (URDF joints: no angle offsets)
+    np.testing.assert_allclose(forms.joints_of(theta), q, atol=1e-12)
+    np.testing.assert_allclose(forms.torque(theta), gravity_batch(model, q), atol=1e-9)
+    assert [cr is not None for cr in forms.sliding] == [j.prismatic for j in model.joints]

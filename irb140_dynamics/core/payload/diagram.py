@@ -118,7 +118,7 @@ def _mixed(origin: StaticForms, steps) -> StaticForms:
         if k:  # (a product with 0 is the float 0, not a sum)
             torque = torque + (other.torque - origin.torque) * k
             omega = tuple(w + (b - a) * k for w, a, b in zip(omega, origin.omega, other.omega))
-    return StaticForms(torque, omega, origin.gravity_norm)
+    return StaticForms(torque, omega, origin.gravity_norm, origin.sliding)
 
 
 def load_diagram(
