@@ -189,3 +189,24 @@ def test_a_prismatic_joint_is_an_angle_of_the_proof():
     np.testing.assert_allclose(forms.joints_of(theta), q, atol=1e-12)
     np.testing.assert_allclose(forms.torque(theta), gravity_batch(model, q), atol=1e-9)
     assert [cr is not None for cr in forms.sliding] == [j.prismatic for j in model.joints]
+
+
+def test_the_direction_sheared_into_the_wrist_angle_keeps_the_sum():
+    """On the Panda (link 7's CoM off its axis) the CoM's direction and joint 7 cannot merge
+    into one angle; sheared (psi = theta_7 + phi), the sum has the same values: at the
+    sheared angles of any pose, within its error, and every psi maps back to a pose."""
+    from irb140_dynamics.core.payload.proof.harmonic import HarmonicSum
+    from irb140_dynamics.core.scalars.interval import Interval
+
+    model, _, _ = urdf_case("panda")
+    arm = pivoted(model)
+    forms = diagram_module._Shapes(arm).family(0.05, 0.1).forms
+    torque = forms[0].affine(forms[1], 2.0).torque[1]  # joint 2's
+    sheared = torque.reduced(merge=True, shear=(arm.n - 1,))
+    assert sheared.shears and sheared.shears[0][1] == arm.n - 1
+    lower, upper = np.array([j.position_limits for j in arm.joints]).T
+    theta = lower + np.random.default_rng(6).random((40, arm.n)) * (upper - lower)
+    as_sum = HarmonicSum(sheared.dims, Interval(sheared.coefficients))
+    np.testing.assert_allclose(as_sum(sheared.fold(theta)), torque(theta), atol=float(sheared.error) + 1e-9)
+    back = sheared.angles(sheared.fold(theta), lower, upper)
+    np.testing.assert_allclose(as_sum(sheared.fold(back)), torque(theta), atol=float(sheared.error) + 1e-9)
