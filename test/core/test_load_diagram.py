@@ -210,3 +210,13 @@ def test_the_direction_sheared_into_the_wrist_angle_keeps_the_sum():
     np.testing.assert_allclose(as_sum(sheared.fold(theta)), torque(theta), atol=float(sheared.error) + 1e-9)
     back = sheared.angles(sheared.fold(theta), lower, upper)
     np.testing.assert_allclose(as_sum(sheared.fold(back)), torque(theta), atol=float(sheared.error) + 1e-9)
+
+
+def test_an_arm_that_cannot_hold_itself_has_no_mass_anywhere():
+    """Joint 2 limited below the arm's own weight: no point holds any mass, none is proven."""
+    model = irb140()
+    limits = np.array(derive_torque_limits(model).values)
+    limits[1] = 1.0
+    diagram = load_diagram(model, limits, [0.0, 0.1], [0.0])
+    assert diagram.proven_share == 0.0
+    assert all(math.isnan(p.mass) and p.reason for p in diagram.points), [p.reason for p in diagram.points]

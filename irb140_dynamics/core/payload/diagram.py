@@ -19,7 +19,9 @@ pose: every limited joint's worst static torque there is proven below its limit 
 decision, far cheaper than the exact maximum). A proof that finds a worse pose than the
 search hands it back to Dinkelbach; one whose budget runs out is tried again with the next
 of MARGINS (ROUNDS proofs at most). Where it still fails the point is unproven, and its
-mass the one the search found: no more can hold.
+mass the one the search found: no more can hold. Once per diagram the arm without payload is
+proven within its limits too: the torques being affine in the mass, every mass below one
+proven to hold then holds as well (else no point is called proven).
 
 The forms of the proof are linear in the payload's mass and first moment, so they are
 made once per arm (at 0 kg, and 1 kg at the origin, at x = 1 m and at z = 1 m) and mixed
@@ -136,6 +138,8 @@ def load_diagram(
     z, l = np.asarray(z, dtype=float), np.asarray(l, dtype=float)
     job = (model, L, l)
     rows: list[list[DiagramPoint]] = [[] for _ in z]
+    _, shapes, ranges = _arm_of(model)  # (made before the workers fork: they inherit it, compiled)
+    alone = _holds_alone(shapes.family(0.0, 0.0), ranges, np.append(L, np.inf))
     if workers > 1 and z.size > 1:
         import multiprocessing
 
@@ -158,6 +162,9 @@ def load_diagram(
             rows[i] = _row((i, zi), job)[1]
             if progress is not None:
                 progress(i + 1, z.size)
+    if not alone:  # a mass proven to hold, but not the masses below it
+        why = "the arm alone is not proven within its limits in every pose"
+        rows = [[replace(p, proven=False, reason=p.reason or why) for p in row] for row in rows]
     return LoadDiagram(model.joint_names, L, z, l, tuple(p for row in rows for p in row))
 
 
@@ -174,16 +181,30 @@ _JOBS: list = [None]
 _ARMS: dict = {}  # per process: the pivoted arm and its forms, per model
 
 
-def _row(item, job=None):
-    """(i, the points at z for every l), warm-starting each point from the last."""
-    i, z = item
-    model, L, l = _JOBS[0] if job is None else job
+def _arm_of(model: RobotModel):
+    """(model, its pivoted arm's shapes, that arm's ranges), made once per model."""
     key = id(model)
     if key not in _ARMS:
         _ARMS.clear()
         arm = pivoted(model)
         _ARMS[key] = (model, _Shapes(arm), JointRanges.of(arm))
-    _, shapes, ranges = _ARMS[key]
+    return _ARMS[key]
+
+
+def _holds_alone(family: PayloadFamily, ranges: JointRanges, L: np.ndarray) -> bool:
+    """Is the arm without payload proven within its limits in every pose? Then, torques
+    being affine in the mass, every mass below one proven to hold holds too."""
+    limited = np.flatnonzero(np.isfinite(np.tile(L, 2)))
+    ceiling = np.tile(L, 2)
+    proof = family.extremes(0.0, ranges, rows=limited, ceiling=ceiling, share=PROOF_SHARE)
+    return bool(np.all(proof.bounds[limited] <= ceiling[limited]))
+
+
+def _row(item, job=None):
+    """(i, the points at z for every l), warm-starting each point from the last."""
+    i, z = item
+    model, L, l = _JOBS[0] if job is None else job
+    _, shapes, ranges = _arm_of(model)
     L_arm = np.append(L, np.inf)
     warm, points = None, []
     for lk in l:
