@@ -35,6 +35,7 @@ setup(
             "record = irb140_dynamics.tools.programs:record",
             "equations = irb140_dynamics.tools.programs:equations",
             "retime = irb140_dynamics.tools.programs:retime",
+            "load_diagram = irb140_dynamics.tools.programs:load_diagram",
             "trajectory_check_node = irb140_dynamics.nodes.trajectory_check_node:main",
             # the tools under names of their own, for an install without the ros2 CLI (pip)
             "irb140-export-urdf = irb140_dynamics.tools.programs:export_urdf",
@@ -43,6 +44,7 @@ setup(
             "irb140-record = irb140_dynamics.tools.programs:record",
             "irb140-equations = irb140_dynamics.tools.programs:equations",
             "irb140-retime = irb140_dynamics.tools.programs:retime",
+            "irb140-load-diagram = irb140_dynamics.tools.programs:load_diagram",
         ],
     },
 )

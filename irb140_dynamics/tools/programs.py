@@ -33,6 +33,13 @@ def identify() -> None:
     finish(main)
 
 
+def load_diagram() -> None:
+    start("load_diagram", TOOL)
+    from irb140_dynamics.tools.load_diagram import main
+
+    finish(main)
+
+
 def record() -> None:
     start("record", RECORDER)
     from irb140_dynamics.tools.record import main

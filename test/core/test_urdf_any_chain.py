@@ -19,6 +19,7 @@ from irb140_dynamics.core import (
     flange_pose,
     forward_dynamics,
     gravity,
+    gravity_batch,
     mass_matrix,
     mass_matrix_batch,
     rnea,
@@ -226,14 +227,19 @@ def test_the_parameter_form_and_the_exported_urdf_give_the_model_back(case):
     assert_close(rnea(exported.with_gravity(model.gravity), q, qd, qdd), rnea(model, q, qd, qdd), 1e-12)
 
 
-def test_the_payload_check_says_its_proof_does_not_cover_prismatic_joints(case):
-    _, loaded, _, _ = case
+def test_the_payload_check_proves_its_bounds_for_prismatic_joints_too(case):
+    """The worst static torques' proven bounds hold above every sampled pose's torques, and
+    the torques found at real poses, whatever the joints' kinds."""
+    _, loaded, _, rng = case
     model = loaded.model
-    if not any(j.prismatic for j in model.joints):
-        assert check_payload(model, RigidBody(0.1)).limits is not None
-        return
-    with pytest.raises(ValueError, match=r"^UNPROVEN: .* is prismatic"):
-        check_payload(model, RigidBody(0.1))
+    check = check_payload(model, RigidBody(0.1), rated_payload=RigidBody(1.0))
+    lower, upper = np.array([j.position_limits for j in model.joints]).T
+    Q = lower + rng.random((3000, model.n)) * (upper - lower)
+    sampled = np.abs(gravity_batch(model.with_payload(RigidBody(0.1)), Q)).max(axis=0)
+    bound = check.workspace.bound
+    assert (sampled <= bound * (1 + 1e-9) + 1e-12).all(), (sampled, bound)
+    assert (np.abs(check.workspace.torque) <= bound * (1 + 1e-9) + 1e-12).all()
+    assert (check.workspace.gap <= 1e-6 * max(1.0, bound.max())).all(), check.report()  # tight: the proof closed
 
 
 def test_gravity_is_the_roots_minus_z_in_the_base_frame():

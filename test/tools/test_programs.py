@@ -22,6 +22,7 @@ TOOLS = {
     "export_urdf": "export-urdf",
     "equations": "equations",
     "retime": "retime",
+    "load_diagram": "load-diagram",
 }
 NODES = ("id_node", "payload_check_node", "sim_node", "demo_node", "trajectory_check_node")
 FULL_ARGV = {"record", "export_urdf"}  # their main() takes argv with the program first (ROS arguments)

@@ -69,6 +69,8 @@ class PayloadFamily:
 
     empty: RobotModel  # the payload at 0 kg
     unit: RobotModel  # the payload at 1 kg
+    given_forms: tuple[StaticForms, StaticForms] | None = None  # the forms, if already known
+    shear: tuple[int, ...] = ()  # joints whose angle the proof may shear (see harmonic.shear_parallel)
 
     def torques(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
         """(tau0, dtau) [N m, N m/kg] that hold the motion (q, qd) with qdd = 0."""
@@ -96,18 +98,30 @@ class PayloadFamily:
         return ranges.maximize(self.static_torque(m), np.vstack([np.eye(n), -np.eye(n)]), sample_torques, warm)
 
     def extremes(
-        self, m: float, ranges: JointRanges, sample_torques=None, warm=None, rows=None, share: float = 1.0, found=None
+        self,
+        m: float,
+        ranges: JointRanges,
+        sample_torques=None,
+        warm=None,
+        rows=None,
+        share: float = 1.0,
+        found=None,
+        ceiling=None,
     ) -> Extremes:
         """The worst static torques at m kg, searched and proven (remembered per m and
         ranges): all 2n of them, or only ``rows`` proven (the others' bounds inf), within
-        ``share`` of the proof's budget; ``found``: (values, poses) of a search at m done."""
+        ``share`` of the proof's budget; ``found``: (values, poses) of a search at m done.
+        ``ceiling`` (2n,): a row's proof may stop once its bound is below it (a limit to
+        prove, not the maximum itself: far cheaper where the maximum is well below it)."""
         rows = np.arange(2 * self.empty.n) if rows is None else np.asarray(rows, dtype=int)
+        ceiling = None if ceiling is None else np.asarray(ceiling, dtype=float)
         key = (float(m), ranges.lower.tobytes(), ranges.upper.tobytes(), rows.tobytes())
+        key += (None if ceiling is None else ceiling.tobytes(),)
         proven = self._proven.get(key)  # (a family may serve several threads: no check-then-get)
         if proven is not None:
             return proven
         values, poses = self.search(m, ranges, sample_torques, warm) if found is None else found
-        proven = self._prove(m, ranges, values, poses, rows, share)
+        proven = self._prove(m, ranges, values, poses, rows, share, ceiling)
         if not ran_out():  # cut short by the deadline: not the proof the budget would give
             if len(self._proven) >= 8:
                 self._proven.pop(next(iter(self._proven)))
@@ -121,16 +135,20 @@ class PayloadFamily:
     @cached_property
     def forms(self) -> tuple[StaticForms, StaticForms] | None:
         """The harmonic forms of the payload at 0 and 1 kg (None for too many joints)."""
+        if self.given_forms is not None:
+            return self.given_forms
         empty = StaticForms.of(self.empty)
         return None if empty is None else (empty, StaticForms.of(self.unit))
 
-    def _prove(self, m, ranges, values, poses, rows, share) -> Extremes:
+    def _prove(self, m, ranges, values, poses, rows, share, ceiling=None) -> Extremes:
         n, torque = self.empty.n, self.static_torque(m)
         bounds = np.full(2 * n, np.inf)
         weights = np.vstack([np.eye(n), -np.eye(n)])
-        offsets = np.array(kernels_of(self.empty).angles)
+        offsets = np.array([0.0 if a is None else a for a in kernels_of(self.empty).angles])
         scale = max(1.0, float(np.max(np.abs(values))))
         tol = CERTIFY_RTOL * np.maximum(np.abs(values), 1e-3 * scale)
+        if ceiling is not None:
+            tol = np.maximum(tol, np.nan_to_num(ceiling - values, posinf=np.inf, neginf=0.0))
         lower, upper = ranges.lower + offsets, ranges.upper + offsets
         joints, signs = rows % n, np.where(rows < n, 1.0, -1.0)
         if self.forms is None:
@@ -139,8 +157,19 @@ class PayloadFamily:
             )
             return Extremes(values, poses, bounds)
         forms = self.forms[0].affine(self.forms[1], m)
+        sliding = np.array([cr is not None for cr in forms.sliding], dtype=bool)
+        lower = np.where(sliding, np.maximum(forms.angles_of(lower) - 1e-12, -np.pi / 2), lower)  # (rounding: wider)
+        upper = np.where(sliding, np.minimum(forms.angles_of(upper) + 1e-12, np.pi / 2), upper)
+
+        def joints_of(theta):  # joint values q of angles theta (prismatic: their displacements)
+            return np.clip(forms.joints_of(theta) - offsets, ranges.lower, ranges.upper)
+
         objectives = [
-            Objective((forms.torque[j] * sign).reduced(merge=True), forms.omega[j].reduced(), forms.gravity_norm)
+            Objective(
+                (forms.torque[j] * sign).reduced(merge=True, shear=self.shear),
+                forms.omega[j].reduced(),
+                forms.gravity_norm,
+            )
             for j, sign in zip(joints, signs)
         ]
         boxes = [objective.value.box(lower, upper) for objective in objectives]
@@ -149,8 +178,8 @@ class PayloadFamily:
             return np.array([objectives[i].value.angles(t, lower, upper)[0] for i, t in zip(k, theta)])
 
         def polish(k, theta):
-            found, pose = ranges.climb(torque, weights[rows[k]], angles(k, theta) - offsets)
-            return found, np.array([objectives[i].value.fold(t)[0] for i, t in zip(k, pose + offsets)])
+            found, pose = ranges.climb(torque, weights[rows[k]], joints_of(angles(k, theta)))
+            return found, np.array([objectives[i].value.fold(t)[0] for i, t in zip(k, forms.angles_of(pose + offsets))])
 
         proof = certify_maxima(
             objectives,
@@ -166,7 +195,7 @@ class PayloadFamily:
         better = np.flatnonzero(proof.value > values[rows])
         found = rows[better]
         if found.size:  # the search missed these maxima: take the real poses' torques
-            pose = angles(better, proof.theta[better]) - offsets
+            pose = joints_of(angles(better, proof.theta[better]))
             value = np.einsum("kn,kn->k", torque(pose), weights[found])
             higher = value > values[found]
             values[found[higher]], poses[found[higher]] = value[higher], pose[higher]
@@ -179,7 +208,8 @@ class PayloadFamily:
 
         def evaluate(lo, hi):
             theta = [Interval(lo[:, k], hi[:, k]) + offsets[k] for k in range(n)]
-            tau = algorithms.rnea(links, [(t.cos(), t.sin()) for t in theta], [0.0] * n, [0.0] * n, gravity)
+            cs = [(t,) if link.prismatic else (t.cos(), t.sin()) for t, link in zip(theta, links)]
+            tau = algorithms.rnea(links, cs, [0.0] * n, [0.0] * n, gravity)
             pairs = [bounds_of(t, len(lo)) for t in tau]
             return np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
 
@@ -192,16 +222,9 @@ def payload_family(model: RobotModel, payload: RigidBody) -> PayloadFamily:
 
     Built once per arm and shape (the last FAMILIES remembered): the two models validate
     the CoM and inertia (ModelError naming ``payload.com`` or ``payload.inertia``) and
-    compile their kernels then. ValueError starting "UNPROVEN:" for an arm with a prismatic
-    joint: the worst-case proof (harmonic sums in the joint angles) does not cover them.
+    compile their kernels then. Prismatic joints too: the proof takes their displacements
+    as angles (see ``harmonic.slide``).
     """
-    sliding = [j.name for j in model.joints if j.prismatic]
-    if sliding:
-        more = f" (and {len(sliding) - 1} more)" if len(sliding) > 1 else ""
-        raise ValueError(
-            f"UNPROVEN: the payload check's worst-case proof covers revolute joints only; joint "
-            f"{sliding[0][:100]!r}{more} is prismatic"
-        )
     arm = tuple(getattr(model, f.name) for f in fields(model) if f.name != "payload")
     key = (arm, tuple(payload.com), tuple(payload.inertia))
     with _LOCK:

@@ -170,10 +170,11 @@ def max_payload_here(tau0, dtau, L, q) -> MaxPayload:
     return _max_payload(float(m), int(joint), q)
 
 
-def _smallest_max_payload(family: PayloadFamily, poses: np.ndarray, L: np.ndarray) -> MaxPayload:
+def smallest_max_payload(family: PayloadFamily, poses: np.ndarray, L: np.ndarray, G0=None, dG=None) -> MaxPayload:
     """The least of the largest static payloads of poses (N, n) (nan if one holds none);
-    of tied poses the one whose limiting joint comes first."""
-    m, joint = max_mass(*family.static_torques(poses), L)
+    of tied poses the one whose limiting joint comes first. (G0, dG): their static
+    torques, if known."""
+    m, joint = max_mass(*(family.static_torques(poses) if G0 is None else (G0, dG)), L)
     if np.isnan(m).any():
         i = int(np.argmax(np.isnan(m)))
     else:
@@ -205,16 +206,16 @@ def _workspace_max_payload(family, ranges, L, G0, dG, own_mass: float, load: Ext
     the proof finds a worse pose, Dinkelbach goes on from it."""
     poses = load.poses
     limited = np.flatnonzero(np.isfinite(np.tile(L, 2)))  # the rows of +-tau_j that matter
-    best = _smallest_max_payload(family, poses, L)
+    best = smallest_max_payload(family, poses, L)
     if best.mass == math.inf:  # no limited joint loaded there: try where the payload loads them most
         _, poses = _most_loaded(family, ranges, dG)
-        best = _smallest_max_payload(family, poses, L)
+        best = smallest_max_payload(family, poses, L)
     for round_ in range(_PROOF_ROUNDS):
         found, searched = None, math.nan
         while math.isfinite(best.mass) and not out_of_time():  # Dinkelbach
             found, searched = family.search(best.mass, ranges, G0 + best.mass * dG, warm=poses), best.mass
             poses = found[1]
-            candidate = _smallest_max_payload(family, poses, L)
+            candidate = smallest_max_payload(family, poses, L)
             if not _lighter(candidate, best):
                 break
             best = candidate
@@ -223,7 +224,7 @@ def _workspace_max_payload(family, ranges, L, G0, dG, own_mass: float, load: Ext
         m = min(best.mass, MAX_MASS)  # beyond the sanity cap no mass is valid anyway
         found = found if m == searched else None  # the last search was at that mass
         proven = family.extremes(m, ranges, G0 + m * dG, warm=poses, rows=limited, share=MASS_PROOF_SHARE, found=found)
-        candidate = _smallest_max_payload(family, proven.poses, L)
+        candidate = smallest_max_payload(family, proven.poses, L)
         if not _lighter(candidate, best) or round_ == _PROOF_ROUNDS - 1 or out_of_time():
             break  # (in the last round the bounds, over the limits, make the mass proven lower)
         best, poses = candidate, proven.poses

@@ -41,13 +41,16 @@ def quasi_random(count: int, dim: int) -> np.ndarray:
     return (0.5 + np.arange(1, count + 1)[:, None] * alpha) % 1.0
 
 
-def right_angle_poses(lower, upper, max_count: int = 4096) -> np.ndarray:
+def right_angle_poses(lower, upper, max_count: int = 4096, sliding=None) -> np.ndarray:
     """All poses with every angle a multiple of 90 deg in (-180, 180] within [lower, upper]
-    (none if more than ``max_count``): the simple poses where maxima often lie."""
+    and every prismatic joint (``sliding``) at an end of its range (none if more than
+    ``max_count``): the simple poses where maxima often lie."""
     quarter = math.pi / 2
     first = [math.ceil(max(lo, -math.pi + 1e-9) / quarter) for lo in lower]
     last = [math.floor(min(up, math.pi) / quarter) for up in upper]
     angles = [quarter * np.arange(a, b + 1) for a, b in zip(first, last)]
+    for k in np.flatnonzero(np.zeros(len(angles), bool) if sliding is None else sliding):
+        angles[k] = np.unique([lower[k], upper[k]])
     if math.prod(len(a) for a in angles) > max_count:
         return np.empty((0, len(angles)))
     return np.stack(np.meshgrid(*angles, indexing="ij"), axis=-1).reshape(-1, len(angles))
@@ -69,13 +72,15 @@ class JointRanges:
     lower: np.ndarray
     upper: np.ndarray
     samples: np.ndarray  # (S, n)
+    sliding: np.ndarray | None = None  # (n,) the prismatic joints (their torques are affine in them)
 
     @classmethod
     def of(cls, model: RobotModel, count: int = 2048) -> JointRanges:
         """The model's joint ranges; samples: ``count`` quasi-random poses and the right angles."""
         lower, upper = np.array([j.position_limits for j in model.joints]).T
+        sliding = np.array([j.prismatic for j in model.joints], dtype=bool)
         spread = lower + quasi_random(count, model.n) * (upper - lower)
-        return cls(lower, upper, np.vstack([right_angle_poses(lower, upper), spread]))
+        return cls(lower, upper, np.vstack([right_angle_poses(lower, upper, sliding=sliding), spread]), sliding)
 
     def maximize(
         self,
@@ -145,7 +150,17 @@ class JointRanges:
         return X, self._values(torque, W, X)
 
     def _coordinate_step(self, torque, W, X, k, tol):
-        """Each X[s, k] moved to the exact maximum along angle k: (X, values)."""
+        """Each X[s, k] moved to the exact maximum along angle k (a prismatic joint: the
+        better end of its range, static torques being affine in it): (X, values)."""
+        if self.sliding is not None and self.sliding[k]:
+            trial = np.repeat(X[None], 3, axis=0)
+            trial[1, ..., k], trial[2, ..., k] = self.lower[k], self.upper[k]
+            f = self._values(torque, W, trial)
+            best = np.argmax(f, axis=0)
+            better = np.take_along_axis(f, best[None], axis=0)[0] > f[0] + 0.01 * tol
+            X = X.copy()
+            X[..., k] = np.where(better, np.take_along_axis(trial[..., k], best[None], axis=0)[0], X[..., k])
+            return X, np.where(better, np.take_along_axis(f, best[None], axis=0)[0], f[0])
         trial = np.repeat(X[None], 3, axis=0)
         trial[..., k] += _THIRDS.reshape(3, 1, 1)
         f = self._values(torque, W, trial)  # (3, S, K), f[0] at X

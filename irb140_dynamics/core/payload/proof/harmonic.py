@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -63,10 +63,12 @@ class HarmonicSum:
         c = self.coefficients
         return HarmonicSum(self.dims, Interval(c.lo[index], c.hi[index]))
 
-    def reduced(self, merge: bool = False) -> Reduced:
+    def reduced(self, merge: bool = False, shear: tuple[int, ...] = ()) -> Reduced:
         """Midpoint coefficients and an error bound, without the joints it hardly depends on
         (whose terms then count in the error: |phi| <= 1); with ``merge`` (a single sum),
-        joints it depends on only through theta_a +- theta_b become one (``merge_parallel``)."""
+        joints it depends on only through theta_a +- theta_b become one (``merge_parallel``),
+        and a joint b of ``shear`` that it depends on only through theta_a +- theta_b besides
+        theta_a alone is replaced by that sum (``shear_parallel``)."""
         c, d = self.coefficients, len(self.dims)
         lead = c.lo.shape[:-1]
         mid = c.mid.reshape(lead + (3,) * d)
@@ -81,10 +83,15 @@ class HarmonicSum:
                 mid, weight = np.take(mid, 0, axis=len(lead) + axis), np.take(weight, 0, axis=axis)
                 del dims[axis]
         merges: list[tuple[int, int, float]] = []
+        shears: list[tuple[int, int, float]] = []
         if merge and not lead:
             mid, residual = merge_parallel(mid, dims, merges, NOISE * total)
             error = error + residual
-        return Reduced(tuple(dims), mid.reshape(lead + (-1,)), np.asarray(error, dtype=float), tuple(merges))
+            if shear:
+                mid, residual = shear_parallel(mid, dims, shear, shears, NOISE * total)
+                error = error + residual
+        reduced = Reduced(tuple(dims), mid.reshape(lead + (-1,)), np.asarray(error, dtype=float), tuple(merges))
+        return replace(reduced, shears=tuple(shears)) if shears else reduced
 
     def __call__(self, theta: np.ndarray) -> np.ndarray:
         """The midpoint sum at angles theta (N, n): (N, ...); for tests."""
@@ -99,20 +106,25 @@ class HarmonicSum:
 @dataclass(frozen=True, eq=False)
 class Reduced:
     """A harmonic sum with point coefficients (..., 3^len(dims)) and a bound on its error;
-    ``merges`` (a, b, sign) in order: theta_b folded into theta_a as theta_a + sign theta_b."""
+    ``merges`` (a, b, sign) in order: theta_b folded into theta_a as theta_a + sign theta_b;
+    then ``shears`` (a, b, sign): theta_b replaced by psi_b = theta_a + sign theta_b."""
 
     dims: tuple[int, ...]
     coefficients: np.ndarray
     error: np.ndarray
     merges: tuple[tuple[int, int, float], ...] = ()
+    shears: tuple[tuple[int, int, float], ...] = ()
 
     def box(self, lower, upper) -> tuple[np.ndarray, np.ndarray]:
         """The box of angles this sum is over, from the joints' (n,): a merged joint a
-        ranges over theta_a + sign theta_b, theta_b is 0."""
+        ranges over theta_a + sign theta_b, theta_b is 0; a sheared joint b over theta_a +
+        sign theta_b (a box holding every pair: exact where theta_b turns a whole turn)."""
         lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
         for a, b, sign in self.merges:
             lo[a], hi[a] = (lo[a] + lo[b], hi[a] + hi[b]) if sign > 0 else (lo[a] - hi[b], hi[a] - lo[b])
             lo[b] = hi[b] = 0.0
+        for a, b, sign in self.shears:
+            lo[b], hi[b] = (lo[a] + lo[b], hi[a] + hi[b]) if sign > 0 else (lo[a] - hi[b], hi[a] - lo[b])
         return lo, hi
 
     def fold(self, theta) -> np.ndarray:
@@ -121,12 +133,18 @@ class Reduced:
         for a, b, sign in self.merges:
             theta[:, a] += sign * theta[:, b]
             theta[:, b] = 0.0
+        for a, b, sign in self.shears:
+            theta[:, b] = theta[:, a] + sign * theta[:, b]
         return theta
 
     def angles(self, theta, lower, upper) -> np.ndarray:
         """Joint angles (K, n) within [lower, upper] with the same sum as theta (K, n) from
         ``box``: each merged sum split back, theta_b near the middle of its range."""
         theta = np.array(theta, dtype=float, ndmin=2)
+        for a, b, sign in reversed(self.shears):  # theta_b back from psi_b, a whole turn taken off if need be
+            turned = sign * (theta[:, b] - theta[:, a])
+            turned = lower[b] + np.mod(turned - lower[b], 2 * math.pi)
+            theta[:, b] = np.clip(turned, lower[b], upper[b])
         lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
         before = []
         for a, b, sign in self.merges:
@@ -147,6 +165,7 @@ class StaticForms:
     torque: HarmonicSum
     omega: tuple[HarmonicSum, ...]
     gravity_norm: float
+    sliding: tuple[tuple[float, float] | None, ...] = ()  # per joint: a prismatic one's (c, r), see ``slide``
 
     @classmethod
     def of(cls, model) -> StaticForms | None:
@@ -154,37 +173,76 @@ class StaticForms:
         if model.n > MAX_JOINTS:
             return None
         kernels = kernels_of(model)
-        return _forms(kernels.links, tuple(kernels.gravity))
+        sliding = tuple(slide(j.position_limits) if j.prismatic else None for j in model.joints)
+        return _forms(kernels.links, tuple(kernels.gravity), sliding)
 
     def affine(self, other: StaticForms, k: float) -> StaticForms:
         """self + k (other - self): the forms of a payload at k kg from those at 0 and 1 kg."""
         torque = self.torque + (other.torque - self.torque) * k
         omega = tuple(a + (b - a) * k for a, b in zip(self.omega, other.omega))
-        return StaticForms(torque, omega, self.gravity_norm)
+        return StaticForms(torque, omega, self.gravity_norm, self.sliding)
+
+    def angles_of(self, q) -> np.ndarray:
+        """A prismatic joint's displacements q [m] (..., n) as the angles of ``slide`` (rad),
+        the revolute joints' values unchanged."""
+        theta = np.array(q, dtype=float)
+        for k, cr in enumerate(self.sliding):
+            if cr is not None:
+                c, r = cr
+                theta[..., k] = np.arcsin(np.clip((theta[..., k] - c) / r, -1.0, 1.0)) if r > 0 else 0.0
+        return theta
+
+    def joints_of(self, theta) -> np.ndarray:
+        """The inverse of ``angles_of``: d = c + r sin(theta) for the prismatic joints."""
+        q = np.array(theta, dtype=float)
+        for k, cr in enumerate(self.sliding):
+            if cr is not None:
+                q[..., k] = cr[0] + cr[1] * np.sin(q[..., k])
+        return q
 
 
-def _forms(links, gravity) -> StaticForms:
+def slide(limits) -> tuple[float, float]:
+    """A prismatic joint's range [lo, hi] as d = c + r sin(theta), theta in [-pi/2, pi/2]:
+    (c, r) with [c - r, c + r] holding [lo, hi] (r rounded up). Static torques are affine
+    in each displacement (a weight's lever arm is), so in theta they are A + C sin(theta):
+    a harmonic sum like a revolute joint's, fitted from theta = 0, pi/2, pi as those are."""
+    lo, hi = (float(x) for x in limits)
+    c = 0.5 * (lo + hi)
+    r = np.nextafter(np.nextafter(max(hi - c, c - lo, 0.0), np.inf), np.inf)
+    return c, float(r)
+
+
+def _forms(links, gravity, sliding) -> StaticForms:
     n = len(links)
     zeros = [0.0] * n
-    values = algorithms.rnea(links, _circle_points(n), zeros, zeros, gravity)
+    values = algorithms.rnea(links, _circle_points(n, sliding=sliding), zeros, zeros, gravity)
     torque = _fit(_stack(values, 3**n), n)
     omega = []
     for j in range(n):
         rest = n - j - 1
-        cs = [(1.0, 0.0)] + _circle_points(rest, copies=3)
+        own = (sliding[j][0],) if sliding[j] is not None else (1.0, 0.0)  # (omega_j does not depend on it)
+        cs = [own] + _circle_points(rest, copies=3, sliding=sliding[j + 1 :])
         unit_gravity = tuple(Interval(np.repeat(np.eye(3)[axis], 3**rest)) for axis in range(3))
         per_axis = algorithms.rnea(links[j:], cs, zeros[j:], zeros[j:], unit_gravity)[0]
         lo, hi = bounds_of(per_axis, 3 * 3**rest)
         omega.append(_fit(Interval(lo.reshape(3, -1), hi.reshape(3, -1)), rest, first=j + 1))
     norm = math.hypot(*gravity)
-    return StaticForms(torque, tuple(omega), float(np.nextafter(norm * (1 + 4e-16), np.inf)))
+    return StaticForms(torque, tuple(omega), float(np.nextafter(norm * (1 + 4e-16), np.inf)), tuple(sliding))
 
 
-def _circle_points(d: int, copies: int = 1) -> list:
+def _circle_points(d: int, copies: int = 1, sliding=()) -> list:
     """(cos, sin) pairs for d joints over the 3^d combinations of theta in {0, pi/2, pi},
-    the first joint slowest; ``copies`` times over."""
+    the first joint slowest; ``copies`` times over; a prismatic joint's (c + r sin theta,)."""
     digits = np.tile(np.array(list(itertools.product(range(3), repeat=d)), dtype=int), (copies, 1))
-    return [(Interval(_COS[column]), Interval(_SIN[column])) for column in digits.T]
+    points = []
+    for k, column in enumerate(digits.T):
+        cr = sliding[k] if k < len(sliding) else None
+        points.append(
+            (Interval(_COS[column]), Interval(_SIN[column]))
+            if cr is None
+            else (Interval(_SIN[column]) * cr[1] + cr[0],)
+        )
+    return points
 
 
 def _stack(values, size: int) -> Interval:
@@ -226,4 +284,29 @@ def merge_parallel(T, dims: list, merges: list, noise: float):
                 break
         else:
             p += 1
+    return T, residual
+
+
+def shear_parallel(T, dims: list, allowed, shears: list, noise: float):
+    """T (3,)*d with each joint b of ``allowed`` that it depends on only through theta_a +-
+    theta_b, besides terms of theta_a alone (a the joint before b: the parallel joint that
+    turns both a link and the payload's direction), written in psi_b = theta_a +- theta_b
+    instead (shears updated); and the size of the terms that did not fit, for the error."""
+    residual = 0.0
+    for p in range(len(dims) - 1):
+        if dims[p + 1] not in allowed:
+            continue
+        X = np.moveaxis(T, (p, p + 1), (0, 1))
+        for sign in (1.0, -1.0):  # B cos(a +- b) + C sin(a +- b), as in merge_parallel
+            B, C = 0.5 * (X[1, 1] - sign * X[2, 2]), 0.5 * (X[2, 1] + sign * X[1, 2])
+            fit = np.zeros_like(X)
+            fit[:, 0], fit[1, 1], fit[2, 2], fit[2, 1], fit[1, 2] = X[:, 0], B, -sign * B, C, sign * C
+            off = np.abs(X - fit).sum()
+            if off <= noise:
+                Y = np.zeros_like(X)
+                Y[:, 0], Y[0, 1], Y[0, 2] = X[:, 0], B, C
+                T = np.moveaxis(Y, (0, 1), (p, p + 1))
+                residual += off
+                shears.append((dims[p], dims[p + 1], sign))
+                break
     return T, residual

@@ -1,0 +1,222 @@
+"""The load diagram: each proven mass is a certified lower bound of the largest payload the
+arm holds at rest in every pose and every direction of the CoM about the flange axis, and
+within 2 % of it. Checked against an independent search on Pinocchio (its own URDF parser
+for the URDF arms): random poses and directions, then local optimisation from the worst."""
+
+import math
+import os
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from scipy.optimize import minimize
+
+from irb140_dynamics.core import RigidBody, derive_torque_limits, gravity, gravity_batch, irb140
+from irb140_dynamics.core.io.urdf import load_urdf
+from irb140_dynamics.core.payload import diagram as diagram_module
+from irb140_dynamics.core.payload.diagram import load_diagram, pivoted
+from irb140_dynamics.core.payload.proof.harmonic import StaticForms
+
+from ..support.paths import URDF_DATA
+from ..support.pinocchio_model import build
+from ..support.urdf_support import ARMS, arm_text, pinocchio_of
+
+DIRECTIONS = np.linspace(-math.pi, math.pi, 16, endpoint=False)
+
+
+class Independent:
+    """The largest payload of CoM (l cos phi, l sin phi, z) at pose q by Pinocchio's gravity
+    torques: linear in the payload's mass and first moment, so five models give them all."""
+
+    def __init__(self, models, limits, lower, upper):
+        self.models = models  # payload none, 1 kg at the origin, at x, y, z = 1 m
+        self.data = [m.createData() for m in models]
+        self.limits, self.lower, self.upper = np.asarray(limits, dtype=float), lower, upper
+
+    def torques(self, q):
+        return [pin.computeGeneralizedGravity(m, d, q)[: self.lower.size] for m, d in zip(self.models, self.data)]
+
+    def mass(self, q, phi, z, l):
+        """The largest mass that pose q holds with the CoM at direction phi (inf: unbounded)."""
+        G0, origin, x, y, up = self.torques(np.clip(q, self.lower, self.upper))
+        dG = origin + l * math.cos(phi) * (x - origin) + l * math.sin(phi) * (y - origin) + z * (up - origin) - G0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            room = np.where(dG > 0, (self.limits - G0) / dG, np.where(dG < 0, (self.limits + G0) / -dG, np.inf))
+        return float(np.min(np.where(np.isfinite(self.limits), room, np.inf)))
+
+    def search(self, z, l, rng, poses=3000, climbs=6) -> float:
+        """Dense random poses and directions, then Powell from the worst ones."""
+        Q = self.lower + rng.random((poses, self.lower.size)) * (self.upper - self.lower)
+        phi = rng.uniform(-math.pi, math.pi, poses)
+        values = np.array([self.mass(q, p, z, l) for q, p in zip(Q, phi)])
+        best = float(values.min())
+        bounds = list(zip(self.lower, self.upper)) + [(-math.pi, math.pi)]
+        for i in np.argsort(values)[:climbs]:
+            found = minimize(
+                lambda x: self.mass(x[:-1], x[-1], z, l),
+                np.append(Q[i], phi[i]),
+                method="Powell",
+                bounds=bounds,
+                options={"xtol": 1e-6, "ftol": 1e-10, "maxfev": 4000},
+            )
+            best = min(best, float(found.fun))
+        return best
+
+
+def payload_models(build_with):
+    bodies = [RigidBody(0.0), RigidBody(1.0)] + [RigidBody(1.0, tuple(np.eye(3)[k])) for k in range(3)]
+    return [build_with(body) for body in bodies]
+
+
+def irb140_case():
+    model = irb140()
+    limits = derive_torque_limits(model).values
+    models = payload_models(lambda body: build(model.with_payload(body)))
+    return model, limits, models
+
+
+def urdf_case(name):
+    text, tip = arm_text(name), ARMS[name][1]
+    loaded = load_urdf(text, tip_link=tip)
+    models = payload_models(lambda body: pinocchio_of(text, loaded.held_joints, tip, body))
+    return loaded.model, loaded.model.torque_limits, models
+
+
+WALL = (0.0, -9.81 * math.sin(0.6), -9.81 * math.cos(0.6))  # mounted on a tilted wall: every joint is loaded
+
+
+def prismatic_case():
+    """The corpus's revolute-prismatic-revolute arm (to its tip ``hand``), its URDF efforts."""
+    text = (URDF_DATA / "prismatic_arm.urdf").read_text()
+    model = load_urdf(text).model.with_gravity(WALL)
+    models = payload_models(lambda body: pinocchio_of(text, (), "hand", body, WALL))
+    return model, model.torque_limits, models
+
+
+CASES = {
+    "irb140": irb140_case,
+    "ur5": lambda: urdf_case("ur5"),
+    "panda": lambda: urdf_case("panda"),
+    "prismatic_arm": prismatic_case,
+}
+GRIDS = {
+    "irb140": ([0.0, 0.12], [0.0, 0.08]),
+    "ur5": ([0.0, 0.15], [0.0, 0.1]),
+    "panda": ([0.0, 0.1], [0.0]),
+    "prismatic_arm": ([0.0, 0.2], [0.0, 0.1]),
+}
+
+
+def test_the_pivot_turns_the_payload_about_the_flange_axis():
+    """The pivoted arm's torques with the payload at (l, 0, z) and the extra joint at phi are
+    Pinocchio's of the arm with the payload at (l cos phi, l sin phi, z)."""
+    rng = np.random.default_rng(3)
+    model = irb140()
+    arm = pivoted(model)
+    for _ in range(5):
+        z, l, phi, m = rng.uniform(0, 0.3), rng.uniform(0, 0.2), rng.uniform(-math.pi, math.pi), rng.uniform(0.5, 5)
+        q = rng.uniform(-2, 2, model.n)
+        ours = gravity(arm.with_payload(RigidBody(m, (l, 0.0, z))), np.append(q, phi))
+        turned = model.with_payload(RigidBody(m, (l * math.cos(phi), l * math.sin(phi), z)))
+        theirs = pin.computeGeneralizedGravity(build(turned), build(turned).createData(), q)
+        np.testing.assert_allclose(ours[:-1], theirs, atol=1e-10)
+
+
+def test_forms_mixed_from_four_enclose_the_direct_ones():
+    """A point's forms, mixed from four, hold the same sums as those made for its CoM."""
+    arm = pivoted(irb140())
+    shapes = diagram_module._Shapes(arm)
+    mixed = shapes.family(0.13, 0.07).forms[1]
+    direct = StaticForms.of(arm.with_payload(RigidBody(1.0, (0.07, 0.0, 0.13))))
+    for a, b in [(mixed.torque, direct.torque)] + list(zip(mixed.omega, direct.omega)):
+        assert (a.coefficients.lo <= b.coefficients.hi + 1e-12).all()
+        assert (b.coefficients.lo <= a.coefficients.hi + 1e-12).all()
+        np.testing.assert_allclose(a.coefficients.mid, b.coefficients.mid, atol=1e-11)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("arm", sorted(CASES))
+def test_proven_masses_are_below_the_true_maximum_and_within_2_percent(arm):
+    model, limits, models = CASES[arm]()
+    z, l = GRIDS[arm]
+    diagram = load_diagram(model, limits, z, l)
+    lower, upper = np.array([j.position_limits for j in model.joints]).T
+    independent = Independent(models, limits, lower, upper)
+    rng = np.random.default_rng(11)
+    assert diagram.proven_share == 1.0, [p.reason for p in diagram.points]
+    for p in diagram.points:
+        found = independent.search(p.z, p.l, rng)
+        assert p.mass <= found * (1 + 1e-9), (p.z, p.l, p.mass, found)  # a real pose holds no more
+        assert p.mass >= 0.98 * found, (p.z, p.l, p.mass, found)
+
+
+def test_the_mass_is_the_minimum_over_directions_not_one_direction():
+    """Off the axis the diagram holds for every direction: below what any one direction
+    allows, as the independent search over directions shows on the IRB-140."""
+    model, limits, models = irb140_case()
+    lower, upper = np.array([j.position_limits for j in model.joints]).T
+    independent = Independent(models, limits, lower, upper)
+    point = load_diagram(model, limits, [0.05], [0.1]).points[0]
+    q = np.zeros(model.n)
+    per_direction = [independent.mass(q, phi, 0.05, 0.1) for phi in DIRECTIONS]
+    assert point.proven and point.mass <= min(per_direction)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not os.environ.get("IRB140_FULL_SWEEP"), reason="the full sweep: set IRB140_FULL_SWEEP=1")
+def test_full_irb140_sweep_is_proven_and_below_the_independent_search():
+    model, limits, models = irb140_case()
+    z, l = np.arange(31) * 0.01, np.arange(21) * 0.01
+    diagram = load_diagram(model, limits, z, l, workers=2)
+    assert diagram.proven_share >= 0.9
+    lower, upper = np.array([j.position_limits for j in model.joints]).T
+    independent = Independent(models, limits, lower, upper)
+    rng = np.random.default_rng(12)
+    for p in diagram.points[::7]:
+        found = independent.search(p.z, p.l, rng, poses=1500, climbs=3)
+        assert p.mass <= found * (1 + 1e-9) and (not p.proven or p.mass >= 0.98 * found), (p.z, p.l, p.mass, found)
+
+
+def test_a_prismatic_joint_is_an_angle_of_the_proof():
+    """The proof's sums of an arm with a prismatic joint, at d = c + r sin(theta), are its
+    static torques; and the angles map back to the displacements."""
+    text = (URDF_DATA / "prismatic_arm.urdf").read_text()
+    model = load_urdf(text).model.with_gravity(WALL).with_payload(RigidBody(2.0, (0.05, 0.02, 0.1)))
+    forms = StaticForms.of(model)
+    lower, upper = np.array([j.position_limits for j in model.joints]).T
+    q = lower + np.random.default_rng(4).random((50, model.n)) * (upper - lower)
+    theta = forms.angles_of(q)  # (URDF joints: no angle offsets)
+    np.testing.assert_allclose(forms.joints_of(theta), q, atol=1e-12)
+    np.testing.assert_allclose(forms.torque(theta), gravity_batch(model, q), atol=1e-9)
+    assert [cr is not None for cr in forms.sliding] == [j.prismatic for j in model.joints]
+
+
+def test_the_direction_sheared_into_the_wrist_angle_keeps_the_sum():
+    """On the Panda (link 7's CoM off its axis) the CoM's direction and joint 7 cannot merge
+    into one angle; sheared (psi = theta_7 + phi), the sum has the same values: at the
+    sheared angles of any pose, within its error, and every psi maps back to a pose."""
+    from irb140_dynamics.core.payload.proof.harmonic import HarmonicSum
+    from irb140_dynamics.core.scalars.interval import Interval
+
+    model, _, _ = urdf_case("panda")
+    arm = pivoted(model)
+    forms = diagram_module._Shapes(arm).family(0.05, 0.1).forms
+    torque = forms[0].affine(forms[1], 2.0).torque[1]  # joint 2's
+    sheared = torque.reduced(merge=True, shear=(arm.n - 1,))
+    assert sheared.shears and sheared.shears[0][1] == arm.n - 1
+    lower, upper = np.array([j.position_limits for j in arm.joints]).T
+    theta = lower + np.random.default_rng(6).random((40, arm.n)) * (upper - lower)
+    as_sum = HarmonicSum(sheared.dims, Interval(sheared.coefficients))
+    np.testing.assert_allclose(as_sum(sheared.fold(theta)), torque(theta), atol=float(sheared.error) + 1e-9)
+    back = sheared.angles(sheared.fold(theta), lower, upper)
+    np.testing.assert_allclose(as_sum(sheared.fold(back)), torque(theta), atol=float(sheared.error) + 1e-9)
+
+
+def test_an_arm_that_cannot_hold_itself_has_no_mass_anywhere():
+    """Joint 2 limited below the arm's own weight: no point holds any mass, none is proven."""
+    model = irb140()
+    limits = np.array(derive_torque_limits(model).values)
+    limits[1] = 1.0
+    diagram = load_diagram(model, limits, [0.0, 0.1], [0.0])
+    assert diagram.proven_share == 0.0
+    assert all(math.isnan(p.mass) and p.reason for p in diagram.points), [p.reason for p in diagram.points]

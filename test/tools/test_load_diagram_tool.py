@@ -1,0 +1,107 @@
+"""The load_diagram tool: the CSV and the PNG of a diagram (a coarse grid), its console
+scripts, and bad input refused in one line, exit status non-zero, nothing written."""
+
+import csv
+import math
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from irb140_dynamics.tools.load_diagram import grid, main
+
+from ..support.paths import CONFIG, ROOT, URDF_DATA
+
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def rows_of(path):
+    with open(path, newline="") as stream:
+        return list(csv.DictReader(stream))
+
+
+@pytest.mark.slow  # compiles the kernels and proves a few points; the plot imports matplotlib
+def test_writes_the_csv_and_the_png_and_prints_one_line(tmp_path, capsys):
+    out = tmp_path / "diagram"
+    code = main(["--params-file", str(CONFIG), "--out", str(out), "--z-max", "0.2", "--l-max", "0.1", "--step", "0.1"])
+    printed = capsys.readouterr()
+    assert code == 0, printed.err
+    assert printed.out.count("\n") == 1 and printed.out.startswith("load_diagram: 6 points (3 z x 2 l), 6 proven")
+    rows = rows_of(out / "load_diagram.csv")
+    assert list(rows[0]) == ["z_m", "l_m", "max_mass_kg", "status", "limiting_joint", "reason"]
+    assert [(float(r["z_m"]), float(r["l_m"])) for r in rows] == [(z, l) for z in (0, 0.1, 0.2) for l in (0, 0.1)]
+    assert all(r["status"] == "proven" and r["reason"] == "" and r["limiting_joint"].startswith("joint_") for r in rows)
+    masses = np.array([float(r["max_mass_kg"]) for r in rows]).reshape(3, 2)
+    assert 5.9 <= masses[0, 0] <= 6.0  # the rated payload at the flange origin: the limits' own case
+    assert (np.diff(masses, axis=0) < 0).all() and (np.diff(masses, axis=1) < 0).all()  # further out, less
+    assert (out / "load_diagram.png").read_bytes()[:8] == PNG
+    assert sorted(p.name for p in out.iterdir()) == ["load_diagram.csv", "load_diagram.png"]
+
+
+@pytest.mark.slow
+def test_a_urdf_arm_with_its_own_effort_limits(tmp_path, capsys):
+    out = tmp_path / "ur5"
+    urdf = str(URDF_DATA / "ur5.urdf")
+    code = main(
+        ["--urdf", urdf, "--tip", "tool0", "--out", str(out), "--z-max", "0.1", "--l-max", "0", "--step", "0.1"]
+    )
+    assert code == 0, capsys.readouterr().err
+    rows = rows_of(out / "load_diagram.csv")
+    assert len(rows) == 2 and all(r["status"] == "proven" for r in rows)
+
+
+def test_the_grid_holds_both_ends():
+    np.testing.assert_allclose(grid(0.3, 0.01), np.arange(31) * 0.01)
+    np.testing.assert_allclose(grid(0.25, 0.1), [0.0, 0.1, 0.2, 0.25])
+    np.testing.assert_allclose(grid(0.0, 0.1), [0.0])
+
+
+@pytest.mark.parametrize(
+    "arguments, says",
+    [
+        (["--z-max", "-0.1"], "argument --z-max: must be >= 0, got -0.1"),
+        (["--l-max", "nan"], "argument --l-max: must be a finite number"),
+        (["--step", "0"], "argument --step: must be > 0, got 0"),
+        (["--step", "1e-5"], "--step 1e-05: 30001 x 20001 points, more than 20,000: give a larger step"),
+        (["--params-file", "missing.yaml"], "missing.yaml: no such file or directory"),
+        (["--urdf", "bad.urdf"], "bad.urdf"),
+        (["--params-file", "bad.yaml"], "bad.yaml"),
+        (["--rated-mass", "0"], "argument --rated-mass: must be > 0, got 0"),
+    ],
+)
+def test_bad_input_is_one_line_a_nonzero_status_and_nothing_written(tmp_path, capsys, monkeypatch, arguments, says):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "bad.urdf").write_text("<robot name='x'><link name='a'/>")
+    (tmp_path / "bad.yaml").write_text("/**:\n  ros__parameters:\n    joint_2.link.mass: -3.0\n")
+    code = main(["--out", "out", *arguments])
+    err = capsys.readouterr().err
+    assert code != 0 and err.count("\n") == 1 and says in err and "Traceback" not in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.urdf", "bad.yaml"]
+
+
+def test_an_output_that_cannot_be_a_folder_is_refused_before_any_work(tmp_path, capsys):
+    (tmp_path / "file").write_text("")
+    assert main(["--out", str(tmp_path / "file"), "--step", "0.1"]) == 1
+    assert "exists and is not a directory" in capsys.readouterr().err
+
+
+def test_console_scripts_and_module_run():
+    text = (ROOT / "setup.py").read_text()
+    scripts = dict(re.findall(r'"([\w-]+) = ([\w.]+:main)"', text))
+    target = "irb140_dynamics.tools.load_diagram:main"
+    assert scripts.get("load_diagram") == target and scripts.get("irb140-load-diagram") == target
+    done = subprocess.run(
+        [sys.executable, "-m", "irb140_dynamics.tools.load_diagram", "--help"], capture_output=True, text=True, cwd=ROOT
+    )
+    assert done.returncode == 0 and done.stdout.startswith("usage: load_diagram") and "--z-max" in done.stdout
+
+
+def test_every_proven_mass_is_written_rounded_down():
+    from irb140_dynamics.core.payload.diagram import DiagramPoint
+    from irb140_dynamics.tools.load_diagram_plot import mass_text
+
+    assert mass_text(DiagramPoint(0, 0, 1.23456789, True, 0)) == "1.234567"
+    assert mass_text(DiagramPoint(0, 0, math.nan, False, 0)) == ""
+    assert mass_text(DiagramPoint(0, 0, math.inf, False, None)) == ""
