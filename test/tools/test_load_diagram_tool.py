@@ -3,7 +3,6 @@ scripts, and bad input refused in one line, exit status non-zero, nothing writte
 
 import csv
 import math
-import re
 import subprocess
 import sys
 
@@ -87,11 +86,8 @@ def test_an_output_that_cannot_be_a_folder_is_refused_before_any_work(tmp_path, 
     assert "exists and is not a directory" in capsys.readouterr().err
 
 
-def test_console_scripts_and_module_run():
-    text = (ROOT / "setup.py").read_text()
-    scripts = dict(re.findall(r'"([\w-]+) = ([\w.]+:main)"', text))
-    target = "irb140_dynamics.tools.load_diagram:main"
-    assert scripts.get("load_diagram") == target and scripts.get("irb140-load-diagram") == target
+def test_the_module_runs_as_a_program():
+    """(Its console scripts go through the entry like every tool's: test/tools/test_programs.py.)"""
     done = subprocess.run(
         [sys.executable, "-m", "irb140_dynamics.tools.load_diagram", "--help"], capture_output=True, text=True, cwd=ROOT
     )
