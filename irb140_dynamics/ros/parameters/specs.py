@@ -1,38 +1,19 @@
-"""Parameters of the nodes: declared with descriptors, validated whole, applied off the executor.
-
-A node lists its parameters as ``Spec``s and gives two functions: ``check`` turns all of
-their values into a draft of the configuration it runs on (a RobotModel, options),
-raising ValueError naming the parameter when something is wrong, quickly; ``finish``
-does the slow rest (compiling kernels, the workspace analysis); a draft may be None while
-an input from elsewhere, a URDF, has yet to come. ``LiveParameters`` (see ``live``)
-declares the parameters, builds the first configuration (a failure stops startup), and
-from then on checks every change whole before it is accepted (a refused change keeps the
-old configuration), then finishes it off the executor and swaps it in: a change stalls no
-message. Parameters given that no node of the package knows are warned about by name,
-with the nearest known name.
-"""
+"""The parameters every node shares: the robot model's (``model_specs``, with the finite
+ranges of its numbers) and the joint_states QoS; and ``check_choice``, the one rule a
+descriptor cannot state for a string (its choices)."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from typing import Any
 
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.core.model.joints import MAX_FRICTION, param_prefix
 from irb140_dynamics.core.model.rigid_body import MAX_MASS as CORE_MAX_MASS
-from irb140_dynamics.core.model.robot_model import check_joint_names
-from irb140_dynamics.package_files import CONFIG_NAME, PACKAGE, default_config_path  # noqa: F401 (PACKAGE, CONFIG_NAME: re-exported)
-from irb140_dynamics.ros.parameters.live import LiveParameters
-from irb140_dynamics.ros.parameters.spec import Spec, declare
-from irb140_dynamics.ros.runtime.command_line import params_files_given
-
-_declare = declare  # the name model_source imports
-
+from irb140_dynamics.ros.parameters.spec import Spec
 
 # The finite ranges of the model's numbers (ParameterDescriptor ranges, `ros2 param describe`):
 # wide, to keep inf, nan and 1e308 out, not to judge the robot.
@@ -70,16 +51,6 @@ QOS_PARAMETERS = [
 def check_choice(name: str, value, choices) -> None:
     if value not in choices:
         raise ValueError(f"{name}: must be one of {', '.join(choices)}; got {value!r}")
-
-
-def check_qos(values: dict) -> None:
-    check_choice("qos.reliability", values["qos.reliability"], RELIABILITIES)
-    check_qos_depth(values["qos.depth"])
-
-
-def check_qos_depth(depth) -> None:
-    if not (isinstance(depth, int) and 1 <= depth <= MAX_QOS_DEPTH):
-        raise ValueError(f"qos.depth: must be between 1 and {MAX_QOS_DEPTH}, got {depth}")
 
 
 def joint_states_qos(node: Node) -> QoSProfile:
@@ -214,47 +185,3 @@ MODEL_NAME = Spec(
     "the robot's name, the hardware_id of the nodes' /diagnostics (a URDF model: its <robot name>)",
     read_only=True,
 )
-
-
-def declare_model(
-    node: Node,
-    extra: list[Spec],
-    check: Callable[[dict], Any],
-    per_joint: Callable[[list[str]], list[Spec]] = None,
-    finish: Callable[[Any, Any], Any] | None = None,
-    startup_wait: float | None = None,
-    quick: Callable[[Any, Any], bool] | None = None,
-) -> LiveParameters:
-    """Declare the robot model's parameters and a node's own (``extra``, and ``per_joint``
-    specs made for the model's joint names), with the default model's defaults (see
-    LiveParameters for ``check``, ``finish``, ``startup_wait`` and ``quick``)."""
-    path = default_config_path()
-    if not path.is_file():
-        raise ValueError(f"default model: no {path}; is the package installed? (or give --params-file)")
-    defaults = read_parameter_file(path)
-    given = params_files_given()
-    if given:
-        node.get_logger().info(f"model: params file {', '.join(given)} (over the built-in IRB-140 model, {path})")
-    else:
-        node.get_logger().info(f"model: the built-in IRB-140 model ({path})")
-    names = declare(
-        node,
-        Spec("joint_names", defaults["joint_names"], "the model's joints, base to flange", read_only=True),
-    )
-    names = check_joint_names(names)  # they become parameter prefixes: check them first
-    robot_name = declare(node, MODEL_NAME)
-    own = per_joint(names) if per_joint else []
-    specs = [*model_specs(names, defaults), *extra, *own]
-    parameters = LiveParameters(
-        node, specs, check, finish, declared=["joint_names", "model.name"], startup_wait=startup_wait, quick=quick
-    )
-    parameters.robot_name = robot_name
-    return parameters
-
-
-def check_number(name: str, value, minimum: float, maximum: float, unit: str = "") -> float:
-    """A finite number within [minimum, maximum], or ValueError naming the parameter."""
-    unit = f" {unit}" if unit else ""
-    if not (isinstance(value, (int, float)) and math.isfinite(value) and minimum <= value <= maximum):
-        raise ValueError(f"{name}: must be between {minimum:g} and {maximum:g}{unit}, got {value}")
-    return float(value)

@@ -161,11 +161,24 @@ def checked_text(text, max_chars: int | None = None) -> str:
 _CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")
 
 
+PARSE_CHUNK = 1 << 16  # characters fed to the XML parser at a time
+
+
+def _parsed(text: str) -> ET.Element:
+    """``ET.fromstring(text)``, fed in chunks: the parser holds the interpreter lock for
+    each call, and a long text in one call would hold up every other thread meanwhile (a
+    node's executor, while a URDF is read in a worker)."""
+    parser = ET.XMLParser()
+    for start in range(0, len(text), PARSE_CHUNK):
+        parser.feed(text[start : start + PARSE_CHUNK])
+    return parser.close()
+
+
 def parse_tree(text: str, max_chars: int | None = None) -> UrdfTree:
     """The tree of a URDF document, or UrdfError naming what is wrong."""
     text = checked_text(text, max_chars)
     try:
-        robot = ET.fromstring(text)
+        robot = _parsed(text)
     except ET.ParseError as error:
         raise UrdfError("XML", f"does not parse: {error}") from None
     except RecursionError:  # not with expat, kept as a guard: one line whatever the parser
