@@ -4,14 +4,16 @@ Subscribes   joint_states          sensor_msgs/JointState (matched by joint name
              ~/reference           trajectory_msgs/JointTrajectory: followed in time from its
                                    header.stamp, or on arrival (see nodes.id_node.tracking)
              robot_description     std_msgs/String (transient local): the model, with model.source
-                                   robot_description and no URDF parameter or file (see ros.parameters.model_source)
+                                   robot_description and no URDF parameter or file
+                                   (see ros.parameters.model_source)
 Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, qdd)
              gravity_torques       sensor_msgs/JointState, effort = g(q)
              effort_commands       std_msgs/Float64MultiArray (when enabled), model joint order:
                                    feed-forward, gravity or computed-torque commands
              ~/tracking_error      sensor_msgs/JointState, position = q_ref - q, velocity = qd_ref - qd
              external_torques      sensor_msgs/JointState, effort = external torques by the momentum
-                                   observer (for joint states that carry efforts; see ros.collision)
+                                   observer (for joint states that carry efforts;
+                                   see nodes.id_node.collision)
              collision             std_msgs/Bool (transient local), any over its collision_threshold
              /diagnostics          diagnostic_msgs/DiagnosticArray, message counts and collision, 1 Hz
              (an empty ~/reference trajectory lets the held reference go)

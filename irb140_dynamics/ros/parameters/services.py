@@ -78,7 +78,7 @@ class ParameterServices:
 
     def _get_types(self, request, response) -> None:
         if self._declared(request.names):
-            response.types = [kind.value for kind in self._node.get_parameter_types(list(request.names))]
+            response.types = self._node.get_parameter_types(list(request.names))
 
     def _list(self, request, response) -> None:
         response.result = self._node.list_parameters(list(request.prefixes), request.depth)

@@ -88,8 +88,7 @@ def declare(node: Node, spec: Spec, given: Parameter | None = None) -> Any:
     else:
         given = as_type(given, spec.type)
         if given.type_ != spec.type:
-            hint = "; write doubles with a decimal point, e.g. 2.0" if spec.type.name.startswith("DOUBLE") else ""
-            raise ValueError(f"{spec.name}: expected a value of type {TYPE_NAMES[spec.type]}{hint}")
+            raise ValueError(f"{spec.name}: expected a value of type {TYPE_NAMES[spec.type]}")
         value = given.value
     try:
         return node.declare_parameter(spec.name, value, descriptor, ignore_override=True).value
