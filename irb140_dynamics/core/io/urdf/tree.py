@@ -35,6 +35,7 @@ from irb140_dynamics.core.model.rigid_body import (
 
 KINDS = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 MAX_URDF_CHARS = MAX_TEXT_BYTES  # characters of URDF text at most (IRB140_MAX_FILE_BYTES changes it)
+PARSE_CHUNK = 1 << 14  # characters the XML parser (and the check for binary data) takes at a time
 MAX_LINE = 299  # characters of a refusal line at most
 RIGHT_ANGLE_TOLERANCE = 1e-10  # rad: an <origin rpy> angle this close to a multiple of pi/2 is taken as it
 
@@ -150,18 +151,17 @@ def checked_text(text, max_chars: int | None = None) -> str:
         raise UrdfError("document", f"expected text, got {type(text).__name__}")
     if len(text) > max_chars:
         raise UrdfError("document", f"{len(text)} characters, more than the limit of {max_chars} (max_chars)")
-    binary = _CONTROL.search(text)
-    if binary:
-        raise UrdfError("document", f"binary data, not text (character {ord(binary.group()):#04x} at {binary.start()})")
-    if not text.strip():
+    for start in range(0, len(text), PARSE_CHUNK):  # in chunks, as the parse (see _parsed)
+        binary = _CONTROL.search(text, start, start + PARSE_CHUNK)
+        if binary:
+            where = f"character {ord(binary.group()):#04x} at {binary.start()}"
+            raise UrdfError("document", f"binary data, not text ({where})")
+    if not text or text.isspace():
         raise UrdfError("document", "empty")
     return text
 
 
 _CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")
-
-
-PARSE_CHUNK = 1 << 16  # characters fed to the XML parser at a time
 
 
 def _parsed(text: str) -> ET.Element:
