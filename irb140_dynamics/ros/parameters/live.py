@@ -73,7 +73,6 @@ class LiveParameters:
         self._node, self._overrides, self._check_values = node, overrides, check
         self._quick = recipe.quick if recipe.finish is not None else (lambda draft, previous: True)
         finish = recipe.finish or (lambda draft, previous: draft)
-        self._values = {name: node.get_parameter_or(name).value for name in node.list_parameters([], 0).names}
         self._declaring = False
         self.declare(specs)
         joint_names = node.get_parameter("joint_names").value if node.has_parameter("joint_names") else None
@@ -103,9 +102,8 @@ class LiveParameters:
 
     def values(self, changes=()) -> dict[str, Any]:
         """All parameter values by name, with ``changes`` (Parameters) applied on top."""
-        values = dict(self._values)
-        values.update({p.name: p.value for p in changes})
-        return values
+        values = {name: parameter.value for name, parameter in self._node.get_parameters_by_prefix("").items()}
+        return values | {p.name: p.value for p in changes}
 
     def on_change(self, listener: Callable[[Any], None]) -> None:
         self._listeners.append(listener)
@@ -117,7 +115,7 @@ class LiveParameters:
         try:
             for spec in specs:
                 if not self._node.has_parameter(spec.name):
-                    self._values[spec.name] = self._overrides.declare(spec)
+                    self._overrides.declare(spec)
         finally:
             self._declaring = False
 
@@ -164,8 +162,6 @@ class LiveParameters:
         """Build the configuration checked by _check for exactly these changes: at once if
         that is quick, else off the executor. (rclpy calls it for declarations too: those
         were not checked, and change nothing.)"""
-        for p in parameters:
-            self._values[p.name] = p.value
         checked, self._checked = self._checked, None
         if checked is None or checked[0] != _changes(parameters):  # not the change just checked
             return
