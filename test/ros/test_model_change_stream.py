@@ -12,6 +12,7 @@ its gravity_torques, whatever the latency: a stall of the executor longer than t
 import contextlib
 import threading
 import time
+import uuid
 
 import rclpy
 from rcl_interfaces.msg import Log
@@ -63,19 +64,24 @@ def chain_text(links: int) -> str:
 class Probe:
     """Publishes joint states, the URDFs, and gathers the replies' stamps and the node's log."""
 
-    def __init__(self, context: Context):
-        self.node = Node("stream_probe", context=context)
+    def __init__(self, context: Context, logger_name: str, namespace: str):
+        self.node = Node("stream_probe", context=context, namespace=namespace)
         self.states = self.node.create_publisher(JointState, "joint_states", RELIABLE)
         self.description = self.node.create_publisher(String, "robot_description", DESCRIPTION_QOS)
         self.answered: dict[int, tuple[str, ...]] = {}  # stamp [ns] -> the joints of the reply
         self.log: list[str] = []
         self.node.create_subscription(JointState, "gravity_torques", self._on_torques, QoSProfile(depth=100_000))
-        self.node.create_subscription(Log, "/rosout", lambda msg: self.log.append(msg.msg), QoSProfile(depth=1000))
+        self.node.create_subscription(Log, "/rosout", self._on_log, QoSProfile(depth=1000))
+        self._logger_name = logger_name
         self.sent: list[int] = []
         self.streaming = threading.Event()
 
     def _on_torques(self, msg) -> None:
         self.answered[msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec] = tuple(msg.name)
+
+    def _on_log(self, msg: Log) -> None:
+        if msg.name == self._logger_name:  # other tests may run in the same domain
+            self.log.append(msg.msg)
 
     def stream(self) -> None:
         """Joint states of both arms' joints at up to RATE, until ``streaming`` is cleared."""
@@ -124,8 +130,9 @@ def test_no_joint_state_goes_unanswered_while_a_urdf_is_refused_or_swapped_in():
         Parameter("qos.depth", value=DEPTH),
         Parameter("qos.reliability", value="reliable"),
     ]
-    node = IdNode(context=context, parameter_overrides=overrides)
-    probe = Probe(context)
+    namespace = f"/stream_{uuid.uuid4().hex[:8]}"  # topics of this test's own
+    node = IdNode(context=context, parameter_overrides=overrides, cli_args=["--ros-args", "-r", f"__ns:={namespace}"])
+    probe = Probe(context, node.get_logger().name, namespace)
     probe_executor = SingleThreadedExecutor(context=context)
     probe_executor.add_node(probe.node)
     threads = [
