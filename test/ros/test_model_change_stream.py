@@ -4,7 +4,8 @@ executor while the model before answers every joint state, then swapped in at on
 id_node runs on its own executor thread, as under ``ros2 run``; joint states come at up to
 1 kHz (never in bursts: a late publisher goes on from where it is) with a unique stamp each.
 Meanwhile a 100,000-link URDF is published (refused: far over the joint limit, after a
-parse that takes seconds) and then a Panda replacing the UR5 in use. Every stamp sent gets
+parse that takes seconds), then a Panda replacing the UR5 in use, then parameter changes
+(payload, gravity). Every stamp sent gets
 its gravity_torques, whatever the latency: a stall of the executor longer than the queue
 (qos.depth) would lose some.
 """
@@ -20,6 +21,7 @@ from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
@@ -158,6 +160,13 @@ def test_no_joint_state_goes_unanswered_while_a_urdf_is_refused_or_swapped_in():
         assert wait_for(lambda: node.settings.model.joint_names == tuple(PANDA_JOINTS), TIMEOUT)
         swapped_at = len(probe.sent)
         assert wait_for(lambda: len(probe.sent) >= swapped_at + 100, TIMEOUT)
+        client = AsyncParameterClient(probe.node, node.get_fully_qualified_name())
+        for change in (Parameter("payload.mass", value=3.0), Parameter("gravity", value=[0.0, 1.0, -9.8])):
+            future = client.set_parameters([change])
+            assert wait_for(future.done, TIMEOUT) and future.result().results[0].successful
+        assert wait_for(lambda: node.settings.model.payload.mass == 3.0, TIMEOUT)
+        changed_at = len(probe.sent)
+        assert wait_for(lambda: len(probe.sent) >= changed_at + 100, TIMEOUT)
         probe.streaming.clear()
         streamer.join(TIMEOUT)
 

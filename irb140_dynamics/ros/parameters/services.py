@@ -13,6 +13,8 @@ warned about (throttled): the node goes on.
 
 from __future__ import annotations
 
+import contextlib
+
 from rcl_interfaces.msg import SetParametersResult
 from rcl_interfaces.srv import (
     DescribeParameters,
@@ -22,6 +24,7 @@ from rcl_interfaces.srv import (
     SetParameters,
     SetParametersAtomically,
 )
+from rclpy.exceptions import ParameterUninitializedException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_parameters
@@ -73,15 +76,17 @@ class ParameterServices:
 
     def _get(self, request, response) -> None:
         if self._declared(request.names):
-            parameters = self._node.get_parameters(list(request.names))
-            response.values = [p.get_parameter_value() for p in parameters]
+            with contextlib.suppress(ParameterUninitializedException):  # as rclpy: one without a value, none
+                parameters = self._node.get_parameters(list(request.names))
+                response.values = [p.get_parameter_value() for p in parameters]
 
     def _get_types(self, request, response) -> None:
         if self._declared(request.names):
             response.types = self._node.get_parameter_types(list(request.names))
 
     def _list(self, request, response) -> None:
-        response.result = self._node.list_parameters(list(request.prefixes), request.depth)
+        with contextlib.suppress(TypeError, ValueError):  # as rclpy: a bad request, an empty list
+            response.result = self._node.list_parameters(list(request.prefixes), request.depth)
 
     def _set(self, request, response) -> None:
         for message in request.parameters:
