@@ -98,7 +98,7 @@ class LiveParameters:
         node.add_pre_set_parameters_callback(self._as_declared_types)
         node.add_on_set_parameters_callback(self._check)
         node.add_post_set_parameters_callback(self._apply)
-        self._services = ParameterServices(node)
+        ParameterServices(node)  # (its services are the node's)
 
     def values(self, changes=()) -> dict[str, Any]:
         """All parameter values by name, with ``changes`` (Parameters) applied on top."""
