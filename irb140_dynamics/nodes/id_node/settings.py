@@ -75,7 +75,7 @@ class IdNodeSettings:
 
 
 def check_settings(values: dict) -> IdNodeSettings:
-    """Validate what the descriptors cannot (quick, within the parameter call); kernels not compiled yet."""
+    """Validate what the descriptors cannot (before a change is accepted); kernels not compiled yet."""
     model = RobotModel.from_params(values)
     check_choice("acceleration.mode", values["acceleration.mode"], ACCELERATION_MODES)
     check_choice("effort_commands.source", values["effort_commands.source"], EFFORT_SOURCES)

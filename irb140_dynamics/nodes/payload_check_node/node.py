@@ -157,7 +157,7 @@ class PayloadCheckSettings:
 
 
 def check_settings(values: dict) -> Draft:
-    """Validate what the descriptors cannot (quick, within the parameter call)."""
+    """Validate what the descriptors cannot (before a change is accepted)."""
     model = RobotModel.from_params(values)
     rated = RigidBody.validated("rated_payload", values["rated_payload.mass"], values["rated_payload.com"])
     period = values["diagnostics.period"]

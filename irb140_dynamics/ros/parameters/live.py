@@ -4,8 +4,8 @@ The node states how its parameters become the configuration it runs on in a ``Re
 ``LiveParameters`` declares them (each with its descriptor, see ``spec``), builds the first
 configuration (a failure stops startup), then, as rclpy's examples do, reacts to changes
 in its ``on_set_parameters`` callback: the whole configuration is checked before a change
-is accepted (a refused change keeps the old one, its reason naming the parameter), then
-finished off the executor and swapped in at once.
+is accepted (off the executor, see ``checked_sets``; a refused change keeps the old one,
+its reason naming the parameter), then finished off the executor and swapped in at once.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from irb140_dynamics.core.errors import one_line
+from irb140_dynamics.ros.parameters.checked_sets import CheckedSets
 from irb140_dynamics.ros.parameters.overrides import Overrides
 from irb140_dynamics.ros.parameters.services import ParameterServices, undeclared
 from irb140_dynamics.ros.parameters.spec import Spec, as_type
@@ -36,8 +37,10 @@ class Recipe:
 
     ``check(values)`` validates all the parameter values at once (what no descriptor can
     say: the model as a whole, rules across parameters) and returns a draft, or raises
-    ValueError naming the parameter; it runs within the parameter call, so it must be
-    quick. ``finish(draft, previous)`` does the slow part (compiling kernels, the workspace
+    ValueError naming the parameter. It runs before a change is accepted: in a worker
+    thread for a change through the parameter services (``checked_sets``), within the call
+    for one set in the process (``node.set_parameters``); it must be thread-safe.
+    ``finish(draft, previous)`` does the slow part (compiling kernels, the workspace
     analysis; None: the draft is the configuration) off the executor; ``previous`` is the
     last configuration finished (None at first). ``quick(draft, previous)``: True when
     finish will be quick (nothing to compile): then it runs at once, and the change is in
@@ -98,7 +101,9 @@ class LiveParameters:
         node.add_pre_set_parameters_callback(self._as_declared_types)
         node.add_on_set_parameters_callback(self._check)
         node.add_post_set_parameters_callback(self._apply)
-        ParameterServices(node)  # (its services are the node's)
+        self._taken = None  # (snapshot, Future): a check done off the executor (CheckedSets), for _check
+        checked_sets = CheckedSets(node, self._snapshot, lambda snapshot: check(snapshot[1]), self._take)
+        ParameterServices(node, checked_sets.submit)
 
     def values(self, changes=()) -> dict[str, Any]:
         """All parameter values by name, with ``changes`` (Parameters) applied on top."""
@@ -149,14 +154,29 @@ class LiveParameters:
         refusal = undeclared(self._node, [p.name for p in parameters])  # rclpy's own check lets '' through
         if refusal is not None:
             return refusal
+        values = self.values(parameters)
         try:
-            self._checked = (_changes(parameters), self._check_values(self.values(parameters)))
+            if self._taken is not None and self._taken[0] == (self._accepted, values):  # checked off the executor
+                draft = self._taken[1].result()
+            else:
+                draft = self._check_values(values)
+            self._checked = (_changes(parameters), draft)
         except ValueError as error:
             return SetParametersResult(successful=False, reason=one_line(error))
         except Exception as error:  # noqa: BLE001  (a defect of ours must not end the node)
             self._node.get_logger().error(f"validating {[p.name for p in parameters]}: {type(error).__name__}: {error}")
             return SetParametersResult(successful=False, reason=f"internal error: {type(error).__name__}: {error}")
         return SetParametersResult(successful=True)
+
+    def _snapshot(self, changes: list[Parameter]) -> tuple[int, dict]:
+        """What a check of ``changes`` starts from: the generation in force (a URDF swapped in
+        meanwhile changes it) and the values."""
+        return self._accepted, self.values(self._as_declared_types(changes))
+
+    def _take(self, snapshot: tuple[int, dict] | None, future=None) -> None:
+        """The check of ``snapshot`` done off the executor (a Future), for the change set next;
+        None after it."""
+        self._taken = None if snapshot is None else (snapshot, future)
 
     def _apply(self, parameters: list[Parameter]) -> None:
         """Build the configuration checked by _check for exactly these changes: at once if

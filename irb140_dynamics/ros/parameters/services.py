@@ -6,14 +6,17 @@ that is not declared through ('' even reaches rclpy's internals) and raise insid
 callback on a parameter type they do not know (a ParameterValue.type of 99, from a
 hand-made client), which ends the node's spin. Here a set request refuses such a parameter
 by name, and an unknown name naming the nearest known one, and hands the rest to
-``set_parameters_atomically`` as rclpy does: one by one (SetParameters) or all or none
-(SetParametersAtomically). Any other failure is answered with an empty response and
+``submit`` (``set_parameters_atomically``, after a check off the executor: see
+``checked_sets``) as rclpy does: one by one (SetParameters) or all or none
+(SetParametersAtomically), the reply sent when all are set. Any other failure is answered with an empty response and
 warned about (throttled): the node goes on.
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
+from collections.abc import Callable
 
 from rcl_interfaces.msg import SetParametersResult
 from rcl_interfaces.srv import (
@@ -30,15 +33,21 @@ from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_parameters
 
 from irb140_dynamics.ros.parameters.overrides import nearest_hint
+from irb140_dynamics.ros.runtime.deferred_reply import DeferredService, Later
+
+Answer = Callable[[SetParametersResult], None]
 
 PARAMETER_TYPES = {kind.value for kind in Parameter.Type}
 
 
 class ParameterServices:
-    """The six parameter services of ``node`` (``~/set_parameters``, ...)."""
+    """The six parameter services of ``node`` (``~/set_parameters``, ...). ``submit(parameters,
+    answer)`` sets a change and calls ``answer`` with its result, now or later (see
+    ``checked_sets``); by default at once."""
 
-    def __init__(self, node: Node):
+    def __init__(self, node: Node, submit: Callable[[list[Parameter], Answer], None] | None = None):
         self._node = node
+        self._submit = submit or (lambda parameters, answer: answer(node.set_parameters_atomically(parameters)))
         for srv_type, name, answer in (
             (DescribeParameters, "describe_parameters", self._describe),
             (GetParameters, "get_parameters", self._get),
@@ -47,7 +56,8 @@ class ParameterServices:
             (SetParameters, "set_parameters", self._set),
             (SetParametersAtomically, "set_parameters_atomically", self._set_atomically),
         ):
-            node.create_service(
+            DeferredService(
+                node,
                 srv_type,
                 f"{node.get_name()}/{name}",
                 self._answered(srv_type, answer),
@@ -57,13 +67,12 @@ class ParameterServices:
     def _answered(self, srv_type, answer):
         def callback(request, response):
             try:
-                answer(request, response)
+                return answer(request, response) or response
             except Exception as error:  # noqa: BLE001  (no request may end the node)
                 self._node.get_logger().warning(
                     f"{srv_type.__name__} request failed: {type(error).__name__}: {error}", throttle_duration_sec=2.0
                 )
                 return srv_type.Response()
-            return response
 
         return callback
 
@@ -88,14 +97,37 @@ class ParameterServices:
         with contextlib.suppress(TypeError, ValueError):  # as rclpy: a bad request, an empty list
             response.result = self._node.list_parameters(list(request.prefixes), request.depth)
 
-    def _set(self, request, response) -> None:
-        for message in request.parameters:
-            refusal = self._refusal([message])
-            response.results.append(refusal or self._node.set_parameters_atomically(_parameters([message])))
+    def _set(self, request, response) -> Later | None:
+        """Each parameter set on its own, in order; answered when all are."""
+        later, results = Later(), [None] * len(request.parameters)
 
-    def _set_atomically(self, request, response) -> None:
+        def done(index: int, result: SetParametersResult) -> None:
+            results[index] = result
+            if all(result is not None for result in results):
+                response.results = results
+                later.answer(response)
+
+        for index, message in enumerate(request.parameters):
+            refusal = self._refusal([message])
+            if refusal is not None:
+                done(index, refusal)
+            else:
+                self._submit(_parameters([message]), functools.partial(done, index))
+        return later if request.parameters else None
+
+    def _set_atomically(self, request, response) -> Later:
+        later = Later()
+
+        def done(result: SetParametersResult) -> None:
+            response.result = result
+            later.answer(response)
+
         refusal = self._refusal(request.parameters)
-        response.result = refusal or self._node.set_parameters_atomically(_parameters(request.parameters))
+        if refusal is not None:
+            done(refusal)
+        else:
+            self._submit(_parameters(request.parameters), done)
+        return later
 
     def _refusal(self, messages) -> SetParametersResult | None:
         """A parameter of no known type, or a name not declared, refused by name; else None."""
