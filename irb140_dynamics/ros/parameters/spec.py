@@ -14,17 +14,7 @@ from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValu
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-TYPE_NAMES = {
-    Parameter.Type.BOOL: "bool",
-    Parameter.Type.INTEGER: "integer",
-    Parameter.Type.DOUBLE: "double",
-    Parameter.Type.STRING: "string",
-    Parameter.Type.BYTE_ARRAY: "byte[]",
-    Parameter.Type.BOOL_ARRAY: "bool[]",
-    Parameter.Type.INTEGER_ARRAY: "integer[]",
-    Parameter.Type.DOUBLE_ARRAY: "double[]",
-    Parameter.Type.STRING_ARRAY: "string[]",
-}
+TYPE_NAMES = {kind: kind.name.lower().replace("_array", "[]") for kind in Parameter.Type}  # as --help says them
 
 
 @dataclass(frozen=True)

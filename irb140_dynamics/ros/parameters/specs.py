@@ -59,6 +59,16 @@ def joint_states_qos(node: Node) -> QoSProfile:
     return QoSProfile(depth=node.get_parameter("qos.depth").value, reliability=reliability)
 
 
+JOINT_NUMBERS = (  # each joint's numbers of 0 and up: (name suffix, description, unit, maximum)
+    ("torque_limit", "joint torque limit, 0 = none given", "N m", MAX_TORQUE),
+    ("velocity_limit", "joint speed limit, 0 = none given", "rad/s", MAX_VELOCITY),
+    ("acceleration_limit", "joint acceleration limit, 0 = none given", "rad/s^2", MAX_ACCELERATION),
+    ("friction.viscous", "viscous friction coefficient", "N m s/rad", MAX_VISCOUS),
+    ("friction.coulomb", "Coulomb friction level (smoothed, see friction.smoothing_velocity)", "N m", MAX_COULOMB),
+    ("armature", "rotor inertia reflected through the gear, added to M's diagonal", "kg m^2", MAX_ARMATURE),
+)
+
+
 def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
     """The model's parameters for these joints; defaults from the default model's file.
 
@@ -100,53 +110,9 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
                 "[lower, upper] joint position",
                 "rad",
             ),
-            Spec(
-                f"{joint}.torque_limit",
-                default(f"{joint}.torque_limit", 0.0),
-                "joint torque limit, 0 = none given",
-                "N m",
-                minimum=0.0,
-                maximum=MAX_TORQUE,
-            ),
-            Spec(
-                f"{joint}.velocity_limit",
-                default(f"{joint}.velocity_limit", 0.0),
-                "joint speed limit, 0 = none given",
-                "rad/s",
-                minimum=0.0,
-                maximum=MAX_VELOCITY,
-            ),
-            Spec(
-                f"{joint}.acceleration_limit",
-                default(f"{joint}.acceleration_limit", 0.0),
-                "joint acceleration limit, 0 = none given",
-                "rad/s^2",
-                minimum=0.0,
-                maximum=MAX_ACCELERATION,
-            ),
-            Spec(
-                f"{joint}.friction.viscous",
-                default(f"{joint}.friction.viscous", 0.0),
-                "viscous friction coefficient",
-                "N m s/rad",
-                minimum=0.0,
-                maximum=MAX_VISCOUS,
-            ),
-            Spec(
-                f"{joint}.friction.coulomb",
-                default(f"{joint}.friction.coulomb", 0.0),
-                "Coulomb friction level (smoothed, see friction.smoothing_velocity)",
-                "N m",
-                minimum=0.0,
-                maximum=MAX_COULOMB,
-            ),
-            Spec(
-                f"{joint}.armature",
-                default(f"{joint}.armature", 0.0),
-                "rotor inertia reflected through the gear, added to M's diagonal",
-                "kg m^2",
-                minimum=0.0,
-                maximum=MAX_ARMATURE,
+            *(
+                Spec(f"{joint}.{suffix}", default(f"{joint}.{suffix}", 0.0), text, unit, minimum=0.0, maximum=maximum)
+                for suffix, text, unit, maximum in JOINT_NUMBERS
             ),
         ]
     return specs
