@@ -109,23 +109,22 @@ def range_text(descriptor: ParameterDescriptor) -> str:
     return f"{ranges[0].from_value:g} to {ranges[0].to_value:g}"
 
 
-def own_arguments(argv: Iterable[str]) -> list[str]:
-    """The arguments outside every ``--ros-args ... [--]`` span (argv without the program)."""
-    own, inside = [], False
+def split_arguments(argv: Iterable[str]) -> tuple[list[str], list[str]]:
+    """(the arguments outside every ``--ros-args ... [--]`` span, those inside), argv without
+    the program."""
+    own, ros, inside = [], [], False
     for argument in list(argv)[1:]:
-        if argument == ROS_ARGS:
-            inside = True
-        elif inside and argument == "--":
-            inside = False
-        elif not inside:
-            own.append(argument)
-    return own
+        if argument == ROS_ARGS or (inside and argument == "--"):
+            inside = argument == ROS_ARGS
+        else:
+            (ros if inside else own).append(argument)
+    return own, ros
 
 
 def refusal(name: str, argv: list[str]) -> str | None:
     """Why the node will not start with these arguments (one line), or None. Help is not
     a refusal (see ``wants_help``)."""
-    own = [a for a in own_arguments(argv) if a not in HELP]
+    own = [a for a in split_arguments(argv)[0] if a not in HELP]
     if not own:
         return None
     first = own[0]
@@ -139,7 +138,7 @@ def refusal(name: str, argv: list[str]) -> str | None:
 
 
 def wants_help(argv: list[str]) -> bool:
-    return any(a in HELP for a in own_arguments(argv))
+    return any(a in HELP for a in split_arguments(argv)[0])
 
 
 _given: list[str] = []  # the params files of the node's command line (set by ``before_start``)
@@ -147,15 +146,8 @@ _given: list[str] = []  # the params files of the node's command line (set by ``
 
 def params_files(argv: list[str]) -> list[str]:
     """The files of every ``--params-file`` inside ``--ros-args``, in order."""
-    files, inside, arguments = [], False, list(argv)[1:]
-    for i, argument in enumerate(arguments):
-        if argument == ROS_ARGS:
-            inside = True
-        elif inside and argument == "--":
-            inside = False
-        elif inside and argument == "--params-file" and i + 1 < len(arguments):
-            files.append(arguments[i + 1])
-    return files
+    ros = split_arguments(argv)[1]
+    return [path for flag, path in zip(ros, ros[1:]) if flag == "--params-file"]
 
 
 def params_files_given() -> list[str]:
