@@ -39,7 +39,7 @@ from irb140_dynamics.package_files import default_config_path
 from irb140_dynamics.ros.parameters.live import LiveParameters, Recipe
 from irb140_dynamics.ros.parameters.overrides import Overrides
 from irb140_dynamics.ros.parameters.spec import Spec
-from irb140_dynamics.ros.parameters.specs import MODEL_NAME, check_choice, model_specs
+from irb140_dynamics.ros.parameters.specs import MODEL_NAME, check_choice, joint_names_spec, model_specs
 from irb140_dynamics.ros.runtime.builder import Builder, Failed
 from irb140_dynamics.ros.runtime.command_line import params_files_given
 
@@ -97,8 +97,9 @@ def declare_model_source(node: Node, recipe: Recipe) -> LiveParameters:
         node.get_logger().info(f"model: params file {', '.join(given)} (over the built-in IRB-140 model, {path})")
     else:
         node.get_logger().info(f"model: the built-in IRB-140 model ({path})")
-    joint_names = Spec("joint_names", defaults["joint_names"], "the model's joints, base to flange", read_only=True)
-    names = check_joint_names(overrides.declare(joint_names))  # they become parameter prefixes: check them first
+    names = check_joint_names(
+        overrides.declare(joint_names_spec(defaults["joint_names"]))
+    )  # they become parameter prefixes: check them first
     robot_name = overrides.declare(MODEL_NAME)
     specs = [*model_specs(names, defaults), *recipe.specs, *recipe.per_joint(names)]
     parameters = LiveParameters(node, overrides, specs, recipe.check, recipe)

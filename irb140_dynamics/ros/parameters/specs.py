@@ -145,6 +145,11 @@ def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
     ]
 
 
+def joint_names_spec(names: list[str]) -> Spec:
+    """``joint_names``, with these names as its default."""
+    return Spec("joint_names", list(names), "the model's joints, base to flange", read_only=True)
+
+
 MODEL_NAME = Spec(
     "model.name",
     "irb140",
