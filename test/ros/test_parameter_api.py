@@ -9,11 +9,14 @@ import re
 
 import pytest
 from rcl_interfaces.msg import ParameterType
+from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from irb140_dynamics.core import RigidBody, irb140
 from irb140_dynamics.nodes.id_node.node import IdNode
 from irb140_dynamics.nodes.sim_node.node import SimNode
+from irb140_dynamics.ros.parameters.live import declare_fixed
+from irb140_dynamics.ros.parameters.spec import Spec
 
 from ..support.ros_harness import running
 
@@ -102,3 +105,15 @@ def test_the_parameter_services_answer_as_rclpys():
         types = harness.call(lambda: client.get_parameter_types(["model.name"])).types
         assert list(types) == [ParameterType.PARAMETER_STRING]
         assert harness.call(lambda: client.describe_parameters(["nothing"])).descriptors == []
+
+
+def test_a_node_made_without_node_options_is_a_defect_said_at_once():
+    """Without them rclpy would keep the values given to itself: they would be lost silently."""
+
+    class Forgetful(Node):
+        def __init__(self, **kwargs):
+            super().__init__("forgetful", **kwargs)
+            declare_fixed(self, [Spec("period", 1.0, "a period", "s", minimum=0.0, maximum=10.0)])
+
+    with pytest.raises(TypeError, match="without NODE_OPTIONS"), running(Forgetful):
+        pass

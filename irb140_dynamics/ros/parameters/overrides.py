@@ -35,6 +35,8 @@ class Overrides:
     """The values given to ``node`` at startup, by name, until its parameters take them."""
 
     def __init__(self, node: Node):
+        if any(service.srv_name.endswith("/set_parameters") for service in node.services):  # rclpy's: no NODE_OPTIONS
+            raise TypeError(f"{node.get_name()} was made without NODE_OPTIONS: the values given would be lost")
         self._node = node
         names = [name for name in node.list_parameters([], 0).names if name not in RCLPY_PARAMETERS]
         self.given: dict[str, Parameter] = {name: node.get_parameter(name) for name in names}
