@@ -60,7 +60,12 @@ class CheckedSets:
                 result = SetParametersResult(successful=False, reason=f"{type(error).__name__}: {error}")
             finally:
                 self._checked(None)
-            answer(result)
+            try:
+                answer(result)
+            except Exception as error:  # noqa: BLE001  (a client gone meanwhile must not end the node)
+                self._node.get_logger().warning(
+                    f"parameter change set, reply not sent: {type(error).__name__}: {error}"
+                )
         if not self._pending:
             self._poll.cancel()
             self._pool.shutdown(wait=False)  # no thread lingers between changes
