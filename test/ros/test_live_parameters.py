@@ -84,6 +84,29 @@ def test_messages_flow_while_a_change_is_built(gated_id_node):
     np.testing.assert_allclose(gravity_now(node), gravity(irb140(payload=RigidBody(5.0)), Q), rtol=1e-12, atol=1e-12)
 
 
+def test_a_change_is_checked_off_the_executor_and_answered_after(monkeypatch):
+    """The whole check of a change (here held at a gate) runs in a worker: joint states are
+    answered meanwhile by the model before, and the reply comes once it is checked and set."""
+    gate = Gate(id_module.check_settings)
+    monkeypatch.setattr(id_module, "check_settings", gate)
+    with running(IdNode) as harness:
+        harness.gravity = harness.listen(JointState, "gravity_torques")
+        harness.joint_states = harness.publisher(JointState, "joint_states")
+        gate.close()
+        client = harness.parameter_client()
+        future = client.set_parameters([Parameter("payload.mass", value=5.0)])
+        assert harness.spin_until(lambda: gate.calls == 2)  # startup, then this change
+        for _ in range(3):
+            np.testing.assert_allclose(gravity_now(harness), gravity(irb140(), Q), rtol=1e-12, atol=1e-12)
+        assert not future.done()
+        gate.open()
+        assert harness.spin_until(future.done)
+        assert [r.successful for r in future.result().results] == [True] and gate.calls == 2  # not checked again
+        harness.settle()
+        expected = gravity(irb140(payload=RigidBody(5.0)), Q)
+        np.testing.assert_allclose(gravity_now(harness), expected, rtol=1e-12, atol=1e-12)
+
+
 def test_changes_faster_than_builds_end_with_the_newest(gated_id_node):
     node = gated_id_node
     node.gate.close()

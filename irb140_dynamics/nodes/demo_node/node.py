@@ -24,7 +24,9 @@ from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from irb140_dynamics.core.io.stamps import nanoseconds, sec_nanosec
-from irb140_dynamics.ros.parameters.spec import Spec, declare
+from irb140_dynamics.ros.parameters.live import declare_fixed
+from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
+from irb140_dynamics.ros.parameters.spec import Spec
 from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.spin import run
 
@@ -73,8 +75,8 @@ def reference_message(period: float) -> JointTrajectory:
 
 class DemoNode(Node):
     def __init__(self, **kwargs):
-        super().__init__("demo_node", **kwargs)
-        self.period, plot_file, duration, self.label = (declare(self, spec) for spec in NODE_PARAMETERS)
+        super().__init__("demo_node", **NODE_OPTIONS, **kwargs)
+        self.period, plot_file, duration, self.label = declare_fixed(self, NODE_PARAMETERS)
         self.plot_file = str(Path(plot_file).expanduser().resolve())
         self._reference_pub = self.create_publisher(JointTrajectory, "/id_node/reference", 10)
         self._positions = {}  # stamp [ns] -> q, of the latest joint states

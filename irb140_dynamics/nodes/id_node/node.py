@@ -2,16 +2,18 @@
 
 Subscribes   joint_states          sensor_msgs/JointState (matched by joint name)
              ~/reference           trajectory_msgs/JointTrajectory: followed in time from its
-                                   header.stamp, or on arrival (see ros.tracking)
+                                   header.stamp, or on arrival (see nodes.id_node.tracking)
              robot_description     std_msgs/String (transient local): the model, with model.source
-                                   robot_description and no URDF parameter or file (see ros.model_source)
+                                   robot_description and no URDF parameter or file
+                                   (see ros.parameters.model_source)
 Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, qdd)
              gravity_torques       sensor_msgs/JointState, effort = g(q)
              effort_commands       std_msgs/Float64MultiArray (when enabled), model joint order:
                                    feed-forward, gravity or computed-torque commands
              ~/tracking_error      sensor_msgs/JointState, position = q_ref - q, velocity = qd_ref - qd
              external_torques      sensor_msgs/JointState, effort = external torques by the momentum
-                                   observer (for joint states that carry efforts; see ros.collision)
+                                   observer (for joint states that carry efforts;
+                                   see nodes.id_node.collision)
              collision             std_msgs/Bool (transient local), any over its collision_threshold
              external_wrench       geometry_msgs/WrenchStamped: the wrench on the flange the external
                                    torques come from (see id_node.wrench)
@@ -23,7 +25,7 @@ Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, q
 Torques are in N m, named and ordered as the model's joints, stamped with the input stamp.
 A message that cannot give finite torques is dropped and counted (per topic), never
 answered; no exception leaves a callback. Joint states are read, and torques published, as
-serialized bytes (ros.joint_state_cdr: a third of rclpy's cost per message).
+serialized bytes (ros.messages.joint_state_cdr: a third of rclpy's cost per message).
 """
 
 from __future__ import annotations
@@ -67,7 +69,9 @@ from irb140_dynamics.ros.messages.joint_messages import (
 )
 from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage, read_joint_state_cdr
 from irb140_dynamics.ros.messages.wrench import chain_links
+from irb140_dynamics.ros.parameters.live import Recipe
 from irb140_dynamics.ros.parameters.model_source import declare_model_source
+from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import joint_states_qos
 from irb140_dynamics.ros.parameters.usage import JOINT, model_sections, per_joint_section
 from irb140_dynamics.ros.runtime.command_line import Usage
@@ -81,7 +85,7 @@ class IdNode(Node):
     """Joint states in; feed-forward and gravity torques out."""
 
     def __init__(self, **kwargs):
-        super().__init__("id_node", **kwargs)
+        super().__init__("id_node", **NODE_OPTIONS, **kwargs)
         self.settings: IdNodeSettings | None = None  # None: waiting for the model (robot_description topic)
         self._started = False
         self.tally = Tally(self.get_logger())
@@ -89,9 +93,8 @@ class IdNode(Node):
         self._reported = self.counts.copy()  # the counts at the last diagnostics
         self.tracker = ReferenceTracker()
         self._differentiator = None
-        self.parameters = declare_model_source(
-            self, NODE_PARAMETERS, check_settings, PER_JOINT_PARAMETERS, finish=finish_settings, quick=compiled
-        )
+        recipe = Recipe(NODE_PARAMETERS, check_settings, PER_JOINT_PARAMETERS, finish=finish_settings, quick=compiled)
+        self.parameters = declare_model_source(self, recipe)
         self.parameters.on_change(self._use)
         self.collision = CollisionMonitor(self, [], self.get_parameter("qos.depth").value)  # joints: by _use
         self.wrench = WrenchSensor(self, self.get_parameter("qos.depth").value)
@@ -146,7 +149,7 @@ class IdNode(Node):
 
     @guarded("joint_states")
     def _on_joint_state(self, msg: bytes | JointState) -> None:
-        """A joint state as DDS carries it (see ros.joint_state_cdr), or as a JointState."""
+        """A joint state as DDS carries it (see ros.messages.joint_state_cdr), or as a JointState."""
         self.counts["joint_states.received"] += 1
         settings = self.settings
         if settings is None:

@@ -1,4 +1,4 @@
-"""id_node's parameters and the settings it runs on, validated whole (see ros.live)."""
+"""id_node's parameters and the settings it runs on, validated whole (see ros.parameters.live)."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ from irb140_dynamics.nodes.id_node.collision import (
 from irb140_dynamics.nodes.id_node.markers import MARKER_PARAMETERS
 from irb140_dynamics.nodes.id_node.tracking import Gains, build_gains, gain_specs
 from irb140_dynamics.nodes.id_node.wrench import WRENCH_PARAMETERS, check_wrench_frame
-from irb140_dynamics.ros.parameters.specs import QOS_PARAMETERS, Spec, check_choice, check_number, check_qos
+from irb140_dynamics.ros.parameters.specs import QOS_PARAMETERS, RELIABILITIES, Spec, check_choice
 
 ACCELERATION_MODES = ("zero", "differentiate")
 EFFORT_SOURCES = ("feedforward", "gravity", "computed_torque")
@@ -83,18 +83,16 @@ class IdNodeSettings:
 
 
 def check_settings(values: dict) -> IdNodeSettings:
-    """Validate every parameter (quick, within the parameter call); kernels not compiled yet."""
+    """Validate what the descriptors cannot (before a change is accepted); kernels not compiled yet."""
     model = RobotModel.from_params(values)
     check_choice("acceleration.mode", values["acceleration.mode"], ACCELERATION_MODES)
     check_choice("effort_commands.source", values["effort_commands.source"], EFFORT_SOURCES)
-    check_qos(values)
+    check_choice("qos.reliability", values["qos.reliability"], RELIABILITIES)
     return IdNodeSettings(
         model,
         values["acceleration.mode"],
-        check_number(
-            "acceleration.cutoff_frequency", values["acceleration.cutoff_frequency"], 1e-3, MAX_CUTOFF_FREQUENCY, "Hz"
-        ),
-        check_number("reference_timeout", values["reference_timeout"], 0.0, MAX_TIMEOUT, "s"),
+        values["acceleration.cutoff_frequency"],
+        values["reference_timeout"],
         values["effort_commands.source"],
         build_collision_settings(values, model.joint_names),
         build_gains(values, model.joint_names),

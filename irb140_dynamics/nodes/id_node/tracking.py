@@ -48,16 +48,8 @@ class Gains:
 
 
 def build_gains(values: dict, joint_names) -> Gains:
-    gains = {}
-    for kind in ("kp", "kd"):
-        array = []
-        for name in joint_names:
-            value = values[f"{name}.{kind}"]
-            if not 0.0 <= value <= MAX_GAIN:
-                raise ValueError(f"{name}.{kind}: must be between 0 and {MAX_GAIN:g}, got {value}")
-            array.append(float(value))
-        gains[kind] = np.array(array)
-    return Gains(gains["kp"], gains["kd"])
+    kp, kd = ([values[f"{name}.{kind}"] for name in joint_names] for kind in ("kp", "kd"))
+    return Gains(np.array(kp, dtype=float), np.array(kd, dtype=float))
 
 
 class ReferenceTracker:

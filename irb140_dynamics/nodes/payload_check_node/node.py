@@ -47,7 +47,6 @@ from irb140_dynamics.nodes.payload_check_node.check_service import CheckService
 from irb140_dynamics.nodes.payload_check_node.payload_estimator import (
     ESTIMATION_PARAMETERS,
     PayloadEstimator,
-    check_estimation,
 )
 from irb140_dynamics.ros.messages.joint_messages import (
     BadMessage,
@@ -57,13 +56,15 @@ from irb140_dynamics.ros.messages.joint_messages import (
     read_effort,
     read_joint_state,
 )
+from irb140_dynamics.ros.parameters.live import Recipe
 from irb140_dynamics.ros.parameters.model_source import declare_model_source
+from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import (
     MAX_MASS,
     QOS_PARAMETERS,
+    RELIABILITIES,
     Spec,
-    check_number,
-    check_qos,
+    check_choice,
     joint_states_qos,
 )
 from irb140_dynamics.ros.parameters.usage import model_sections
@@ -156,24 +157,23 @@ class PayloadCheckSettings:
 
 
 def check_settings(values: dict) -> Draft:
-    """Validate every parameter (quick, within the parameter call)."""
+    """Validate what the descriptors cannot (before a change is accepted)."""
     model = RobotModel.from_params(values)
     rated = RigidBody.validated("rated_payload", values["rated_payload.mass"], values["rated_payload.com"])
-    warn_use = check_number("diagnostics.warn_use", values["diagnostics.warn_use"], 0.0, MAX_WARN_USE, "%")
     period = values["diagnostics.period"]
     if period != 0.0 and not MIN_DIAGNOSTICS_PERIOD <= period <= MAX_DIAGNOSTICS_PERIOD:
         raise ValueError(
             f"diagnostics.period: must be 0 (only on ~/check) or between {MIN_DIAGNOSTICS_PERIOD:g} "
             f"and {MAX_DIAGNOSTICS_PERIOD:g} s, got {period}"
         )
-    analysis_timeout = check_number(
-        "check.analysis_timeout", values["check.analysis_timeout"], MIN_ANALYSIS_TIME, MAX_ANALYSIS_TIME, "s"
-    )
-    check_number("check.wait_timeout", values["check.wait_timeout"], 0.0, MAX_WAIT, "s")
-    check_qos(values)
-    check_estimation(values)
+    check_choice("qos.reliability", values["qos.reliability"], RELIABILITIES)
     return Draft(
-        model, rated, warn_use, values["estimation.rest_velocity"], values["estimation.rest_time"], analysis_timeout
+        model,
+        rated,
+        values["diagnostics.warn_use"],
+        values["estimation.rest_velocity"],
+        values["estimation.rest_time"],
+        values["check.analysis_timeout"],
     )
 
 
@@ -207,15 +207,16 @@ def analysed(draft: Draft, previous: PayloadCheckSettings | None) -> bool:
 
 class PayloadCheckNode(Node):
     def __init__(self, **kwargs):
-        super().__init__("payload_check_node", **kwargs)
+        super().__init__("payload_check_node", **NODE_OPTIONS, **kwargs)
         self.settings: PayloadCheckSettings | None = None  # None: waiting for the model (robot_description topic)
         self._started = False
         self._state = None  # (q, qd, time received [node clock]) of the latest good joint state
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
-        self.parameters = declare_model_source(
-            self, NODE_PARAMETERS, check_settings, finish=finish_settings, startup_wait=STARTUP_WAIT, quick=analysed
+        recipe = Recipe(
+            NODE_PARAMETERS, check_settings, finish=finish_settings, quick=analysed, startup_wait=STARTUP_WAIT
         )
+        self.parameters = declare_model_source(self, recipe)
         self.parameters.on_change(self._use)
         self.estimator = PayloadEstimator(self, self._model)
         if self.parameters.current is not None:

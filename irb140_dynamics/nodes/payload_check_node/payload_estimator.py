@@ -44,14 +44,6 @@ ESTIMATION_PARAMETERS = [
 ]
 
 
-def check_estimation(values: dict) -> None:
-    for name in ("estimation.rest_velocity", "estimation.rest_time"):
-        if not 0.0 <= values[name] < float("inf"):
-            raise ValueError(f"{name}: must be >= 0 and finite, got {values[name]}")
-    if not values["estimation.rest_velocity"] > 0.0:
-        raise ValueError(f"estimation.rest_velocity: must be > 0, got {values['estimation.rest_velocity']}")
-
-
 def _failed(what: str):
     """A guarded service's answer to an exception of ours."""
 

@@ -42,7 +42,9 @@ from irb140_dynamics.nodes.sim_node.push import HeldWrench
 from irb140_dynamics.nodes.sim_node.settings import NODE_PARAMETERS, SimNodeSettings, build_settings, read_command  # noqa: F401 (NODE_PARAMETERS: read by ros.overrides)
 from irb140_dynamics.ros.messages.joint_messages import BadMessage
 from irb140_dynamics.ros.messages.wrench import chain_links
+from irb140_dynamics.ros.parameters.live import Recipe
 from irb140_dynamics.ros.parameters.model_source import declare_model_source
+from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.usage import model_sections
 from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
@@ -63,13 +65,13 @@ class SimNode(Node):
     """The simulated arm: torques in, joint states out, in real time or in lockstep."""
 
     def __init__(self, **kwargs):
-        super().__init__("sim_node", **kwargs)
+        super().__init__("sim_node", **NODE_OPTIONS, **kwargs)
         self.settings: SimNodeSettings | None = None  # None: waiting for the model (robot_description topic)
         self.arm: SimulatedArm | None = None  # the engine, stepped under self._lock
         self._lock = threading.Lock()  # the arm and settings: the stepping thread against callbacks
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
-        self.parameters = declare_model_source(self, NODE_PARAMETERS, build_settings)
+        self.parameters = declare_model_source(self, Recipe(NODE_PARAMETERS, build_settings))
         self.parameters.on_change(self._use)
         self._reported = Counter()  # the counts at the last diagnostics
         self._command = None  # (time received [s, monotonic], torques)

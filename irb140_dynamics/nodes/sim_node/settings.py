@@ -1,4 +1,4 @@
-"""sim_node's parameters and the settings it runs on, validated whole (see ros.live)."""
+"""sim_node's parameters and the settings it runs on, validated whole (see ros.parameters.live)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from std_msgs.msg import Float64MultiArray
 from irb140_dynamics.core import RobotModel
 from irb140_dynamics.ros.messages.joint_messages import BadMessage
 from irb140_dynamics.ros.parameters.model_source import STAND_IN
-from irb140_dynamics.ros.parameters.specs import MAX_QOS_DEPTH, Spec, check_choice, check_number, check_qos_depth
+from irb140_dynamics.ros.parameters.specs import MAX_QOS_DEPTH, Spec, check_choice
 from irb140_dynamics.sim.engine import DEFAULT_INTEGRATOR, SimulatedArm
 from irb140_dynamics.sim.mjcf import INTEGRATORS
 
@@ -128,22 +128,10 @@ class SimNodeSettings:
 
 
 def build_settings(values: dict) -> SimNodeSettings:
-    """Validate everything and compile the MuJoCo model here, not on a step."""
+    """Validate what the descriptors cannot and compile the MuJoCo model here, not on a step."""
     model = RobotModel.from_params(values)
     waiting = model.joint_names == STAND_IN.joint_names  # checked on a stand-in until a URDF comes
     check_choice("integrator", values["integrator"], INTEGRATORS)
-    if not 1 <= values["substeps"] <= MAX_SUBSTEPS:
-        raise ValueError(f"substeps: must be between 1 and {MAX_SUBSTEPS}, got {values['substeps']}")
-    if not 0 <= values["thread_priority"] <= 99:
-        raise ValueError(f"thread_priority: must be 0..99, got {values['thread_priority']}")
-    for name, limit in (
-        ("command_timeout", MAX_TIME),
-        ("reset_hold", MAX_TIME),
-        ("noise.position", MAX_POSITION_NOISE),
-        ("noise.effort", MAX_EFFORT_NOISE),
-    ):
-        check_number(name, values[name], 0.0, limit)
-    check_qos_depth(values["qos.depth"])
     engine = SimulatedArm(model, 1.0 / values["rate"], values["substeps"], values["integrator"])
     initial = np.zeros(model.n) if waiting else initial_positions(model, values["initial_positions"])
     return SimNodeSettings(

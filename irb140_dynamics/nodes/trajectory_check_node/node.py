@@ -45,8 +45,10 @@ from irb140_dynamics.nodes.trajectory_check_node.messages import (
     trajectory_message,
     trajectory_of,
 )
+from irb140_dynamics.ros.parameters.live import Recipe
 from irb140_dynamics.ros.parameters.model_source import declare_model_source
-from irb140_dynamics.ros.parameters.specs import Spec, check_number
+from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
+from irb140_dynamics.ros.parameters.specs import Spec
 from irb140_dynamics.ros.parameters.usage import model_sections
 from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
@@ -92,12 +94,7 @@ class TrajectoryCheckSettings:
 
 
 def check_settings(values: dict) -> Draft:
-    model = RobotModel.from_params(values)
-    grid = values["retime.grid"]
-    if not MIN_GRID <= grid <= MAX_GRID:
-        raise ValueError(f"retime.grid: must be {MIN_GRID} to {MAX_GRID}, got {grid}")
-    warn_use = check_number("diagnostics.warn_use", values["diagnostics.warn_use"], 0.0, MAX_WARN_USE, "%")
-    return Draft(model, grid, warn_use)
+    return Draft(RobotModel.from_params(values), values["retime.grid"], values["diagnostics.warn_use"])
 
 
 def finish_settings(draft: Draft, previous: TrajectoryCheckSettings | None) -> TrajectoryCheckSettings:
@@ -121,12 +118,11 @@ def quick(draft: Draft, previous: TrajectoryCheckSettings | None) -> bool:
 
 class TrajectoryCheckNode(Node):
     def __init__(self, **kwargs):
-        super().__init__("trajectory_check_node", **kwargs)
+        super().__init__("trajectory_check_node", **NODE_OPTIONS, **kwargs)
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
-        self.parameters = declare_model_source(
-            self, NODE_PARAMETERS, check_settings, finish=finish_settings, startup_wait=STARTUP_WAIT, quick=quick
-        )
+        recipe = Recipe(NODE_PARAMETERS, check_settings, finish=finish_settings, quick=quick, startup_wait=STARTUP_WAIT)
+        self.parameters = declare_model_source(self, recipe)
         self._report_pub = self.create_publisher(DiagnosticStatus, "~/trajectory_report", 10)
         self._retimed_pub = self.create_publisher(JointTrajectory, "~/retimed", 10)
         self.create_subscription(JointTrajectory, "~/check_trajectory", self._on_check, 10)

@@ -1,5 +1,6 @@
-"""Parameters of the nodes: one parameter (``spec``), the shared catalogues of model and
-QoS parameters and their checks (``specs``), parameters kept live and validated whole
-(``live``), where the model comes from (``model_source``: parameters or URDF), the guarded
-parameter services (``services``), and the warning about unknown ones (``overrides``,
-``catalog``)."""
+"""Parameters of the nodes, on rclpy's public API: one parameter and its descriptor
+(``spec``), the values given at startup (``overrides``), the parameters every node shares
+(``specs``), a node's configuration kept in step with its parameters (``live``), where the
+model comes from (``model_source``: parameters or URDF), the parameter services
+(``services``), the names of the nodes' own parameters (``catalog``) and ``--help``'s model
+sections (``usage``)."""

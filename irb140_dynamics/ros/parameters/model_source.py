@@ -3,14 +3,16 @@
 ``model.source`` (read-only):
 
 - ``parameters`` (default): the model's parameters (``joint_names``, ``<joint>.*``; see
-  ``params.declare_model``), as in config/irb140.yaml.
+  ``declare_model_source``), as in config/irb140.yaml.
 - ``robot_description``: the chain from ``model.base_link`` to ``model.tip_link`` of a URDF
   (see ``core.urdf``), taken from the string parameter ``robot_description`` when it is set,
   else from the file ``model.urdf_file`` when that is set, else from the topic
   ``robot_description`` (std_msgs/String, reliable, transient local: as
   robot_state_publisher publishes it). From the topic, the node waits (publishing
-  nothing) until a valid model arrives; each later URDF is checked whole, with the current
-  parameters, and then swapped in at once, or refused (logged) keeping the model in use.
+  nothing) until a valid model arrives; each later URDF is read off the executor (a text
+  over the size limit refused before that), checked whole with the current parameters,
+  and then swapped in at once, or refused (logged) keeping the model in use: the model
+  before answers every message meanwhile.
   The per-joint parameters are not declared in this mode: the URDF gives the joints, their
   names, inertials, limits and friction; ``gravity`` (here in the URDF's root frame, turned
   into base_link's), ``friction.smoothing_velocity``, ``payload.*`` (on the tip link) and
@@ -21,7 +23,6 @@
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Callable
 from typing import Any
 
 from rclpy.node import Node
@@ -30,12 +31,18 @@ from std_msgs.msg import String
 
 from irb140_dynamics.core import Joint, RigidBody, RobotModel
 from irb140_dynamics.core.errors import one_line
-from irb140_dynamics.core.io.urdf import LoadedUrdf, UrdfError, load_urdf, read_urdf
-from irb140_dynamics.ros.parameters.live import LiveParameters
-from irb140_dynamics.ros.parameters.spec import declare
-from irb140_dynamics.ros.parameters.specs import Spec, check_choice, declare_model, model_specs
+from irb140_dynamics.core.io.params_file import read_parameter_file
+from irb140_dynamics.core.io.text_files import size_limit
+from irb140_dynamics.core.io.urdf import MAX_URDF_CHARS, LoadedUrdf, UrdfError, load_urdf, read_urdf
+from irb140_dynamics.core.model.robot_model import check_joint_names
+from irb140_dynamics.package_files import default_config_path
+from irb140_dynamics.ros.parameters.live import LiveParameters, Recipe
+from irb140_dynamics.ros.parameters.overrides import Overrides
+from irb140_dynamics.ros.parameters.spec import Spec
+from irb140_dynamics.ros.parameters.specs import MODEL_NAME, check_choice, joint_names_spec, model_specs
+from irb140_dynamics.ros.runtime.builder import Builder, Failed
+from irb140_dynamics.ros.runtime.command_line import params_files_given
 
-PerJoint = Callable[[list[str]], list[Spec]]  # a node's parameters for each joint of a model
 SOURCES = ("parameters", "robot_description")
 DESCRIPTION_QOS = QoSProfile(
     depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
@@ -47,6 +54,7 @@ SOURCE = Spec(
     "where the model comes from: 'parameters' (joint_names and <joint>.*) or 'robot_description' (URDF)",
     read_only=True,
 )
+
 DESCRIPTION_PARAMETERS = [
     Spec(
         "robot_description",
@@ -70,53 +78,55 @@ DESCRIPTION_PARAMETERS = [
 ]
 
 
-def declare_model_source(
-    node: Node,
-    extra: list[Spec],
-    check: Callable[[dict], Any],
-    per_joint: PerJoint | None = None,
-    finish: Callable[[Any, Any], Any] | None = None,
-    startup_wait: float | None = None,
-    quick: Callable[[Any, Any], bool] | None = None,
-) -> LiveParameters:
-    """Declare ``model.source`` and the model's parameters of that source, and a node's own
-    (``extra``, and ``per_joint`` specs made for the model's joint names); ``check``,
-    ``finish``, ``startup_wait`` and ``quick`` as for LiveParameters. With the
-    robot_description topic the returned parameters' ``current`` is None until a model
-    arrives, and the per-joint specs are declared as models come."""
-    source = declare(node, SOURCE)
+def declare_model_source(node: Node, recipe: Recipe) -> LiveParameters:
+    """Declare ``model.source``, the model's parameters of that source and the node's own
+    (``recipe``); the parameters, their first configuration built. With the
+    robot_description topic ``current`` stays None until a model arrives, and the per-joint
+    parameters are declared as models come."""
+    overrides = Overrides(node)
+    source = overrides.declare(SOURCE)
     check_choice("model.source", source, SOURCES)
-    if source == "parameters":
-        return declare_model(node, extra, check, per_joint, finish, startup_wait, quick)
-    later = dict(finish=finish, startup_wait=startup_wait, quick=quick)
-    return RobotDescription(node, extra, check, per_joint or (lambda names: []), later).parameters
+    if source == "robot_description":
+        return RobotDescription(node, overrides, recipe).parameters
+    path = default_config_path()
+    if not path.is_file():
+        raise ValueError(f"default model: no {path}; is the package installed? (or give --params-file)")
+    defaults = read_parameter_file(path)
+    given = params_files_given()
+    if given:
+        node.get_logger().info(f"model: params file {', '.join(given)} (over the built-in IRB-140 model, {path})")
+    else:
+        node.get_logger().info(f"model: the built-in IRB-140 model ({path})")
+    names = check_joint_names(
+        overrides.declare(joint_names_spec(defaults["joint_names"]))
+    )  # they become parameter prefixes: check them first
+    robot_name = overrides.declare(MODEL_NAME)
+    specs = [*model_specs(names, defaults), *recipe.specs, *recipe.per_joint(names)]
+    parameters = LiveParameters(node, overrides, specs, recipe.check, recipe)
+    parameters.robot_name = robot_name
+    return parameters
 
 
 class RobotDescription:
     """The model of a node from a URDF: parameter, file or topic (see the module)."""
 
-    def __init__(
-        self,
-        node: Node,
-        extra: list[Spec],
-        check: Callable[[dict], Any],
-        per_joint: PerJoint,
-        later: dict | None = None,
-    ):
-        """``later``: LiveParameters' finish, startup_wait and quick."""
-        self._node, self._build_node, self._per_joint = node, check, per_joint
-        text, path, base, tip = (declare(node, spec) for spec in DESCRIPTION_PARAMETERS)
+    def __init__(self, node: Node, overrides: Overrides, recipe: Recipe):
+        self._node, self._recipe = node, recipe
+        text, path, base, tip = (overrides.declare(spec) for spec in DESCRIPTION_PARAMETERS)
         self._chain_ends = (base or None, tip or None)
         self.urdf: LoadedUrdf | None = None  # the URDF's chain of the model in use
         self.refused, self.last_refusal = 0, ""  # URDFs refused on the topic, and why the last one was
         origin = "robot_description parameter" if text else f"model.urdf_file {path}"
         if text or path:
             self.urdf = self._load(text or _read(path), origin)
-        own = per_joint(self.urdf.model.joint_names) if self.urdf is not None else []
-        self.parameters = LiveParameters(node, [*model_specs([], {}), *extra, *own], self._build, **(later or {}))
+        own = recipe.per_joint(self.urdf.model.joint_names) if self.urdf is not None else []
+        self.parameters = LiveParameters(
+            node, overrides, [*model_specs([], {}), *recipe.specs, *own], self._build, recipe
+        )
         if self.urdf is not None:
             self._announce(origin)
             return
+        self._reader = Builder(node, self._read_topic, self._use, f"{node.get_name()} robot_description")
         subscription = node.create_subscription(String, "robot_description", self._on_description, DESCRIPTION_QOS)
         node.get_logger().info(
             f"waiting for the model: a URDF on {subscription.topic_name} (std_msgs/String, transient local); "
@@ -149,8 +159,8 @@ class RobotDescription:
         parameter values. Until a URDF has come: None, the parameters checked on a stand-in
         one-joint arm."""
         if self.urdf is None:
-            stand_in_defaults = {spec.name: spec.default for spec in self._per_joint(STAND_IN.joint_names)}
-            self._build_node({**STAND_IN.to_params(), **stand_in_defaults, **values})
+            stand_in_defaults = {spec.name: spec.default for spec in self._recipe.per_joint(STAND_IN.joint_names)}
+            self._recipe.check({**STAND_IN.to_params(), **stand_in_defaults, **values})
             return None
         return self._build_with(self.urdf, values)
 
@@ -159,25 +169,44 @@ class RobotDescription:
         values = dict(values)
         with contextlib.suppress(KeyError, TypeError, ValueError):  # absent or not 3 numbers: the check names it
             values["gravity"] = urdf.in_base(values["gravity"])
-        return self._build_node({**urdf.model.to_params(), **values})
+        return self._recipe.check({**urdf.model.to_params(), **values})
 
     def _on_description(self, msg: String) -> None:
-        """A new URDF: checked whole, then swapped in, or refused keeping the model in use."""
-        logger = self._node.get_logger()
-        keeping = "still waiting" if self.urdf is None else f"keeping the model of {self.urdf.model.n} joints"
+        """A new URDF: read off the executor (``_read_topic``), then ``_use``d; a text over
+        the size limit is refused at once, unread."""
+        limit = size_limit(MAX_URDF_CHARS)
+        if len(msg.data) > limit:
+            too_long = UrdfError("document", f"{len(msg.data)} characters, more than the limit of {limit} (max_chars)")
+            self._refuse(ValueError(f"robot_description topic: {too_long}"))
+            return
+        self._reader.submit(0, msg.data)
+
+    def _read_topic(self, text: str, previous) -> LoadedUrdf:
+        """In the reader's worker thread: the URDF's chain (the slow part: parsing)."""
+        return self._load(text, "robot_description topic")
+
+    def _use(self, generation: int, urdf: LoadedUrdf | Failed) -> None:
+        """On the executor thread: the URDF read, checked whole with the current parameters,
+        then swapped in (finished off the executor when slow), or refused keeping the model
+        in use."""
         try:
-            urdf = self._load(msg.data, "robot_description topic")
-            self.parameters.declare(self._per_joint(urdf.model.joint_names))
+            if isinstance(urdf, Failed):
+                raise urdf.error
+            self.parameters.declare(self._recipe.per_joint(urdf.model.joint_names))
             draft = self._build_with(urdf, self.parameters.values())
         except Exception as error:  # noqa: BLE001 (nothing of ours may leave a callback)
-            self.refused += 1
-            kind = "" if isinstance(error, ValueError) else f"{type(error).__name__}: "
-            self.last_refusal = f"{kind}{one_line(error)}"
-            logger.error(f"refused a robot_description ({keeping}): {self.last_refusal}")
+            self._refuse(error)
             return
         self.urdf = urdf
         self.parameters.submit(draft)  # finished (compiled, analysed) off the executor when slow
         self._announce("robot_description topic")
+
+    def _refuse(self, error: BaseException) -> None:
+        self.refused += 1
+        kind = "" if isinstance(error, ValueError) else f"{type(error).__name__}: "
+        self.last_refusal = f"{kind}{one_line(error)}"
+        keeping = "still waiting" if self.urdf is None else f"keeping the model of {self.urdf.model.n} joints"
+        self._node.get_logger().error(f"refused a robot_description ({keeping}): {self.last_refusal}")
 
 
 def _read(path: str) -> str:

@@ -1,53 +1,83 @@
-"""Parameters given to a node that no node of this package has: warned about by name.
+"""The parameter values given to a node at startup (params files, ``-p``), read through rclpy's
+public API, and the warning about those no node of the package has.
 
-A typo in a params file (``payload.mas``) or on the command line, or a list parameter
-written as a mapping (``dh: {a: ..., alpha: ...}``, which rcl flattens to ``dh.a``, ...),
-would otherwise leave the default in force without a word. A parameter of a sibling node
-(one ``/**`` section serves them all) is not warned about.
+A node is made with ``NODE_OPTIONS``: rclpy then declares every value given as a parameter
+of its own (``automatically_declare_parameters_from_overrides``), which is how its name,
+type and value can be read. ``Overrides`` takes them over: it undeclares them at once and
+keeps them, and each of the node's parameters is then declared with its descriptor and the
+value given (see ``spec.declare``: an integer for a double taken as that double). What is
+left when the node has declared everything is warned about by name, with the nearest known
+name: a typo in a params file (``payload.mas``), or a list written as a mapping (``dh: {a:
+...}``, which rcl flattens to ``dh.a``, ...), would otherwise leave the default in force
+without a word. A parameter of a sibling node (one ``/**`` section serves them all) is not
+warned about.
 """
 
 from __future__ import annotations
 
 import difflib
+from typing import Any
 
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 
 from irb140_dynamics.ros.parameters.catalog import PER_JOINT_SUFFIXES, sibling_parameter_names
+from irb140_dynamics.ros.parameters.spec import Spec, declare
 
+# how every node of the package is made: the values given read as parameters (see above);
+# the parameter services are the package's own (``services``)
+NODE_OPTIONS = {"automatically_declare_parameters_from_overrides": True, "start_parameter_services": False}
+RCLPY_PARAMETERS = ("use_sim_time", "start_type_description_service")  # declared by rclpy itself: left to it
 MAX_UNKNOWN_WARNINGS = 10
 
 
-def warn_unknown_overrides(node: Node) -> None:
-    """Warn about each parameter given to the node (params file, -p) that no node of this
-    package declares, with the nearest known name."""
-    declared = set(node.list_parameters([], 0).names)
-    unknown = sorted(name for name in node._parameter_overrides if name not in declared)
-    if not unknown:
-        return
-    joint_names = node.get_parameter("joint_names").value if node.has_parameter("joint_names") else None
-    known, per_joint_suffixes = sibling_parameter_names(joint_names), PER_JOINT_SUFFIXES
-    known |= declared
-    lines, by_parent = [], {}
-    for name in unknown:
-        if name in known or (joint_names is None and name.endswith(per_joint_suffixes)):
-            continue  # a sibling's, or a per-joint one of a model still to come (a URDF topic)
-        parent = _known_parent(name, declared)
-        if parent is not None:
-            by_parent.setdefault(parent, []).append(name)
-            continue
-        nearest = difflib.get_close_matches(name, sorted(known), n=1, cutoff=0.6)
-        hint = f"; did you mean {nearest[0]}?" if nearest else ""
-        lines.append(f"unknown parameter {name} (ignored){hint}")
-    for parent, names in by_parent.items():
-        what = node.describe_parameter(parent).description
-        lines.append(
-            f"unknown parameter{'s' if len(names) > 1 else ''} {', '.join(names)} (ignored): "
-            f"{parent} is one parameter, not a mapping: {what}"
-        )
-    for line in lines[:MAX_UNKNOWN_WARNINGS]:
-        node.get_logger().warning(line)
-    if len(lines) > MAX_UNKNOWN_WARNINGS:
-        node.get_logger().warning(f"... and {len(lines) - MAX_UNKNOWN_WARNINGS} more unknown parameters")
+class Overrides:
+    """The values given to ``node`` at startup, by name, until its parameters take them."""
+
+    def __init__(self, node: Node):
+        if any(service.srv_name.endswith("/set_parameters") for service in node.services):  # rclpy's: no NODE_OPTIONS
+            raise TypeError(f"{node.get_name()} was made without NODE_OPTIONS: the values given would be lost")
+        self._node = node
+        names = [name for name in node.list_parameters([], 0).names if name not in RCLPY_PARAMETERS]
+        self.given: dict[str, Parameter] = {name: node.get_parameter(name) for name in names}
+        for name in names:
+            node.undeclare_parameter(name)
+
+    def declare(self, spec: Spec) -> Any:
+        """Declare ``spec``'s parameter with the value given, else its default; its value."""
+        return declare(self._node, spec, self.given.pop(spec.name, None))
+
+    def warn_unknown(self, joint_names) -> None:
+        """Warn about each value given that no node of the package has (``joint_names``:
+        the model's, None while a URDF is awaited)."""
+        declared = set(self._node.list_parameters([], 0).names)
+        known = sibling_parameter_names(joint_names) | declared
+        lines, by_parent = [], {}
+        for name in sorted(self.given):
+            if name in known or (joint_names is None and name.endswith(PER_JOINT_SUFFIXES)):
+                continue  # a sibling's, or a per-joint one of a model still to come (a URDF topic)
+            parent = _known_parent(name, declared)
+            if parent is not None:
+                by_parent.setdefault(parent, []).append(name)
+                continue
+            lines.append(f"unknown parameter {name} (ignored){nearest_hint(name, known)}")
+        for parent, names in by_parent.items():
+            what = self._node.describe_parameter(parent).description
+            lines.append(
+                f"unknown parameter{'s' if len(names) > 1 else ''} {', '.join(names)} (ignored): "
+                f"{parent} is one parameter, not a mapping: {what}"
+            )
+        logger = self._node.get_logger()
+        for line in lines[:MAX_UNKNOWN_WARNINGS]:
+            logger.warning(line)
+        if len(lines) > MAX_UNKNOWN_WARNINGS:
+            logger.warning(f"... and {len(lines) - MAX_UNKNOWN_WARNINGS} more unknown parameters")
+
+
+def nearest_hint(name: str, known) -> str:
+    """'; did you mean <the nearest known name>?', or '' when none is near."""
+    nearest = difflib.get_close_matches(name, sorted(known), n=1, cutoff=0.6)
+    return f"; did you mean {nearest[0]}?" if nearest else ""
 
 
 def _known_parent(name: str, declared: set[str]) -> str | None:

@@ -1,81 +1,156 @@
-"""rclpy's parameter services of a node, made safe against malformed requests.
+"""A node's parameter services (the six of rcl_interfaces, as ``ros2 param`` calls them),
+answered through the node's public parameter API, and safe against any request.
 
-rclpy turns each requested parameter into a Parameter before anything checks it: a
-parameter type it does not know (a ParameterValue.type of 99, from a hand-made client)
-raises ValueError inside the service callback, which ends the node's spin. Here the set
-services refuse such a parameter by name and handle the others as rclpy does, one by one
-(SetParameters) or not at all (SetParametersAtomically); any other failure of a parameter
-service is answered with an empty response and logged, the node goes on.
+The node is made without rclpy's own (``NODE_OPTIONS``), whose set services let a name
+that is not declared through ('' even reaches rclpy's internals) and raise inside the
+callback on a parameter type they do not know (a ParameterValue.type of 99, from a
+hand-made client), which ends the node's spin. Here a set request refuses such a parameter
+by name, and an unknown name naming the nearest known one, and hands the rest to
+``submit`` (``set_parameters_atomically``, after a check off the executor: see
+``checked_sets``) as rclpy does: one by one (SetParameters) or all or none
+(SetParametersAtomically), the reply sent when all are set. Any other failure is answered with an empty response and
+warned about (throttled): the node goes on.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
+from collections.abc import Callable
 
 from rcl_interfaces.msg import SetParametersResult
-from rcl_interfaces.srv import SetParameters, SetParametersAtomically
+from rcl_interfaces.srv import (
+    DescribeParameters,
+    GetParameters,
+    GetParameterTypes,
+    ListParameters,
+    SetParameters,
+    SetParametersAtomically,
+)
+from rclpy.exceptions import ParameterUninitializedException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.qos import qos_profile_parameters
+
+from irb140_dynamics.ros.parameters.overrides import nearest_hint
+from irb140_dynamics.ros.runtime.deferred_reply import DeferredService, Later
+
+Answer = Callable[[SetParametersResult], None]
 
 PARAMETER_TYPES = {kind.value for kind in Parameter.Type}
 
 
-def guard_parameter_services(node: Node) -> None:
-    """Wrap the callbacks of the node's parameter services (rclpy's ParameterService)."""
-    for service in node.services:
-        if service.srv_type is SetParameters:
-            service.callback = _one_by_one(service.callback)
-        elif service.srv_type is SetParametersAtomically:
-            service.callback = _all_or_none(service.callback)
-        if service.srv_type.__module__.startswith("rcl_interfaces"):
-            service.callback = _answered(node, service.callback, service.srv_type)
+class ParameterServices:
+    """The six parameter services of ``node`` (``~/set_parameters``, ...). ``submit(parameters,
+    answer)`` sets a change and calls ``answer`` with its result, now or later (see
+    ``checked_sets``); by default at once."""
+
+    def __init__(self, node: Node, submit: Callable[[list[Parameter], Answer], None] | None = None):
+        self._node = node
+        self._submit = submit or (lambda parameters, answer: answer(node.set_parameters_atomically(parameters)))
+        for srv_type, name, answer in (
+            (DescribeParameters, "describe_parameters", self._describe),
+            (GetParameters, "get_parameters", self._get),
+            (GetParameterTypes, "get_parameter_types", self._get_types),
+            (ListParameters, "list_parameters", self._list),
+            (SetParameters, "set_parameters", self._set),
+            (SetParametersAtomically, "set_parameters_atomically", self._set_atomically),
+        ):
+            DeferredService(
+                node,
+                srv_type,
+                f"{node.get_name()}/{name}",
+                self._answered(srv_type, answer),
+                qos_profile=qos_profile_parameters,
+            )
+
+    def _answered(self, srv_type, answer):
+        def callback(request, response):
+            try:
+                return answer(request, response) or response
+            except Exception as error:  # noqa: BLE001  (no request may end the node)
+                self._node.get_logger().warning(
+                    f"{srv_type.__name__} request failed: {type(error).__name__}: {error}", throttle_duration_sec=2.0
+                )
+                return srv_type.Response()
+
+        return callback
+
+    def _declared(self, names) -> bool:
+        return all(self._node.has_parameter(name) for name in names)
+
+    def _describe(self, request, response) -> None:
+        if self._declared(request.names):  # as rclpy: one name not declared, none answered
+            response.descriptors = self._node.describe_parameters(list(request.names))
+
+    def _get(self, request, response) -> None:
+        if self._declared(request.names):
+            with contextlib.suppress(ParameterUninitializedException):  # as rclpy: one without a value, none
+                parameters = self._node.get_parameters(list(request.names))
+                response.values = [p.get_parameter_value() for p in parameters]
+
+    def _get_types(self, request, response) -> None:
+        if self._declared(request.names):
+            response.types = self._node.get_parameter_types(list(request.names))
+
+    def _list(self, request, response) -> None:
+        with contextlib.suppress(TypeError, ValueError):  # as rclpy: a bad request, an empty list
+            response.result = self._node.list_parameters(list(request.prefixes), request.depth)
+
+    def _set(self, request, response) -> Later | None:
+        """Each parameter set on its own, in order; answered when all are."""
+        later, results = Later(), [None] * len(request.parameters)
+
+        def done(index: int, result: SetParametersResult) -> None:
+            results[index] = result
+            if all(result is not None for result in results):
+                response.results = results
+                later.answer(response)
+
+        for index, message in enumerate(request.parameters):
+            refusal = self._refusal([message])
+            if refusal is not None:
+                done(index, refusal)
+            else:
+                self._submit(_parameters([message]), functools.partial(done, index))
+        return later if request.parameters else None
+
+    def _set_atomically(self, request, response) -> Later:
+        later = Later()
+
+        def done(result: SetParametersResult) -> None:
+            response.result = result
+            later.answer(response)
+
+        refusal = self._refusal(request.parameters)
+        if refusal is not None:
+            done(refusal)
+        else:
+            self._submit(_parameters(request.parameters), done)
+        return later
+
+    def _refusal(self, messages) -> SetParametersResult | None:
+        """A parameter of no known type, or a name not declared, refused by name; else None."""
+        for message in messages:
+            if message.value.type not in PARAMETER_TYPES:
+                return _refused(f"{message.name!r}: {message.value.type} is not a parameter type")
+        return undeclared(self._node, [m.name for m in messages])
 
 
-def _unknown_type(parameter) -> SetParametersResult | None:
-    if parameter.value.type in PARAMETER_TYPES:
+def undeclared(node: Node, names) -> SetParametersResult | None:
+    """The refusal of the names not declared ('' included), naming the nearest known one; None when all are."""
+    unknown = [name for name in names if not name or not node.has_parameter(name)]
+    if not unknown:
         return None
-    return SetParametersResult(
-        successful=False, reason=f"{parameter.name!r}: {parameter.value.type} is not a parameter type"
+    hint = nearest_hint(unknown[0], node.list_parameters([], 0).names) if unknown[0] else ""
+    return _refused(
+        f"undeclared parameter{'s' if len(unknown) > 1 else ''} {unknown}: not a parameter of this node{hint}"
     )
 
 
-def _one_by_one(callback):
-    @functools.wraps(callback)
-    def set_parameters(request, response):
-        for parameter in request.parameters:
-            refusal = _unknown_type(parameter)
-            if refusal is None:
-                one = callback(SetParameters.Request(parameters=[parameter]), SetParameters.Response())
-                response.results.extend(one.results)
-            else:
-                response.results.append(refusal)
-        return response
-
-    return set_parameters
+def _parameters(messages) -> list[Parameter]:
+    return [Parameter.from_parameter_msg(message) for message in messages]
 
 
-def _all_or_none(callback):
-    @functools.wraps(callback)
-    def set_parameters_atomically(request, response):
-        for parameter in request.parameters:
-            refusal = _unknown_type(parameter)
-            if refusal is not None:
-                response.result = refusal
-                return response
-        return callback(request, response)
-
-    return set_parameters_atomically
-
-
-def _answered(node: Node, callback, srv_type):
-    @functools.wraps(callback)
-    def answered(request, response):
-        try:
-            return callback(request, response)
-        except Exception as error:  # noqa: BLE001  (rclpy's, but it would end our node)
-            node.get_logger().warning(
-                f"{srv_type.__name__} request failed: {type(error).__name__}: {error}", throttle_duration_sec=2.0
-            )
-            return srv_type.Response()
-
-    return answered
+def _refused(reason: str) -> SetParametersResult:
+    return SetParametersResult(successful=False, reason=reason)

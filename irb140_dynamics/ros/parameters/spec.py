@@ -1,5 +1,7 @@
-"""One parameter of a node (``Spec``: name, default, descriptor with its range) and its
-declaration, a value rclpy refuses made a ValueError naming the parameter."""
+"""One parameter of a node (``Spec``): its name, default, and the ``ParameterDescriptor`` that
+states its type, range, read-only flag and description once, for rclpy to enforce, for
+``ros2 param describe`` and for ``--help``; and its declaration with a value given at startup.
+"""
 
 from __future__ import annotations
 
@@ -12,10 +14,12 @@ from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValu
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
+TYPE_NAMES = {kind: kind.name.lower().replace("_array", "[]") for kind in Parameter.Type}  # as --help says them
+
 
 @dataclass(frozen=True)
 class Spec:
-    """One parameter: its name, default (or type when it has none) and descriptor text."""
+    """One parameter: its name, default (or its type when it has none) and descriptor text."""
 
     name: str
     default: Any
@@ -26,23 +30,27 @@ class Spec:
     maximum: float | None = None
 
     @property
-    def numeric(self) -> bool:
-        """An integer or double parameter (not bool, not an array)."""
-        kind = self.default
-        if isinstance(kind, Parameter.Type):
-            return kind in (Parameter.Type.INTEGER, Parameter.Type.DOUBLE)
-        return isinstance(kind, (int, float)) and not isinstance(kind, bool)
+    def type(self) -> Parameter.Type:
+        if isinstance(self.default, Parameter.Type):
+            return self.default
+        return Parameter.Type.from_parameter_value(self.default)
+
+    @property
+    def has_default(self) -> bool:
+        return not isinstance(self.default, Parameter.Type)
 
     def descriptor(self) -> ParameterDescriptor:
         """The descriptor, with the range; a numeric parameter must have a finite one (no
         inf, nan or 1e308 gets past rclpy's range check then)."""
         unit = f" [{self.unit}]" if self.unit else ""
-        descriptor = ParameterDescriptor(description=self.description + unit, read_only=self.read_only)
-        if not self.numeric:
+        descriptor = ParameterDescriptor(
+            name=self.name, type=self.type.value, description=self.description + unit, read_only=self.read_only
+        )
+        if self.type not in (Parameter.Type.INTEGER, Parameter.Type.DOUBLE):
             return descriptor
         if self.minimum is None or self.maximum is None or not math.isfinite(self.maximum - self.minimum):
             raise ValueError(f"{self.name}: a numeric parameter needs a finite range (minimum and maximum)")
-        if self.default == Parameter.Type.INTEGER or isinstance(self.default, int):
+        if self.type == Parameter.Type.INTEGER:
             descriptor.integer_range = [IntegerRange(from_value=int(self.minimum), to_value=int(self.maximum), step=1)]
         else:
             descriptor.floating_point_range = [
@@ -51,47 +59,32 @@ class Spec:
         return descriptor
 
 
-def _range_text(spec: Spec) -> str:
-    if spec.minimum is not None and spec.maximum is not None:
-        return f"must be between {spec.minimum:g} and {spec.maximum:g}"
-    if spec.minimum is not None:
-        return f"must be >= {spec.minimum:g}"
-    return f"must be <= {spec.maximum:g}"
-
-
-def declare(node: Node, spec) -> Any:
-    """Declare a parameter of a Spec; a value rclpy refuses is a ValueError naming it."""
-    _as_double(node, spec)
-    try:
-        return node.declare_parameter(spec.name, spec.default, spec.descriptor()).value
-    except InvalidParameterTypeException:
-        kind = spec.default
-        if not isinstance(kind, Parameter.Type):
-            kind = Parameter.Type.from_parameter_value(kind)
-        hint = "; write doubles with a decimal point, e.g. 2.0" if "DOUBLE" in kind.name else ""
-        raise ValueError(f"{spec.name}: expected a value of type {kind.name.lower()}{hint}") from None
-    except InvalidParameterValueException as error:
-        given = node._parameter_overrides.get(spec.name)  # the value rclpy refused (its range)
-        if given is None or (spec.minimum is None and spec.maximum is None):
-            raise ValueError(f"{spec.name}: {error}") from None
-        raise ValueError(f"{spec.name}: {_range_text(spec)}, got {given.value}") from None
-
-
-def _as_double(node: Node, spec) -> None:
+def as_type(parameter: Parameter, wanted: Parameter.Type) -> Parameter:
     """An integer given for a double parameter (``-p payload.mass:=2``, a params file's
-    ``mass: 2``) is taken as that double, as ``ros2 param set`` users expect."""
-    given = node._parameter_overrides.get(spec.name)
+    ``mass: 2``, ``ros2 param set ... payload.mass 3``) as that double; else unchanged."""
+    if wanted == Parameter.Type.DOUBLE and parameter.type_ == Parameter.Type.INTEGER:
+        return Parameter(parameter.name, Parameter.Type.DOUBLE, float(parameter.value))
+    if wanted == Parameter.Type.DOUBLE_ARRAY and parameter.type_ == Parameter.Type.INTEGER_ARRAY:
+        return Parameter(parameter.name, Parameter.Type.DOUBLE_ARRAY, [float(x) for x in parameter.value])
+    return parameter
+
+
+def declare(node: Node, spec: Spec, given: Parameter | None = None) -> Any:
+    """Declare the parameter of ``spec`` with the value ``given`` at startup (None: its
+    default); its value, or a ValueError in one line naming it when rclpy refuses the value."""
+    descriptor = spec.descriptor()
     if given is None:
-        return
-    kind = spec.default if isinstance(spec.default, Parameter.Type) else None
-    if kind is None and not isinstance(spec.default, bool):
-        if isinstance(spec.default, float):
-            kind = Parameter.Type.DOUBLE
-        elif isinstance(spec.default, list) and spec.default and all(isinstance(x, float) for x in spec.default):
-            kind = Parameter.Type.DOUBLE_ARRAY
-    if kind == Parameter.Type.DOUBLE and given.type_ == Parameter.Type.INTEGER:
-        node._parameter_overrides[spec.name] = Parameter(spec.name, Parameter.Type.DOUBLE, float(given.value))
-    elif kind == Parameter.Type.DOUBLE_ARRAY and given.type_ == Parameter.Type.INTEGER_ARRAY:
-        node._parameter_overrides[spec.name] = Parameter(
-            spec.name, Parameter.Type.DOUBLE_ARRAY, [float(x) for x in given.value]
-        )
+        value = spec.default
+    else:
+        given = as_type(given, spec.type)
+        if given.type_ != spec.type:
+            raise ValueError(f"{spec.name}: expected a value of type {TYPE_NAMES[spec.type]}")
+        value = given.value
+    try:
+        return node.declare_parameter(spec.name, value, descriptor, ignore_override=True).value
+    except InvalidParameterTypeException:
+        raise ValueError(f"{spec.name}: expected a value of type {TYPE_NAMES[spec.type]}") from None
+    except InvalidParameterValueException as error:
+        if given is None or spec.minimum is None:
+            raise ValueError(f"{spec.name}: {error}") from None
+        raise ValueError(f"{spec.name}: must be between {spec.minimum:g} and {spec.maximum:g}, got {value}") from None

@@ -1,35 +1,19 @@
-"""Parameters of the nodes: declared with descriptors, validated whole, applied off the executor.
-
-A node lists its parameters as ``Spec``s and gives two functions: ``check`` turns all of
-their values into a draft of the configuration it runs on (a RobotModel, options),
-raising ValueError naming the parameter when something is wrong, quickly; ``finish``
-does the slow rest (compiling kernels, the workspace analysis); a draft may be None while
-an input from elsewhere, a URDF, has yet to come. ``LiveParameters`` (see ``live``)
-declares the parameters, builds the first configuration (a failure stops startup), and
-from then on checks every change whole before it is accepted (a refused change keeps the
-old configuration), then finishes it off the executor and swaps it in: a change stalls no
-message. Parameters given that no node of the package knows are warned about by name,
-with the nearest known name.
-"""
+"""The parameters every node shares: the robot model's (``model_specs``, with the finite
+ranges of its numbers) and the joint_states QoS; and ``check_choice``, the one rule a
+descriptor cannot state for a string (its choices)."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from typing import Any
 
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.core.model.joints import MAX_FRICTION, param_prefix
 from irb140_dynamics.core.model.rigid_body import MAX_MASS as CORE_MAX_MASS
-from irb140_dynamics.core.model.robot_model import check_joint_names
-from irb140_dynamics.package_files import CONFIG_NAME, PACKAGE, default_config_path  # noqa: F401 (PACKAGE, CONFIG_NAME: re-exported)
-from irb140_dynamics.ros.parameters.live import LiveParameters
-from irb140_dynamics.ros.parameters.spec import Spec, declare
-from irb140_dynamics.ros.runtime.command_line import params_files_given
+from irb140_dynamics.ros.parameters.spec import Spec
 
 # The finite ranges of the model's numbers (ParameterDescriptor ranges, `ros2 param describe`):
 # wide, to keep inf, nan and 1e308 out, not to judge the robot.
@@ -69,20 +53,20 @@ def check_choice(name: str, value, choices) -> None:
         raise ValueError(f"{name}: must be one of {', '.join(choices)}; got {value!r}")
 
 
-def check_qos(values: dict) -> None:
-    check_choice("qos.reliability", values["qos.reliability"], RELIABILITIES)
-    check_qos_depth(values["qos.depth"])
-
-
-def check_qos_depth(depth) -> None:
-    if not (isinstance(depth, int) and 1 <= depth <= MAX_QOS_DEPTH):
-        raise ValueError(f"qos.depth: must be between 1 and {MAX_QOS_DEPTH}, got {depth}")
-
-
 def joint_states_qos(node: Node) -> QoSProfile:
     """The joint_states subscription's QoS from the node's qos.* parameters."""
     reliability = RELIABILITIES[node.get_parameter("qos.reliability").value]
     return QoSProfile(depth=node.get_parameter("qos.depth").value, reliability=reliability)
+
+
+JOINT_NUMBERS = (  # each joint's numbers of 0 and up: (name suffix, description, unit, maximum)
+    ("torque_limit", "joint torque limit, 0 = none given", "N m", MAX_TORQUE),
+    ("velocity_limit", "joint speed limit, 0 = none given", "rad/s", MAX_VELOCITY),
+    ("acceleration_limit", "joint acceleration limit, 0 = none given", "rad/s^2", MAX_ACCELERATION),
+    ("friction.viscous", "viscous friction coefficient", "N m s/rad", MAX_VISCOUS),
+    ("friction.coulomb", "Coulomb friction level (smoothed, see friction.smoothing_velocity)", "N m", MAX_COULOMB),
+    ("armature", "rotor inertia reflected through the gear, added to M's diagonal", "kg m^2", MAX_ARMATURE),
+)
 
 
 def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
@@ -126,53 +110,9 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
                 "[lower, upper] joint position",
                 "rad",
             ),
-            Spec(
-                f"{joint}.torque_limit",
-                default(f"{joint}.torque_limit", 0.0),
-                "joint torque limit, 0 = none given",
-                "N m",
-                minimum=0.0,
-                maximum=MAX_TORQUE,
-            ),
-            Spec(
-                f"{joint}.velocity_limit",
-                default(f"{joint}.velocity_limit", 0.0),
-                "joint speed limit, 0 = none given",
-                "rad/s",
-                minimum=0.0,
-                maximum=MAX_VELOCITY,
-            ),
-            Spec(
-                f"{joint}.acceleration_limit",
-                default(f"{joint}.acceleration_limit", 0.0),
-                "joint acceleration limit, 0 = none given",
-                "rad/s^2",
-                minimum=0.0,
-                maximum=MAX_ACCELERATION,
-            ),
-            Spec(
-                f"{joint}.friction.viscous",
-                default(f"{joint}.friction.viscous", 0.0),
-                "viscous friction coefficient",
-                "N m s/rad",
-                minimum=0.0,
-                maximum=MAX_VISCOUS,
-            ),
-            Spec(
-                f"{joint}.friction.coulomb",
-                default(f"{joint}.friction.coulomb", 0.0),
-                "Coulomb friction level (smoothed, see friction.smoothing_velocity)",
-                "N m",
-                minimum=0.0,
-                maximum=MAX_COULOMB,
-            ),
-            Spec(
-                f"{joint}.armature",
-                default(f"{joint}.armature", 0.0),
-                "rotor inertia reflected through the gear, added to M's diagonal",
-                "kg m^2",
-                minimum=0.0,
-                maximum=MAX_ARMATURE,
+            *(
+                Spec(f"{joint}.{suffix}", default(f"{joint}.{suffix}", 0.0), text, unit, minimum=0.0, maximum=maximum)
+                for suffix, text, unit, maximum in JOINT_NUMBERS
             ),
         ]
     return specs
@@ -205,53 +145,14 @@ def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
     ]
 
 
+def joint_names_spec(names: list[str]) -> Spec:
+    """``joint_names``, with these names as its default."""
+    return Spec("joint_names", list(names), "the model's joints, base to flange", read_only=True)
+
+
 MODEL_NAME = Spec(
     "model.name",
     "irb140",
     "the robot's name, the hardware_id of the nodes' /diagnostics (a URDF model: its <robot name>)",
     read_only=True,
 )
-
-
-def declare_model(
-    node: Node,
-    extra: list[Spec],
-    check: Callable[[dict], Any],
-    per_joint: Callable[[list[str]], list[Spec]] = None,
-    finish: Callable[[Any, Any], Any] | None = None,
-    startup_wait: float | None = None,
-    quick: Callable[[Any, Any], bool] | None = None,
-) -> LiveParameters:
-    """Declare the robot model's parameters and a node's own (``extra``, and ``per_joint``
-    specs made for the model's joint names), with the default model's defaults (see
-    LiveParameters for ``check``, ``finish``, ``startup_wait`` and ``quick``)."""
-    path = default_config_path()
-    if not path.is_file():
-        raise ValueError(f"default model: no {path}; is the package installed? (or give --params-file)")
-    defaults = read_parameter_file(path)
-    given = params_files_given()
-    if given:
-        node.get_logger().info(f"model: params file {', '.join(given)} (over the built-in IRB-140 model, {path})")
-    else:
-        node.get_logger().info(f"model: the built-in IRB-140 model ({path})")
-    names = declare(
-        node,
-        Spec("joint_names", defaults["joint_names"], "the model's joints, base to flange", read_only=True),
-    )
-    names = check_joint_names(names)  # they become parameter prefixes: check them first
-    robot_name = declare(node, MODEL_NAME)
-    own = per_joint(names) if per_joint else []
-    specs = [*model_specs(names, defaults), *extra, *own]
-    parameters = LiveParameters(
-        node, specs, check, finish, declared=["joint_names", "model.name"], startup_wait=startup_wait, quick=quick
-    )
-    parameters.robot_name = robot_name
-    return parameters
-
-
-def check_number(name: str, value, minimum: float, maximum: float, unit: str = "") -> float:
-    """A finite number within [minimum, maximum], or ValueError naming the parameter."""
-    unit = f" {unit}" if unit else ""
-    if not (isinstance(value, (int, float)) and math.isfinite(value) and minimum <= value <= maximum):
-        raise ValueError(f"{name}: must be between {minimum:g} and {maximum:g}{unit}, got {value}")
-    return float(value)

@@ -8,7 +8,7 @@ from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.package_files import default_config_path
 from irb140_dynamics.ros.parameters.model_source import DESCRIPTION_PARAMETERS, SOURCE
 from irb140_dynamics.ros.parameters.spec import Spec
-from irb140_dynamics.ros.parameters.specs import MODEL_NAME, model_specs
+from irb140_dynamics.ros.parameters.specs import MODEL_NAME, joint_names_spec, model_specs
 
 JOINT = "NAME"  # stands for each joint of joint_names in the per-joint parameters
 
@@ -28,11 +28,10 @@ def model_sections() -> list[tuple[str, list[Spec]]]:
         if not spec.name.startswith(f"{JOINT}.")
     ]
     per_joint = [spec for spec in specs if spec.name.startswith(f"{JOINT}.")]
-    joint_names = Spec("joint_names", names or [JOINT], "the model's joints, base to flange", read_only=True)
     return [
         (
             "The model (defaults: the built-in IRB-140 model, config/irb140.yaml)",
-            [SOURCE, MODEL_NAME, joint_names, *whole],
+            [SOURCE, MODEL_NAME, joint_names_spec(names or [JOINT]), *whole],
         ),
         (f"Per joint, {JOINT} = each of joint_names (the built-in model gives every one for its joints)", per_joint),
         ("The model from a URDF (model.source: robot_description)", list(DESCRIPTION_PARAMETERS)),

@@ -2,22 +2,24 @@
 
 A node takes no arguments of its own: everything it reads comes after ``--ros-args``
 (``-p NAME:=VALUE``, ``--params-file FILE``, remappings). ``-h``/``--help`` prints the
-node's usage, its parameters listed from their Specs (name, type, default, range, unit,
-description), and exits 0 without starting ROS. A ROS argument typed before
+node's usage, its parameters listed from their descriptors (name, type, default, range,
+unit, description), and exits 0 without starting ROS. A ROS argument typed before
 ``--ros-args`` (``id_node -p payload.mass:=2.0``) would be ignored by rcl and leave the
 default in force without a word: it is refused, with the line to type instead.
 """
 
 from __future__ import annotations
 
-import math
 import textwrap
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from rcl_interfaces.msg import ParameterDescriptor
+
 from irb140_dynamics.core.io.text_files import InputFileError, read_text_file
+from irb140_dynamics.ros.parameters.spec import TYPE_NAMES, Spec
 
 ROS_ARGS = "--ros-args"
 HELP = ("-h", "--help")
@@ -47,7 +49,7 @@ class Usage:
 
     name: str
     summary: str
-    sections: list[tuple[str, list]] = field(default_factory=list)  # (title, Specs)
+    sections: list[tuple[str, list[Spec]]] = field(default_factory=list)  # (title, Specs)
     notes: list[str] = field(default_factory=list)
 
     def text(self) -> str:
@@ -70,86 +72,59 @@ class Usage:
         return "\n".join(lines) + "\n"
 
 
-def describe_spec(spec) -> list[str]:
-    """Two or more lines for one parameter: name (type, default, range, unit), then its description."""
+def describe_spec(spec: Spec) -> list[str]:
+    """Two or more lines for one parameter, from its descriptor: name (type, default, range,
+    unit, read-only), then its description."""
+    descriptor = spec.descriptor()
     unit = f" {spec.unit}" if spec.unit else ""
-    facts = [type_name(spec.default)]
-    default = default_text(spec.default)
-    if default is not None:
-        facts.append(f"default {default}{unit}")
-    bounds = range_text(spec)
+    facts = [TYPE_NAMES[spec.type]]
+    if spec.has_default:
+        facts.append(f"default {default_text(spec.default)}{unit}")
+    bounds = range_text(descriptor)
     if bounds:
         facts.append(f"{bounds}{unit}")
-    elif unit and default is None:
+    elif unit and not spec.has_default:
         facts.append(unit.strip())
-    if spec.read_only:
+    if descriptor.read_only:
         facts.append("read-only: set at startup")
     body = textwrap.wrap(spec.description, 88, initial_indent="      ", subsequent_indent="      ")
     return [f"  {spec.name} ({', '.join(facts)})", *body]
 
 
-def type_name(default: Any) -> str:
-    """The ROS parameter type of a Spec's default (a value, or a Parameter.Type)."""
-    if hasattr(default, "name") and not isinstance(default, (str, bool, int, float, list, tuple)):
-        return {
-            "DOUBLE_ARRAY": "double[]",
-            "INTEGER_ARRAY": "integer[]",
-            "STRING_ARRAY": "string[]",
-            "BOOL_ARRAY": "bool[]",
-        }.get(default.name, default.name.lower())
-    if isinstance(default, bool):
-        return "bool"
-    if isinstance(default, int):
-        return "integer"
-    if isinstance(default, float):
-        return "double"
-    if isinstance(default, str):
-        return "string"
-    if isinstance(default, (list, tuple)):
-        item = type_name(default[0]) if default else "double"
-        return f"{item}[]"
-    return type(default).__name__
-
-
-def default_text(default: Any) -> str | None:
-    """The default as a user would write it; None when there is none (a type only)."""
-    if hasattr(default, "name") and not isinstance(default, (str, bool, int, float, list, tuple)):
-        return None
+def default_text(default: Any) -> str:
+    """A default as a user would write it."""
     if isinstance(default, bool):
         return "true" if default else "false"
     if isinstance(default, str):
         return f"'{default}'"
     if isinstance(default, (list, tuple)):
-        return "[" + ", ".join(default_text(x) or "" for x in default) + "]"
+        return "[" + ", ".join(default_text(x) for x in default) + "]"
     return repr(default)
 
 
-def range_text(spec) -> str:
-    low, high = getattr(spec, "minimum", None), getattr(spec, "maximum", None)
-    if low is None and high is None:
+def range_text(descriptor: ParameterDescriptor) -> str:
+    ranges = descriptor.floating_point_range or descriptor.integer_range
+    if not ranges:
         return ""
-    low = "-inf" if low is None or math.isinf(low) else f"{low:g}"
-    high = "inf" if high is None or math.isinf(high) else f"{high:g}"
-    return f"{low} to {high}"
+    return f"{ranges[0].from_value:g} to {ranges[0].to_value:g}"
 
 
-def own_arguments(argv: Iterable[str]) -> list[str]:
-    """The arguments outside every ``--ros-args ... [--]`` span (argv without the program)."""
-    own, inside = [], False
+def split_arguments(argv: Iterable[str]) -> tuple[list[str], list[str]]:
+    """(the arguments outside every ``--ros-args ... [--]`` span, those inside), argv without
+    the program."""
+    own, ros, inside = [], [], False
     for argument in list(argv)[1:]:
-        if argument == ROS_ARGS:
-            inside = True
-        elif inside and argument == "--":
-            inside = False
-        elif not inside:
-            own.append(argument)
-    return own
+        if argument == ROS_ARGS or (inside and argument == "--"):
+            inside = argument == ROS_ARGS
+        else:
+            (ros if inside else own).append(argument)
+    return own, ros
 
 
 def refusal(name: str, argv: list[str]) -> str | None:
     """Why the node will not start with these arguments (one line), or None. Help is not
     a refusal (see ``wants_help``)."""
-    own = [a for a in own_arguments(argv) if a not in HELP]
+    own = [a for a in split_arguments(argv)[0] if a not in HELP]
     if not own:
         return None
     first = own[0]
@@ -163,7 +138,7 @@ def refusal(name: str, argv: list[str]) -> str | None:
 
 
 def wants_help(argv: list[str]) -> bool:
-    return any(a in HELP for a in own_arguments(argv))
+    return any(a in HELP for a in split_arguments(argv)[0])
 
 
 _given: list[str] = []  # the params files of the node's command line (set by ``before_start``)
@@ -171,15 +146,8 @@ _given: list[str] = []  # the params files of the node's command line (set by ``
 
 def params_files(argv: list[str]) -> list[str]:
     """The files of every ``--params-file`` inside ``--ros-args``, in order."""
-    files, inside, arguments = [], False, list(argv)[1:]
-    for i, argument in enumerate(arguments):
-        if argument == ROS_ARGS:
-            inside = True
-        elif inside and argument == "--":
-            inside = False
-        elif inside and argument == "--params-file" and i + 1 < len(arguments):
-            files.append(arguments[i + 1])
-    return files
+    ros = split_arguments(argv)[1]
+    return [path for flag, path in zip(ros, ros[1:]) if flag == "--params-file"]
 
 
 def params_files_given() -> list[str]:

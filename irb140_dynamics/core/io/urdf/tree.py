@@ -35,6 +35,7 @@ from irb140_dynamics.core.model.rigid_body import (
 
 KINDS = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 MAX_URDF_CHARS = MAX_TEXT_BYTES  # characters of URDF text at most (IRB140_MAX_FILE_BYTES changes it)
+PARSE_CHUNK = 1 << 14  # characters the XML parser (and the check for binary data) takes at a time
 MAX_LINE = 299  # characters of a refusal line at most
 RIGHT_ANGLE_TOLERANCE = 1e-10  # rad: an <origin rpy> angle this close to a multiple of pi/2 is taken as it
 
@@ -150,10 +151,12 @@ def checked_text(text, max_chars: int | None = None) -> str:
         raise UrdfError("document", f"expected text, got {type(text).__name__}")
     if len(text) > max_chars:
         raise UrdfError("document", f"{len(text)} characters, more than the limit of {max_chars} (max_chars)")
-    binary = _CONTROL.search(text)
-    if binary:
-        raise UrdfError("document", f"binary data, not text (character {ord(binary.group()):#04x} at {binary.start()})")
-    if not text.strip():
+    for start in range(0, len(text), PARSE_CHUNK):  # in chunks, as the parse (see _parsed)
+        binary = _CONTROL.search(text, start, start + PARSE_CHUNK)
+        if binary:
+            where = f"character {ord(binary.group()):#04x} at {binary.start()}"
+            raise UrdfError("document", f"binary data, not text ({where})")
+    if not text or text.isspace():
         raise UrdfError("document", "empty")
     return text
 
@@ -161,11 +164,21 @@ def checked_text(text, max_chars: int | None = None) -> str:
 _CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")
 
 
+def _parsed(text: str) -> ET.Element:
+    """``ET.fromstring(text)``, fed in chunks: the parser holds the interpreter lock for
+    each call, and a long text in one call would hold up every other thread meanwhile (a
+    node's executor, while a URDF is read in a worker)."""
+    parser = ET.XMLParser()
+    for start in range(0, len(text), PARSE_CHUNK):
+        parser.feed(text[start : start + PARSE_CHUNK])
+    return parser.close()
+
+
 def parse_tree(text: str, max_chars: int | None = None) -> UrdfTree:
     """The tree of a URDF document, or UrdfError naming what is wrong."""
     text = checked_text(text, max_chars)
     try:
-        robot = ET.fromstring(text)
+        robot = _parsed(text)
     except ET.ParseError as error:
         raise UrdfError("XML", f"does not parse: {error}") from None
     except RecursionError:  # not with expat, kept as a guard: one line whatever the parser
