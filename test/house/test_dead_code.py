@@ -16,17 +16,9 @@ from ..support.paths import ROOT
 vulture = pytest.importorskip("vulture", reason="vulture is in requirements/test.txt: ./scripts/test.sh installs it")
 
 PACKAGE = "irb140_dynamics"
-THIS_FILE = Path(__file__).resolve()  # (its list below names dead code)
+THIS_FILE = Path(__file__).resolve()  # not a user: its own test names dead code on purpose
 USERS = (PACKAGE, "test", "bench", "launch")
 MIN_CONFIDENCE = 60
-
-# Dead code in the files other engineers are rewriting (the ROS floor, the nodes, the
-# command-line entry and the code generator): to be fixed by the floor rewrite. Each entry is
-# "file: name"; the lead empties this list after merging it.
-TO_BE_FIXED_BY_THE_FLOOR_REWRITE = {
-    "irb140_dynamics/ros/parameters/live.py: _check_undeclared_parameters",
-    "irb140_dynamics/ros/messages/joint_messages.py: read_reference",
-}
 
 
 def unused_code(paths) -> set[str]:
@@ -70,12 +62,7 @@ def dead_code() -> frozenset[str]:
 
 
 def test_no_dead_code_in_the_package():
-    assert sorted(dead_code() - TO_BE_FIXED_BY_THE_FLOOR_REWRITE) == []
-
-
-def test_the_floor_rewrite_list_holds_only_dead_code():
-    """An entry that is used again (or whose file is gone) leaves the list."""
-    assert sorted(TO_BE_FIXED_BY_THE_FLOOR_REWRITE - dead_code()) == []
+    assert sorted(dead_code()) == []
 
 
 def test_dead_code_is_found(tmp_path):

@@ -34,26 +34,6 @@ SHORT_NAME = re.compile(rf"(?<![\w./\-]){'(?:' + '|'.join(SUBPACKAGES) + ')'}(?:
 PY_PATH = re.compile(r"(?<![\w./*~\-])(?:[\w\-]+/)+[\w\-]+\.py\b")
 FILE_SUFFIX = re.compile(r"\.(md|py|yaml|yml|txt|urdf|xml|json|csv|launch|png|mcap|db3|toml|sh)$")
 
-# Stale names in the files other engineers are rewriting (the ROS floor, the nodes, the
-# command-line entry and the code generator): to be fixed by the floor rewrite. Each entry is
-# "file: name"; the lead empties this list after merging it.
-TO_BE_FIXED_BY_THE_FLOOR_REWRITE = {
-    "irb140_dynamics/nodes/id_node/collision.py: core.observer",
-    "irb140_dynamics/nodes/id_node/node.py: ros.tracking",
-    "irb140_dynamics/nodes/id_node/node.py: ros.model_source",
-    "irb140_dynamics/nodes/id_node/node.py: ros.collision",
-    "irb140_dynamics/nodes/id_node/node.py: ros.joint_state_cdr",
-    "irb140_dynamics/nodes/id_node/settings.py: ros.live",
-    "irb140_dynamics/nodes/id_node/tracking.py: core.trajectory.computed_torque",
-    "irb140_dynamics/nodes/payload_check_node/node.py: ros.estimation",
-    "irb140_dynamics/nodes/payload_check_node/node.py: ros.model_source",
-    "irb140_dynamics/nodes/payload_check_node/payload_estimator.py: core.payload_estimation",
-    "irb140_dynamics/nodes/sim_node/node.py: ros.guard",
-    "irb140_dynamics/nodes/sim_node/node.py: ros.overrides",
-    "irb140_dynamics/nodes/sim_node/settings.py: ros.live",
-    "irb140_dynamics/ros/messages/joint_messages.py: ros.joint_state_cdr.EffortMessage",
-}
-
 
 def cited_files():
     for folder in (PACKAGE, "test", "bench"):
@@ -185,12 +165,7 @@ def stale_names() -> frozenset[str]:
 
 
 def test_every_cited_name_of_the_package_exists():
-    assert sorted(stale_names() - TO_BE_FIXED_BY_THE_FLOOR_REWRITE) == []
-
-
-def test_the_floor_rewrite_list_holds_only_stale_names():
-    """An entry that resolves again (or whose file is gone) leaves the list."""
-    assert sorted(TO_BE_FIXED_BY_THE_FLOOR_REWRITE - stale_names()) == []
+    assert sorted(stale_names()) == []
 
 
 def test_stale_names_are_found(tmp_path):

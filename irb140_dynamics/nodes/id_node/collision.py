@@ -1,4 +1,4 @@
-"""id_node's external-torque estimate and collision flag: the ROS side of core.observer.
+"""id_node's external-torque estimate and collision flag: the ROS side of core.monitoring.observer.
 
 Publishes    external_torques   sensor_msgs/JointState, effort = the observer's residual r
                                 [N m], model joint order, stamped like the input

@@ -11,7 +11,7 @@ With ``effort_commands.source: computed_torque`` the commands are
 
     tau = M(q) (qdd_ref + Kd (qd_ref - qd) + Kp (q_ref - q)) + C(q, qd) qd + g(q) + tau_f(qd_ref)
 
-(core.trajectory.computed_torque), with per-joint gains ``<joint>.kp`` [1/s^2] and
+(core.trajectories.reference.computed_torque), with per-joint gains ``<joint>.kp`` [1/s^2] and
 ``<joint>.kd`` [1/s]; without a reference in force the arm holds the position measured
 when it had none. ``~/tracking_error`` (sensor_msgs/JointState) publishes q_ref - q as
 ``position`` and qd_ref - qd as ``velocity`` while a reference is in force.

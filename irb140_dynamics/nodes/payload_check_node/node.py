@@ -7,9 +7,9 @@ Serves       ~/check        std_srvs/Trigger: the configured payload (payload.* 
                             message: a one-line verdict (OK, OVER-LIMIT or UNPROVEN), then
                             the report
              ~/estimate_payload, ~/clear_samples   std_srvs/Trigger: payload estimation from the
-                            efforts at rest (see ros.estimation)
+                            efforts at rest (see nodes/payload_check_node/payload_estimator.py)
 Subscribes   joint_states   sensor_msgs/JointState (matched by joint name, as in id_node)
-             robot_description  std_msgs/String: the model, as in id_node (see ros.model_source)
+             robot_description  std_msgs/String: the model, as in id_node (see ros.parameters.model_source)
 Publishes    /diagnostics   diagnostic_msgs/DiagnosticArray: one status per joint and one for
                             the payload, after each check and every diagnostics.period
 

@@ -1,4 +1,4 @@
-"""payload_check_node's payload estimation: the ROS side of core.payload_estimation.
+"""payload_check_node's payload estimation: the ROS side of core.payload.mass_com_estimation.
 
 Serves       ~/estimate_payload   std_srvs/Trigger: mass and CoM from the rest poses seen so far
              ~/clear_samples      std_srvs/Trigger: forget them and the last estimate

@@ -18,7 +18,7 @@ its own, catching up late steps (counted) and skipping when far behind (counted)
 ``lockstep`` it steps once per command instead (sim.lockstep), stamps with simulated time
 and publishes it on /clock. Bad commands (wrong length, NaN or infinite) are dropped,
 counted and warned about, never applied; no exception of ours leaves a callback
-(ros.guard). See docs/sim.md.
+(ros.runtime.guard). See docs/sim.md.
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.nodes.sim_node.push import HeldWrench
-from irb140_dynamics.nodes.sim_node.settings import NODE_PARAMETERS, SimNodeSettings, build_settings, read_command  # noqa: F401 (NODE_PARAMETERS: read by ros.overrides)
+from irb140_dynamics.nodes.sim_node.settings import NODE_PARAMETERS, SimNodeSettings, build_settings, read_command
 from irb140_dynamics.ros.messages.joint_messages import BadMessage
 from irb140_dynamics.ros.messages.wrench import chain_links
 from irb140_dynamics.ros.parameters.live import Recipe

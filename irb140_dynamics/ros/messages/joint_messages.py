@@ -20,7 +20,6 @@ __all__ = [
     "publish_efforts",
     "read_effort",
     "read_joint_state",
-    "read_reference",
     "read_trajectory",
 ]
 
@@ -83,21 +82,6 @@ def read_effort(msg: JointState, order: JointOrder) -> list[float] | None:
         raise BadMessage("effort_not_finite", str(error)) from None
 
 
-def read_reference(msg: JointTrajectory, order: JointOrder):
-    """(q, qd, qdd or None) of the model's joints from the first point of a non-empty trajectory.
-
-    Velocities count as zero when empty; accelerations are None when empty (not given).
-    """
-    point = msg.points[0]
-    index, length = _index(msg.joint_names, len(point.positions), order)
-    q = _pick(point.positions, index, "positions", length, required=True)
-    qd = _pick(point.velocities, index, "velocities", length, required=False)
-    qdd = None
-    if len(point.accelerations):
-        qdd = _pick(point.accelerations, index, "accelerations", length, required=True)
-    return q, qd, qdd
-
-
 def read_trajectory(msg: JointTrajectory, order: JointOrder):
     """The whole trajectory of a non-empty message as a core Trajectory (points by
     time_from_start). Velocities count as zero when empty; accelerations are given on
@@ -125,7 +109,7 @@ def _index(names, n_positions: int, order: JointOrder) -> tuple[list[int], int]:
 
 
 def publish_efforts(publisher, message, stamp, effort) -> None:
-    """Publish ``message`` (a ros.joint_state_cdr.EffortMessage: fixed names) with ``stamp``
+    """Publish ``message`` (a ros.messages.joint_state_cdr.EffortMessage: fixed names) with ``stamp``
     and ``effort`` on a ListenedPublisher, if anything subscribes: a message nobody has
     subscribed to would cost its serialization for nothing."""
     if publisher.subscribers:
