@@ -60,8 +60,8 @@ class Figure:
 
     @classmethod
     def cost(cls, samples: Sequence[float], unit: str = "us") -> Figure:
-        """Seconds per call (lower is better) as microseconds or milliseconds."""
-        scale = {"us": 1e6, "ms": 1e3, "s": 1.0}[unit]
+        """Seconds per call (lower is better) as nanoseconds, microseconds or milliseconds."""
+        scale = {"ns": 1e9, "us": 1e6, "ms": 1e3, "s": 1.0}[unit]
         return cls(min(samples) * scale, statistics.median(samples) * scale, unit)
 
     @classmethod
