@@ -53,6 +53,7 @@ from irb140_dynamics.nodes.id_node.settings import (  # noqa: F401 (finish_setti
     check_settings,
     compiled,
     finish_settings,
+    kernels_text,
 )
 from irb140_dynamics.nodes.id_node.tracking import ReferenceTracker
 from irb140_dynamics.nodes.id_node.wrench import WrenchSensor
@@ -122,6 +123,8 @@ class IdNode(Node):
         """Switch to new (validated, compiled) settings; new joints come with a new model. A
         held reference the new model gives no finite torques for is let go."""
         first, names = self.settings is None, list(settings.model.joint_names)
+        if not first and self._started and settings.kernels is not self.settings.kernels:
+            self.get_logger().info(f"new model in force; {kernels_text(settings.kernels)}")
         if first or names != list(self.settings.model.joint_names):
             self._order = JointOrder(names)
             self._zeros = [0.0] * len(names)
@@ -145,7 +148,10 @@ class IdNode(Node):
 
     def _log_ready(self) -> None:
         names = list(self.settings.model.joint_names)
-        self.get_logger().info(f"ready: {len(names)} joints {names}, payload {self.settings.model.payload.mass} kg")
+        self.get_logger().info(
+            f"ready: {len(names)} joints {names}, payload {self.settings.model.payload.mass} kg; "
+            f"{kernels_text(self.settings.kernels)}"
+        )
 
     @guarded("joint_states")
     def _on_joint_state(self, msg: bytes | JointState) -> None:

@@ -5,7 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from irb140_dynamics.core import RobotModel
-from irb140_dynamics.core.codegen.kernels import WITH_FRICTION, kernels_of
+from irb140_dynamics.core.codegen import native
+from irb140_dynamics.core.codegen.kernels import WITH_FRICTION, Preparation, kernels_of, prepare
 from irb140_dynamics.core.payload.limits import derive_torque_limits
 from irb140_dynamics.core.payload.stop import stopping
 from irb140_dynamics.nodes.id_node.collision import (
@@ -80,6 +81,7 @@ class IdNodeSettings:
     gains: Gains
     wrench_frame: str  # external_wrench.frame: "tip" or "base"
     torque_limits: tuple[float, ...] | None = None  # N m (inf: none), the payload check's; set by finish_settings
+    kernels: Preparation | None = None  # how the model's kernels were made ready (set by finish_settings)
 
 
 def check_settings(values: dict) -> IdNodeSettings:
@@ -101,16 +103,18 @@ def check_settings(values: dict) -> IdNodeSettings:
 
 
 KERNELS = (WITH_FRICTION, "gravity_torques", "momentum", "monitor")  # what a message uses (rnea, gravity; the observer)
+NATIVE_WAIT = 30.0  # s: the longest a new model waits for its kernels' C (docs/id_node.md); then Python meanwhile
 
 
 def finish_settings(settings: IdNodeSettings, previous: IdNodeSettings | None) -> IdNodeSettings:
-    """Compile the kernels the messages use, here and not on a message (off the executor
-    unless they exist already: a payload or gravity change shares the arm's code)."""
+    """Make the kernels the messages use native (compiled as C, or loaded from the cache),
+    here and not on a message: at startup before the first message, after a change off the
+    executor while the old model answers (see core.codegen.kernels.prepare). A compile
+    longer than NATIVE_WAIT goes on in the background, the Python form answering meanwhile."""
     if previous is not None and previous.model == settings.model:
-        return replace(settings, model=previous.model, torque_limits=previous.torque_limits)
-    for name in KERNELS:
-        getattr(kernels_of(settings.model), name)  # compiles it
-    return replace(settings, torque_limits=torque_limits(settings.model))
+        return replace(settings, model=previous.model, torque_limits=previous.torque_limits, kernels=previous.kernels)
+    kernels = prepare(settings.model, timeout=NATIVE_WAIT, names=KERNELS)
+    return replace(settings, torque_limits=torque_limits(settings.model), kernels=kernels)
 
 
 LIMITS_TIME = 5.0  # s: the search for derived limits stops by then (what it found stands)
@@ -124,4 +128,24 @@ def torque_limits(model: RobotModel) -> tuple[float, ...]:
 
 
 def compiled(settings: IdNodeSettings, previous: IdNodeSettings | None) -> bool:
-    return kernels_of(settings.model).compiled(*KERNELS)
+    """Whether finish_settings would be quick (the arm's code traced, and native already or
+    never): then it may run on the executor."""
+    kernels = kernels_of(settings.model)
+    if not kernels.compiled(*KERNELS):
+        return False
+    return not native.enabled() or all(kernels.kernel(name).native is not None for name in KERNELS)
+
+
+def kernels_text(kernels: Preparation | None) -> str:
+    """How the model's kernels run, for the log: native (and how long that took) or Python."""
+    if kernels is None:
+        return "kernels: Python form"
+    if kernels.native:
+        return f"kernels: native (compiled or loaded in {kernels.seconds:.1f} s)"
+    if kernels.compiling:
+        return (
+            f"kernels: Python form for now: compiling them as C took over {NATIVE_WAIT:g} s, "
+            "native once the compile is done"
+        )
+    why = "IRB140_NATIVE=0" if native.compiler() is not None else "no C compiler"
+    return f"kernels: Python form ({why}; traced in {kernels.seconds:.1f} s)"
