@@ -159,8 +159,31 @@ def _not_a_recording(path, work):
     return out
 
 
+def _changed(name, change):
+    """The recording with ``change(data)`` applied to its columns (time, Q, QD, TAU)."""
+
+    def make(path, work):
+        data = np.loadtxt(path, delimiter=",", skiprows=1)
+        change(data)
+        out = work / name
+        np.savetxt(out, data, delimiter=",", header=path.read_text().splitlines()[0], comments="")
+        return out
+
+    return make
+
+
+def _scale(columns, factor):
+    def change(data):
+        data[:, columns] *= factor
+
+    return change
+
+
 BAD = {
     "missing recording": (lambda rec, work: work / "nowhere.csv", "nowhere.csv"),
+    "time stamps in microseconds": (_changed("us.csv", _scale(0, 1e-6)), "check that the time stamps are in seconds"),
+    "efforts all zero": (_changed("zero.csv", _scale(slice(13, 19), 0.0)), "no physical payload explains them"),
+    "efforts of the other sign": (_changed("sign.csv", _scale(slice(13, 19), -1.0)), "no physical payload explains"),
     "not a recording": (_not_a_recording, "bad.csv"),
     "no efforts": (_without_efforts, "effort"),
     "not exciting": (_last_joint_only, "does not excite the payload's Ixx, Ixy, Iyy"),
