@@ -39,7 +39,16 @@ import argparse
 import sys
 from pathlib import Path
 
-from irb140_dynamics.tools.cli import Parser, ToolError, input_path, number, output_directory, output_file, run
+from irb140_dynamics.tools.cli import (
+    Parser,
+    ToolError,
+    input_path,
+    number,
+    output_directory,
+    output_file,
+    refuse_input_as_output,
+    run,
+)
 from irb140_dynamics.tools.common import add_model_arguments
 
 DEFAULT_HELD_OUT = 0.2
@@ -133,9 +142,7 @@ def _identify(argv: list[str], interrupts) -> int:
     urdf_out = output_file(args.urdf_out) if args.urdf_out else None
     plots = output_directory(args.plots) if args.plots else None
     inputs = ((args.recording, recording), (args.validate, validate), (args.params_file, params), (args.urdf, urdf))
-    for given, path in inputs:
-        if path is not None and path in (out, urdf_out, plots):
-            raise ToolError(f"{given}: is an input and an output; give the output another name")
+    refuse_input_as_output(inputs, (out, urdf_out, plots))
 
     import shlex
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 import shlex
 
-from irb140_dynamics.tools.cli import ToolError, input_path, output_file
+from irb140_dynamics.tools.cli import ToolError, input_path, output_file, refuse_input_as_output
 
 NOT_WITH_PAYLOAD_ONLY = ("validate", "plots", "urdf_out", "offsets")
 
@@ -24,9 +24,7 @@ def identify_payload(args: argparse.Namespace, argv: list[str], interrupts) -> i
     recording = input_path(args.recording)
     model_files = [(given, input_path(given)) for given in (args.params_file, args.urdf) if given]
     out = output_file(args.out)
-    for given, path in [(args.recording, recording), *model_files]:
-        if path == out:
-            raise ToolError(f"{given}: is an input and an output; give the output another name")
+    refuse_input_as_output([(args.recording, recording), *model_files], [out])
 
     from irb140_dynamics.identification.payload import fit_payload
     from irb140_dynamics.identification.payload_report import payload_file, payload_summary

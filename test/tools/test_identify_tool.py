@@ -336,3 +336,27 @@ def test_arguments_and_outputs_are_checked_before_the_recording_is_read(workflow
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and problem in err[0], (args, err)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
+
+
+@pytest.mark.parametrize("mode", [[], ["--payload-only"]])
+def test_an_input_reached_by_another_path_is_not_overwritten(tmp_path, capsys, mode):
+    """--out naming an input through a linked folder or a hard link: refused, the input kept."""
+    from ..support.paths import ROOT
+
+    arm = tmp_path / "arms" / "arm.yaml"
+    arm.parent.mkdir()
+    arm.write_text((ROOT / "config" / "true_arm.yaml").read_text())
+    (tmp_path / "linked").symlink_to(arm.parent)
+    recording = tmp_path / "run.csv"
+    recording.write_text("time\n")
+    (tmp_path / "hard.csv").hardlink_to(recording)
+    before = arm.read_text()
+    cases = [
+        (["--params-file", str(tmp_path / "linked" / "arm.yaml"), str(recording), "--out", str(arm)], "arm.yaml"),
+        (["--params-file", str(arm), str(recording), "--out", str(tmp_path / "hard.csv")], "run.csv"),
+    ]
+    for args, given in cases:
+        assert identify_tool.main([*mode, *args, "--quiet"]) == 1
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and f"{given}: is an input and an output" in err[0], err
+    assert arm.read_text() == before and recording.read_text() == "time\n"
