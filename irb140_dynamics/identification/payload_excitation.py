@@ -38,7 +38,8 @@ def wrist(model: RobotModel) -> np.ndarray:
 
 def payload_limits(model: RobotModel, margin: float = DEFAULT_MARGIN, pose=None) -> Limits:
     """The model's limits with the joints before the wrist pinned at ``pose`` (default: the
-    middle of their ranges); ValueError naming a pose outside its joint's range."""
+    middle of their ranges; the wrist's own values are not used, it moves over its range);
+    ValueError naming a pose outside its joint's range, the wrist's included."""
     limits = Limits.of(model, margin)
     held = np.setdiff1d(np.arange(model.n), wrist(model))
     centre = (limits.lower + limits.upper) / 2.0
@@ -46,11 +47,11 @@ def payload_limits(model: RobotModel, margin: float = DEFAULT_MARGIN, pose=None)
     if pose.shape != (model.n,) or not np.all(np.isfinite(pose)):
         raise ValueError(f"pose: expected {model.n} finite joint positions, got {np.ravel(pose).tolist()}")
     lower, upper = limits.lower.copy(), limits.upper.copy()
-    for j in held:
-        low, high = model.joints[j].position_limits
+    for j, joint in enumerate(model.joints):
+        low, high = joint.position_limits
         if not low <= pose[j] <= high:
-            raise ValueError(f"pose: {model.joints[j].name} at {pose[j]:g} rad is outside [{low:g}, {high:g}] rad")
-        lower[j] = upper[j] = pose[j]
+            raise ValueError(f"pose: {joint.name} at {pose[j]:g} rad is outside [{low:g}, {high:g}] rad")
+    lower[held] = upper[held] = pose[held]
     return Limits(lower, upper, limits.speed, limits.acceleration)
 
 

@@ -85,7 +85,8 @@ def parser() -> Parser:
         "--pose",
         type=_pose,
         metavar="Q1,...,Qn",
-        help="with --payload: the pose [rad] the joints before the wrist hold (default: mid-range)",
+        help="with --payload: the pose [rad] the joints before the wrist hold, one value per joint within its "
+        "range (the wrist's are not used; default: mid-range)",
     )
     add_model_arguments(p, "the model and its limits (default: the package's IRB-140)")
     return p
@@ -180,10 +181,19 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
 
 
 def _payload_excitation(model, path: str, args: argparse.Namespace):
-    from irb140_dynamics.identification.payload_excitation import optimise_payload_excitation, wrist
+    from irb140_dynamics.identification.payload_excitation import (
+        optimise_payload_excitation,
+        payload_limits,
+        wrist,
+    )
 
     if args.pose is not None and len(args.pose) != model.n:
         raise ToolError(f"--pose: expected {model.n} joint positions, got {len(args.pose)}")
+    try:
+        payload_limits(model, args.margin, args.pose)  # the pose refused before the work
+    except ValueError as error:
+        message = str(error)
+        raise ToolError(f"--{message}" if message.startswith("pose:") else message) from None
     moving = ", ".join(model.joint_names[j] for j in wrist(model))
     print(f"model: {path}; payload motion of {moving}; optimising ({args.iterations} iterations)...", flush=True)
     try:

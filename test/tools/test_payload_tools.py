@@ -235,6 +235,9 @@ def test_excitation_payload_refuses_more_than_30_s_and_a_bad_pose(tmp_path, caps
     assert "at most 30 s, got 40 s" in capsys.readouterr().err
     assert excitation_tool.main(["--payload", "--out", str(out), "--pose", "0,3,0,0,0,0", "--iterations", "0"]) == 1
     assert "--pose: joint_2 at 3 rad is outside" in capsys.readouterr().err
+    assert excitation_tool.main(["--payload", "--out", str(out), "--pose", "0,0,0,0,0,9", "--iterations", "0"]) == 1
+    out_text, err = capsys.readouterr()
+    assert "--pose: joint_6 at 9 rad is outside" in err and out_text == ""  # refused before any work
     assert excitation_tool.main(["--out", str(out), "--pose", "0,0,0,0,0,0"]) == 1
     assert "--pose: only with --payload" in capsys.readouterr().err
     assert not out.exists()
