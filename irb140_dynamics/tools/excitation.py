@@ -32,6 +32,7 @@ import sys
 from irb140_dynamics.tools.cli import Parser, ToolError, check_model_paths, number, output_file, run
 
 MAX_POINTS = 1_000_000  # points written: 100 MB of YAML
+POINTS_PER_CYCLE = 4  # of the highest harmonic: fewer points do not show the motion
 SHELL_ARGUMENT_LIMIT = 128 * 1024  # bytes: Linux's MAX_ARG_STRLEN
 
 
@@ -113,6 +114,12 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
     points = args.rate * args.period * args.periods
     if points > MAX_POINTS:
         raise ToolError(f"--rate x --period x --periods gives {points:.3g} points, more than {MAX_POINTS:,}")
+    if args.rate * args.period < POINTS_PER_CYCLE * args.harmonics:
+        raise ToolError(
+            f"--rate x --period gives {args.rate * args.period:.3g} points per period, fewer than "
+            f"{POINTS_PER_CYCLE * args.harmonics} ({POINTS_PER_CYCLE} per cycle of harmonic {args.harmonics}): "
+            "raise --rate"
+        )
     if args.pose is not None and not args.payload:
         raise ToolError("--pose: only with --payload")
     from irb140_dynamics.identification.payload_excitation import MAX_PAYLOAD_DURATION
