@@ -226,7 +226,9 @@ def _check_mass(path, estimate: Estimate) -> None:
 def _check_excitation(path, estimate: Estimate) -> None:
     """RecordingError naming the parameters whose standard deviation exceeds MAX_RELATIVE_STD
     of the payload's own scale: m_ref = max(m, MIN_MASS) for the mass, m_ref L for the first
-    moments and m_ref L^2 for the inertia, L = max(|c|, MIN_LENGTH)."""
+    moments and m_ref L^2 for the inertia, L = max(|c|, MIN_LENGTH). The deviations grow
+    with the torques the arm's own model leaves unexplained (a params file without the
+    arm's friction) as well as with a weak motion: the line names both."""
     phi = estimate.beta
     mass = max(abs(phi[0]), MIN_MASS)
     length = max(float(np.linalg.norm(phi[1:4])) / mass, MIN_LENGTH)
@@ -234,16 +236,18 @@ def _check_excitation(path, estimate: Estimate) -> None:
     std = estimate.std
     weak = np.flatnonzero(~(std <= MAX_RELATIVE_STD * scale))
     units = ["kg"] + ["kg m"] * 3 + ["kg m^2"] * 6
-    _refuse(path, weak, [f" (+- {std[k]:.2g} {units[k]})" for k in range(10)])
+    notes = [f" (+- {std[k]:.2g} {units[k]})" for k in range(10)]
+    _refuse(path, weak, notes, ", or check the arm's parameters")
 
 
-def _refuse(path, weak, notes: list[str] | None) -> None:
+def _refuse(path, weak, notes: list[str] | None, also: str = "") -> None:
+    """RecordingError naming the ``weak`` parameters; ``also``: a cause besides the motion."""
     if len(weak):
         names = ", ".join(f"{PARAMETER_LABELS[k]}{notes[k] if notes else ''}" for k in weak)
         raise RecordingError(
             path,
             f"the motion does not excite the payload's {names} (flange frame, inertia about its origin): "
-            "record `excitation --payload` (wrist motion)",
+            f"record `excitation --payload` (wrist motion){also}",
         )
 
 

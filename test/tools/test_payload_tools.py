@@ -172,6 +172,11 @@ def _changed(name, change):
     return make
 
 
+def _with_model(path, work, params):
+    """The recording, and ``--params-file`` another arm file (its argument, after the recording's)."""
+    return path, ["--params-file", str(ROOT / params)]
+
+
 def _scale(columns, factor):
     def change(data):
         data[:, columns] *= factor
@@ -184,6 +189,11 @@ BAD = {
     "time stamps in microseconds": (_changed("us.csv", _scale(0, 1e-6)), "check that the time stamps are in seconds"),
     "efforts all zero": (_changed("zero.csv", _scale(slice(13, 19), 0.0)), "no physical payload explains them"),
     "efforts of the other sign": (_changed("sign.csv", _scale(slice(13, 19), -1.0)), "no physical payload explains"),
+    "the arm's own model without friction": (
+        lambda rec, work: _with_model(rec, work, "config/irb140.yaml"),
+        "kg m^2) (flange frame, inertia about its origin): record `excitation --payload` (wrist motion), "
+        "or check the arm's parameters",
+    ),
     "not a recording": (_not_a_recording, "bad.csv"),
     "no efforts": (_without_efforts, "effort"),
     "not exciting": (_last_joint_only, "does not excite the payload's Ixx, Ixy, Iyy"),
@@ -196,11 +206,10 @@ def test_bad_recordings_are_refused_in_one_line_and_nothing_is_written(workflow,
     _, _, _, recording, _ = workflow
     make, problem = BAD[case]
     bad = make(recording, tmp_path)
+    bad, model = bad if isinstance(bad, tuple) else (bad, ["--params-file", str(ARM)])
     out = tmp_path / "load.yaml"
     capsys.readouterr()
-    assert (
-        identify_tool.main(["--payload-only", "--quiet", "--params-file", str(ARM), str(bad), "--out", str(out)]) == 1
-    )
+    assert identify_tool.main(["--payload-only", "--quiet", *model, str(bad), "--out", str(out)]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("identify: error: ") and problem in err[0], err
     assert not out.exists()
