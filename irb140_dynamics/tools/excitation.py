@@ -173,8 +173,11 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
     text = joint_trajectory_text(model.joint_names, times, Q, QD, QDD, comments)
     with Outputs(interrupts) as outputs:
         outputs.text(out, args.out, text)
+        print(  # before the commit: `| head` stops the tool with nothing written
+            f"condition number: {result.condition_number:.2f} (random start {result.start_condition_number:.2f})",
+            flush=True,
+        )
         outputs.commit()
-    print(f"condition number: {result.condition_number:.2f} (random start {result.start_condition_number:.2f})")
     print(
         f"wrote {args.out}: {len(times)} points over {times[-1]:g} s; start at "
         f"[{', '.join(f'{x:.4f}' for x in Q[0])}] rad"

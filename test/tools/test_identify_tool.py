@@ -281,6 +281,23 @@ def test_excitation_refuses_bad_options(tmp_path, capsys):
     assert not (tmp_path / "t.yaml").exists()
 
 
+class _ReaderGoneAfterOneLine(io.StringIO):
+    """A standard output whose reader has read one line and gone (`tool | head -1`)."""
+
+    def write(self, text):
+        if "\n" in self.getvalue():
+            raise BrokenPipeError(32, "Broken pipe")
+        return super().write(text)
+
+
+@pytest.mark.parametrize("payload", [[], ["--payload"]])
+def test_excitation_piped_to_head_writes_nothing(tmp_path, payload):
+    """`excitation ... | head -1`: ended as SIGPIPE ends a program (141), its file not written."""
+    with contextlib.redirect_stdout(_ReaderGoneAfterOneLine()):
+        status = excitation_tool.main(["--out", str(tmp_path / "t.yaml"), "--iterations", "0", *payload])
+    assert status == 141 and not (tmp_path / "t.yaml").exists()
+
+
 def test_progress_bar_ends_at_100_percent_on_its_own_line():
     from irb140_dynamics.tools.common import ProgressBar
 
