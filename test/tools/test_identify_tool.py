@@ -278,6 +278,10 @@ def test_excitation_refuses_bad_options(tmp_path, capsys):
             assert excitation_tool.main(["--out", str(tmp_path / "t.yaml"), "--rate", rate, *payload]) == 1
             err = capsys.readouterr().err.strip().splitlines()
             assert len(err) == 1 and "points per period, fewer than 20 (4 per cycle of harmonic 5)" in err[0], err
+    locked = ["-p", "joint_1.position_limits:=[0.0,0.0]", "--iterations", "0"]  # a condition number of inf
+    assert excitation_tool.main(["--out", str(tmp_path / "t.yaml"), *locked]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "joint_1: no position range to move in" in err[0], err
     assert not (tmp_path / "t.yaml").exists()
 
 
