@@ -40,7 +40,11 @@ def identify_payload(args: argparse.Namespace, argv: list[str], interrupts) -> i
         fit = fit_payload(arm, args.recording, settings, progress)
         print(f"arm: {source.origin}")
         print(payload_summary(fit, arm), flush=True)
-        outputs.text(out, args.out, payload_file(fit, arm, shlex.join(["identify", *argv])))
+        outputs.text(
+            out,
+            args.out,
+            payload_file(fit, arm, shlex.join(["identify", *argv]), source.origin if source.urdf else None),
+        )
         for typed in outputs.commit():
             print(f"wrote {typed}")
     return 0

@@ -250,3 +250,26 @@ def test_excitation_payload_refuses_more_than_30_s_and_a_bad_pose(tmp_path, caps
     assert excitation_tool.main(["--out", str(out), "--pose", "0,0,0,0,0,0"]) == 1
     assert "--pose: only with --payload" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_the_load_file_of_a_urdf_arm_says_how_the_nodes_take_it(tmp_path):
+    """The nodes declare DH joints only: a URDF arm's LOAD.yaml (origin/axis joints) is for the
+    tools; its comment tells how the nodes take the payload (the arm from the URDF)."""
+    from irb140_dynamics.core.io.model_source import tool_model
+    from irb140_dynamics.identification.payload_excitation import optimise_payload_excitation
+
+    from ..support.paths import URDF_DATA
+
+    urdf = ["--urdf", str(URDF_DATA / "ur5.urdf"), "--base", "base_link", "--tip", "tool0"]
+    arm = tool_model(None, urdf[1], "base_link", "tool0").model
+    trajectory = optimise_payload_excitation(arm, iterations=0).trajectory
+    t = np.arange(0.0, 2 * trajectory.period, 0.004)
+    Q, QD, QDD = trajectory.evaluate(t)
+    tau = rnea_batch(arm.with_payload(PAYLOAD), Q, QD, QDD)
+    recording = write_csv(tmp_path / "ur5.csv", arm.joint_names, t, Q, QD, tau)
+    out = tmp_path / "load.yaml"
+    assert identify_tool.main(["--payload-only", "--quiet", *urdf, str(recording), "--out", str(out)]) == 0
+    assert tool_model(out).model.payload.mass == pytest.approx(PAYLOAD.mass, rel=1e-3)  # the tools take it
+    comments = " ".join(line for line in out.read_text().splitlines() if line.startswith("#"))
+    assert "the nodes take this arm from its URDF (model.source: robot_description" in comments
+    assert "Load it into the nodes" not in comments
