@@ -12,7 +12,7 @@ import shlex
 
 from irb140_dynamics.tools.cli import ToolError, input_path, output_file, refuse_input_as_output
 
-NOT_WITH_PAYLOAD_ONLY = ("validate", "plots", "urdf_out", "offsets")
+NOT_WITH_PAYLOAD_ONLY = ("validate", "plots", "urdf_out", "offsets", "held_out", "prior_weight")  # None: not given
 
 
 def identify_payload(args: argparse.Namespace, argv: list[str], interrupts) -> int:

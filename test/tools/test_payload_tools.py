@@ -221,6 +221,8 @@ def test_bad_recordings_are_refused_in_one_line_and_nothing_is_written(workflow,
         (["--params-file", "nowhere.yaml"], "nowhere.yaml"),
         ([], "--payload-only: give the arm's model"),
         (["--params-file", str(ARM), "--plots", "plots"], "--plots: not with --payload-only"),
+        (["--params-file", str(ARM), "--held-out", "0.5"], "--held-out: not with --payload-only"),
+        (["--params-file", str(ARM), "--prior-weight", "2"], "--prior-weight: not with --payload-only"),
         (["--params-file", "BADFILE"], "BADFILE"),
     ],
 )
