@@ -6,6 +6,8 @@ payload along the points the command wrote, its torques by our RNEA with 1 % noi
 joint's peak (the MuJoCo-simulated arms: test/identification/test_payload_identification.py).
 """
 
+import re
+
 import numpy as np
 import pytest
 import yaml
@@ -249,6 +251,15 @@ def test_excitation_payload_refuses_more_than_30_s_and_a_bad_pose(tmp_path, caps
     assert excitation_tool.main(["--payload", "--out", str(out), "--pose", "0,0,0,0,0,9", "--iterations", "0"]) == 1
     out_text, err = capsys.readouterr()
     assert "--pose: joint_6 at 9 rad is outside" in err and out_text == ""  # refused before any work
+    # forearm straight up (joint_3 at 90 degrees): the wrist's turns cannot tell some parameters apart
+    assert (
+        excitation_tool.main(["--payload", "--out", str(out), "--pose", "0,0,1.5708,0,0,0", "--iterations", "0"]) == 1
+    )
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and re.search(
+        r"--pose: at this pose the wrist's motion cannot tell the payload's .+ apart", err[0]
+    )
+    assert "hold another --pose" in err[0], err
     assert excitation_tool.main(["--out", str(out), "--pose", "0,0,0,0,0,0"]) == 1
     assert "--pose: only with --payload" in capsys.readouterr().err
     assert not out.exists()
