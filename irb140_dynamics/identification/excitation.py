@@ -136,13 +136,17 @@ def optimise_excitation(
     margin: float = DEFAULT_MARGIN,
     base: BaseParameters | None = None,
 ) -> Excitation:
-    """A trajectory within the model's limits minimising the base regressor's condition number."""
+    """A trajectory within the model's limits minimising the base regressor's condition number;
+    ValueError naming the joints whose position range (less ``margin``) is empty."""
     if not period > 0.0:
         raise ValueError(f"period: must be > 0 s, got {period}")
     if harmonics < 2:
         raise ValueError(f"harmonics: at least 2 are needed to start at rest, got {harmonics}")
     base = base or find_base_parameters(model)
     limits = Limits.of(model, margin)
+    locked = [joint.name for joint, low, high in zip(model.joints, limits.lower, limits.upper) if not high > low]
+    if locked:  # its friction (and what only it moves) would not be excited: condition number inf
+        raise ValueError(f"{', '.join(locked)}: no position range to move in (position_limits less --margin)")
     samples = samples or max(4 * harmonics * 2 + 1, 2 * base.count // model.n + 20, 100)
     n = model.n
     evaluations = 0

@@ -16,8 +16,8 @@ still throughout (it carries the payload's static load). Weighted least squares 
 phi_hat and its covariance. The recording is refused, naming the parameters, when it does
 not excite one: its column (in units of a 1 kg body 0.1 m out) vanishes to rounding or
 lies in the others' span (``excitation``), or its standard deviation exceeds
-MAX_RELATIVE_STD of the payload's own scale (m, m L, m L^2; see ``_check_excitation``).
-The payload is then the physical body closest to phi_hat in its covariance's metric:
+MAX_RELATIVE_STD of the payload's own scale (m, m L, m L^2; see ``_check_excitation``);
+and when its mass comes out negative beyond the noise (``_check_mass``). The payload is then the physical body closest to phi_hat in its covariance's metric:
 phi = phi(theta) through the log-Cholesky pseudo-inertia of ``consistent`` (mass > 0,
 inertia about the CoM positive definite, triangle inequality hold for any theta), so a
 phi_hat that is physical is kept as it is.
@@ -64,6 +64,7 @@ MIN_EXCITATION = 1e-6  # sine of the angle between a parameter's column and the 
 WEAK_EXCITATION = 1e-3  # named (with the least excited) when the regressor is singular
 MAX_RELATIVE_STD = 0.05  # of the payload's own scale (see _check_excitation)
 MIN_MASS = 0.1  # kg
+NEGATIVE_MASS_SIGMAS = 5.0  # a mass estimate below -5 standard deviations: no payload (see _check_mass)
 MIN_LENGTH = 0.1  # m
 UNIT_SCALE = np.array([1.0, 0.1, 0.1, 0.1, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01])  # 1 kg, 0.1 m out
 PARAMETER_LABELS = ("mass", "m*cx", "m*cy", "m*cz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")  # phi's, as printed
@@ -167,6 +168,7 @@ def fit_payload(
         Y, tau_arm = payload_regressor(arm, batch.q, batch.qd, batch.qdd)
         equations.add(Y, batch.tau - tau_arm, use[start : start + FIT_BATCH])
     estimate = _estimate(tally.path, equations, tally.design.noise_correlation())
+    _check_mass(tally.path, estimate)
     _check_excitation(tally.path, estimate)
     phi, misfit = _nearest_physical(estimate)
     return PayloadFit(
@@ -208,10 +210,25 @@ def _estimate(path, equations: NormalEquations, correlation: float) -> Estimate:
     return replace(estimate, beta=estimate.beta * UNIT_SCALE, covariance=covariance)
 
 
+def _check_mass(path, estimate: Estimate) -> None:
+    """RecordingError when the torques ask for a negative mass beyond NEGATIVE_MASS_SIGMAS of
+    its standard deviation: no physical payload explains them (efforts of the other sign or
+    not in N m, or the arm's own parameters far off), and the nearest one would be noise."""
+    mass, std = float(estimate.beta[0]), float(estimate.std[0])
+    if mass < -NEGATIVE_MASS_SIGMAS * std:
+        raise RecordingError(
+            path,
+            f"the torques give the payload a mass of {mass:.3g} +- {std:.2g} kg: no physical payload explains "
+            "them; check the efforts (their sign, N m) and the arm's own parameters (`identify` it first)",
+        )
+
+
 def _check_excitation(path, estimate: Estimate) -> None:
     """RecordingError naming the parameters whose standard deviation exceeds MAX_RELATIVE_STD
     of the payload's own scale: m_ref = max(m, MIN_MASS) for the mass, m_ref L for the first
-    moments and m_ref L^2 for the inertia, L = max(|c|, MIN_LENGTH)."""
+    moments and m_ref L^2 for the inertia, L = max(|c|, MIN_LENGTH). The deviations grow
+    with the torques the arm's own model leaves unexplained (a params file without the
+    arm's friction) as well as with a weak motion: the line names both."""
     phi = estimate.beta
     mass = max(abs(phi[0]), MIN_MASS)
     length = max(float(np.linalg.norm(phi[1:4])) / mass, MIN_LENGTH)
@@ -219,16 +236,18 @@ def _check_excitation(path, estimate: Estimate) -> None:
     std = estimate.std
     weak = np.flatnonzero(~(std <= MAX_RELATIVE_STD * scale))
     units = ["kg"] + ["kg m"] * 3 + ["kg m^2"] * 6
-    _refuse(path, weak, [f" (+- {std[k]:.2g} {units[k]})" for k in range(10)])
+    notes = [f" (+- {std[k]:.2g} {units[k]})" for k in range(10)]
+    _refuse(path, weak, notes, ", or check the arm's parameters")
 
 
-def _refuse(path, weak, notes: list[str] | None) -> None:
+def _refuse(path, weak, notes: list[str] | None, also: str = "") -> None:
+    """RecordingError naming the ``weak`` parameters; ``also``: a cause besides the motion."""
     if len(weak):
         names = ", ".join(f"{PARAMETER_LABELS[k]}{notes[k] if notes else ''}" for k in weak)
         raise RecordingError(
             path,
             f"the motion does not excite the payload's {names} (flange frame, inertia about its origin): "
-            "record `excitation --payload` (wrist motion)",
+            f"record `excitation --payload` (wrist motion){also}",
         )
 
 

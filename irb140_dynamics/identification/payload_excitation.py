@@ -22,13 +22,15 @@ from scipy.optimize import minimize
 
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.identification.excitation import DEFAULT_MARGIN, Excitation, FourierTrajectory, Limits, shaped
-from irb140_dynamics.identification.payload import payload_regressor
+from irb140_dynamics.identification.payload import PARAMETER_LABELS, excitation, payload_regressor
 
 WRIST_JOINTS = 3
 DEFAULT_PAYLOAD_PERIOD = 10.0  # s
 MAX_PAYLOAD_DURATION = 30.0  # s: a load identification is a short routine
 MIN_WRIST_TRAVEL = 0.1  # rad: each wrist joint's motion at least this wide
 SAMPLES = 120
+MAX_CONDITION = 1e3  # above: a parameter (nearly) in the others' span; a good pose gives 4 to 15
+WEAKLY_SEEN = 0.01  # sine of the angle between a parameter's column and the others': named when refused
 
 
 def wrist(model: RobotModel) -> np.ndarray:
@@ -38,7 +40,8 @@ def wrist(model: RobotModel) -> np.ndarray:
 
 def payload_limits(model: RobotModel, margin: float = DEFAULT_MARGIN, pose=None) -> Limits:
     """The model's limits with the joints before the wrist pinned at ``pose`` (default: the
-    middle of their ranges); ValueError naming a pose outside its joint's range."""
+    middle of their ranges; the wrist's own values are not used, it moves over its range);
+    ValueError naming a pose outside its joint's range, the wrist's included."""
     limits = Limits.of(model, margin)
     held = np.setdiff1d(np.arange(model.n), wrist(model))
     centre = (limits.lower + limits.upper) / 2.0
@@ -46,11 +49,11 @@ def payload_limits(model: RobotModel, margin: float = DEFAULT_MARGIN, pose=None)
     if pose.shape != (model.n,) or not np.all(np.isfinite(pose)):
         raise ValueError(f"pose: expected {model.n} finite joint positions, got {np.ravel(pose).tolist()}")
     lower, upper = limits.lower.copy(), limits.upper.copy()
-    for j in held:
-        low, high = model.joints[j].position_limits
+    for j, joint in enumerate(model.joints):
+        low, high = joint.position_limits
         if not low <= pose[j] <= high:
-            raise ValueError(f"pose: {model.joints[j].name} at {pose[j]:g} rad is outside [{low:g}, {high:g}] rad")
-        lower[j] = upper[j] = pose[j]
+            raise ValueError(f"pose: {joint.name} at {pose[j]:g} rad is outside [{low:g}, {high:g}] rad")
+    lower[held] = upper[held] = pose[held]
     return Limits(lower, upper, limits.speed, limits.acceleration)
 
 
@@ -62,13 +65,18 @@ def _trajectory(free, model: RobotModel, harmonics: int, period: float, limits: 
         return shaped(full.ravel(), model.n, harmonics, period, limits)
 
 
-def payload_condition_number(model: RobotModel, trajectory: FourierTrajectory, samples: int = SAMPLES) -> float:
-    """cond of the payload's weighted, column-scaled regressor over one period (see above)."""
+def _weighted_regressor(model: RobotModel, trajectory: FourierTrajectory, samples: int = SAMPLES) -> np.ndarray:
+    """The payload's regressor over one period, each joint's rows divided by its peak torque."""
     states = trajectory.evaluate(np.linspace(0.0, trajectory.period, samples, endpoint=False))
     Y, tau_arm = payload_regressor(model, *states)
     peak = np.abs(tau_arm).max(axis=0)
     weights = 1.0 / np.maximum(peak, 1e-6 * max(float(peak.max()), 1e-300))
-    stacked = (Y * weights[None, :, None]).reshape(-1, Y.shape[-1])
+    return (Y * weights[None, :, None]).reshape(-1, Y.shape[-1])
+
+
+def payload_condition_number(model: RobotModel, trajectory: FourierTrajectory, samples: int = SAMPLES) -> float:
+    """cond of the payload's weighted, column-scaled regressor over one period (see above)."""
+    stacked = _weighted_regressor(model, trajectory, samples)
     norms = np.linalg.norm(stacked, axis=0)
     if not np.all(norms > 0.0):
         return math.inf
@@ -86,7 +94,8 @@ def optimise_payload_excitation(
     pose=None,
 ) -> Excitation:
     """A wrist motion within the model's limits minimising the payload regressor's condition
-    number; ValueError when the wrist's limits leave a joint less than MIN_WRIST_TRAVEL."""
+    number; ValueError when the wrist's limits leave a joint less than MIN_WRIST_TRAVEL, or
+    when the pose leaves the condition number above MAX_CONDITION (naming the parameters)."""
     if not 0.0 < period <= MAX_PAYLOAD_DURATION:
         raise ValueError(f"period: must be within (0, {MAX_PAYLOAD_DURATION:g}] s, got {period}")
     if harmonics < 2:
@@ -114,4 +123,13 @@ def optimise_payload_excitation(
                 f"{model.joints[j].name}: its limits allow a motion of only {travel[j]:.3g} rad, "
                 f"{MIN_WRIST_TRAVEL:g} rad needed"
             )
-    return Excitation(trajectory, payload_condition_number(model, trajectory), math.exp(start_cost), evaluations)
+    condition = payload_condition_number(model, trajectory)
+    if not condition <= MAX_CONDITION:
+        stacked = _weighted_regressor(model, trajectory)
+        seen = excitation(stacked.T @ stacked)
+        names = ", ".join(PARAMETER_LABELS[k] for k in np.flatnonzero(seen <= max(WEAKLY_SEEN, seen.min())))
+        raise ValueError(
+            f"pose: at this pose the wrist's motion cannot tell the payload's {names} apart from the others "
+            f"(condition number {condition:.3g}): hold another --pose"
+        )
+    return Excitation(trajectory, condition, math.exp(start_cost), evaluations)

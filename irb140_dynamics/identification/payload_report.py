@@ -41,14 +41,24 @@ def payload_summary(fit: PayloadFit, arm: RobotModel) -> str:
     return "\n".join(lines)
 
 
-def payload_file(fit: PayloadFit, arm: RobotModel, command: str) -> str:
-    """The arm's parameter file with ``payload.*`` the identified payload, the summary as comments."""
+def payload_file(fit: PayloadFit, arm: RobotModel, command: str, urdf: str | None = None) -> str:
+    """The arm's parameter file with ``payload.*`` the identified payload, the summary as
+    comments; ``urdf``: the URDF the arm came from (its joints are then in URDF form, which
+    the nodes do not declare: the comments say how they take the payload)."""
     date = datetime.now(UTC).isoformat(timespec="seconds")
+    if urdf is None:
+        use = ["Load it into the nodes and tools with --params-file. Units: SI (m, kg, kg m^2)."]
+    else:
+        use = [
+            "Load it into the tools with --params-file. Units: SI (m, kg, kg m^2). The nodes declare DH",
+            f"joints only: the nodes take this arm from its URDF (model.source: robot_description, {urdf})",
+            "and payload.* from this file (its per-joint entries are then reported unknown and ignored).",
+        ]
     comments = [
         f"payload identified by irb140_dynamics `identify --payload-only` on {date}:",
         f"  {command}",
-        "The arm's own parameters are the params file's; payload.* is identified.",
-        "Load it into the nodes and tools with --params-file. Units: SI (m, kg, kg m^2).",
+        "The arm's own parameters are those it was given; payload.* is identified.",
+        *use,
         "",
         *payload_summary(fit, arm).splitlines(),
         "",

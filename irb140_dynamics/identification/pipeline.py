@@ -189,7 +189,10 @@ def read_fit_points(prior, recording, settings, progress) -> tuple[SampleTally, 
     for chunk in recording.chunks():
         tally.read += len(chunk)
         if differentiator is None:
-            design = FilterDesign.of(_rate(recording, chunk), settings.cutoff)
+            try:
+                design = FilterDesign.of(_rate(recording, chunk), settings.cutoff)
+            except ValueError as error:
+                raise RecordingError(recording.path, str(error)) from None
             tally.design, tally.has_velocity = design, bool(np.isfinite(chunk.velocity).all())
             differentiator = Differentiator(design, prior.n, tally.has_velocity)
         finite = chunk.time[np.isfinite(chunk.time)]

@@ -32,6 +32,7 @@ POLYORDER = 4
 DEFAULT_CUTOFF = 10.0  # Hz
 POINTS_PER_CUTOFF = 4.0  # fit points per second per Hz of cut-off
 LARGEST = 1e6  # rad, rad/s, N m: a larger value (or NaN) makes its sample invalid
+MAX_WINDOW = 100_001  # samples: 1 Hz cut-off at 60 kHz; longer is a unit mistake (time stamps, --cutoff)
 
 
 @dataclass(frozen=True)
@@ -48,6 +49,11 @@ class FilterDesign:
         nyquist_fraction = min(cutoff / (rate / 2.0), 1.0)
         half = math.ceil(((POLYORDER + 1) / nyquist_fraction + 4.6) / 3.2)
         half = max(half, POLYORDER // 2 + 1)
+        if 2 * half + 1 > MAX_WINDOW:
+            raise ValueError(
+                f"a cut-off of {cutoff:g} Hz at {rate:.6g} samples/s needs a filter window of {2 * half + 1:,} "
+                f"samples, more than {MAX_WINDOW:,}: raise --cutoff, or check that the time stamps are in seconds"
+            )
         stride = max(1, int(rate / (POINTS_PER_CUTOFF * cutoff)))
         return cls(rate, cutoff, 2 * half + 1, stride)
 

@@ -153,6 +153,25 @@ def input_path(path: str, what: str = "file") -> Path:
     return target
 
 
+def refuse_input_as_output(inputs, outputs) -> None:
+    """ToolError when an output is one of the inputs by any path (as typed, through a linked
+    folder, a hard link): writing it would replace the input. ``inputs``: (as typed,
+    absolute path or None) pairs; ``outputs``: absolute paths or None."""
+    written = [path for path in outputs if path is not None]
+    for given, path in inputs:
+        if path is not None and any(_same_file(path, output) for output in written):
+            raise ToolError(f"{given}: is an input and an output; give the output another name")
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        if os.path.samefile(a, b):
+            return True
+    except OSError:  # the output is not there yet
+        pass
+    return os.path.realpath(a) == os.path.realpath(b)
+
+
 def _nearest_file(path: Path) -> Path:
     """The ancestor of ``path`` that exists (a file, when a path goes on 'under' one)."""
     while not os.path.lexists(path):

@@ -32,6 +32,7 @@ import sys
 from irb140_dynamics.tools.cli import Parser, ToolError, check_model_paths, number, output_file, run
 
 MAX_POINTS = 1_000_000  # points written: 100 MB of YAML
+POINTS_PER_CYCLE = 4  # of the highest harmonic: fewer points do not show the motion
 SHELL_ARGUMENT_LIMIT = 128 * 1024  # bytes: Linux's MAX_ARG_STRLEN
 
 
@@ -85,7 +86,8 @@ def parser() -> Parser:
         "--pose",
         type=_pose,
         metavar="Q1,...,Qn",
-        help="with --payload: the pose [rad] the joints before the wrist hold (default: mid-range)",
+        help="with --payload: the pose [rad] the joints before the wrist hold, one value per joint within its "
+        "range (the wrist's are not used; default: mid-range)",
     )
     add_model_arguments(p, "the model and its limits (default: the package's IRB-140)")
     return p
@@ -112,6 +114,12 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
     points = args.rate * args.period * args.periods
     if points > MAX_POINTS:
         raise ToolError(f"--rate x --period x --periods gives {points:.3g} points, more than {MAX_POINTS:,}")
+    if args.rate * args.period < POINTS_PER_CYCLE * args.harmonics:
+        raise ToolError(
+            f"--rate x --period gives {args.rate * args.period:.3g} points per period, fewer than "
+            f"{POINTS_PER_CYCLE * args.harmonics} ({POINTS_PER_CYCLE} per cycle of harmonic {args.harmonics}): "
+            "raise --rate"
+        )
     if args.pose is not None and not args.payload:
         raise ToolError("--pose: only with --payload")
     from irb140_dynamics.identification.payload_excitation import MAX_PAYLOAD_DURATION
@@ -165,8 +173,11 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
     text = joint_trajectory_text(model.joint_names, times, Q, QD, QDD, comments)
     with Outputs(interrupts) as outputs:
         outputs.text(out, args.out, text)
+        print(  # before the commit: `| head` stops the tool with nothing written
+            f"condition number: {result.condition_number:.2f} (random start {result.start_condition_number:.2f})",
+            flush=True,
+        )
         outputs.commit()
-    print(f"condition number: {result.condition_number:.2f} (random start {result.start_condition_number:.2f})")
     print(
         f"wrote {args.out}: {len(times)} points over {times[-1]:g} s; start at "
         f"[{', '.join(f'{x:.4f}' for x in Q[0])}] rad"
@@ -180,10 +191,19 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
 
 
 def _payload_excitation(model, path: str, args: argparse.Namespace):
-    from irb140_dynamics.identification.payload_excitation import optimise_payload_excitation, wrist
+    from irb140_dynamics.identification.payload_excitation import (
+        optimise_payload_excitation,
+        payload_limits,
+        wrist,
+    )
 
     if args.pose is not None and len(args.pose) != model.n:
         raise ToolError(f"--pose: expected {model.n} joint positions, got {len(args.pose)}")
+    try:
+        payload_limits(model, args.margin, args.pose)  # the pose refused before the work
+    except ValueError as error:
+        message = str(error)
+        raise ToolError(f"--{message}" if message.startswith("pose:") else message) from None
     moving = ", ".join(model.joint_names[j] for j in wrist(model))
     print(f"model: {path}; payload motion of {moving}; optimising ({args.iterations} iterations)...", flush=True)
     try:

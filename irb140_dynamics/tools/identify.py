@@ -39,10 +39,20 @@ import argparse
 import sys
 from pathlib import Path
 
-from irb140_dynamics.tools.cli import Parser, ToolError, input_path, number, output_directory, output_file, run
+from irb140_dynamics.tools.cli import (
+    Parser,
+    ToolError,
+    input_path,
+    number,
+    output_directory,
+    output_file,
+    refuse_input_as_output,
+    run,
+)
 from irb140_dynamics.tools.common import add_model_arguments
 
 DEFAULT_HELD_OUT = 0.2
+DEFAULT_PRIOR_WEIGHT = 1.0
 
 
 def parser() -> Parser:
@@ -81,16 +91,14 @@ def parser() -> Parser:
     p.add_argument(
         "--held-out",
         type=number(0.0, 1.0, above=True),
-        default=DEFAULT_HELD_OUT,
         metavar="FRACTION",
         help=f"fraction of BAG's moving fit points, at its end, held out (default {DEFAULT_HELD_OUT:g})",
     )
     p.add_argument(
         "--prior-weight",
         type=number(0.0, 1e6, above=True),
-        default=1.0,
         metavar="W",
-        help="strength of the pull toward the prior (default 1; see docs/identification.md)",
+        help=f"strength of the pull toward the prior (default {DEFAULT_PRIOR_WEIGHT:g}; see docs/identification.md)",
     )
     p.add_argument(
         "--offsets", action="store_true", help="fit a constant torque offset per joint (a sensor's bias; default off)"
@@ -123,6 +131,8 @@ def _identify(argv: list[str], interrupts) -> int:
         from irb140_dynamics.tools.identify_payload import identify_payload
 
         return identify_payload(args, argv, interrupts)
+    args.held_out = DEFAULT_HELD_OUT if args.held_out is None else args.held_out  # None: not given
+    args.prior_weight = DEFAULT_PRIOR_WEIGHT if args.prior_weight is None else args.prior_weight
     if not args.held_out < 1.0:
         raise ToolError(f"--held-out: must be < 1, got {args.held_out:g}")
     recording = input_path(args.recording)
@@ -133,9 +143,7 @@ def _identify(argv: list[str], interrupts) -> int:
     urdf_out = output_file(args.urdf_out) if args.urdf_out else None
     plots = output_directory(args.plots) if args.plots else None
     inputs = ((args.recording, recording), (args.validate, validate), (args.params_file, params), (args.urdf, urdf))
-    for given, path in inputs:
-        if path is not None and path in (out, urdf_out, plots):
-            raise ToolError(f"{given}: is an input and an output; give the output another name")
+    refuse_input_as_output(inputs, (out, urdf_out, plots))
 
     import shlex
 

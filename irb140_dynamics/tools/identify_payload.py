@@ -10,9 +10,9 @@ from __future__ import annotations
 import argparse
 import shlex
 
-from irb140_dynamics.tools.cli import ToolError, input_path, output_file
+from irb140_dynamics.tools.cli import ToolError, input_path, output_file, refuse_input_as_output
 
-NOT_WITH_PAYLOAD_ONLY = ("validate", "plots", "urdf_out", "offsets")
+NOT_WITH_PAYLOAD_ONLY = ("validate", "plots", "urdf_out", "offsets", "held_out", "prior_weight")  # None: not given
 
 
 def identify_payload(args: argparse.Namespace, argv: list[str], interrupts) -> int:
@@ -24,9 +24,7 @@ def identify_payload(args: argparse.Namespace, argv: list[str], interrupts) -> i
     recording = input_path(args.recording)
     model_files = [(given, input_path(given)) for given in (args.params_file, args.urdf) if given]
     out = output_file(args.out)
-    for given, path in [(args.recording, recording), *model_files]:
-        if path == out:
-            raise ToolError(f"{given}: is an input and an output; give the output another name")
+    refuse_input_as_output([(args.recording, recording), *model_files], [out])
 
     from irb140_dynamics.identification.payload import fit_payload
     from irb140_dynamics.identification.payload_report import payload_file, payload_summary
@@ -42,7 +40,11 @@ def identify_payload(args: argparse.Namespace, argv: list[str], interrupts) -> i
         fit = fit_payload(arm, args.recording, settings, progress)
         print(f"arm: {source.origin}")
         print(payload_summary(fit, arm), flush=True)
-        outputs.text(out, args.out, payload_file(fit, arm, shlex.join(["identify", *argv])))
+        outputs.text(
+            out,
+            args.out,
+            payload_file(fit, arm, shlex.join(["identify", *argv]), source.origin if source.urdf else None),
+        )
         for typed in outputs.commit():
             print(f"wrote {typed}")
     return 0

@@ -160,3 +160,20 @@ def test_nothing_stops_outside_a_stopping():
         assert stop.out_of_time() and inner.ran_out and not outer.ran_out
     with pytest.raises(ValueError, match="seconds: must be >= 0"), stopping(seconds=float("nan")):
         pass
+
+
+def test_the_ur5_with_a_2_kg_tool_gives_its_max_payload_without_a_numpy_warning():
+    """Where the bounds barely change between two masses, the division that mixes them may
+    overflow to inf in a joint it does not select: no RuntimeWarning reaches the node's log."""
+    import warnings
+
+    from irb140_dynamics.core.urdf import load_urdf
+
+    from ..support.paths import URDF_DATA
+
+    model = load_urdf((URDF_DATA / "ur5.urdf").read_text(), "base_link", "tool0").model
+    tool = RigidBody(2.0, (0.04, -0.03, 0.06))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        best = workspace_load(model, tool, derive_torque_limits(model)).max_payload
+    assert best.mass > 0 and np.isfinite(best.mass)

@@ -24,7 +24,7 @@ from irb140_dynamics.identification.consistent import (
 )
 from irb140_dynamics.identification.least_squares import NormalEquations, weighted_least_squares
 from irb140_dynamics.identification.recording import RawChunk
-from irb140_dynamics.identification.signals import POLYORDER, Differentiator, FilterDesign
+from irb140_dynamics.identification.signals import MAX_WINDOW, POLYORDER, Differentiator, FilterDesign
 
 from ..support.synthetic_arm import true_arm
 
@@ -56,6 +56,15 @@ def test_design_follows_the_cutoff():
     assert 0.6 < gain[1] < 0.8  # -3 dB near the cut-off
     assert gain[2] < 0.15
     assert design.window % 2 == 1 and design.stride == 25
+
+
+@pytest.mark.parametrize("rate, cutoff", [(2.5e8, 10.0), (250.0, 1e-6)])
+def test_a_window_too_long_to_filter_is_refused_before_any_work(rate, cutoff):
+    """Time stamps in the wrong unit (microseconds read as seconds) or a tiny cut-off would
+    ask for a window of millions of samples: memory and time beyond any recording."""
+    with pytest.raises(ValueError, match=r"filter window of [0-9,]+ samples, more than [0-9,]+: raise --cutoff"):
+        FilterDesign.of(rate, cutoff)
+    assert FilterDesign.of(10_000.0, 1.0).window <= MAX_WINDOW  # a fast logger, a slow motion: still filtered
 
 
 def test_streaming_filter_is_the_whole_segment_filter_whatever_the_chunks():

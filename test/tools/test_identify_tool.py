@@ -284,7 +284,33 @@ def test_identify_errors_are_one_line_and_write_nothing(workflow, tmp_path, caps
 def test_excitation_refuses_bad_options(tmp_path, capsys):
     assert excitation_tool.main(["--out", str(tmp_path / "t.yaml"), "--rate", "0"]) == 2
     assert "excitation: error: argument --rate: must be > 0, got 0" in capsys.readouterr().err
+    for payload in ([], ["--payload"]):  # one point 'over 0 s', or too few to follow the top harmonic
+        for rate in ("0.01", "1"):
+            assert excitation_tool.main(["--out", str(tmp_path / "t.yaml"), "--rate", rate, *payload]) == 1
+            err = capsys.readouterr().err.strip().splitlines()
+            assert len(err) == 1 and "points per period, fewer than 20 (4 per cycle of harmonic 5)" in err[0], err
+    locked = ["-p", "joint_1.position_limits:=[0.0,0.0]", "--iterations", "0"]  # a condition number of inf
+    assert excitation_tool.main(["--out", str(tmp_path / "t.yaml"), *locked]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "joint_1: no position range to move in" in err[0], err
     assert not (tmp_path / "t.yaml").exists()
+
+
+class _ReaderGoneAfterOneLine(io.StringIO):
+    """A standard output whose reader has read one line and gone (`tool | head -1`)."""
+
+    def write(self, text):
+        if "\n" in self.getvalue():
+            raise BrokenPipeError(32, "Broken pipe")
+        return super().write(text)
+
+
+@pytest.mark.parametrize("payload", [[], ["--payload"]])
+def test_excitation_piped_to_head_writes_nothing(tmp_path, payload):
+    """`excitation ... | head -1`: ended as SIGPIPE ends a program (141), its file not written."""
+    with contextlib.redirect_stdout(_ReaderGoneAfterOneLine()):
+        status = excitation_tool.main(["--out", str(tmp_path / "t.yaml"), "--iterations", "0", *payload])
+    assert status == 141 and not (tmp_path / "t.yaml").exists()
 
 
 def test_progress_bar_ends_at_100_percent_on_its_own_line():
@@ -349,3 +375,27 @@ def test_arguments_and_outputs_are_checked_before_the_recording_is_read(workflow
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and problem in err[0], (args, err)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
+
+
+@pytest.mark.parametrize("mode", [[], ["--payload-only"]])
+def test_an_input_reached_by_another_path_is_not_overwritten(tmp_path, capsys, mode):
+    """--out naming an input through a linked folder or a hard link: refused, the input kept."""
+    from ..support.paths import ROOT
+
+    arm = tmp_path / "arms" / "arm.yaml"
+    arm.parent.mkdir()
+    arm.write_text((ROOT / "config" / "true_arm.yaml").read_text())
+    (tmp_path / "linked").symlink_to(arm.parent)
+    recording = tmp_path / "run.csv"
+    recording.write_text("time\n")
+    (tmp_path / "hard.csv").hardlink_to(recording)
+    before = arm.read_text()
+    cases = [
+        (["--params-file", str(tmp_path / "linked" / "arm.yaml"), str(recording), "--out", str(arm)], "arm.yaml"),
+        (["--params-file", str(arm), str(recording), "--out", str(tmp_path / "hard.csv")], "run.csv"),
+    ]
+    for args, given in cases:
+        assert identify_tool.main([*mode, *args, "--quiet"]) == 1
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and f"{given}: is an input and an output" in err[0], err
+    assert arm.read_text() == before and recording.read_text() == "time\n"

@@ -77,6 +77,28 @@ def test_bad_model_arguments_are_one_line(kwargs, message):
     assert message in str(error.value) and "\n" not in str(error.value)
 
 
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda tmp: "/dev/zero", "/dev/zero: not a regular file"),
+        (lambda tmp: tmp, "is a folder"),
+        (lambda tmp: tmp / "missing.yaml", "missing.yaml: no such parameter file"),
+        (lambda tmp: _written(tmp / "digits.yaml", "/**:\n  ros__parameters:\n    a: " + "9" * 5000), "digits.yaml: "),
+    ],
+)
+def test_a_params_file_that_is_no_file_or_no_yaml_is_named_with_the_reason(tmp_path, make, message):
+    """The reasons read_parameter_file gives (a device, a folder: not 'no such file'; a
+    number YAML cannot convert: the file named)."""
+    with pytest.raises(ValueError) as error:
+        tool_model(make(tmp_path), defaults_file=CONFIG)
+    assert message in str(error.value) and "\n" not in str(error.value), error.value
+
+
+def _written(path, text):
+    path.write_text(text)
+    return path
+
+
 def test_excitation_for_a_urdf_arm(tmp_path):
     out = tmp_path / "excitation.yaml"
     arguments = ["--out", str(out), "--urdf", str(UR5_URDF), "--base", BASE, "--tip", TIP, "--iterations", "0"]

@@ -6,6 +6,8 @@ payload along the points the command wrote, its torques by our RNEA with 1 % noi
 joint's peak (the MuJoCo-simulated arms: test/identification/test_payload_identification.py).
 """
 
+import re
+
 import numpy as np
 import pytest
 import yaml
@@ -159,8 +161,41 @@ def _not_a_recording(path, work):
     return out
 
 
+def _changed(name, change):
+    """The recording with ``change(data)`` applied to its columns (time, Q, QD, TAU)."""
+
+    def make(path, work):
+        data = np.loadtxt(path, delimiter=",", skiprows=1)
+        change(data)
+        out = work / name
+        np.savetxt(out, data, delimiter=",", header=path.read_text().splitlines()[0], comments="")
+        return out
+
+    return make
+
+
+def _with_model(path, work, params):
+    """The recording, and ``--params-file`` another arm file (its argument, after the recording's)."""
+    return path, ["--params-file", str(ROOT / params)]
+
+
+def _scale(columns, factor):
+    def change(data):
+        data[:, columns] *= factor
+
+    return change
+
+
 BAD = {
     "missing recording": (lambda rec, work: work / "nowhere.csv", "nowhere.csv"),
+    "time stamps in microseconds": (_changed("us.csv", _scale(0, 1e-6)), "check that the time stamps are in seconds"),
+    "efforts all zero": (_changed("zero.csv", _scale(slice(13, 19), 0.0)), "no physical payload explains them"),
+    "efforts of the other sign": (_changed("sign.csv", _scale(slice(13, 19), -1.0)), "no physical payload explains"),
+    "the arm's own model without friction": (
+        lambda rec, work: _with_model(rec, work, "config/irb140.yaml"),
+        "kg m^2) (flange frame, inertia about its origin): record `excitation --payload` (wrist motion), "
+        "or check the arm's parameters",
+    ),
     "not a recording": (_not_a_recording, "bad.csv"),
     "no efforts": (_without_efforts, "effort"),
     "not exciting": (_last_joint_only, "does not excite the payload's Ixx, Ixy, Iyy"),
@@ -173,11 +208,10 @@ def test_bad_recordings_are_refused_in_one_line_and_nothing_is_written(workflow,
     _, _, _, recording, _ = workflow
     make, problem = BAD[case]
     bad = make(recording, tmp_path)
+    bad, model = bad if isinstance(bad, tuple) else (bad, ["--params-file", str(ARM)])
     out = tmp_path / "load.yaml"
     capsys.readouterr()
-    assert (
-        identify_tool.main(["--payload-only", "--quiet", "--params-file", str(ARM), str(bad), "--out", str(out)]) == 1
-    )
+    assert identify_tool.main(["--payload-only", "--quiet", *model, str(bad), "--out", str(out)]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("identify: error: ") and problem in err[0], err
     assert not out.exists()
@@ -189,6 +223,8 @@ def test_bad_recordings_are_refused_in_one_line_and_nothing_is_written(workflow,
         (["--params-file", "nowhere.yaml"], "nowhere.yaml"),
         ([], "--payload-only: give the arm's model"),
         (["--params-file", str(ARM), "--plots", "plots"], "--plots: not with --payload-only"),
+        (["--params-file", str(ARM), "--held-out", "0.5"], "--held-out: not with --payload-only"),
+        (["--params-file", str(ARM), "--prior-weight", "2"], "--prior-weight: not with --payload-only"),
         (["--params-file", "BADFILE"], "BADFILE"),
     ],
 )
@@ -212,6 +248,41 @@ def test_excitation_payload_refuses_more_than_30_s_and_a_bad_pose(tmp_path, caps
     assert "at most 30 s, got 40 s" in capsys.readouterr().err
     assert excitation_tool.main(["--payload", "--out", str(out), "--pose", "0,3,0,0,0,0", "--iterations", "0"]) == 1
     assert "--pose: joint_2 at 3 rad is outside" in capsys.readouterr().err
+    assert excitation_tool.main(["--payload", "--out", str(out), "--pose", "0,0,0,0,0,9", "--iterations", "0"]) == 1
+    out_text, err = capsys.readouterr()
+    assert "--pose: joint_6 at 9 rad is outside" in err and out_text == ""  # refused before any work
+    # forearm straight up (joint_3 at 90 degrees): the wrist's turns cannot tell some parameters apart
+    assert (
+        excitation_tool.main(["--payload", "--out", str(out), "--pose", "0,0,1.5708,0,0,0", "--iterations", "0"]) == 1
+    )
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and re.search(
+        r"--pose: at this pose the wrist's motion cannot tell the payload's .+ apart", err[0]
+    )
+    assert "hold another --pose" in err[0], err
     assert excitation_tool.main(["--out", str(out), "--pose", "0,0,0,0,0,0"]) == 1
     assert "--pose: only with --payload" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_the_load_file_of_a_urdf_arm_says_how_the_nodes_take_it(tmp_path):
+    """The nodes declare DH joints only: a URDF arm's LOAD.yaml (origin/axis joints) is for the
+    tools; its comment tells how the nodes take the payload (the arm from the URDF)."""
+    from irb140_dynamics.core.io.model_source import tool_model
+    from irb140_dynamics.identification.payload_excitation import optimise_payload_excitation
+
+    from ..support.paths import URDF_DATA
+
+    urdf = ["--urdf", str(URDF_DATA / "ur5.urdf"), "--base", "base_link", "--tip", "tool0"]
+    arm = tool_model(None, urdf[1], "base_link", "tool0").model
+    trajectory = optimise_payload_excitation(arm, iterations=0).trajectory
+    t = np.arange(0.0, 2 * trajectory.period, 0.004)
+    Q, QD, QDD = trajectory.evaluate(t)
+    tau = rnea_batch(arm.with_payload(PAYLOAD), Q, QD, QDD)
+    recording = write_csv(tmp_path / "ur5.csv", arm.joint_names, t, Q, QD, tau)
+    out = tmp_path / "load.yaml"
+    assert identify_tool.main(["--payload-only", "--quiet", *urdf, str(recording), "--out", str(out)]) == 0
+    assert tool_model(out).model.payload.mass == pytest.approx(PAYLOAD.mass, rel=1e-3)  # the tools take it
+    comments = " ".join(line for line in out.read_text().splitlines() if line.startswith("#"))
+    assert "the nodes take this arm from its URDF (model.source: robot_description" in comments
+    assert "Load it into the nodes" not in comments

@@ -145,10 +145,8 @@ def _from_urdf(values, params_file, urdf_file, base_link, tip_link) -> ToolModel
 def _parameters(path) -> dict[str, Any]:
     if path is None:
         return {}
-    if not Path(path).is_file():
-        raise ValueError(f"{path}: no such parameter file")
-    try:
-        return read_parameter_file(path)  # a ValueError naming the file when it is no parameter file
+    try:  # a ValueError naming the file and why when it is none (missing, a folder, a device, bad YAML)
+        return read_parameter_file(path)
     except OSError as error:
         raise ValueError(f"{path}: cannot be read ({error.strerror or error})") from None
 

@@ -32,6 +32,8 @@ def read_parameter_file(path, node_name: str | None = None) -> dict[str, Any]:
         raise ValueError(f"{path}: not valid YAML{where}: {getattr(error, 'problem', None) or error}") from None
     except RecursionError:
         raise ValueError(f"{path}: nested too deeply to be a parameter file") from None
+    except ValueError as error:  # a value YAML cannot convert (an integer of more than 4300 digits)
+        raise ValueError(f"{path}: not a parameter file: {error}") from None
     if not isinstance(document, Mapping):
         raise ValueError(f"{path}: not a parameter file (expected a mapping of node names)")
     params: dict[str, Any] = {}

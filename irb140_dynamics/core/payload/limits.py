@@ -253,7 +253,7 @@ def _proven_mass(family, ranges, L, G0, best: MaxPayload, at_best: Extremes, lim
     if not (m0 < m1 and np.all(a[limited] <= limit[limited])):
         m0, a = 0.0, family.extremes(0.0, ranges, G0, rows=limited, share=MASS_PROOF_SHARE).bounds
     over_a, over_b = a > limit, b > limit
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # in joints np.where leaves out
         highest = np.min(np.where(over_b, (limit - a) / (b - a), 1.0))
         lowest = np.max(np.where(over_a, (a - limit) / (a - b), 0.0))
     proven = m0 + (m1 - m0) * highest if not (over_a & over_b).any() and lowest <= highest else math.nan
