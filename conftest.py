@@ -4,6 +4,12 @@
 # spin while they wait, and on a shared 2-core machine the identification tests took ten
 # times longer with them. Set before anything imports NumPy; an explicit setting wins.
 import os
+import random
 
 if not {"OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"} & set(os.environ):
     os.environ["OPENBLAS_NUM_THREADS"] = "1"
+
+# The run's first DDS domain, drawn here, where pytest-xdist's controller draws it too (it
+# reads no test/ conftest): its workers inherit it and take one domain each from it
+# (test/conftest.py), so no two workers of a run share one.
+os.environ.setdefault("IRB140_TEST_DOMAIN", str(random.SystemRandom().randint(1, 93)))

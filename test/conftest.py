@@ -14,7 +14,7 @@ from pathlib import Path
 
 # Set before rclpy is imported anywhere: a domain of our own, discovery on localhost only.
 WORKERS_AT_MOST = 8  # pytest-xdist workers: domains FIRST_DOMAIN to FIRST_DOMAIN + 7
-FIRST_DOMAIN = int(
+FIRST_DOMAIN = int(  # drawn by the conftest.py at the root (the run's), else here
     os.environ.setdefault("IRB140_TEST_DOMAIN", str(random.SystemRandom().randint(1, 101 - WORKERS_AT_MOST)))
 )
 WORKER = int(os.environ.get("PYTEST_XDIST_WORKER", "gw0").removeprefix("gw"))

@@ -25,6 +25,7 @@ from irb140_dynamics.identification.consistent import is_consistent
 from irb140_dynamics.identification.pipeline import identify
 from irb140_dynamics.tools import excitation as excitation_tool
 from irb140_dynamics.tools import identify as identify_tool
+from irb140_dynamics.tools.cli import shown
 
 from ..support.synthetic_arm import Samples, joint_state_messages, true_arm, write_bag, write_csv
 
@@ -362,9 +363,15 @@ def test_arguments_and_outputs_are_checked_before_the_recording_is_read(workflow
     afile.write_text("")
     cases = [
         (["--out", "/proc/o.yaml"], "identify: error: /proc/o.yaml: cannot write in /proc"),
-        (["--out", f"{afile}/o.yaml"], f"identify: error: {afile}/o.yaml: {afile} is not a directory"),
-        (["--out", str(tmp_path)], f"identify: error: {tmp_path}: is a directory"),
-        (["--out", f"{tmp_path}/o.yaml", "--plots", f"{afile}/p"], f"{afile}/p: {afile} is not a directory"),
+        (
+            ["--out", f"{afile}/o.yaml"],
+            f"identify: error: {shown(f'{afile}/o.yaml')}: {shown(afile)} is not a directory",
+        ),
+        (["--out", str(tmp_path)], f"identify: error: {shown(tmp_path)}: is a directory"),
+        (
+            ["--out", f"{tmp_path}/o.yaml", "--plots", f"{afile}/p"],
+            f"{shown(f'{afile}/p')}: {shown(afile)} is not a directory",
+        ),
         (["--out", f"{tmp_path}/o.yaml", "--cutoff", "inf"], "argument --cutoff: must be a finite number, got 'inf'"),
         (["--out", f"{tmp_path}/o.yaml", "--held-out", "1"], "--held-out: must be < 1, got 1"),
         (["--out", f"{tmp_path}/o.yaml", "--prior-weight", "-1"], "argument --prior-weight: must be > 0, got -1"),

@@ -243,6 +243,8 @@ def prepare(model, timeout: float | None = None, names: tuple[str, ...] = NATIVE
     kernels = kernels_of(model)
     wanted = [kernels.kernel(name) for name in names]
     missing = [kernel for kernel in wanted if kernel.native is None]
+    if native.enabled():  # code of the same arm compiled before: bound at once, no queue
+        missing = [kernel for kernel in missing if not native.COMPILER.bind_built(kernel)]
     compiling = False
     if missing and native.enabled():
         left = None if timeout is None else max(0.0, timeout - (time.monotonic() - start))

@@ -339,6 +339,20 @@ class _Compiler:
         self._put([*kernels, done], first=True)
         return done.wait(timeout)
 
+    def bind_built(self, kernel) -> bool:
+        """Make ``kernel`` native here and now with code compiled already for its program (a
+        model that differs from one compiled before only in payload or gravity): True if so,
+        False when there is none yet (or it gives other numbers). Never waits for the worker."""
+        built = self._built.get((kernel.program, kernel.full_matrix))
+        if built is None or kernel.constants is None:
+            return False
+        bind, lengths, _ = built
+        found = bind(array.array("d", kernel.constants).tobytes())
+        if not same_as_python(found, kernel.scalar, lengths, kernel.full_matrix):
+            return False
+        kernel.native = found
+        return True
+
     def _run(self) -> None:
         while True:
             with self._ready:

@@ -133,7 +133,10 @@ def compiled(settings: IdNodeSettings, previous: IdNodeSettings | None) -> bool:
     kernels = kernels_of(settings.model)
     if not kernels.compiled(*KERNELS):
         return False
-    return not native.enabled() or all(kernels.kernel(name).native is not None for name in KERNELS)
+    return not native.enabled() or all(
+        kernel.native is not None or native.COMPILER.bind_built(kernel)
+        for kernel in (kernels.kernel(name) for name in KERNELS)
+    )
 
 
 def kernels_text(kernels: Preparation | None) -> str:
