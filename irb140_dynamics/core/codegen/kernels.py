@@ -253,13 +253,19 @@ def prepare(model, timeout: float | None = None, names: tuple[str, ...] = NATIVE
     return Preparation(done, time.monotonic() - start, compiling and not done)
 
 
+_MAKING = threading.Lock()  # one Kernels per model, also when threads ask for it at once
+
+
 def kernels_of(model) -> Kernels:
     """The model's kernels, made on first use and kept with the model (models are immutable,
     so they never go stale; a changed model is a new model, with kernels of its own)."""
-    try:
-        return model.__dict__["_kernels"]
-    except KeyError:
-        kernels = model.__dict__["_kernels"] = Kernels(model)
+    kernels = model.__dict__.get("_kernels")
+    if kernels is not None:
+        return kernels
+    with _MAKING:
+        kernels = model.__dict__.get("_kernels")
+        if kernels is None:
+            kernels = model.__dict__["_kernels"] = Kernels(model)
         return kernels
 
 
