@@ -11,6 +11,8 @@ import subprocess
 import sys
 import textwrap
 
+import pytest
+
 from ..support.paths import ROOT
 
 # Run in a fresh interpreter: imports every module under the given packages (the package
@@ -68,6 +70,7 @@ def changes(packages: list[str], roots: list[str], path: str) -> dict:
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
+@pytest.mark.ros  # every module, the nodes' too: needs ROS's messages
 def test_importing_every_module_of_the_package_changes_nothing():
     found = changes(["irb140_dynamics"], [str(ROOT / "irb140_dynamics")], str(ROOT))
     imported = set(found["imported"])

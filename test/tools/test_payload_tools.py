@@ -83,6 +83,7 @@ def test_identify_payload_only_prints_values_with_deviations_and_writes_the_arm_
         assert any(line.startswith(f"#   {label} ") and "+-" in line for line in text.splitlines()), label
 
 
+@pytest.mark.ros  # trajectory_check_node's settings: ROS's messages
 def test_retime_and_the_trajectory_check_use_the_identified_inertia(workflow, identified, capsys):
     """`retime --check-only --params-file LOAD.yaml` prints the torques of the identified
     payload, inertia included (not those of the same mass and CoM without it), and the
