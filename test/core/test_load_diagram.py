@@ -191,25 +191,33 @@ def test_a_prismatic_joint_is_an_angle_of_the_proof():
     assert [cr is not None for cr in forms.sliding] == [j.prismatic for j in model.joints]
 
 
-def test_the_direction_sheared_into_the_wrist_angle_keeps_the_sum():
-    """On the Panda (link 7's CoM off its axis) the CoM's direction and joint 7 cannot merge
-    into one angle; sheared (psi = theta_7 + phi), the sum has the same values: at the
-    sheared angles of any pose, within its error, and every psi maps back to a pose."""
-    from irb140_dynamics.core.payload.proof.harmonic import HarmonicSum
-    from irb140_dynamics.core.scalars.interval import Interval
+def test_the_worst_direction_is_a_lever_and_the_wrist_angle_drops_out():
+    """On the Panda (link 7's CoM off its axis), joint 2's sum over the pose and the CoM's
+    direction phi is A + X cos(phi) + Y sin(phi); without joint 7, A0 + |(P, Q)| + |(X0,
+    Y0)| is the largest value over every turn of joint 7 and every direction."""
+    from irb140_dynamics.core.payload.proof.harmonic import without_wrist
 
     model, _, _ = urdf_case("panda")
     arm = pivoted(model)
     forms = diagram_module._Shapes(arm).family(0.05, 0.1).forms
     torque = forms[0].affine(forms[1], 2.0).torque[1]  # joint 2's
-    sheared = torque.reduced(merge=True, shear=(arm.n - 1,))
-    assert sheared.shears and sheared.shears[0][1] == arm.n - 1
+    parts = torque.over_direction()
     lower, upper = np.array([j.position_limits for j in arm.joints]).T
     theta = lower + np.random.default_rng(6).random((40, arm.n)) * (upper - lower)
-    as_sum = HarmonicSum(sheared.dims, Interval(sheared.coefficients))
-    np.testing.assert_allclose(as_sum(sheared.fold(theta)), torque(theta), atol=float(sheared.error) + 1e-9)
-    back = sheared.angles(sheared.fold(theta), lower, upper)
-    np.testing.assert_allclose(as_sum(sheared.fold(back)), torque(theta), atol=float(sheared.error) + 1e-9)
+    A, X, Y = parts(theta[:, :-1]).T
+    phi = theta[:, -1]
+    np.testing.assert_allclose(A + X * np.cos(phi) + Y * np.sin(phi), torque(theta), atol=1e-9)
+    wrist = without_wrist(parts)
+    assert wrist is not None and wrist.dims == parts.dims[:-1]
+    A0, P, Q, X0, Y0 = wrist(theta[:, :-2]).T
+    bound = A0 + np.hypot(P, Q) + np.hypot(X0, Y0)
+    turns = np.linspace(-math.pi, math.pi, 3601)
+    for k in range(5):  # the worst direction of each turn of joint 7 (A + |(X, Y)|, as checked above)
+        grid = np.repeat(theta[k : k + 1, :-1], turns.size, axis=0)
+        grid[:, -1] = turns
+        A, X, Y = parts(grid).T
+        worst = np.max(A + np.hypot(X, Y))
+        assert bound[k] - 1e-6 <= worst <= bound[k] + 1e-9, (worst, bound[k])
 
 
 def test_an_arm_that_cannot_hold_itself_has_no_mass_anywhere():

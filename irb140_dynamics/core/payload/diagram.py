@@ -47,7 +47,7 @@ from irb140_dynamics.core.payload.workspace import JointRanges
 
 MARGINS = (0.005, 0.015)  # the proof aims at (1 - margin) of the mass the search finds; the next if it fails
 ROUNDS = 4  # proofs per point (each after Dinkelbach from the worse poses the last one found, or with the next margin)
-PROOF_SHARE = 4.0  # of ``certify.EVALUATIONS`` per proof: a heavy arm's own torques leave a payload little room
+PROOF_SHARE = 16.0  # of ``certify.EVALUATIONS`` per proof: a heavy arm's own torques leave a payload little room
 DIRECTION = "load_direction"  # the name of the joint that turns the CoM about the flange axis
 
 
@@ -109,7 +109,7 @@ class _Shapes:
         if self.forms is not None:
             empty, origin, x, up = self.forms
             given = (empty, _mixed(origin, [(x, l), (up, z)]))
-        direction = (self.arm.n - 1,)  # a whole turn: its shear is exact
+        direction = self.arm.n - 1  # a whole turn: the worst direction is A + |(X, Y)|
         return PayloadFamily(self.arm.with_payload(RigidBody(0.0)), self.arm.with_payload(shape), given, direction)
 
 

@@ -34,7 +34,7 @@ from irb140_dynamics.core.model.rigid_body import RigidBody
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.payload.proof import certify
 from irb140_dynamics.core.payload.proof.certify import Objective, certify_maxima, interval_maxima
-from irb140_dynamics.core.payload.proof.harmonic import StaticForms
+from irb140_dynamics.core.payload.proof.harmonic import StaticForms, without_wrist
 from irb140_dynamics.core.payload.stop import ran_out
 from irb140_dynamics.core.payload.workspace import JointRanges
 from irb140_dynamics.core.scalars.interval import Interval, bounds_of
@@ -70,7 +70,7 @@ class PayloadFamily:
     empty: RobotModel  # the payload at 0 kg
     unit: RobotModel  # the payload at 1 kg
     given_forms: tuple[StaticForms, StaticForms] | None = None  # the forms, if already known
-    shear: tuple[int, ...] = ()  # joints whose angle the proof may shear (see harmonic.shear_parallel)
+    direction: int | None = None  # the last joint, if it turns the payload's CoM about the flange axis (a whole turn)
 
     def torques(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
         """(tau0, dtau) [N m, N m/kg] that hold the motion (q, qd) with qdd = 0."""
@@ -164,14 +164,7 @@ class PayloadFamily:
         def joints_of(theta):  # joint values q of angles theta (prismatic: their displacements)
             return np.clip(forms.joints_of(theta) - offsets, ranges.lower, ranges.upper)
 
-        objectives = [
-            Objective(
-                (forms.torque[j] * sign).reduced(merge=True, shear=self.shear),
-                forms.omega[j].reduced(),
-                forms.gravity_norm,
-            )
-            for j, sign in zip(joints, signs)
-        ]
+        objectives = [self._objective(forms, j, sign, m) for j, sign in zip(joints, signs)]
         boxes = [objective.value.box(lower, upper) for objective in objectives]
 
         def angles(k, theta):  # the joint angles of objective k's box (parallel joints merged)
@@ -200,6 +193,22 @@ class PayloadFamily:
             higher = value > values[found]
             values[found[higher]], poses[found[higher]] = value[higher], pose[higher]
         return Extremes(values, poses, np.maximum(bounds, values))
+
+    def _objective(self, forms: StaticForms, j: int, sign: float, m: float) -> Objective:
+        """+-tau_j at m kg as the proof's objective; with a ``direction`` joint, its worst
+        value over the directions: A + |(X, Y)| (see ``Objective``), not one more angle;
+        and without the last joint where it only turns the CoM about the flange axis (see
+        ``harmonic.without_wrist``: a lever more)."""
+        torque, omega = forms.torque[j] * sign, forms.omega[j]
+        if self.direction is None or j == self.direction:
+            return Objective(torque.reduced(merge=True), omega.reduced(), forms.gravity_norm)
+        parts = torque.over_direction()
+        if parts.dims and parts.dims[-1] == self.direction - 1:
+            parts = without_wrist(parts) or parts
+        parts = parts.reduced(merge=True)
+        value = replace(parts, coefficients=parts.coefficients[0], error=parts.error[0])
+        lever = replace(parts, coefficients=parts.coefficients[1:], error=parts.error[1:])
+        return Objective(value, omega.reduced(), forms.gravity_norm, lever)
 
     def _interval_torques(self, m, offsets):
         """(lo, hi) per joint (n, B) of the static torques at m kg over boxes of q (B, n)."""

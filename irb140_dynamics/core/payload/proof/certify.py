@@ -59,11 +59,18 @@ SLICE = 2048  # box bounds per turn of a group
 
 @dataclass(frozen=True, eq=False)
 class Objective:
-    """Maximise ``value`` over the box; |value| <= gravity_norm |norm| holds too (norm: 3 sums)."""
+    """Maximise ``value`` + sum of |lever_p| over the box (lever: pairs of sums over the
+    value's joints, merged alike, or none); the objective is at most gravity_norm |norm|
+    too (norm: 3 sums, over the box's joints).
+
+    A lever is a payload's CoM turned about the flange axis in the worst direction phi:
+    the torque A + X cos(phi) + Y sin(phi) is at most A + |(X, Y)|, reached at some phi
+    (see ``harmonic.HarmonicSum.over_direction``)."""
 
     value: Reduced
     norm: Reduced
     gravity_norm: float
+    lever: Reduced | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,7 +105,7 @@ def certify_maxima(objectives, lower, upper, incumbent, tol, polish=None, evalua
     n = lower.shape[1]
     members: dict[tuple, list[int]] = {}
     for k, objective in enumerate(objectives):
-        members.setdefault((objective.value.dims, objective.norm.dims), []).append(k)
+        members.setdefault((objective.value.dims, objective.norm.dims, objective.lever is None), []).append(k)
     groups = []
     for ks in members.values():
         ks = np.array(ks)
@@ -134,10 +141,18 @@ class _Group:
         norm_error = np.array([np.sum(o.norm.error) for o in objectives])
         self.norm_slack = g * (norm_error + rounding(len(self.norm_dims)) * norm_size)
         self.gravity = g * (1 + 8 * U)
-        self.cost = max(1.0, (3 ** len(self.value_dims) + 3 ** (len(self.norm_dims) + 1)) / TERMS)
+        self.levers, self.lever_slack = None, np.zeros(len(objectives))
+        if first.lever is not None:
+            self.levers = np.array([o.lever.coefficients for o in objectives])  # (K, 2 P, 3^d): P pairs
+            lever_error = np.array([np.sum(o.lever.error) for o in objectives])
+            self.lever_slack = lever_error + rounding(len(self.value_dims)) * np.abs(self.levers).sum(axis=(1, 2))
+        levers = 0 if self.levers is None else self.levers.shape[1] * 3 ** len(self.value_dims)
+        self.cost = max(1.0, (3 ** len(self.value_dims) + levers + 3 ** (len(self.norm_dims) + 1)) / TERMS)
         K, n = lower.shape
         upper = np.minimum(upper, lower + 2 * math.pi)  # the sums repeat every turn
-        self.tol = np.maximum(tol, 4 * (self.value_slack + self.norm_slack))  # rounding is not to be closed
+        self.tol = np.maximum(
+            tol, 4 * (self.value_slack + self.lever_slack + self.norm_slack)
+        )  # rounding is not to be closed
         self.polish = polish
         self.lo, self.hi, self.owner = lower.copy(), upper.copy(), np.arange(K)
         self.inherited = np.full(K, np.inf)
@@ -234,12 +249,58 @@ class _Group:
         B, n = centre.shape
         d = self.value_dims
         D = expand(self.values[owner], centre[:, d])
-        g, Q, high, terms = model(D, sizes(radius[:, d]), radius[:, d])
+        W, sigma = sizes(radius[:, d]), sizes_of_s(radius[:, d])
+        g, Q, high, terms = model(D, W, radius[:, d])
         base = D[:, 0] + high + self.value_slack[owner]
-        bound = base + quadratic_max(g, Q, sizes_of_s(radius[:, d]), enough=target - base)
+        value = D[:, 0] - self.value_slack[owner]
+        if self.levers is None:
+            bound = base + quadratic_max(g, Q, sigma, enough=target - base)
+        else:
+            bound, at_centre, lever_terms = self._lever_bound(
+                owner, centre[:, d], radius[:, d], W, sigma, (g, Q, base), target
+            )
+            value = value + at_centre - self.lever_slack[owner]
+            terms = terms + lever_terms
         weight = np.zeros((B, n))
         weight[:, d] = terms @ layout(len(d)).involves
-        return bound, D[:, 0] - self.value_slack[owner], weight
+        return bound, value, weight
+
+    def _lever_bound(self, owner, centre, radius, W, sigma, value_model, target):
+        """Bounds of value + sum of |v_p| over the boxes, v_p = (X_p, Y_p) the levers, given
+        the value's quadratic model (g, Q; the rest ``base``); the sum at the centres; the
+        size of the levers' terms.
+
+        |v|^2 <= M(s), a quadratic model as in ``_norm_bound``. For any a > 0, |v| <= a / 2
+        + |v|^2 / (2 a) (equal where |v| = a): with a = |v(centre)| the bound is one model,
+        exact to first order, maximised with the value's. Also, where that one is above
+        its target: value's bound + sum of sqrt(max M_p)."""
+        B, d = centre.shape
+        g, Q, base = value_model
+        pairs = self.levers.shape[1] // 2
+        N = expand(self.levers[owner].reshape(B * 2 * pairs, -1), np.repeat(centre, 2 * pairs, axis=0))
+        N = N.reshape(B, pairs, 2, -1)
+        models = [_squared_model(N[:, p], W, sigma, radius) for p in range(pairs)]
+        at_centre = sum(m[0] for m in models)
+        lever_terms = sum(m[4] for m in models)
+        constant, g_all, Q_all, room = base + self.lever_slack[owner], g.copy(), Q.copy(), np.abs(base)
+        for size, squared, g_v, Q_v, _ in models:
+            a = np.maximum(size, 1e-150)
+            k = 0.5 / a
+            constant = constant + 0.5 * a + k * squared
+            g_all, Q_all = g_all + 2 * k[:, None] * g_v, Q_all + 2 * k[:, None, None] * Q_v
+            room = room + a + k * np.abs(squared)
+        room = 1e-12 * room
+        enough = target - constant - room - 1e-12 * np.abs(target)
+        bound = constant + quadratic_max(g_all, Q_all, sigma, enough)
+        bound = bound + room + 1e-12 * np.abs(bound)
+        rows = np.flatnonzero(~(bound <= target))
+        if rows.size:
+            second = base[rows] + quadratic_max(g[rows], Q[rows], sigma[rows]) + self.lever_slack[owner[rows]]
+            for _, squared, g_v, Q_v, _ in models:
+                norm_max = squared[rows] + quadratic_max(2 * g_v[rows], 2 * Q_v[rows], sigma[rows])
+                second = second + np.sqrt(np.maximum(norm_max, 0.0)) * (1 + 1e-12)
+            bound[rows] = np.minimum(bound[rows], second + room[rows] + 1e-12 * np.abs(second))
+        return bound, at_centre * (1 - 1e-12), lever_terms
 
     def _norm_bound(self, owner, centre, radius, target):
         """|tau_j| <= |g| |omega_j| over the boxes, |g| |omega_j| at the centres, and the
@@ -270,6 +331,27 @@ class _Group:
         weight = np.zeros((B, n))
         weight[:, e] = (along_terms + (np.abs(N) * W[:, None]).sum(axis=1)) @ where.involves
         return bound, gravity * np.sqrt((at_centre**2).sum(axis=1)), weight
+
+
+def _squared_model(N, W, sigma, radius):
+    """For 2 sums re-expanded about the centres N (B, 2, 3^d): |v| at the centres, and
+    |v|^2 <= squared + 2 g . s + s^T Q s over the boxes (as in ``_norm_bound``); the size
+    of each term (B, 3^d)."""
+    where = layout(radius.shape[1])
+    middle = N[:, :, 0]
+    along = np.einsum("bc,bca->ba", middle, N)
+    along[:, 0] = 0.0
+    g_v, Q_v, high_v, _ = model(along, W, radius)
+    A = N[:, :, where.single_s]  # (B, 2, d)
+    rest = np.abs(N) * W[:, None]
+    terms = rest.sum(axis=1)
+    rest[:, :, 0] = 0.0
+    rest[:, :, where.single_s] = 0.0
+    rest = np.sqrt((rest.sum(axis=2) ** 2).sum(axis=1))
+    linear = (np.sqrt((A**2).sum(axis=1)) * sigma).sum(axis=1)
+    size = np.sqrt((middle**2).sum(axis=1))
+    squared = size**2 + 2 * high_v + 2 * linear * rest + rest**2
+    return size, squared, g_v, Q_v + np.einsum("bck,bcl->bkl", A, A), terms
 
 
 INTERVAL_WORK = 20_000  # box x joint evaluations of plain interval bounds (beyond harmonic.MAX_JOINTS)
