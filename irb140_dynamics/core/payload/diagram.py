@@ -48,6 +48,9 @@ from irb140_dynamics.core.payload.workspace import JointRanges
 MARGINS = (0.005, 0.015)  # the proof aims at (1 - margin) of the mass the search finds; the next if it fails
 ROUNDS = 4  # proofs per point (each after Dinkelbach from the worse poses the last one found, or with the next margin)
 PROOF_SHARE = 16.0  # of ``certify.EVALUATIONS`` per proof: a heavy arm's own torques leave a payload little room
+MOST_JOINTS = (
+    9  # moving joints whose diagram the harmonic proof takes (3^10 terms with the direction; plain intervals beyond)
+)
 DIRECTION = "load_direction"  # the name of the joint that turns the CoM about the flange axis
 
 
@@ -100,7 +103,7 @@ class _Shapes:
     def __init__(self, arm: RobotModel):
         self.arm = arm
         basis = [RigidBody(0.0), RigidBody(1.0), RigidBody(1.0, (1.0, 0.0, 0.0)), RigidBody(1.0, (0.0, 0.0, 1.0))]
-        forms = [StaticForms.of(arm.with_payload(body)) for body in basis]
+        forms = [StaticForms.of(arm.with_payload(body), MOST_JOINTS + 1) for body in basis]
         self.forms = None if forms[0] is None else forms
 
     def family(self, z: float, l: float) -> PayloadFamily:

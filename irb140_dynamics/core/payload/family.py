@@ -165,14 +165,18 @@ class PayloadFamily:
             return np.clip(forms.joints_of(theta) - offsets, ranges.lower, ranges.upper)
 
         objectives = [self._objective(forms, j, sign, m) for j, sign in zip(joints, signs)]
-        boxes = [objective.value.box(lower, upper) for objective in objectives]
+        boxes = [objective.norm.box(*objective.value.box(lower, upper)) for objective in objectives]
 
-        def angles(k, theta):  # the joint angles of objective k's box (parallel joints merged)
-            return np.array([objectives[i].value.angles(t, lower, upper)[0] for i, t in zip(k, theta)])
+        def angles(k, theta):  # the joint angles of objective k's box (parallel joints merged: before j, after j)
+            joined = [(objectives[i], objectives[i].norm.angles(t, lower, upper)) for i, t in zip(k, theta)]
+            return np.array([objective.value.angles(t, lower, upper)[0] for objective, t in joined])
 
         def polish(k, theta):
             found, pose = ranges.climb(torque, weights[rows[k]], joints_of(angles(k, theta)))
-            return found, np.array([objectives[i].value.fold(t)[0] for i, t in zip(k, forms.angles_of(pose + offsets))])
+            folded = [
+                objectives[i].norm.fold(objectives[i].value.fold(t)) for i, t in zip(k, forms.angles_of(pose + offsets))
+            ]
+            return found, np.array([t[0] for t in folded])
 
         proof = certify_maxima(
             objectives,
@@ -182,6 +186,7 @@ class PayloadFamily:
             tol[rows],
             polish,
             int(share * certify.EVALUATIONS),
+            None if ceiling is None else ceiling[rows],
         )
         bounds[rows] = proof.bound
         values, poses = values.copy(), poses.copy()
@@ -207,8 +212,15 @@ class PayloadFamily:
             parts = without_wrist(parts) or parts
         parts = parts.reduced(merge=True)
         value = replace(parts, coefficients=parts.coefficients[0], error=parts.error[0])
-        lever = replace(parts, coefficients=parts.coefficients[1:], error=parts.error[1:])
-        return Objective(value, omega.reduced(), forms.gravity_norm, lever)
+        pairs = [p for p in range(parts.error.size // 2) if np.any(parts.coefficients[1 + 2 * p : 3 + 2 * p])]
+        keep = [1 + 2 * p + k for p in pairs for k in (0, 1)]  # (a pair all zeros: a CoM on the axis)
+        vanished = float(np.sum(np.delete(parts.error[1:], np.array(keep, dtype=int) - 1)))
+        value = replace(value, error=value.error + vanished)
+        lever = replace(parts, coefficients=parts.coefficients[keep], error=parts.error[keep]) if keep else None
+        norm = omega.reduced(merge=True)  # (the direction an angle there, merged with a wrist it turns with)
+        if any(a in value.dims or b in value.dims for a, b, _ in norm.merges):  # (their box is the value's too)
+            norm = omega.reduced()
+        return Objective(value, norm, forms.gravity_norm, lever)
 
     def _interval_torques(self, m, offsets):
         """(lo, hi) per joint (n, B) of the static torques at m kg over boxes of q (B, n)."""

@@ -85,7 +85,9 @@ class Maxima:
     evaluations: int
 
 
-def certify_maxima(objectives, lower, upper, incumbent, tol, polish=None, evaluations: int | None = None) -> Maxima:
+def certify_maxima(
+    objectives, lower, upper, incumbent, tol, polish=None, evaluations: int | None = None, ceiling=None
+) -> Maxima:
     """Upper bounds of the objectives' maxima over theta in [lower, upper] ((n,), or (K, n):
     a box per objective), proven to
     within ``tol`` (K,) of the best value known (``incumbent`` (K,), values at real poses)
@@ -96,6 +98,8 @@ def certify_maxima(objectives, lower, upper, incumbent, tol, polish=None, evalua
     Where a box's centre beats the best value known by more than tol, the search missed a
     maximum there: ``polish(indices, theta)`` (objectives (P,), angles (P, n)) -> (values,
     theta) climbs from it to the real poses' values, which then serve as the best known.
+    ``ceiling`` (K,): a box whose bound is at most its objective's ceiling is closed too,
+    however the best value moves (a decision: is the maximum below the ceiling?).
     """
     evaluations = EVALUATIONS if evaluations is None else evaluations
     K = len(objectives)
@@ -110,7 +114,10 @@ def certify_maxima(objectives, lower, upper, incumbent, tol, polish=None, evalua
     for ks in members.values():
         ks = np.array(ks)
         climb = None if polish is None else (lambda local, theta, ks=ks: polish(ks[local], theta))
-        groups.append((ks, _Group([objectives[k] for k in ks], lower[ks], upper[ks], incumbent[ks], tol[ks], climb)))
+        group = _Group([objectives[k] for k in ks], lower[ks], upper[ks], incumbent[ks], tol[ks], climb)
+        if ceiling is not None:
+            group.ceiling = np.asarray(ceiling, dtype=float)[ks]
+        groups.append((ks, group))
     spent = sum(group.advance(group.boxes) * group.cost for _, group in groups)  # the whole box, whatever the budget
     while spent < evaluations and not out_of_time():
         open_groups = [group for _, group in groups if group.boxes]
@@ -154,6 +161,9 @@ class _Group:
             tol, 4 * (self.value_slack + self.lever_slack + self.norm_slack)
         )  # rounding is not to be closed
         self.polish = polish
+        self.ceiling = np.full(
+            K, np.inf
+        )  # a bound at most this closes a box, whatever the best value (see certify_maxima)
         self.lo, self.hi, self.owner = lower.copy(), upper.copy(), np.arange(K)
         self.inherited = np.full(K, np.inf)
         self.best, self.closed = incumbent.copy(), np.full(K, -np.inf)
@@ -181,12 +191,13 @@ class _Group:
             now, later = order[:take], order[take:]
             centre, radius = 0.5 * (lo[now] + hi[now]), 0.5 * (hi[now] - lo[now])
             k = owner[now]
-            bound, value, weight = self._bound(k, centre, radius, best[k] + tol[k])
+            target = np.maximum(np.minimum(best[k] + tol[k], self.ceiling[k]), best[k])
+            bound, value, weight = self._bound(k, centre, radius, target)
             spent += take
             self._improve(k, value, centre, best, tol, self.polish, self.best_value, self.best_theta)
             weight = np.where(hi[now] > lo[now], weight, -1.0)  # a joint whose range is a point cannot split
             kept = bound >= best[k]
-            done = kept & ((bound <= best[k] + tol[k]) | (weight.max(axis=1) <= 0))  # (nothing to split: as is)
+            done = kept & ((bound <= target) | (weight.max(axis=1) <= 0))  # (nothing to split: as is)
             np.maximum.at(self.closed, k[done], bound[done])
             split = now[kept & ~done]
             axis = np.argmax(weight[kept & ~done], axis=1)
@@ -295,9 +306,10 @@ class _Group:
         bound = bound + room + 1e-12 * np.abs(bound)
         rows = np.flatnonzero(~(bound <= target))
         if rows.size:
-            second = base[rows] + quadratic_max(g[rows], Q[rows], sigma[rows]) + self.lever_slack[owner[rows]]
+            never = None
+            second = base[rows] + quadratic_max(g[rows], Q[rows], sigma[rows], never) + self.lever_slack[owner[rows]]
             for _, squared, g_v, Q_v, _ in models:
-                norm_max = squared[rows] + quadratic_max(2 * g_v[rows], 2 * Q_v[rows], sigma[rows])
+                norm_max = squared[rows] + quadratic_max(2 * g_v[rows], 2 * Q_v[rows], sigma[rows], never)
                 second = second + np.sqrt(np.maximum(norm_max, 0.0)) * (1 + 1e-12)
             bound[rows] = np.minimum(bound[rows], second + room[rows] + 1e-12 * np.abs(second))
         return bound, at_centre * (1 - 1e-12), lever_terms

@@ -164,9 +164,9 @@ class StaticForms:
     sliding: tuple[tuple[float, float] | None, ...] = ()  # per joint: a prismatic one's (c, r), see ``slide``
 
     @classmethod
-    def of(cls, model) -> StaticForms | None:
-        """The forms of ``model`` (None beyond MAX_JOINTS joints)."""
-        if model.n > MAX_JOINTS:
+    def of(cls, model, most: int = MAX_JOINTS) -> StaticForms | None:
+        """The forms of ``model`` (None beyond ``most`` joints)."""
+        if model.n > most:
             return None
         kernels = kernels_of(model)
         sliding = tuple(slide(j.position_limits) if j.prismatic else None for j in model.joints)
