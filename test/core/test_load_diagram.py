@@ -5,17 +5,19 @@ for the URDF arms): random poses and directions, then local optimisation from th
 
 import math
 import os
+from dataclasses import replace
 
 import numpy as np
 import pinocchio as pin
 import pytest
 from scipy.optimize import minimize
 
-from irb140_dynamics.core import RigidBody, derive_torque_limits, gravity, gravity_batch, irb140
+from irb140_dynamics.core import Joint, RigidBody, RobotModel, derive_torque_limits, gravity, gravity_batch, irb140
 from irb140_dynamics.core.io.urdf import load_urdf
 from irb140_dynamics.core.payload import diagram as diagram_module
 from irb140_dynamics.core.payload.diagram import load_diagram, pivoted
 from irb140_dynamics.core.payload.proof.harmonic import StaticForms
+from irb140_dynamics.core.urdf import export_urdf
 
 from ..support.paths import URDF_DATA
 from ..support.pinocchio_model import build
@@ -93,8 +95,28 @@ def prismatic_case():
     return model, model.torque_limits, models
 
 
+def gantry():
+    """A 9-joint arm: the IRB-140 on a 3-axis gantry (x, y, z prismatic, 15 kg carriages)."""
+    arm = irb140()
+    carriage = RigidBody(15.0, (0.0, 0.0, 0.05), (0.3, 0.3, 0.3, 0.0, 0.0, 0.0))
+    slides = [
+        Joint(f"gantry_{name}", link=carriage, position_limits=(0.0, 1.5), axis=axis, kind="prismatic")
+        for name, axis in (("x", (1.0, 0.0, 0.0)), ("y", (0.0, 1.0, 0.0)), ("z", (0.0, 0.0, 1.0)))
+    ]
+    return RobotModel(tuple(slides) + arm.joints, arm.gravity)
+
+
+def gantry_case():
+    """The gantry, its limits derived; Pinocchio's models from its URDF (Pinocchio's parser)."""
+    model = gantry()
+    text = export_urdf(model, name="gantry_irb140")
+    models = payload_models(lambda body: pinocchio_of(text, (), "flange", body))
+    return model, derive_torque_limits(model).values, models
+
+
 CASES = {
     "irb140": irb140_case,
+    "gantry_irb140": gantry_case,
     "ur5": lambda: urdf_case("ur5"),
     "panda": lambda: urdf_case("panda"),
     "prismatic_arm": prismatic_case,
@@ -102,7 +124,8 @@ CASES = {
 GRIDS = {
     "irb140": ([0.0, 0.12], [0.0, 0.08]),
     "ur5": ([0.0, 0.15], [0.0, 0.1]),
-    "panda": ([0.0, 0.1], [0.0]),
+    "panda": ([0.0], [0.0, 0.05]),
+    "gantry_irb140": ([0.0, 0.1], [0.0, 0.1]),
     "prismatic_arm": ([0.0, 0.2], [0.0, 0.1]),
 }
 
@@ -148,6 +171,14 @@ def test_proven_masses_are_below_the_true_maximum_and_within_2_percent(arm):
         found = independent.search(p.z, p.l, rng)
         assert p.mass <= found * (1 + 1e-9), (p.z, p.l, p.mass, found)  # a real pose holds no more
         assert p.mass >= 0.98 * found, (p.z, p.l, p.mass, found)
+
+
+def test_nine_moving_joints_get_the_harmonic_proof():
+    """Up to 9 moving joints (10 angles with the CoM's direction) the diagram's proof is the
+    harmonic one; beyond, plain interval bounds."""
+    assert diagram_module._Shapes(pivoted(gantry())).forms is not None
+    ten = RobotModel((replace(gantry().joints[0], name="gantry_w"),) + gantry().joints, irb140().gravity)
+    assert diagram_module._Shapes(pivoted(ten)).forms is None
 
 
 def test_the_mass_is_the_minimum_over_directions_not_one_direction():

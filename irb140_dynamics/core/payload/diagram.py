@@ -42,15 +42,13 @@ from irb140_dynamics.core.model.rigid_body import MAX_MASS, RigidBody
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.payload.family import PayloadFamily
 from irb140_dynamics.core.payload.limits import limit_values, smallest_max_payload
-from irb140_dynamics.core.payload.proof.harmonic import StaticForms
+from irb140_dynamics.core.payload.proof.harmonic import MAX_JOINTS, StaticForms
 from irb140_dynamics.core.payload.workspace import JointRanges
 
 MARGINS = (0.005, 0.015)  # the proof aims at (1 - margin) of the mass the search finds; the next if it fails
 ROUNDS = 4  # proofs per point (each after Dinkelbach from the worse poses the last one found, or with the next margin)
 PROOF_SHARE = 16.0  # of ``certify.EVALUATIONS`` per proof: a heavy arm's own torques leave a payload little room
-MOST_JOINTS = (
-    9  # moving joints whose diagram the harmonic proof takes (3^10 terms with the direction; plain intervals beyond)
-)
+MOST_JOINTS = MAX_JOINTS  # moving joints the harmonic proof takes (and the direction: 3^10 terms; intervals beyond)
 DIRECTION = "load_direction"  # the name of the joint that turns the CoM about the flange axis
 
 
@@ -199,7 +197,10 @@ def _holds_alone(family: PayloadFamily, ranges: JointRanges, L: np.ndarray) -> b
     being affine in the mass, every mass below one proven to hold holds too."""
     limited = np.flatnonzero(np.isfinite(np.tile(L, 2)))
     ceiling = np.tile(L, 2)
-    proof = family.extremes(0.0, ranges, rows=limited, ceiling=ceiling, share=PROOF_SHARE)
+    found = family.search(0.0, ranges)
+    if np.any(found[0][limited] > ceiling[limited]):  # a real pose beyond a limit: no proof can hold
+        return False
+    proof = family.extremes(0.0, ranges, rows=limited, found=found, ceiling=ceiling, share=PROOF_SHARE)
     return bool(np.all(proof.bounds[limited] <= ceiling[limited]))
 
 

@@ -36,7 +36,7 @@ from irb140_dynamics.core.algorithms import recursions as algorithms
 from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.scalars.interval import Interval, bounds_of
 
-MAX_JOINTS = 8  # 3^8 = 6561 coefficients per sum
+MAX_JOINTS = 9  # 3^9 = 19683 coefficients per sum
 NOISE = 1e-14  # a joint whose terms weigh less than this fraction of a sum is dropped from it
 _COS, _SIN = np.array([1.0, 0.0, -1.0]), np.array([0.0, 1.0, 0.0])  # theta = 0, pi/2, pi
 
