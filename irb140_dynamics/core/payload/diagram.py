@@ -8,9 +8,11 @@ it may point in any direction about the axis (how the tool is turned is not know
 mass must hold for every direction phi too: the CoM (l cos phi, l sin phi, z). The
 direction is one more joint: ``pivoted`` adds a massless revolute joint about the flange's
 z axis, turning over [-pi, pi], and the payload sits at (l, 0, z) in its frame; its own
-torque is not limited. The proof then covers every pose AND every direction at once (for
-a wrist whose last joint turns about the flange axis the two merge into one angle, see
-``harmonic.merge_parallel``).
+torque is not limited. The search takes it as an angle; the proof covers every pose AND
+every direction at once without one: at a pose a torque is A + X cos(phi) + Y sin(phi),
+at most A + |(X, Y)| (see ``family.PayloadFamily.direction``), bounded over the poses, and
+a wrist joint that only turns the CoM about the flange axis drops out with it
+(``harmonic.without_wrist``).
 
 At each point the payload's torques are affine in its mass (see ``family``). Dinkelbach's
 iteration over searched poses gives the mass m* at which a real pose reaches a limit (an

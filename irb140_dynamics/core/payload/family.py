@@ -210,6 +210,7 @@ class PayloadFamily:
         parts = torque.over_direction()
         if parts.dims and parts.dims[-1] == self.direction - 1:
             parts = without_wrist(parts) or parts
+        reached = (False, True) if parts.coefficients.lo.shape[0] == 5 else (True,)  # ((P, Q): the wrist's turn)
         parts = parts.reduced(merge=True)
         value = replace(parts, coefficients=parts.coefficients[0], error=parts.error[0])
         pairs = [p for p in range(parts.error.size // 2) if np.any(parts.coefficients[1 + 2 * p : 3 + 2 * p])]
@@ -217,10 +218,11 @@ class PayloadFamily:
         vanished = float(np.sum(np.delete(parts.error[1:], np.array(keep, dtype=int) - 1)))
         value = replace(value, error=value.error + vanished)
         lever = replace(parts, coefficients=parts.coefficients[keep], error=parts.error[keep]) if keep else None
+        reached = tuple(reached[p] for p in pairs)
         norm = omega.reduced(merge=True)  # (the direction an angle there, merged with a wrist it turns with)
         if any(a in value.dims or b in value.dims for a, b, _ in norm.merges):  # (their box is the value's too)
             norm = omega.reduced()
-        return Objective(value, norm, forms.gravity_norm, lever)
+        return Objective(value, norm, forms.gravity_norm, lever, reached)
 
     def _interval_torques(self, m, offsets):
         """(lo, hi) per joint (n, B) of the static torques at m kg over boxes of q (B, n)."""

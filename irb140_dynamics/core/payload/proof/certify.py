@@ -65,12 +65,14 @@ class Objective:
 
     A lever is a payload's CoM turned about the flange axis in the worst direction phi:
     the torque A + X cos(phi) + Y sin(phi) is at most A + |(X, Y)|, reached at some phi
-    (see ``harmonic.HarmonicSum.over_direction``)."""
+    (see ``harmonic.HarmonicSum.over_direction``); one of a joint whose range is not a whole
+    turn is not always reached (``reached``: the value at a box's centre counts -|lever|)."""
 
     value: Reduced
     norm: Reduced
     gravity_norm: float
     lever: Reduced | None = None
+    reached: tuple[bool, ...] = ()  # per pair: is |lever_p| reached in the box (a whole turn)? (else -|lever_p|)
 
 
 @dataclass(frozen=True, eq=False)
@@ -151,6 +153,8 @@ class _Group:
         self.levers, self.lever_slack = None, np.zeros(len(objectives))
         if first.lever is not None:
             self.levers = np.array([o.lever.coefficients for o in objectives])  # (K, 2 P, 3^d): P pairs
+            pairs = self.levers.shape[1] // 2
+            self.reached = np.array([[o.reached[p] if o.reached else True for p in range(pairs)] for o in objectives])
             lever_error = np.array([np.sum(o.lever.error) for o in objectives])
             self.lever_slack = lever_error + rounding(len(self.value_dims)) * np.abs(self.levers).sum(axis=(1, 2))
         levers = 0 if self.levers is None else self.levers.shape[1] * 3 ** len(self.value_dims)
@@ -291,7 +295,8 @@ class _Group:
         N = expand(self.levers[owner].reshape(B * 2 * pairs, -1), np.repeat(centre, 2 * pairs, axis=0))
         N = N.reshape(B, pairs, 2, -1)
         models = [_squared_model(N[:, p], W, sigma, radius) for p in range(pairs)]
-        at_centre = sum(m[0] for m in models)
+        reached = np.where(self.reached[owner], 1.0, -1.0)  # (a value at the centres: a real one, or below)
+        at_centre = sum(m[0] * reached[:, p] for p, m in enumerate(models))
         lever_terms = sum(m[4] for m in models)
         constant, g_all, Q_all, room = base + self.lever_slack[owner], g.copy(), Q.copy(), np.abs(base)
         for size, squared, g_v, Q_v, _ in models:
