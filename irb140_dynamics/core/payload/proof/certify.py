@@ -47,6 +47,7 @@ from irb140_dynamics.core.payload.proof.bounds import (
     rounding,
     sizes,
     sizes_of_s,
+    squared_model,
 )
 from irb140_dynamics.core.payload.proof.harmonic import Reduced
 from irb140_dynamics.core.payload.stop import out_of_time
@@ -197,6 +198,7 @@ class _Group:
             k = owner[now]
             target = np.maximum(np.minimum(best[k] + tol[k], self.ceiling[k]), best[k])
             bound, value, weight = self._bound(k, centre, radius, target)
+            bound = np.where(np.isnan(bound), np.inf, bound)  # (a bound that failed bounds nothing: the box stays)
             spent += take
             self._improve(k, value, centre, best, tol, self.polish, self.best_value, self.best_theta)
             weight = np.where(hi[now] > lo[now], weight, -1.0)  # a joint whose range is a point cannot split
@@ -285,7 +287,7 @@ class _Group:
         the value's quadratic model (g, Q; the rest ``base``); the sum at the centres; the
         size of the levers' terms.
 
-        |v|^2 <= M(s), a quadratic model as in ``_norm_bound``. For any a > 0, |v| <= a / 2
+        |v|^2 <= M(s), a quadratic model (``bounds.squared_model``). For any a > 0, |v| <= a / 2
         + |v|^2 / (2 a) (equal where |v| = a): with a = |v(centre)| the bound is one model,
         exact to first order, maximised with the value's. Also, where that one is above
         its target: value's bound + sum of sqrt(max M_p)."""
@@ -294,7 +296,7 @@ class _Group:
         pairs = self.levers.shape[1] // 2
         N = expand(self.levers[owner].reshape(B * 2 * pairs, -1), np.repeat(centre, 2 * pairs, axis=0))
         N = N.reshape(B, pairs, 2, -1)
-        models = [_squared_model(N[:, p], W, sigma, radius) for p in range(pairs)]
+        models = [squared_model(N[:, p], W, sigma, radius) for p in range(pairs)]
         reached = np.where(self.reached[owner], 1.0, -1.0)  # (a value at the centres: a real one, or below)
         at_centre = sum(m[0] * reached[:, p] for p, m in enumerate(models))
         lever_terms = sum(m[4] for m in models)
@@ -311,64 +313,28 @@ class _Group:
         bound = bound + room + 1e-12 * np.abs(bound)
         rows = np.flatnonzero(~(bound <= target))
         if rows.size:
-            never = None
-            second = base[rows] + quadratic_max(g[rows], Q[rows], sigma[rows], never) + self.lever_slack[owner[rows]]
+            second = base[rows] + quadratic_max(g[rows], Q[rows], sigma[rows]) + self.lever_slack[owner[rows]]
             for _, squared, g_v, Q_v, _ in models:
-                norm_max = squared[rows] + quadratic_max(2 * g_v[rows], 2 * Q_v[rows], sigma[rows], never)
+                norm_max = squared[rows] + quadratic_max(2 * g_v[rows], 2 * Q_v[rows], sigma[rows])
                 second = second + np.sqrt(np.maximum(norm_max, 0.0)) * (1 + 1e-12)
-            bound[rows] = np.minimum(bound[rows], second + room[rows] + 1e-12 * np.abs(second))
-        return bound, at_centre * (1 - 1e-12), lever_terms
+            bound[rows] = np.fmin(bound[rows], second + room[rows] + 1e-12 * np.abs(second))  # (nan: the other)
+        return bound, at_centre - 1e-12 * sum(m[0] for m in models), lever_terms
 
     def _norm_bound(self, owner, centre, radius, target):
         """|tau_j| <= |g| |omega_j| over the boxes, |g| |omega_j| at the centres, and the
-        joints' weights in it.
-
-        |omega|^2 = |omega(c)|^2 + 2 omega(c) . delta + |delta|^2, delta = omega - omega(c)
-        = A s + rest: the first two terms as a quadratic model, |delta|^2 <= |A s|^2 +
-        2 |A s| |rest| + |rest|^2 by the sizes of the terms."""
+        joints' weights in it (|omega_j|^2 by its quadratic model, ``bounds.squared_model``)."""
         B, n = centre.shape
         e = self.norm_dims
         N = expand(self.norms[owner].reshape(B * 3, -1), np.repeat(centre[:, e], 3, axis=0)).reshape(B, 3, -1)
-        W, sigma, where = sizes(radius[:, e]), sizes_of_s(radius[:, e]), layout(len(e))
-        at_centre = N[:, :, 0]
-        along = np.einsum("bc,bca->ba", at_centre, N)
-        along[:, 0] = 0.0
-        g, Q, high, along_terms = model(along, W, radius[:, e])
-        A = N[:, :, where.single_s]  # (B, 3, d')
-        rest = np.abs(N) * W[:, None]
-        rest[:, :, 0] = 0.0
-        rest[:, :, where.single_s] = 0.0
-        rest = np.sqrt((rest.sum(axis=2) ** 2).sum(axis=1))
-        linear = (np.sqrt((A**2).sum(axis=1)) * sigma).sum(axis=1)
-        base = (at_centre**2).sum(axis=1) + 2 * high + 2 * linear * rest + rest**2
+        W, sigma = sizes(radius[:, e]), sizes_of_s(radius[:, e])
+        size, base, g, Q, terms = squared_model(N, W, sigma, radius[:, e])
         gravity, slack = self.gravity[owner], self.norm_slack[owner]
         enough = ((target - slack) / gravity) ** 2 - base  # |omega|^2 that would do
-        squared = base + quadratic_max(2 * g, 2 * Q + 2 * np.einsum("bck,bcl->bkl", A, A), sigma, enough)
+        squared = base + quadratic_max(2 * g, 2 * Q, sigma, enough)
         bound = gravity * np.sqrt(np.maximum(squared, 0.0)) * (1 + 4 * U) + slack
         weight = np.zeros((B, n))
-        weight[:, e] = (along_terms + (np.abs(N) * W[:, None]).sum(axis=1)) @ where.involves
-        return bound, gravity * np.sqrt((at_centre**2).sum(axis=1)), weight
-
-
-def _squared_model(N, W, sigma, radius):
-    """For 2 sums re-expanded about the centres N (B, 2, 3^d): |v| at the centres, and
-    |v|^2 <= squared + 2 g . s + s^T Q s over the boxes (as in ``_norm_bound``); the size
-    of each term (B, 3^d)."""
-    where = layout(radius.shape[1])
-    middle = N[:, :, 0]
-    along = np.einsum("bc,bca->ba", middle, N)
-    along[:, 0] = 0.0
-    g_v, Q_v, high_v, _ = model(along, W, radius)
-    A = N[:, :, where.single_s]  # (B, 2, d)
-    rest = np.abs(N) * W[:, None]
-    terms = rest.sum(axis=1)
-    rest[:, :, 0] = 0.0
-    rest[:, :, where.single_s] = 0.0
-    rest = np.sqrt((rest.sum(axis=2) ** 2).sum(axis=1))
-    linear = (np.sqrt((A**2).sum(axis=1)) * sigma).sum(axis=1)
-    size = np.sqrt((middle**2).sum(axis=1))
-    squared = size**2 + 2 * high_v + 2 * linear * rest + rest**2
-    return size, squared, g_v, Q_v + np.einsum("bck,bcl->bkl", A, A), terms
+        weight[:, e] = terms @ layout(len(e)).involves
+        return bound, gravity * size, weight
 
 
 INTERVAL_WORK = 20_000  # box x joint evaluations of plain interval bounds (beyond harmonic.MAX_JOINTS)
