@@ -5,17 +5,19 @@ for the URDF arms): random poses and directions, then local optimisation from th
 
 import math
 import os
+from dataclasses import replace
 
 import numpy as np
 import pinocchio as pin
 import pytest
 from scipy.optimize import minimize
 
-from irb140_dynamics.core import RigidBody, derive_torque_limits, gravity, gravity_batch, irb140
+from irb140_dynamics.core import Joint, RigidBody, RobotModel, derive_torque_limits, gravity, gravity_batch, irb140
 from irb140_dynamics.core.io.urdf import load_urdf
 from irb140_dynamics.core.payload import diagram as diagram_module
 from irb140_dynamics.core.payload.diagram import load_diagram, pivoted
 from irb140_dynamics.core.payload.proof.harmonic import StaticForms
+from irb140_dynamics.core.urdf import export_urdf
 
 from ..support.paths import URDF_DATA
 from ..support.pinocchio_model import build
@@ -93,8 +95,28 @@ def prismatic_case():
     return model, model.torque_limits, models
 
 
+def gantry():
+    """A 9-joint arm: the IRB-140 on a 3-axis gantry (x, y, z prismatic, 15 kg carriages)."""
+    arm = irb140()
+    carriage = RigidBody(15.0, (0.0, 0.0, 0.05), (0.3, 0.3, 0.3, 0.0, 0.0, 0.0))
+    slides = [
+        Joint(f"gantry_{name}", link=carriage, position_limits=(0.0, 1.5), axis=axis, kind="prismatic")
+        for name, axis in (("x", (1.0, 0.0, 0.0)), ("y", (0.0, 1.0, 0.0)), ("z", (0.0, 0.0, 1.0)))
+    ]
+    return RobotModel(tuple(slides) + arm.joints, arm.gravity)
+
+
+def gantry_case():
+    """The gantry, its limits derived; Pinocchio's models from its URDF (Pinocchio's parser)."""
+    model = gantry()
+    text = export_urdf(model, name="gantry_irb140")
+    models = payload_models(lambda body: pinocchio_of(text, (), "flange", body))
+    return model, derive_torque_limits(model).values, models
+
+
 CASES = {
     "irb140": irb140_case,
+    "gantry_irb140": gantry_case,
     "ur5": lambda: urdf_case("ur5"),
     "panda": lambda: urdf_case("panda"),
     "prismatic_arm": prismatic_case,
@@ -102,7 +124,8 @@ CASES = {
 GRIDS = {
     "irb140": ([0.0, 0.12], [0.0, 0.08]),
     "ur5": ([0.0, 0.15], [0.0, 0.1]),
-    "panda": ([0.0, 0.1], [0.0]),
+    "panda": ([0.0], [0.0, 0.05]),
+    "gantry_irb140": ([0.0, 0.1], [0.0, 0.1]),
     "prismatic_arm": ([0.0, 0.2], [0.0, 0.1]),
 }
 
@@ -150,6 +173,14 @@ def test_proven_masses_are_below_the_true_maximum_and_within_2_percent(arm):
         assert p.mass >= 0.98 * found, (p.z, p.l, p.mass, found)
 
 
+def test_nine_moving_joints_get_the_harmonic_proof():
+    """Up to 9 moving joints (10 angles with the CoM's direction) the diagram's proof is the
+    harmonic one; beyond, plain interval bounds."""
+    assert diagram_module._Shapes(pivoted(gantry())).forms is not None
+    ten = RobotModel((replace(gantry().joints[0], name="gantry_w"),) + gantry().joints, irb140().gravity)
+    assert diagram_module._Shapes(pivoted(ten)).forms is None
+
+
 def test_the_mass_is_the_minimum_over_directions_not_one_direction():
     """Off the axis the diagram holds for every direction: below what any one direction
     allows, as the independent search over directions shows on the IRB-140."""
@@ -191,25 +222,33 @@ def test_a_prismatic_joint_is_an_angle_of_the_proof():
     assert [cr is not None for cr in forms.sliding] == [j.prismatic for j in model.joints]
 
 
-def test_the_direction_sheared_into_the_wrist_angle_keeps_the_sum():
-    """On the Panda (link 7's CoM off its axis) the CoM's direction and joint 7 cannot merge
-    into one angle; sheared (psi = theta_7 + phi), the sum has the same values: at the
-    sheared angles of any pose, within its error, and every psi maps back to a pose."""
-    from irb140_dynamics.core.payload.proof.harmonic import HarmonicSum
-    from irb140_dynamics.core.scalars.interval import Interval
+def test_the_worst_direction_is_a_lever_and_the_wrist_angle_drops_out():
+    """On the Panda (link 7's CoM off its axis), joint 2's sum over the pose and the CoM's
+    direction phi is A + X cos(phi) + Y sin(phi); without joint 7, A0 + |(P, Q)| + |(X0,
+    Y0)| is the largest value over every turn of joint 7 and every direction."""
+    from irb140_dynamics.core.payload.proof.harmonic import without_wrist
 
     model, _, _ = urdf_case("panda")
     arm = pivoted(model)
     forms = diagram_module._Shapes(arm).family(0.05, 0.1).forms
     torque = forms[0].affine(forms[1], 2.0).torque[1]  # joint 2's
-    sheared = torque.reduced(merge=True, shear=(arm.n - 1,))
-    assert sheared.shears and sheared.shears[0][1] == arm.n - 1
+    parts = torque.over_direction()
     lower, upper = np.array([j.position_limits for j in arm.joints]).T
     theta = lower + np.random.default_rng(6).random((40, arm.n)) * (upper - lower)
-    as_sum = HarmonicSum(sheared.dims, Interval(sheared.coefficients))
-    np.testing.assert_allclose(as_sum(sheared.fold(theta)), torque(theta), atol=float(sheared.error) + 1e-9)
-    back = sheared.angles(sheared.fold(theta), lower, upper)
-    np.testing.assert_allclose(as_sum(sheared.fold(back)), torque(theta), atol=float(sheared.error) + 1e-9)
+    A, X, Y = parts(theta[:, :-1]).T
+    phi = theta[:, -1]
+    np.testing.assert_allclose(A + X * np.cos(phi) + Y * np.sin(phi), torque(theta), atol=1e-9)
+    wrist = without_wrist(parts)
+    assert wrist is not None and wrist.dims == parts.dims[:-1]
+    A0, P, Q, X0, Y0 = wrist(theta[:, :-2]).T
+    bound = A0 + np.hypot(P, Q) + np.hypot(X0, Y0)
+    turns = np.linspace(-math.pi, math.pi, 3601)
+    for k in range(5):  # the worst direction of each turn of joint 7 (A + |(X, Y)|, as checked above)
+        grid = np.repeat(theta[k : k + 1, :-1], turns.size, axis=0)
+        grid[:, -1] = turns
+        A, X, Y = parts(grid).T
+        worst = np.max(A + np.hypot(X, Y))
+        assert bound[k] - 1e-6 <= worst <= bound[k] + 1e-9, (worst, bound[k])
 
 
 def test_an_arm_that_cannot_hold_itself_has_no_mass_anywhere():

@@ -2,7 +2,7 @@
 finished computation (a bound within the limit; a real torque over it), UNPROVEN with the
 best bound and the reason where a proof ran out of budget or the analysis out of time; a
 cancelled analysis stops at its next check. The chains here are beyond the harmonic proofs
-(more than 8 joints: plain interval bounds, their budget spent) or slow to analyse (30)."""
+(more than 9 joints: plain interval bounds, their budget spent) or slow to analyse (30)."""
 
 import threading
 from dataclasses import replace
@@ -45,7 +45,7 @@ def test_a_payload_that_fits_where_searched_but_not_proven_is_unproven_not_over(
     assert headline.startswith("UNPROVEN: 3.000 kg not proven to fit: joint_")
     assert "worst static torque is proven only up to" in headline
     assert headline.endswith(
-        "the proof's budget ran out (plain interval bounds: more than 8 joints); 11 more joints unproven"
+        "the proof's budget ran out (plain interval bounds: more than 9 joints); 11 more joints unproven"
     )
 
 

@@ -1,5 +1,5 @@
 """Long serial chains built in code: arms beyond the reach of the payload proofs (more than
-8 joints get plain interval bounds, whose budget they exhaust) and slow to analyse (30
+9 joints get plain interval bounds, whose budget they exhaust) and slow to analyse (30
 joints: the search alone takes many seconds)."""
 
 import math

@@ -8,9 +8,11 @@ it may point in any direction about the axis (how the tool is turned is not know
 mass must hold for every direction phi too: the CoM (l cos phi, l sin phi, z). The
 direction is one more joint: ``pivoted`` adds a massless revolute joint about the flange's
 z axis, turning over [-pi, pi], and the payload sits at (l, 0, z) in its frame; its own
-torque is not limited. The proof then covers every pose AND every direction at once (for
-a wrist whose last joint turns about the flange axis the two merge into one angle, see
-``harmonic.merge_parallel``).
+torque is not limited. The search takes it as an angle; the proof covers every pose AND
+every direction at once without one: at a pose a torque is A + X cos(phi) + Y sin(phi),
+at most A + |(X, Y)| (see ``family.PayloadFamily.direction``), bounded over the poses, and
+a wrist joint that only turns the CoM about the flange axis drops out with it
+(``harmonic.without_wrist``).
 
 At each point the payload's torques are affine in its mass (see ``family``). Dinkelbach's
 iteration over searched poses gives the mass m* at which a real pose reaches a limit (an
@@ -42,12 +44,13 @@ from irb140_dynamics.core.model.rigid_body import MAX_MASS, RigidBody
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.payload.family import PayloadFamily
 from irb140_dynamics.core.payload.limits import limit_values, smallest_max_payload
-from irb140_dynamics.core.payload.proof.harmonic import StaticForms
+from irb140_dynamics.core.payload.proof.harmonic import MAX_JOINTS, StaticForms
 from irb140_dynamics.core.payload.workspace import JointRanges
 
 MARGINS = (0.005, 0.015)  # the proof aims at (1 - margin) of the mass the search finds; the next if it fails
 ROUNDS = 4  # proofs per point (each after Dinkelbach from the worse poses the last one found, or with the next margin)
-PROOF_SHARE = 4.0  # of ``certify.EVALUATIONS`` per proof: a heavy arm's own torques leave a payload little room
+PROOF_SHARE = 16.0  # of ``certify.EVALUATIONS`` per proof: a heavy arm's own torques leave a payload little room
+MOST_JOINTS = MAX_JOINTS  # moving joints the harmonic proof takes (and the direction: 3^10 terms; intervals beyond)
 DIRECTION = "load_direction"  # the name of the joint that turns the CoM about the flange axis
 
 
@@ -100,7 +103,7 @@ class _Shapes:
     def __init__(self, arm: RobotModel):
         self.arm = arm
         basis = [RigidBody(0.0), RigidBody(1.0), RigidBody(1.0, (1.0, 0.0, 0.0)), RigidBody(1.0, (0.0, 0.0, 1.0))]
-        forms = [StaticForms.of(arm.with_payload(body)) for body in basis]
+        forms = [StaticForms.of(arm.with_payload(body), MOST_JOINTS + 1) for body in basis]
         self.forms = None if forms[0] is None else forms
 
     def family(self, z: float, l: float) -> PayloadFamily:
@@ -109,7 +112,7 @@ class _Shapes:
         if self.forms is not None:
             empty, origin, x, up = self.forms
             given = (empty, _mixed(origin, [(x, l), (up, z)]))
-        direction = (self.arm.n - 1,)  # a whole turn: its shear is exact
+        direction = self.arm.n - 1  # a whole turn: the worst direction is A + |(X, Y)|
         return PayloadFamily(self.arm.with_payload(RigidBody(0.0)), self.arm.with_payload(shape), given, direction)
 
 
@@ -196,7 +199,10 @@ def _holds_alone(family: PayloadFamily, ranges: JointRanges, L: np.ndarray) -> b
     being affine in the mass, every mass below one proven to hold holds too."""
     limited = np.flatnonzero(np.isfinite(np.tile(L, 2)))
     ceiling = np.tile(L, 2)
-    proof = family.extremes(0.0, ranges, rows=limited, ceiling=ceiling, share=PROOF_SHARE)
+    found = family.search(0.0, ranges)
+    if np.any(found[0][limited] > ceiling[limited]):  # a real pose beyond a limit: no proof can hold
+        return False
+    proof = family.extremes(0.0, ranges, rows=limited, found=found, ceiling=ceiling, share=PROOF_SHARE)
     return bool(np.all(proof.bounds[limited] <= ceiling[limited]))
 
 

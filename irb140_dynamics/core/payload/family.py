@@ -34,7 +34,7 @@ from irb140_dynamics.core.model.rigid_body import RigidBody
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.payload.proof import certify
 from irb140_dynamics.core.payload.proof.certify import Objective, certify_maxima, interval_maxima
-from irb140_dynamics.core.payload.proof.harmonic import StaticForms
+from irb140_dynamics.core.payload.proof.harmonic import StaticForms, without_wrist
 from irb140_dynamics.core.payload.stop import ran_out
 from irb140_dynamics.core.payload.workspace import JointRanges
 from irb140_dynamics.core.scalars.interval import Interval, bounds_of
@@ -70,7 +70,7 @@ class PayloadFamily:
     empty: RobotModel  # the payload at 0 kg
     unit: RobotModel  # the payload at 1 kg
     given_forms: tuple[StaticForms, StaticForms] | None = None  # the forms, if already known
-    shear: tuple[int, ...] = ()  # joints whose angle the proof may shear (see harmonic.shear_parallel)
+    direction: int | None = None  # the last joint, if it turns the payload's CoM about the flange axis (a whole turn)
 
     def torques(self, q, qd) -> tuple[np.ndarray, np.ndarray]:
         """(tau0, dtau) [N m, N m/kg] that hold the motion (q, qd) with qdd = 0."""
@@ -164,22 +164,19 @@ class PayloadFamily:
         def joints_of(theta):  # joint values q of angles theta (prismatic: their displacements)
             return np.clip(forms.joints_of(theta) - offsets, ranges.lower, ranges.upper)
 
-        objectives = [
-            Objective(
-                (forms.torque[j] * sign).reduced(merge=True, shear=self.shear),
-                forms.omega[j].reduced(),
-                forms.gravity_norm,
-            )
-            for j, sign in zip(joints, signs)
-        ]
-        boxes = [objective.value.box(lower, upper) for objective in objectives]
+        objectives = [self._objective(forms, j, sign, m) for j, sign in zip(joints, signs)]
+        boxes = [objective.norm.box(*objective.value.box(lower, upper)) for objective in objectives]
 
-        def angles(k, theta):  # the joint angles of objective k's box (parallel joints merged)
-            return np.array([objectives[i].value.angles(t, lower, upper)[0] for i, t in zip(k, theta)])
+        def angles(k, theta):  # the joint angles of objective k's box (parallel joints merged: before j, after j)
+            joined = [(objectives[i], objectives[i].norm.angles(t, lower, upper)) for i, t in zip(k, theta)]
+            return np.array([objective.value.angles(t, lower, upper)[0] for objective, t in joined])
 
         def polish(k, theta):
             found, pose = ranges.climb(torque, weights[rows[k]], joints_of(angles(k, theta)))
-            return found, np.array([objectives[i].value.fold(t)[0] for i, t in zip(k, forms.angles_of(pose + offsets))])
+            folded = [
+                objectives[i].norm.fold(objectives[i].value.fold(t)) for i, t in zip(k, forms.angles_of(pose + offsets))
+            ]
+            return found, np.array([t[0] for t in folded])
 
         proof = certify_maxima(
             objectives,
@@ -189,6 +186,7 @@ class PayloadFamily:
             tol[rows],
             polish,
             int(share * certify.EVALUATIONS),
+            None if ceiling is None else ceiling[rows],
         )
         bounds[rows] = proof.bound
         values, poses = values.copy(), poses.copy()
@@ -200,6 +198,31 @@ class PayloadFamily:
             higher = value > values[found]
             values[found[higher]], poses[found[higher]] = value[higher], pose[higher]
         return Extremes(values, poses, np.maximum(bounds, values))
+
+    def _objective(self, forms: StaticForms, j: int, sign: float, m: float) -> Objective:
+        """+-tau_j at m kg as the proof's objective; with a ``direction`` joint, its worst
+        value over the directions: A + |(X, Y)| (see ``Objective``), not one more angle;
+        and without the last joint where it only turns the CoM about the flange axis (see
+        ``harmonic.without_wrist``: a lever more)."""
+        torque, omega = forms.torque[j] * sign, forms.omega[j]
+        if self.direction is None or j == self.direction:
+            return Objective(torque.reduced(merge=True), omega.reduced(), forms.gravity_norm)
+        parts = torque.over_direction()
+        if parts.dims and parts.dims[-1] == self.direction - 1:
+            parts = without_wrist(parts) or parts
+        reached = (False, True) if parts.coefficients.lo.shape[0] == 5 else (True,)  # ((P, Q): the wrist's turn)
+        parts = parts.reduced(merge=True)
+        value = replace(parts, coefficients=parts.coefficients[0], error=parts.error[0])
+        pairs = [p for p in range(parts.error.size // 2) if np.any(parts.coefficients[1 + 2 * p : 3 + 2 * p])]
+        keep = [1 + 2 * p + k for p in pairs for k in (0, 1)]  # (a pair all zeros: a CoM on the axis)
+        vanished = float(np.sum(np.delete(parts.error[1:], np.array(keep, dtype=int) - 1)))
+        value = replace(value, error=value.error + vanished)
+        lever = replace(parts, coefficients=parts.coefficients[keep], error=parts.error[keep]) if keep else None
+        reached = tuple(reached[p] for p in pairs)
+        norm = omega.reduced(merge=True)  # (the direction an angle there, merged with a wrist it turns with)
+        if any(a in value.dims or b in value.dims for a, b, _ in norm.merges):  # (their box is the value's too)
+            norm = omega.reduced()
+        return Objective(value, norm, forms.gravity_norm, lever, reached)
 
     def _interval_torques(self, m, offsets):
         """(lo, hi) per joint (n, B) of the static torques at m kg over boxes of q (B, n)."""

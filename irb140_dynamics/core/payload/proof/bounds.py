@@ -166,3 +166,28 @@ def layout(d: int) -> Layout:
         single_v=place,
         pair=2 * place[k] + 2 * place[l],
     )
+
+
+def squared_model(N, W, sigma, radius):
+    """For a vector of sums re-expanded about the centres, N (B, c, 3^d): |v| at the
+    centres, and |v|^2 <= squared + 2 g . s + s^T Q s over the boxes; each term's weight
+    (B, 3^d), for choosing a split.
+
+    |v|^2 = |v(c)|^2 + 2 v(c) . delta + |delta|^2, delta = v - v(c) = A s + rest: the first
+    two terms as a quadratic model, |delta|^2 <= |A s|^2 + 2 |A s| |rest| + |rest|^2 by the
+    sizes of the terms."""
+    where = layout(radius.shape[1])
+    middle = N[:, :, 0]
+    along = np.einsum("bc,bca->ba", middle, N)
+    along[:, 0] = 0.0
+    g_v, Q_v, high_v, along_terms = model(along, W, radius)
+    A = N[:, :, where.single_s]  # (B, c, d)
+    rest = np.abs(N) * W[:, None]
+    terms = along_terms + rest.sum(axis=1)
+    rest[:, :, 0] = 0.0
+    rest[:, :, where.single_s] = 0.0
+    rest = np.sqrt((rest.sum(axis=2) ** 2).sum(axis=1))
+    linear = (np.sqrt((A**2).sum(axis=1)) * sigma).sum(axis=1)
+    size = np.sqrt((middle**2).sum(axis=1))
+    squared = size**2 + 2 * high_v + 2 * linear * rest + rest**2
+    return size, squared, g_v, Q_v + np.einsum("bck,bcl->bkl", A, A), terms

@@ -47,6 +47,7 @@ from irb140_dynamics.core.payload.proof.bounds import (
     rounding,
     sizes,
     sizes_of_s,
+    squared_model,
 )
 from irb140_dynamics.core.payload.proof.harmonic import Reduced
 from irb140_dynamics.core.payload.stop import out_of_time
@@ -59,11 +60,20 @@ SLICE = 2048  # box bounds per turn of a group
 
 @dataclass(frozen=True, eq=False)
 class Objective:
-    """Maximise ``value`` over the box; |value| <= gravity_norm |norm| holds too (norm: 3 sums)."""
+    """Maximise ``value`` + sum of |lever_p| over the box (lever: pairs of sums over the
+    value's joints, merged alike, or none); the objective is at most gravity_norm |norm|
+    too (norm: 3 sums, over the box's joints).
+
+    A lever is a payload's CoM turned about the flange axis in the worst direction phi:
+    the torque A + X cos(phi) + Y sin(phi) is at most A + |(X, Y)|, reached at some phi
+    (see ``harmonic.HarmonicSum.over_direction``); one of a joint whose range is not a whole
+    turn is not always reached (``reached``: the value at a box's centre counts -|lever|)."""
 
     value: Reduced
     norm: Reduced
     gravity_norm: float
+    lever: Reduced | None = None
+    reached: tuple[bool, ...] = ()  # per pair: is |lever_p| reached in the box (a whole turn)? (else -|lever_p|)
 
 
 @dataclass(frozen=True, eq=False)
@@ -78,7 +88,9 @@ class Maxima:
     evaluations: int
 
 
-def certify_maxima(objectives, lower, upper, incumbent, tol, polish=None, evaluations: int | None = None) -> Maxima:
+def certify_maxima(
+    objectives, lower, upper, incumbent, tol, polish=None, evaluations: int | None = None, ceiling=None
+) -> Maxima:
     """Upper bounds of the objectives' maxima over theta in [lower, upper] ((n,), or (K, n):
     a box per objective), proven to
     within ``tol`` (K,) of the best value known (``incumbent`` (K,), values at real poses)
@@ -89,6 +101,8 @@ def certify_maxima(objectives, lower, upper, incumbent, tol, polish=None, evalua
     Where a box's centre beats the best value known by more than tol, the search missed a
     maximum there: ``polish(indices, theta)`` (objectives (P,), angles (P, n)) -> (values,
     theta) climbs from it to the real poses' values, which then serve as the best known.
+    ``ceiling`` (K,): a box whose bound is at most its objective's ceiling is closed too,
+    however the best value moves (a decision: is the maximum below the ceiling?).
     """
     evaluations = EVALUATIONS if evaluations is None else evaluations
     K = len(objectives)
@@ -98,12 +112,15 @@ def certify_maxima(objectives, lower, upper, incumbent, tol, polish=None, evalua
     n = lower.shape[1]
     members: dict[tuple, list[int]] = {}
     for k, objective in enumerate(objectives):
-        members.setdefault((objective.value.dims, objective.norm.dims), []).append(k)
+        members.setdefault((objective.value.dims, objective.norm.dims, objective.lever is None), []).append(k)
     groups = []
     for ks in members.values():
         ks = np.array(ks)
         climb = None if polish is None else (lambda local, theta, ks=ks: polish(ks[local], theta))
-        groups.append((ks, _Group([objectives[k] for k in ks], lower[ks], upper[ks], incumbent[ks], tol[ks], climb)))
+        group = _Group([objectives[k] for k in ks], lower[ks], upper[ks], incumbent[ks], tol[ks], climb)
+        if ceiling is not None:
+            group.ceiling = np.asarray(ceiling, dtype=float)[ks]
+        groups.append((ks, group))
     spent = sum(group.advance(group.boxes) * group.cost for _, group in groups)  # the whole box, whatever the budget
     while spent < evaluations and not out_of_time():
         open_groups = [group for _, group in groups if group.boxes]
@@ -134,11 +151,24 @@ class _Group:
         norm_error = np.array([np.sum(o.norm.error) for o in objectives])
         self.norm_slack = g * (norm_error + rounding(len(self.norm_dims)) * norm_size)
         self.gravity = g * (1 + 8 * U)
-        self.cost = max(1.0, (3 ** len(self.value_dims) + 3 ** (len(self.norm_dims) + 1)) / TERMS)
+        self.levers, self.lever_slack = None, np.zeros(len(objectives))
+        if first.lever is not None:
+            self.levers = np.array([o.lever.coefficients for o in objectives])  # (K, 2 P, 3^d): P pairs
+            pairs = self.levers.shape[1] // 2
+            self.reached = np.array([[o.reached[p] if o.reached else True for p in range(pairs)] for o in objectives])
+            lever_error = np.array([np.sum(o.lever.error) for o in objectives])
+            self.lever_slack = lever_error + rounding(len(self.value_dims)) * np.abs(self.levers).sum(axis=(1, 2))
+        levers = 0 if self.levers is None else self.levers.shape[1] * 3 ** len(self.value_dims)
+        self.cost = max(1.0, (3 ** len(self.value_dims) + levers + 3 ** (len(self.norm_dims) + 1)) / TERMS)
         K, n = lower.shape
         upper = np.minimum(upper, lower + 2 * math.pi)  # the sums repeat every turn
-        self.tol = np.maximum(tol, 4 * (self.value_slack + self.norm_slack))  # rounding is not to be closed
+        self.tol = np.maximum(
+            tol, 4 * (self.value_slack + self.lever_slack + self.norm_slack)
+        )  # rounding is not to be closed
         self.polish = polish
+        self.ceiling = np.full(
+            K, np.inf
+        )  # a bound at most this closes a box, whatever the best value (see certify_maxima)
         self.lo, self.hi, self.owner = lower.copy(), upper.copy(), np.arange(K)
         self.inherited = np.full(K, np.inf)
         self.best, self.closed = incumbent.copy(), np.full(K, -np.inf)
@@ -166,12 +196,14 @@ class _Group:
             now, later = order[:take], order[take:]
             centre, radius = 0.5 * (lo[now] + hi[now]), 0.5 * (hi[now] - lo[now])
             k = owner[now]
-            bound, value, weight = self._bound(k, centre, radius, best[k] + tol[k])
+            target = np.maximum(np.minimum(best[k] + tol[k], self.ceiling[k]), best[k])
+            bound, value, weight = self._bound(k, centre, radius, target)
+            bound = np.where(np.isnan(bound), np.inf, bound)  # (a bound that failed bounds nothing: the box stays)
             spent += take
             self._improve(k, value, centre, best, tol, self.polish, self.best_value, self.best_theta)
             weight = np.where(hi[now] > lo[now], weight, -1.0)  # a joint whose range is a point cannot split
             kept = bound >= best[k]
-            done = kept & ((bound <= best[k] + tol[k]) | (weight.max(axis=1) <= 0))  # (nothing to split: as is)
+            done = kept & ((bound <= target) | (weight.max(axis=1) <= 0))  # (nothing to split: as is)
             np.maximum.at(self.closed, k[done], bound[done])
             split = now[kept & ~done]
             axis = np.argmax(weight[kept & ~done], axis=1)
@@ -234,42 +266,75 @@ class _Group:
         B, n = centre.shape
         d = self.value_dims
         D = expand(self.values[owner], centre[:, d])
-        g, Q, high, terms = model(D, sizes(radius[:, d]), radius[:, d])
+        W, sigma = sizes(radius[:, d]), sizes_of_s(radius[:, d])
+        g, Q, high, terms = model(D, W, radius[:, d])
         base = D[:, 0] + high + self.value_slack[owner]
-        bound = base + quadratic_max(g, Q, sizes_of_s(radius[:, d]), enough=target - base)
+        value = D[:, 0] - self.value_slack[owner]
+        if self.levers is None:
+            bound = base + quadratic_max(g, Q, sigma, enough=target - base)
+        else:
+            bound, at_centre, lever_terms = self._lever_bound(
+                owner, centre[:, d], radius[:, d], W, sigma, (g, Q, base), target
+            )
+            value = value + at_centre - self.lever_slack[owner]
+            terms = terms + lever_terms
         weight = np.zeros((B, n))
         weight[:, d] = terms @ layout(len(d)).involves
-        return bound, D[:, 0] - self.value_slack[owner], weight
+        return bound, value, weight
+
+    def _lever_bound(self, owner, centre, radius, W, sigma, value_model, target):
+        """Bounds of value + sum of |v_p| over the boxes, v_p = (X_p, Y_p) the levers, given
+        the value's quadratic model (g, Q; the rest ``base``); the sum at the centres; the
+        size of the levers' terms.
+
+        |v|^2 <= M(s), a quadratic model (``bounds.squared_model``). For any a > 0, |v| <= a / 2
+        + |v|^2 / (2 a) (equal where |v| = a): with a = |v(centre)| the bound is one model,
+        exact to first order, maximised with the value's. Also, where that one is above
+        its target: value's bound + sum of sqrt(max M_p)."""
+        B, d = centre.shape
+        g, Q, base = value_model
+        pairs = self.levers.shape[1] // 2
+        N = expand(self.levers[owner].reshape(B * 2 * pairs, -1), np.repeat(centre, 2 * pairs, axis=0))
+        N = N.reshape(B, pairs, 2, -1)
+        models = [squared_model(N[:, p], W, sigma, radius) for p in range(pairs)]
+        reached = np.where(self.reached[owner], 1.0, -1.0)  # (a value at the centres: a real one, or below)
+        at_centre = sum(m[0] * reached[:, p] for p, m in enumerate(models))
+        lever_terms = sum(m[4] for m in models)
+        constant, g_all, Q_all, room = base + self.lever_slack[owner], g.copy(), Q.copy(), np.abs(base)
+        for size, squared, g_v, Q_v, _ in models:
+            a = np.maximum(size, 1e-150)
+            k = 0.5 / a
+            constant = constant + 0.5 * a + k * squared
+            g_all, Q_all = g_all + 2 * k[:, None] * g_v, Q_all + 2 * k[:, None, None] * Q_v
+            room = room + a + k * np.abs(squared)
+        room = 1e-12 * room
+        enough = target - constant - room - 1e-12 * np.abs(target)
+        bound = constant + quadratic_max(g_all, Q_all, sigma, enough)
+        bound = bound + room + 1e-12 * np.abs(bound)
+        rows = np.flatnonzero(~(bound <= target))
+        if rows.size:
+            second = base[rows] + quadratic_max(g[rows], Q[rows], sigma[rows]) + self.lever_slack[owner[rows]]
+            for _, squared, g_v, Q_v, _ in models:
+                norm_max = squared[rows] + quadratic_max(2 * g_v[rows], 2 * Q_v[rows], sigma[rows])
+                second = second + np.sqrt(np.maximum(norm_max, 0.0)) * (1 + 1e-12)
+            bound[rows] = np.fmin(bound[rows], second + room[rows] + 1e-12 * np.abs(second))  # (nan: the other)
+        return bound, at_centre - 1e-12 * sum(m[0] for m in models), lever_terms
 
     def _norm_bound(self, owner, centre, radius, target):
         """|tau_j| <= |g| |omega_j| over the boxes, |g| |omega_j| at the centres, and the
-        joints' weights in it.
-
-        |omega|^2 = |omega(c)|^2 + 2 omega(c) . delta + |delta|^2, delta = omega - omega(c)
-        = A s + rest: the first two terms as a quadratic model, |delta|^2 <= |A s|^2 +
-        2 |A s| |rest| + |rest|^2 by the sizes of the terms."""
+        joints' weights in it (|omega_j|^2 by its quadratic model, ``bounds.squared_model``)."""
         B, n = centre.shape
         e = self.norm_dims
         N = expand(self.norms[owner].reshape(B * 3, -1), np.repeat(centre[:, e], 3, axis=0)).reshape(B, 3, -1)
-        W, sigma, where = sizes(radius[:, e]), sizes_of_s(radius[:, e]), layout(len(e))
-        at_centre = N[:, :, 0]
-        along = np.einsum("bc,bca->ba", at_centre, N)
-        along[:, 0] = 0.0
-        g, Q, high, along_terms = model(along, W, radius[:, e])
-        A = N[:, :, where.single_s]  # (B, 3, d')
-        rest = np.abs(N) * W[:, None]
-        rest[:, :, 0] = 0.0
-        rest[:, :, where.single_s] = 0.0
-        rest = np.sqrt((rest.sum(axis=2) ** 2).sum(axis=1))
-        linear = (np.sqrt((A**2).sum(axis=1)) * sigma).sum(axis=1)
-        base = (at_centre**2).sum(axis=1) + 2 * high + 2 * linear * rest + rest**2
+        W, sigma = sizes(radius[:, e]), sizes_of_s(radius[:, e])
+        size, base, g, Q, terms = squared_model(N, W, sigma, radius[:, e])
         gravity, slack = self.gravity[owner], self.norm_slack[owner]
         enough = ((target - slack) / gravity) ** 2 - base  # |omega|^2 that would do
-        squared = base + quadratic_max(2 * g, 2 * Q + 2 * np.einsum("bck,bcl->bkl", A, A), sigma, enough)
+        squared = base + quadratic_max(2 * g, 2 * Q, sigma, enough)
         bound = gravity * np.sqrt(np.maximum(squared, 0.0)) * (1 + 4 * U) + slack
         weight = np.zeros((B, n))
-        weight[:, e] = (along_terms + (np.abs(N) * W[:, None]).sum(axis=1)) @ where.involves
-        return bound, gravity * np.sqrt((at_centre**2).sum(axis=1)), weight
+        weight[:, e] = terms @ layout(len(e)).involves
+        return bound, gravity * size, weight
 
 
 INTERVAL_WORK = 20_000  # box x joint evaluations of plain interval bounds (beyond harmonic.MAX_JOINTS)

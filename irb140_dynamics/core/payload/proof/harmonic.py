@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -36,7 +36,7 @@ from irb140_dynamics.core.algorithms import recursions as algorithms
 from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.scalars.interval import Interval, bounds_of
 
-MAX_JOINTS = 8  # 3^8 = 6561 coefficients per sum
+MAX_JOINTS = 9  # 3^9 = 19683 coefficients per sum
 NOISE = 1e-14  # a joint whose terms weigh less than this fraction of a sum is dropped from it
 _COS, _SIN = np.array([1.0, 0.0, -1.0]), np.array([0.0, 1.0, 0.0])  # theta = 0, pi/2, pi
 
@@ -63,12 +63,11 @@ class HarmonicSum:
         c = self.coefficients
         return HarmonicSum(self.dims, Interval(c.lo[index], c.hi[index]))
 
-    def reduced(self, merge: bool = False, shear: tuple[int, ...] = ()) -> Reduced:
+    def reduced(self, merge: bool = False) -> Reduced:
         """Midpoint coefficients and an error bound, without the joints it hardly depends on
-        (whose terms then count in the error: |phi| <= 1); with ``merge`` (a single sum),
-        joints it depends on only through theta_a +- theta_b become one (``merge_parallel``),
-        and a joint b of ``shear`` that it depends on only through theta_a +- theta_b besides
-        theta_a alone is replaced by that sum (``shear_parallel``)."""
+        (whose terms then count in the error: |phi| <= 1); with ``merge``, joints it depends
+        on only through theta_a +- theta_b become one (``merge_parallel``; several sums:
+        only where all of them do)."""
         c, d = self.coefficients, len(self.dims)
         lead = c.lo.shape[:-1]
         mid = c.mid.reshape(lead + (3,) * d)
@@ -83,15 +82,23 @@ class HarmonicSum:
                 mid, weight = np.take(mid, 0, axis=len(lead) + axis), np.take(weight, 0, axis=axis)
                 del dims[axis]
         merges: list[tuple[int, int, float]] = []
-        shears: list[tuple[int, int, float]] = []
-        if merge and not lead:
-            mid, residual = merge_parallel(mid, dims, merges, NOISE * total)
-            error = error + residual
-            if shear:
-                mid, residual = shear_parallel(mid, dims, shear, shears, NOISE * total)
-                error = error + residual
-        reduced = Reduced(tuple(dims), mid.reshape(lead + (-1,)), np.asarray(error, dtype=float), tuple(merges))
-        return replace(reduced, shears=tuple(shears)) if shears else reduced
+        if merge:
+            leading = tuple(range(len(lead)))
+            trailing = tuple(range(-len(lead), 0))
+            merged, residual = merge_parallel(np.moveaxis(mid, leading, trailing), dims, merges, NOISE * total)
+            mid, error = np.moveaxis(merged, trailing, leading), error + residual
+        return Reduced(tuple(dims), mid.reshape(lead + (-1,)), np.asarray(error, dtype=float), tuple(merges))
+
+    def over_direction(self) -> HarmonicSum:
+        """Sums whose last joint phi turns a payload's CoM about the flange axis (a whole
+        turn): (A, X, Y) (a leading axis) over the other joints, each sum being A + X
+        cos(phi) + Y sin(phi) exactly (only the CoM's offset turns with phi, its terms are
+        of degree one in phi). A single sum's maximum over the directions is A + |(X, Y)|;
+        A alone is the sum of the CoM on the axis."""
+        c = self.coefficients
+        lead = c.lo.shape[:-1]
+        lo, hi = (np.moveaxis(x.reshape(lead + (-1, 3)), -1, 0) for x in (c.lo, c.hi))
+        return HarmonicSum(self.dims[:-1], Interval(lo, hi))
 
     def __call__(self, theta: np.ndarray) -> np.ndarray:
         """The midpoint sum at angles theta (N, n): (N, ...); for tests."""
@@ -106,25 +113,20 @@ class HarmonicSum:
 @dataclass(frozen=True, eq=False)
 class Reduced:
     """A harmonic sum with point coefficients (..., 3^len(dims)) and a bound on its error;
-    ``merges`` (a, b, sign) in order: theta_b folded into theta_a as theta_a + sign theta_b;
-    then ``shears`` (a, b, sign): theta_b replaced by psi_b = theta_a + sign theta_b."""
+    ``merges`` (a, b, sign) in order: theta_b folded into theta_a as theta_a + sign theta_b."""
 
     dims: tuple[int, ...]
     coefficients: np.ndarray
     error: np.ndarray
     merges: tuple[tuple[int, int, float], ...] = ()
-    shears: tuple[tuple[int, int, float], ...] = ()
 
     def box(self, lower, upper) -> tuple[np.ndarray, np.ndarray]:
         """The box of angles this sum is over, from the joints' (n,): a merged joint a
-        ranges over theta_a + sign theta_b, theta_b is 0; a sheared joint b over theta_a +
-        sign theta_b (a box holding every pair: exact where theta_b turns a whole turn)."""
+        ranges over theta_a + sign theta_b, theta_b is 0."""
         lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
         for a, b, sign in self.merges:
             lo[a], hi[a] = (lo[a] + lo[b], hi[a] + hi[b]) if sign > 0 else (lo[a] - hi[b], hi[a] - lo[b])
             lo[b] = hi[b] = 0.0
-        for a, b, sign in self.shears:
-            lo[b], hi[b] = (lo[a] + lo[b], hi[a] + hi[b]) if sign > 0 else (lo[a] - hi[b], hi[a] - lo[b])
         return lo, hi
 
     def fold(self, theta) -> np.ndarray:
@@ -133,18 +135,12 @@ class Reduced:
         for a, b, sign in self.merges:
             theta[:, a] += sign * theta[:, b]
             theta[:, b] = 0.0
-        for a, b, sign in self.shears:
-            theta[:, b] = theta[:, a] + sign * theta[:, b]
         return theta
 
     def angles(self, theta, lower, upper) -> np.ndarray:
         """Joint angles (K, n) within [lower, upper] with the same sum as theta (K, n) from
         ``box``: each merged sum split back, theta_b near the middle of its range."""
         theta = np.array(theta, dtype=float, ndmin=2)
-        for a, b, sign in reversed(self.shears):  # theta_b back from psi_b, a whole turn taken off if need be
-            turned = sign * (theta[:, b] - theta[:, a])
-            turned = lower[b] + np.mod(turned - lower[b], 2 * math.pi)
-            theta[:, b] = np.clip(turned, lower[b], upper[b])
         lo, hi = np.array(lower, dtype=float), np.array(upper, dtype=float)
         before = []
         for a, b, sign in self.merges:
@@ -168,9 +164,9 @@ class StaticForms:
     sliding: tuple[tuple[float, float] | None, ...] = ()  # per joint: a prismatic one's (c, r), see ``slide``
 
     @classmethod
-    def of(cls, model) -> StaticForms | None:
-        """The forms of ``model`` (None beyond MAX_JOINTS joints)."""
-        if model.n > MAX_JOINTS:
+    def of(cls, model, most: int = MAX_JOINTS) -> StaticForms | None:
+        """The forms of ``model`` (None beyond ``most`` joints)."""
+        if model.n > most:
             return None
         kernels = kernels_of(model)
         sliding = tuple(slide(j.position_limits) if j.prismatic else None for j in model.joints)
@@ -287,26 +283,27 @@ def merge_parallel(T, dims: list, merges: list, noise: float):
     return T, residual
 
 
-def shear_parallel(T, dims: list, allowed, shears: list, noise: float):
-    """T (3,)*d with each joint b of ``allowed`` that it depends on only through theta_a +-
-    theta_b, besides terms of theta_a alone (a the joint before b: the parallel joint that
-    turns both a link and the payload's direction), written in psi_b = theta_a +- theta_b
-    instead (shears updated); and the size of the terms that did not fit, for the error."""
-    residual = 0.0
-    for p in range(len(dims) - 1):
-        if dims[p + 1] not in allowed:
-            continue
-        X = np.moveaxis(T, (p, p + 1), (0, 1))
-        for sign in (1.0, -1.0):  # B cos(a +- b) + C sin(a +- b), as in merge_parallel
-            B, C = 0.5 * (X[1, 1] - sign * X[2, 2]), 0.5 * (X[2, 1] + sign * X[1, 2])
-            fit = np.zeros_like(X)
-            fit[:, 0], fit[1, 1], fit[2, 2], fit[2, 1], fit[1, 2] = X[:, 0], B, -sign * B, C, sign * C
-            off = np.abs(X - fit).sum()
-            if off <= noise:
-                Y = np.zeros_like(X)
-                Y[:, 0], Y[0, 1], Y[0, 2] = X[:, 0], B, C
-                T = np.moveaxis(Y, (0, 1), (p, p + 1))
-                residual += off
-                shears.append((dims[p], dims[p + 1], sign))
-                break
-    return T, residual
+def without_wrist(parts: HarmonicSum) -> HarmonicSum | None:
+    """``over_direction``'s (A, X, Y) without their last joint b, where b turns the CoM's
+    offset about the flange axis, X + iY = exp(+-i theta_b) (X0 + iY0): then A = A0 + P
+    cos(theta_b) + Q sin(theta_b) and A + |(X, Y)| <= A0 + |(P, Q)| + |(X0, Y0)| (exact
+    where b turns a whole turn). The sums (A0, P, Q, X0, Y0) over the joints before b, or
+    None where b is not such (the terms that do not fit go to the constant coefficients'
+    radius, as errors, when they are rounding noise)."""
+    c = parts.coefficients
+    mid, rad = c.mid.reshape(3, -1, 3), c.rad.reshape(3, -1, 3)
+    A, X, Y = mid
+    if not parts.dims:
+        return None
+    size = np.abs(mid[1:]).sum()
+    for sign in (1.0, -1.0):  # X = cos(b) X0 - sign sin(b) Y0, Y = sign sin(b) X0 + cos(b) Y0
+        X0, Y0 = 0.5 * (X[:, 1] + sign * Y[:, 2]), 0.5 * (Y[:, 1] - sign * X[:, 2])
+        misfit = np.abs(X[:, 0]).sum() + np.abs(Y[:, 0]).sum() + np.abs(X[:, 1] - X0).sum() + np.abs(Y[:, 1] - Y0).sum()
+        misfit += np.abs(Y[:, 2] - sign * X0).sum() + np.abs(X[:, 2] + sign * Y0).sum()
+        if misfit <= NOISE * size:
+            kept = np.stack([A[:, 0], A[:, 1], A[:, 2], X0, Y0])
+            error = np.zeros_like(kept)
+            error[:3, 0] = rad[0].reshape(-1, 3).sum(axis=0) * (1 + 1e-12)
+            error[3, 0] = (misfit + rad[1:].sum()) * (1 + 1e-12)
+            return HarmonicSum(parts.dims[:-1], Interval(kept - error, kept + error))
+    return None
