@@ -18,6 +18,7 @@ from __future__ import annotations
 import struct
 from typing import NamedTuple
 
+import numpy as np
 from rclpy.serialization import deserialize_message
 from sensor_msgs.msg import JointState
 
@@ -142,6 +143,8 @@ class EffortMessage:
         """The message with ``stamp`` (anything with sec, nanosec) and ``effort`` (one per name)."""
         buffer = bytearray(self._template)
         _STAMP.pack_into(buffer, HEADER, stamp.sec, stamp.nanosec)
+        if type(effort) is np.ndarray:  # floats unpacked from a list: a fifth of the cost of NumPy's scalars
+            effort = effort.tolist()
         self._efforts.pack_into(buffer, self._at, *effort)
         return bytes(buffer)
 
