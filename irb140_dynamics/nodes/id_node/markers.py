@@ -188,8 +188,8 @@ class MarkerPublisher:
     @guarded("markers")
     def publish(self) -> None:
         """The markers of the last joint state, if one came since the last call and a model
-        is loaded (the node's settings) and anything subscribes (markers nobody takes would
-        cost the stream some 0.75 ms each); none that is not finite (counted, warned)."""
+        is loaded (the node's settings) and anything subscribes (building markers for nobody
+        would take the stream's time for nothing); none that is not finite (counted, warned)."""
         settings = getattr(self._node, "settings", None)
         if not self._fresh or settings is None or self._last is None or not self._publisher.subscribers:
             return
