@@ -97,11 +97,14 @@ def stream_run(
     change_period: float | None = None,
     effort: bool = False,
     depth: int = QOS_DEPTH,
+    listen: tuple[type, str] | None = None,
 ) -> dict:
     """Start the node, stream joint states at ``rate`` through it, return the raw figures.
 
     ``effort``: every joint state carries efforts (id_node then runs its momentum observer
     and publishes external_torques too).
+    ``listen``: (message type, topic under the node's namespace) subscribed here too, as a
+    viewer would (RViz for ~/markers): id_node builds what nobody subscribes to not at all.
     ``profile``: py-spy samples the node over the measured window (bench/results/profile_*.txt).
     ``change_period``: set payload.mass (a new value each time) every that many seconds
     over the measured window, through the parameter service (see ParameterChanger).
@@ -111,7 +114,7 @@ def stream_run(
 
     namespace = f"/bench_nodes_{os.getpid()}_{index}"
     process = NodeProcess(node_command(kind, executor, namespace, lean, depth), env)
-    publisher = subscription = receiver = spy = changer = None
+    publisher = subscription = receiver = spy = changer = viewer = None
     changes = None
     profile_path = RESULTS / f"profile_{kind}_{executor}_{rate:g}hz.txt"
     try:
@@ -126,9 +129,13 @@ def stream_run(
             lambda msg: None,
             QoSProfile(depth=RECEIVER_DEPTH, reliability=ReliabilityPolicy.RELIABLE),
         )
+        if listen is not None:  # its messages are left in its queue: never taken, as cheap as can be here
+            viewer = node.create_subscription(listen[0], f"{namespace}/{listen[1]}", lambda msg: None, 10)
         wait_for(
             lambda: (
-                publisher.get_subscription_count() > 0 and node.count_publishers(f"{namespace}/feedforward_torques") > 0
+                publisher.get_subscription_count() > 0
+                and node.count_publishers(f"{namespace}/feedforward_torques") > 0
+                and (viewer is None or viewer.get_publisher_count() > 0)
             ),
             STARTUP_TIMEOUT,
             process,
@@ -202,6 +209,8 @@ def stream_run(
                 spy.wait(timeout=5)
         if subscription is not None:
             node.destroy_subscription(subscription)
+        if viewer is not None:
+            node.destroy_subscription(viewer)
         if publisher is not None:
             node.destroy_publisher(publisher)
         process.stop()

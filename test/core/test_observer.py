@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import Friction, RigidBody, coriolis_matrix, gravity, irb140, mass_matrix, rnea
-from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.codegen import native
+from irb140_dynamics.core.codegen.kernels import kernels_of, prepare
 from irb140_dynamics.core.monitoring.observer import MomentumObserver, monitor_terms
 
 from ..support.common import random_urdf_model
@@ -58,6 +59,27 @@ def test_monitor_terms_are_the_separate_algorithms_to_the_last_bit(make):
         assert (p, beta) == tuple(observer._momentum_terms(q, qd))
     with pytest.raises(ValueError, match="rnea: the result is not finite"), np.errstate(all="ignore"):
         monitor_terms(model, [0.0] * model.n, [1e200] * model.n, [0.0] * model.n)
+
+
+@pytest.mark.skipif(not native.enabled(), reason="no C compiler (or IRB140_NATIVE=0)")
+def test_monitor_terms_of_arrays_run_native_to_the_same_bits(monkeypatch):
+    """Float64 arrays go to the C kernel (the node's joint states), lists to the Python form:
+    the same numbers, the refusal of a non-finite result the same."""
+    model = arm_with_friction()
+    assert prepare(model, names=("monitor",)).native
+    kernel = kernels_of(model).monitor
+    python_calls = []
+    monkeypatch.setattr(kernel, "used", lambda: python_calls.append(1))
+    rng = np.random.default_rng(2)
+    for _ in range(50):
+        q, qd, qdd = (rng.uniform(-3.0, 3.0, model.n) for _ in range(3))
+        before = len(python_calls)
+        from_arrays = monitor_terms(model, q, qd, qdd)
+        assert len(python_calls) == before  # no call of the Python form
+        assert from_arrays == monitor_terms(model, q.tolist(), qd.tolist(), qdd.tolist())
+    assert len(python_calls) == 50
+    with pytest.raises(ValueError, match="rnea: the result is not finite"), np.errstate(all="ignore"):
+        monitor_terms(model, np.zeros(model.n), np.full(model.n, 1e200), np.zeros(model.n))
 
 
 def run(model, duration, external=lambda t: np.zeros(6), observer=None):

@@ -138,6 +138,22 @@ def test_the_node_publishes_markers_after_joint_states_only():
     assert {m.header.frame_id for m in last.values()} == {"base_link"}
 
 
+def test_no_markers_are_built_while_nobody_subscribes():
+    with running(IdNode, parameter_overrides=[Parameter("markers.rate", value=50.0)]) as harness:
+        torques = harness.listen(JointState, "feedforward_torques")
+        states = harness.publisher(JointState, "joint_states")
+        msg = JointState(name=list(MODEL.joint_names), position=Q.tolist(), velocity=[0.0] * 6)
+        states.publish(msg)
+        assert harness.spin_until(lambda: torques)
+        harness.spin_for(0.3)  # 15 ticks of the markers' timer
+        assert harness.node.markers.published == 0
+        markers = harness.listen(MarkerArray, "/id_node/markers")
+        states.publish(msg)  # the last joint state's markers go to the subscriber once it is matched
+        assert harness.spin_until(lambda: markers)
+    assert harness.node.markers.published >= 1
+    assert {m.ns for m in markers[-1].markers} >= {"joint_load", "joint_label"}
+
+
 def test_a_urdf_arm_s_markers_are_in_its_base_link():
     from ..support.urdf_support import ARMS, arm_text
 

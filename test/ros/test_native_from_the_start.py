@@ -65,3 +65,29 @@ def test_without_native_code_the_log_says_python(monkeypatch):
         kernels = harness.node.settings.kernels
         assert not kernels.native and not kernels.compiling
         assert kernels_text(kernels).startswith("kernels: Python form (")
+
+
+@needs_a_compiler
+@pytest.mark.parametrize("mode", ["zero", "differentiate"])
+def test_joint_states_are_answered_by_the_native_kernels(monkeypatch, mode):
+    """The torques of every joint state come from the C kernels, never from their Python
+    form (which a state in another form than the native one takes would fall back to)."""
+    with running(IdNode, parameter_overrides=[Parameter("acceleration.mode", value=mode)]) as harness:
+        model = harness.node.settings.model
+        kernels = kernels_of(model)
+        python_calls = []
+        for kernel in (kernels.rnea_with_friction, kernels.gravity_torques):
+            assert kernel.native is not None
+            monkeypatch.setattr(kernel, "used", lambda kernel=kernel: python_calls.append(kernel))
+        feedforward = harness.listen(JointState, "feedforward_torques")
+        gravity_torques = harness.listen(JointState, "gravity_torques")
+        states = harness.publisher(JointState, "joint_states")
+        q = np.array([0.2, -0.5, 0.3, 0.1, 0.6, -0.2])
+        for k in range(20):
+            msg = JointState(name=list(model.joint_names), position=q.tolist(), velocity=[0.1 * k] * 6)
+            msg.header.stamp.sec, msg.header.stamp.nanosec = 3, k * 1_000_000
+            states.publish(msg)
+            harness.spin_for(0.002)
+        assert harness.spin_until(lambda: len(feedforward) >= 10 and len(gravity_torques) >= 10)
+    assert python_calls == []
+    np.testing.assert_allclose(gravity_torques[-1].effort, gravity(model, q), rtol=1e-12)

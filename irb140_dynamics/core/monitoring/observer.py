@@ -34,10 +34,17 @@ def monitor_terms(model: RobotModel, q, qd, qdd) -> tuple[list, list, list, list
     """(tau, g, p, beta) of one sample, in one pass over the arm (lists of floats): tau =
     rnea(q, qd, qdd) and g = gravity(q), checked finite (else ValueError, as rnea's), and
     the observer's p = M qd and beta = C^T qd - g - tau_f (see MomentumObserver.advance).
-    What a node that monitors the arm needs per sample, at about the cost of one rnea."""
+    What a node that monitors the arm needs per sample, at about the cost of one rnea: run
+    as C once the kernel is native (see dynamics.rnea) and the states are float64 arrays."""
     n = model.n
-    q, qd, qdd = state(q, n, "q"), state(qd, n, "qd"), state(qdd, n, "qdd")
-    terms = kernels_of(model).monitor.scalar(q, qd, qdd)
+    kernel = kernels_of(model).monitor
+    found = None if kernel.native is None else kernel.native(q, qd, qdd)  # None unless (n,) float64, finite
+    if found is not None:
+        terms, qd = found.tolist(), qd.tolist()
+    else:
+        kernel.used()
+        q, qd, qdd = state(q, n, "q"), state(qd, n, "qd"), state(qdd, n, "qdd")
+        terms = kernel.scalar(q, qd, qdd)
     tau, g, p, c = list(terms[:n]), list(terms[n : 2 * n]), list(terms[2 * n : 3 * n]), terms[3 * n :]
     if not math.isfinite(sum(tau) + sum(g)):
         finite_result(tau, "rnea", q=q, qd=qd, qdd=qdd)

@@ -37,6 +37,7 @@ from irb140_dynamics.core.monitoring.wrench import flange_wrench
 from irb140_dynamics.ros.messages.wrench import chain_links
 from irb140_dynamics.ros.parameters.specs import Spec
 from irb140_dynamics.ros.runtime.guard import guarded
+from irb140_dynamics.ros.runtime.listened import ListenedPublisher
 
 MAX_RATE = 100.0  # Hz
 LIFETIME_PERIODS = 3.0  # a marker lives this many periods (at least MIN_LIFETIME): a stopped stream's go
@@ -156,11 +157,11 @@ def _check_finite(marker: Marker) -> None:
 
 class MarkerPublisher:
     """Keeps the last joint state's numbers (cheap, per message) and publishes their markers
-    on a timer at ``rate`` [Hz] (0: never)."""
+    on a timer at ``rate`` [Hz] (0: never), while anything subscribes to them."""
 
     def __init__(self, node: Node, rate: float):
         self._node, self.tally = node, node.tally
-        self._publisher = node.create_publisher(MarkerArray, "~/markers", 10)
+        self._publisher = ListenedPublisher(node, MarkerArray, "~/markers", 10)
         self._rate = rate
         self._life = lifetime(rate) if rate > 0.0 else 0.0
         self._last = None  # (stamp, q, tau): the last joint state
@@ -187,9 +188,10 @@ class MarkerPublisher:
     @guarded("markers")
     def publish(self) -> None:
         """The markers of the last joint state, if one came since the last call and a model
-        is loaded (the node's settings); none that is not finite (counted, warned)."""
+        is loaded (the node's settings) and anything subscribes (building markers for nobody
+        would take the stream's time for nothing); none that is not finite (counted, warned)."""
         settings = getattr(self._node, "settings", None)
-        if not self._fresh or settings is None or self._last is None:
+        if not self._fresh or settings is None or self._last is None or not self._publisher.subscribers:
             return
         self._fresh = False
         stamp, q, tau = self._last

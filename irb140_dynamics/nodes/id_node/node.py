@@ -127,7 +127,7 @@ class IdNode(Node):
             self.get_logger().info(f"new model in force; {kernels_text(settings.kernels)}")
         if first or names != list(self.settings.model.joint_names):
             self._order = JointOrder(names)
-            self._zeros = [0.0] * len(names)
+            self._zeros = np.zeros(len(names))
             self._feedforward_msg = EffortMessage(names)
             self._gravity_msg = EffortMessage(names)
             self._tracking_msg = JointState(name=names)
@@ -165,6 +165,7 @@ class IdNode(Node):
             if isinstance(msg, bytes):
                 msg = read_joint_state_cdr(msg)
             q, qd = read_joint_state(msg, self._order)
+            q, qd = np.array(q), np.array(qd)  # float64 arrays: what the native kernels take
             t = self._time_of(msg)
             tau, g, command, reference, terms = self._torques(msg, t, q, qd, settings)
         except NotForThisModel:
@@ -266,11 +267,11 @@ class IdNode(Node):
     def _estimated_acceleration(self, t: float, qd, settings: IdNodeSettings):
         if settings.acceleration_mode == "zero":
             return self._zeros
-        qdd = self._differentiator.update(t, qd)
+        qdd = self._differentiator.update(t, qd.tolist())  # Python floats: an overflow is inf, no warning
         if not all(map(math.isfinite, qdd)):  # an absurd velocity jump overflowed the difference
             self._differentiator.reset()
             raise BadMessage("not_finite_acceleration", f"the differentiated velocities give {qdd}")
-        return qdd
+        return np.array(qdd)
 
     def _time_of(self, msg) -> float:
         """The message's stamp [s]; for an unstamped stream, the time of arrival."""

@@ -38,7 +38,8 @@ def finite_torques(function, model, *state):
     BadMessage non_finite_torques (an absurd but finite state can overflow the model's
     sums; the core may return the non-finite torques or refuse them with ValueError)."""
     tau = core_result(function, model, *state)
-    if not (math.isfinite(sum(tau)) or all(map(math.isfinite, tau))):
+    values = tau.tolist() if type(tau) is np.ndarray else tau  # a sum of floats: a fraction of NumPy's
+    if not (math.isfinite(sum(values)) or all(map(math.isfinite, values))):
         raise BadMessage("non_finite_torques", f"the model gives {[float(x) for x in tau]}")
     return tau
 
