@@ -60,6 +60,17 @@ def _slide(axis: np.ndarray, distance: float) -> np.ndarray:
     return move
 
 
+def _flange_matrix(model: RobotModel) -> np.ndarray:
+    """The flange's placement on the last link, 4x4, made on first use and kept with the
+    model (as ``_placements``)."""
+    try:
+        return model.__dict__["_flange_matrix"]
+    except KeyError:
+        matrix = model.__dict__["_flange_matrix"] = model.flange.matrix()
+        matrix.setflags(write=False)  # shared by every caller
+        return matrix
+
+
 def _placements(model: RobotModel) -> list[tuple]:
     """Per joint (pre, post as 4x4, axis, offset, prismatic), made on first use and kept with
     the model (models are immutable: see codegen.kernels_of)."""
@@ -81,13 +92,24 @@ def _placements(model: RobotModel) -> list[tuple]:
 
 def flange_pose(model: RobotModel, q) -> np.ndarray:
     """The flange pose in the base frame, 4x4 (for DH models frame n)."""
-    return link_frames(model, q)[-1] @ model.flange.matrix()
+    return link_frames(model, q)[-1] @ _flange_matrix(model)
 
 
 def joint_origins(model: RobotModel, q) -> np.ndarray:
     """Where each joint's axis is placed, (n, 3) m in the base frame: the origin of joint i's
     frame (link frame i-1 placed by pre_i), which is URDF joint i's origin and URDF link i's."""
+    return _origins(model, link_frames(model, q))
+
+
+def joint_origins_and_flange(model: RobotModel, q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``joint_origins``, ``flange_pose`` and ``flange_jacobian`` from one pass of forward
+    kinematics."""
     frames = link_frames(model, q)
+    pose = frames[-1] @ _flange_matrix(model)
+    return _origins(model, frames), pose, _flange_jacobian(model, frames, pose)
+
+
+def _origins(model: RobotModel, frames: np.ndarray) -> np.ndarray:
     return np.array([(frame @ placed[0])[:3, 3] for frame, placed in zip(frames[:-1], _placements(model))])
 
 
@@ -100,12 +122,12 @@ def flange_jacobian(model: RobotModel, q) -> np.ndarray:
 def flange_pose_and_jacobian(model: RobotModel, q) -> tuple[np.ndarray, np.ndarray]:
     """``flange_pose`` and ``flange_jacobian`` from one pass of forward kinematics."""
     frames = link_frames(model, q)
-    pose = frames[-1] @ model.flange.matrix()
+    pose = frames[-1] @ _flange_matrix(model)
     return pose, _flange_jacobian(model, frames, pose)
 
 
 def _flange_jacobian(model: RobotModel, frames: np.ndarray, pose: np.ndarray | None = None) -> np.ndarray:
-    flange = (frames[-1] @ model.flange.matrix() if pose is None else pose)[:3, 3]
+    flange = (frames[-1] @ _flange_matrix(model) if pose is None else pose)[:3, 3]
     J = np.empty((6, model.n))
     for i, (frame, (pre, _, turning_axis, _, prismatic)) in enumerate(zip(frames[:-1], _placements(model))):
         joint_frame = frame @ pre  # joint i+1's axis passes through its origin

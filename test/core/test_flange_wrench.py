@@ -8,7 +8,7 @@ import pytest
 
 from irb140_dynamics.core import RobotModel, irb140
 from irb140_dynamics.core.io.urdf import export_urdf, load_urdf
-from irb140_dynamics.core.kinematics import flange_pose, joint_origins
+from irb140_dynamics.core.kinematics import flange_pose, joint_origins, joint_origins_and_flange
 from irb140_dynamics.core.monitoring import display
 from irb140_dynamics.core.monitoring.wrench import (
     MAX_DAMPING,
@@ -16,6 +16,7 @@ from irb140_dynamics.core.monitoring.wrench import (
     flange_jacobian_in,
     flange_wrench,
     in_base_axes,
+    wrench_of,
 )
 
 from ..support.urdf_support import ARMS, arm_text, pinocchio_of
@@ -60,6 +61,23 @@ def test_joint_origins_are_pinocchios(arm):
     pin.forwardKinematics(pm, data, q)
     expected = [data.oMi[pm.getJointId(name)].translation for name in model.joint_names]
     np.testing.assert_allclose(joint_origins(model, q), expected, atol=1e-10)
+
+
+def test_one_pass_of_kinematics_gives_the_same_numbers(arm):
+    # the markers' path: origins, pose, Jacobian and wrench from one pass, as the separate calls
+    model, pm, data, frame = arm
+    for q in np.random.default_rng(3).uniform(-2.0, 2.0, (3, model.n)):
+        origins, pose, J = joint_origins_and_flange(model, q)
+        np.testing.assert_array_equal(origins, joint_origins(model, q))
+        np.testing.assert_array_equal(pose, flange_pose(model, q))
+        np.testing.assert_array_equal(J, flange_jacobian_in(model, q, "base"))
+        tau_ext = np.random.default_rng(4).uniform(-20.0, 20.0, model.n)
+        for side in ("tip", "base"):
+            np.testing.assert_array_equal(
+                wrench_of(pose, J, tau_ext, side).vector, flange_wrench(model, q, tau_ext, side).vector
+            )
+    with pytest.raises(ValueError):
+        wrench_of(pose, J, [np.nan] * model.n, "base")
 
 
 @pytest.mark.parametrize("frame", ["tip", "base"])

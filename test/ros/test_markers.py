@@ -15,7 +15,7 @@ from irb140_dynamics.core.io.urdf import export_urdf, load_urdf
 from irb140_dynamics.core.kinematics import flange_pose
 from irb140_dynamics.core.monitoring import display
 from irb140_dynamics.core.monitoring.wrench import flange_jacobian_in
-from irb140_dynamics.nodes.id_node.markers import build_markers, lifetime
+from irb140_dynamics.nodes.id_node.markers import MarkerScene, build_markers, lifetime
 from irb140_dynamics.nodes.id_node.node import IdNode
 
 from ..support.ros_harness import running
@@ -100,6 +100,23 @@ def test_without_efforts_or_collision_their_markers_are_deleted(limits):
     markers = scene(limits, np.zeros(6))
     for key in (("external_force", 0), ("external_force", 1), ("collision", 0)):
         assert markers[key].action == Marker.DELETE
+
+
+def test_a_scene_kept_between_states_publishes_what_a_fresh_build_does(limits):
+    # the node keeps one scene per model and frame: arrows, collision texts and limits come
+    # and go between states; each update must equal the markers built afresh, nothing stale
+    kept = MarkerScene(MODEL, "base_link", 0.3)
+    rng = np.random.default_rng(5)
+    for i in range(12):
+        q, tau = rng.uniform(-2.0, 2.0, 6), rng.uniform(-200.0, 200.0, 6)
+        external = rng.uniform(-30.0, 30.0, 6) if i % 3 else None
+        colliding, shown = ("joint_2", "joint_3")[: i % 3], None if i % 4 == 0 else limits
+        stamp = Time(sec=i, nanosec=1000 * i)
+        fresh = build_markers(MODEL, shown, "base_link", stamp, q, tau, external, colliding, 0.3)
+        assert kept.update(shown, stamp, q, tau, external, colliding) == fresh, f"state {i}"
+    with pytest.raises(ValueError):  # refused; the next state is drawn whole again
+        kept.update(limits, Time(), [np.nan] * 6, np.zeros(6))
+    assert kept.update(shown, stamp, q, tau, external, colliding) == fresh
 
 
 def test_lifetime_spans_three_periods():

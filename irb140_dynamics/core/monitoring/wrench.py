@@ -69,6 +69,15 @@ def flange_wrench(model: RobotModel, q, tau_ext, frame: str = "tip") -> FlangeWr
     _check_frame(frame)
     tau_ext = state(tau_ext, model.n, "tau_ext")
     pose, J = flange_pose_and_jacobian(model, q)
+    return wrench_of(pose, J, tau_ext, frame)
+
+
+def wrench_of(pose: np.ndarray, J: np.ndarray, tau_ext, frame: str = "tip") -> FlangeWrench:
+    """``flange_wrench`` from the flange pose and base-axes Jacobian already computed for q
+    (``kinematics.flange_pose_and_jacobian``). ValueError if tau_ext is not n finite numbers,
+    or for another frame."""
+    _check_frame(frame)
+    tau_ext = state(tau_ext, J.shape[1], "tau_ext")
     if frame == "tip":
         J = _turned(pose[:3, :3].T, J)
     U, s, Vt = np.linalg.svd(J.T, full_matrices=False)  # J^T = U diag(s) Vt, s descending

@@ -29,11 +29,12 @@ import numpy as np
 from builtin_interfaces.msg import Duration
 from geometry_msgs.msg import Point
 from rclpy.node import Node
+from std_msgs.msg import Header
 from visualization_msgs.msg import Marker, MarkerArray
 
-from irb140_dynamics.core.kinematics import flange_pose, joint_origins
+from irb140_dynamics.core.kinematics import joint_origins_and_flange
 from irb140_dynamics.core.monitoring import display
-from irb140_dynamics.core.monitoring.wrench import flange_wrench
+from irb140_dynamics.core.monitoring.wrench import wrench_of
 from irb140_dynamics.ros.messages.wrench import chain_links
 from irb140_dynamics.ros.parameters.specs import Spec
 from irb140_dynamics.ros.runtime.guard import guarded
@@ -72,48 +73,94 @@ def build_markers(model, limits, frame_id: str, stamp, q, tau, external=None, co
     shown, ``external`` the observer's external torques (None: no efforts measured),
     ``colliding`` the names of the joints over their thresholds. ValueError if a number
     is not finite (the core's refusal, or here)."""
-    markers = MarkerArray()
-    new = _maker(frame_id, stamp, life)
-    limits = np.full(model.n, np.inf) if limits is None else limits  # none known (yet): grey
-    origins = joint_origins(model, q)
-    loads = display.joint_loads(tau, limits)
-    for j, (name, origin, torque, load) in enumerate(zip(model.joint_names, origins, tau, loads)):
-        below = sum(float(np.linalg.norm(origins[i] - origin)) < SAME_PLACE for i in range(j))  # joints here before j
-        size = JOINT_DIAMETER * 0.7**below  # nested, each seen through the one around it
-        colour = display.load_colour(load)
-        markers.markers.append(new("joint_load", j, Marker.SPHERE, origin, size, colour, alpha=JOINT_ALPHA))
-        label = display.load_label(name, float(torque), load)
-        above = origin + (0.0, 0.0, LABEL_RISE * (1 + below))  # stacked where joints share a place
-        markers.markers.append(new("joint_label", j, Marker.TEXT_VIEW_FACING, above, TEXT_HEIGHT, WHITE, label))
-    pose = flange_pose(model, q)
-    payload = model.payload
-    if payload.mass > 0.0:
-        com = pose[:3, :3] @ np.asarray(payload.com, dtype=float) + pose[:3, 3]
-        size = display.payload_diameter(payload.mass)
-        markers.markers.append(new("payload", 0, Marker.SPHERE, com, size, PAYLOAD, alpha=0.7))
-    flange = pose[:3, 3]
-    if external is not None:
-        force = flange_wrench(model, q, external, "base").force
-        arrow = new("external_force", 0, Marker.ARROW, np.zeros(3), 0.0, FORCE)
-        arrow.points = [_point(flange), _point(display.arrow_end(flange, force))]
-        arrow.scale.x, arrow.scale.y, arrow.scale.z = 0.015, 0.03, 0.05  # shaft, head diameters, head length
-        markers.markers.append(arrow)
-        text = f"{float(np.linalg.norm(force)):.1f} N"
-        where = display.arrow_end(flange, force) + (0.0, 0.0, LABEL_RISE)
-        markers.markers.append(new("external_force", 1, Marker.TEXT_VIEW_FACING, where, TEXT_HEIGHT, FORCE, text))
-    else:  # gone at once, not after their lifetime
-        markers.markers += [_deleted(frame_id, "external_force", 0), _deleted(frame_id, "external_force", 1)]
-    if colliding:
-        text = "collision: " + ", ".join(colliding)
-        where = flange + (0.0, 0.0, 3 * LABEL_RISE)
-        markers.markers.append(
-            new("collision", 0, Marker.TEXT_VIEW_FACING, where, 1.5 * TEXT_HEIGHT, COLLISION_RED, text)
-        )
-    else:
-        markers.markers.append(_deleted(frame_id, "collision", 0))
-    for marker in markers.markers:
-        _check_finite(marker)
-    return markers
+    return MarkerScene(model, frame_id, life).update(limits, stamp, q, tau, external, colliding)
+
+
+class MarkerScene:
+    """The Marker messages of one model, frame and lifetime, made once (namespace, id, type,
+    lifetime, alpha, a text's height); ``update`` writes one joint state's numbers into them
+    (positions, sizes, colours, texts, the stamp) and returns the MarkerArray of those shown.
+    The same messages serve every update: a publisher serialises them when called, so the
+    stream's callbacks are not kept waiting while ~20 messages are made at each tick."""
+
+    def __init__(self, model, frame_id: str, life: float):
+        self.model, self.frame_id, self.life = model, frame_id, life
+        self._header = Header(frame_id=frame_id)
+        new = _maker(self._header, life)
+        self._spheres = [new("joint_load", j, Marker.SPHERE, JOINT_ALPHA) for j in range(model.n)]
+        self._labels = [new("joint_label", j, Marker.TEXT_VIEW_FACING, text_height=TEXT_HEIGHT) for j in range(model.n)]
+        self._payload = new("payload", 0, Marker.SPHERE, 0.7, PAYLOAD) if model.payload.mass > 0.0 else None
+        if self._payload is not None:
+            size = float(display.payload_diameter(model.payload.mass))
+            self._payload.scale.x = self._payload.scale.y = self._payload.scale.z = size
+        self._payload_com = np.asarray(model.payload.com, dtype=float)
+        self._arrow = new("external_force", 0, Marker.ARROW, 1.0, FORCE)
+        self._arrow.scale.x, self._arrow.scale.y, self._arrow.scale.z = (
+            0.015,
+            0.03,
+            0.05,
+        )  # shaft, head diameters, head length
+        self._arrow.points = [Point(), Point()]
+        self._force_text = new("external_force", 1, Marker.TEXT_VIEW_FACING, 1.0, FORCE, TEXT_HEIGHT)
+        self._collision = new("collision", 0, Marker.TEXT_VIEW_FACING, 1.0, COLLISION_RED, 1.5 * TEXT_HEIGHT)
+        self._no_force = [_deleted(frame_id, "external_force", 0), _deleted(frame_id, "external_force", 1)]
+        self._no_collision = _deleted(frame_id, "collision", 0)
+        self._all_limits = np.full(model.n, np.inf)
+        self._array = MarkerArray()
+
+    def update(self, limits, stamp, q, tau, external=None, colliding=()) -> MarkerArray:
+        """The markers of one joint state (see ``build_markers``); nothing is written when a
+        number is not finite (ValueError)."""
+        model = self.model
+        origins, pose, J = joint_origins_and_flange(model, q)  # one pass of forward kinematics
+        flange = pose[:3, 3]
+        gap = np.linalg.norm(origins[:, None, :] - origins[None, :, :], axis=2) < SAME_PLACE
+        below = np.tril(gap, -1).sum(axis=1).tolist()  # the joints at j's place before j
+        sizes = [JOINT_DIAMETER * 0.7**k for k in below]  # nested, each seen through the one around it
+        com = pose[:3, :3] @ self._payload_com + flange
+        if external is not None:
+            force = wrench_of(pose, J, external, "base").force
+            end = display.arrow_end(flange, force)
+            numbers = (origins, com, flange, end)
+        else:
+            numbers = (origins, com, flange)
+        if not all(np.isfinite(x).all() for x in numbers):
+            raise ValueError("markers not finite")
+        loads = display.joint_loads(tau, self._all_limits if limits is None else limits)  # none known (yet): grey
+        stamp_of = self._header.stamp
+        stamp_of.sec, stamp_of.nanosec = stamp.sec, stamp.nanosec
+        shown = []
+        names, torques = model.joint_names, np.asarray(tau, dtype=float).tolist()
+        for j, (x, y, z) in enumerate(origins.tolist()):
+            sphere, label, load, k = self._spheres[j], self._labels[j], loads[j], below[j]
+            _place(sphere, x, y, z)
+            sphere.scale.x = sphere.scale.y = sphere.scale.z = sizes[j]
+            _paint(sphere, display.load_colour(load))
+            _place(label, x, y, z + LABEL_RISE * (1 + k))  # stacked where joints share a place
+            label.text = display.load_label(names[j], torques[j], load)
+            shown += (sphere, label)
+        if self._payload is not None:
+            _place(self._payload, *com.tolist())
+            shown.append(self._payload)
+        fx, fy, fz = flange.tolist()
+        if external is not None:
+            start, tip = self._arrow.points
+            start.x, start.y, start.z = fx, fy, fz
+            tip.x, tip.y, tip.z = end.tolist()
+            self._force_text.text = f"{float(np.linalg.norm(force)):.1f} N"
+            ex, ey, ez = end.tolist()
+            _place(self._force_text, ex, ey, ez + LABEL_RISE)
+            shown += (self._arrow, self._force_text)
+        else:  # gone at once, not after their lifetime
+            shown += self._no_force
+        if colliding:
+            self._collision.text = "collision: " + ", ".join(colliding)
+            _place(self._collision, fx, fy, fz + 3 * LABEL_RISE)
+            shown.append(self._collision)
+        else:
+            shown.append(self._no_collision)
+        self._array.markers = shown
+        return self._array
 
 
 def _deleted(frame_id: str, ns: str, id_: int) -> Marker:
@@ -122,37 +169,31 @@ def _deleted(frame_id: str, ns: str, id_: int) -> Marker:
     return marker
 
 
-def _maker(frame_id: str, stamp, life: float):
+def _maker(header: Header, life: float):
     seconds = math.floor(life)
     duration = Duration(sec=int(seconds), nanosec=int(round((life - seconds) * 1e9)) % 1_000_000_000)
 
-    def new(ns, id_, kind, position, size, colour, text="", alpha=1.0) -> Marker:
-        marker = Marker(ns=ns, id=id_, type=kind, action=Marker.ADD, text=text, lifetime=duration)
-        marker.header.frame_id = frame_id
-        marker.header.stamp.sec, marker.header.stamp.nanosec = stamp.sec, stamp.nanosec
-        p = marker.pose.position
-        p.x, p.y, p.z = (float(x) for x in position)
+    def new(ns, id_, kind, alpha=1.0, colour=WHITE, text_height=None) -> Marker:
+        """A marker shown (ADD) in ``header``'s frame and at its stamp; its pose unturned."""
+        marker = Marker(ns=ns, id=id_, type=kind, action=Marker.ADD, lifetime=duration, header=header)
         marker.pose.orientation.w = 1.0
-        if kind == Marker.TEXT_VIEW_FACING:
-            marker.scale.z = float(size)  # a text's height
-        else:
-            marker.scale.x = marker.scale.y = marker.scale.z = float(size)
-        c = marker.color
-        c.r, c.g, c.b, c.a = (float(x) for x in (*colour, alpha))
+        if text_height is not None:
+            marker.scale.z = float(text_height)  # a text's height
+        _paint(marker, colour)
+        marker.color.a = float(alpha)
         return marker
 
     return new
 
 
-def _point(xyz) -> Point:
-    return Point(x=float(xyz[0]), y=float(xyz[1]), z=float(xyz[2]))
+def _place(marker: Marker, x: float, y: float, z: float) -> None:
+    p = marker.pose.position
+    p.x, p.y, p.z = x, y, z
 
 
-def _check_finite(marker: Marker) -> None:
-    p, s = marker.pose.position, marker.scale
-    numbers = [p.x, p.y, p.z, s.x, s.y, s.z] + [v for point in marker.points for v in (point.x, point.y, point.z)]
-    if not all(map(math.isfinite, numbers)):
-        raise ValueError(f"marker {marker.ns} {marker.id} not finite")
+def _paint(marker: Marker, colour) -> None:
+    c = marker.color
+    c.r, c.g, c.b = (float(x) for x in colour)
 
 
 class MarkerPublisher:
@@ -167,6 +208,7 @@ class MarkerPublisher:
         self._last = None  # (stamp, q, tau): the last joint state
         self._observed = None  # (external torques, colliding joint names) of the last joint state, or None
         self._fresh = False
+        self._scene = None  # the markers' messages, of the model and frame they were made for
         self.published = 0
         if rate > 0.0:
             node.create_timer(1.0 / rate, self.publish)
@@ -197,10 +239,11 @@ class MarkerPublisher:
         stamp, q, tau = self._last
         external, colliding = self._observed or (None, ())
         frame_id = chain_links(self._node.parameters)[0]
+        scene = self._scene
+        if scene is None or scene.model is not settings.model or scene.frame_id != frame_id:
+            scene = self._scene = MarkerScene(settings.model, frame_id, self._life)
         try:
-            markers = build_markers(
-                settings.model, settings.torque_limits, frame_id, stamp, q, tau, external, colliding, self._life
-            )
+            markers = scene.update(settings.torque_limits, stamp, q, tau, external, colliding)
         except ValueError as error:
             self.tally.add("markers", "not_finite")
             self.tally.warn("markers", f"markers not published ({error})")
