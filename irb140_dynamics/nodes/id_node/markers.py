@@ -35,6 +35,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 from irb140_dynamics.core.kinematics import joint_origins_and_flange
 from irb140_dynamics.core.monitoring import display
 from irb140_dynamics.core.monitoring.wrench import wrench_of
+from irb140_dynamics.nodes.id_node.marker_bytes import packed
 from irb140_dynamics.ros.messages.wrench import chain_links
 from irb140_dynamics.ros.parameters.specs import Spec
 from irb140_dynamics.ros.runtime.guard import guarded
@@ -248,5 +249,5 @@ class MarkerPublisher:
             self.tally.add("markers", "not_finite")
             self.tally.warn("markers", f"markers not published ({error})")
             return
-        self._publisher.publish(markers)
+        self._publisher.publish(packed(markers))  # bytes: rclpy's field-by-field conversion skipped
         self.published += 1
