@@ -3,7 +3,7 @@ little-endian, as ``rclpy.serialization.serialize_message`` gives), made in Pyth
 each marker's constant parts (frame, namespace, id, type, action, lifetime, the empty
 texture, mesh and colour lists) encoded once.
 
-rclpy converts a message field by field before serialising it, ~9 us a Marker whatever
+rclpy converts a message field by field before serialising it, every Marker whatever
 changed; ``packed`` writes only what a marker's update changes (stamp, pose, scale, colour,
 points, text) between chunks kept per marker. Markers with per-vertex colours, textures,
 uv coordinates or meshes are not among id_node's: ``packed`` refuses them (ValueError).
