@@ -21,7 +21,6 @@ Every pair is checked to give the same numbers before it is timed.
 
 from __future__ import annotations
 
-import importlib.metadata
 import math
 import os
 import time
@@ -37,6 +36,7 @@ from common import (
     Figure,
     Row,
     Target,
+    example_robot_urdf,
     machine_info,
     print_table,
     seconds_per_call,
@@ -325,13 +325,11 @@ def paired_seconds_per_call(ours, baseline, blocks: int = PAIRED_BLOCKS, calls: 
 
 def _urdf_paths() -> dict[str, tuple[Path, str]]:
     """name -> (URDF file, tip link) of example-robot-data's UR5 and Panda."""
-    files = importlib.metadata.distribution("example-robot-data").files or ()
-    paths = {str(f).split("robots/")[-1]: f for f in files}
     arms = {
         "UR5": ("ur_description/urdf/ur5_robot.urdf", "tool0"),
         "Panda": ("panda_description/urdf/panda.urdf", "panda_hand"),
     }
-    return {name: (Path(paths[path].locate()), tip) for name, (path, tip) in arms.items()}
+    return {name: (example_robot_urdf(path), tip) for name, (path, tip) in arms.items()}
 
 
 URDF_PATHS = _urdf_paths()

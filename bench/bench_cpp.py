@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import argparse
 import hashlib
-import importlib.metadata
 import json
 import shutil
 import subprocess
@@ -45,6 +44,7 @@ from common import (
     Figure,
     Row,
     Target,
+    example_robot_urdf,
     machine_info,
     print_table,
     shown,
@@ -83,10 +83,8 @@ def arms(names: list[str]) -> dict:
         if name == "IRB-140":
             model = irb140()
         else:
-            files = importlib.metadata.distribution("example-robot-data").files or ()
-            paths = {str(f).split("robots/")[-1]: f for f in files}
             path, tip = URDF_ARMS[name]
-            model = load_urdf(paths[path].locate().read_text(), tip_link=tip).model
+            model = load_urdf(example_robot_urdf(path).read_text(), tip_link=tip).model
         joints = tuple(replace(joint, friction=Friction()) for joint in model.joints)
         found[name] = replace(model, joints=joints)
     return found

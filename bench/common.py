@@ -294,3 +294,11 @@ def set_priority(priority: int) -> bool:
         return True
     except (OSError, AttributeError):  # not permitted (no CAP_SYS_NICE), or not Linux
         return False
+
+
+def example_robot_urdf(path: str) -> Path:
+    """An example-robot-data URDF file, by its path under the package's robots/ folder
+    (e.g. "ur_description/urdf/ur5_robot.urdf")."""
+    files = metadata.distribution("example-robot-data").files or ()
+    (found,) = [f for f in files if str(f).split("robots/")[-1] == path]
+    return Path(found.locate())
