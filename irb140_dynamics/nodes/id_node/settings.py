@@ -129,7 +129,8 @@ def torque_limits(model: RobotModel) -> tuple[float, ...]:
 
 def compiled(settings: IdNodeSettings, previous: IdNodeSettings | None) -> bool:
     """Whether finish_settings would be quick (the arm's code traced, and native already or
-    never): then it may run on the executor."""
+    never): then it may run on the executor. On the way, a kernel whose arm has compiled
+    code already is bound to it (cheap; what prepare would do first)."""
     kernels = kernels_of(settings.model)
     if not kernels.compiled(*KERNELS):
         return False
