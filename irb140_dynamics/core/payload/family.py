@@ -34,7 +34,7 @@ from irb140_dynamics.core.model.rigid_body import RigidBody
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.payload.proof import certify
 from irb140_dynamics.core.payload.proof.certify import Objective, certify_maxima, interval_maxima
-from irb140_dynamics.core.payload.proof.harmonic import StaticForms, without_wrist
+from irb140_dynamics.core.payload.proof.harmonic import NOISE, StaticForms, without_wrist
 from irb140_dynamics.core.payload.stop import ran_out
 from irb140_dynamics.core.payload.workspace import JointRanges
 from irb140_dynamics.core.scalars.interval import Interval, bounds_of
@@ -171,12 +171,15 @@ class PayloadFamily:
             joined = [(objectives[i], objectives[i].norm.angles(t, lower, upper)) for i, t in zip(k, theta)]
             return np.array([objective.value.angles(t, lower, upper)[0] for objective, t in joined])
 
-        def polish(k, theta):
-            found, pose = ranges.climb(torque, weights[rows[k]], joints_of(angles(k, theta)))
-            folded = [
+        def folded(k, pose):  # the angles of objective k's box at joint values q (P, n)
+            at = [
                 objectives[i].norm.fold(objectives[i].value.fold(t)) for i, t in zip(k, forms.angles_of(pose + offsets))
             ]
-            return found, np.array([t[0] for t in folded])
+            return np.array([t[0] for t in at])
+
+        def polish(k, theta):
+            found, pose = ranges.climb(torque, weights[rows[k]], joints_of(angles(k, theta)))
+            return found, folded(k, pose)
 
         proof = certify_maxima(
             objectives,
@@ -187,6 +190,7 @@ class PayloadFamily:
             polish,
             int(share * certify.EVALUATIONS),
             None if ceiling is None else ceiling[rows],
+            folded(range(rows.size), poses[rows]),
         )
         bounds[rows] = proof.bound
         values, poses = values.copy(), poses.copy()
@@ -213,9 +217,12 @@ class PayloadFamily:
         reached = (False, True) if parts.coefficients.lo.shape[0] == 5 else (True,)  # ((P, Q): the wrist's turn)
         parts = parts.reduced(merge=True)
         value = replace(parts, coefficients=parts.coefficients[0], error=parts.error[0])
-        pairs = [p for p in range(parts.error.size // 2) if np.any(parts.coefficients[1 + 2 * p : 3 + 2 * p])]
-        keep = [1 + 2 * p + k for p in pairs for k in (0, 1)]  # (a pair all zeros: a CoM on the axis)
-        vanished = float(np.sum(np.delete(parts.error[1:], np.array(keep, dtype=int) - 1)))
+        size = np.abs(parts.coefficients).sum(axis=1)
+        noise = NOISE * size.sum()  # (a pair of rounding noise: a CoM on the axis)
+        pairs = [p for p in range(parts.error.size // 2) if size[1 + 2 * p : 3 + 2 * p].sum() > noise]
+        keep = [1 + 2 * p + k for p in pairs for k in (0, 1)]
+        dropped = np.delete(np.arange(1, parts.error.size), np.array(keep, dtype=int) - 1)
+        vanished = float(np.sum(parts.error[dropped]) + np.sum(size[dropped]))  # |(X, Y)| <= |X| + |Y|
         value = replace(value, error=value.error + vanished)
         lever = replace(parts, coefficients=parts.coefficients[keep], error=parts.error[keep]) if keep else None
         reached = tuple(reached[p] for p in pairs)

@@ -16,7 +16,12 @@ of two bounds: the sum's own, a second-order expansion about the box's centre (s
 ``bounds``: off by O(r^3) near a maximum), and |tau_j| <= |g| |omega_j(theta after j)|
 (Cauchy-Schwarz), which holds whatever the joints before j do: it closes the boxes along
 the curves of poses that share a maximum (a wrist turning about its own axis, joints that
-only turn gravity), where no expansion gets tight.
+only turn gravity), where no expansion gets tight. A box is split where the bound it gets
+weighs most. The norm is reached only where the joints up to j can turn gravity in frame j
+to omega_j's direction; where they cannot at the best pose known (a shoulder whose range
+ends before the arm is level, a torso that leans a little), a box wider than TURNING in
+those joints is split by the value's terms: else the norm's joints are cut ever finer
+while the box stays wide in the joints that bound the maximum.
 
 Rigour: the sums' coefficients are enclosures (Interval arithmetic); their widths and the
 terms of the joints dropped are the sums' ``error``, and ``bounds.rounding`` covers the
@@ -56,6 +61,8 @@ EVALUATIONS = 50_000  # box bounds per call, shared by the groups of objectives,
 TERMS = 200  # bounds of sums of this many terms (the IRB-140's): a box over more terms counts more
 BATCH = 1024  # boxes bounded at once (the most promising first)
 SLICE = 2048  # box bounds per turn of a group
+TURNING = 1.0  # rad: a half-width of a joint turning gravity past which the norm does not choose the split...
+REACHED = 0.99  # ...unless the best value known is at least this share of the norm at its pose
 
 
 @dataclass(frozen=True, eq=False)
@@ -89,7 +96,7 @@ class Maxima:
 
 
 def certify_maxima(
-    objectives, lower, upper, incumbent, tol, polish=None, evaluations: int | None = None, ceiling=None
+    objectives, lower, upper, incumbent, tol, polish=None, evaluations: int | None = None, ceiling=None, at=None
 ) -> Maxima:
     """Upper bounds of the objectives' maxima over theta in [lower, upper] ((n,), or (K, n):
     a box per objective), proven to
@@ -102,7 +109,9 @@ def certify_maxima(
     maximum there: ``polish(indices, theta)`` (objectives (P,), angles (P, n)) -> (values,
     theta) climbs from it to the real poses' values, which then serve as the best known.
     ``ceiling`` (K,): a box whose bound is at most its objective's ceiling is closed too,
-    however the best value moves (a decision: is the maximum below the ceiling?).
+    however the best value moves (a decision: is the maximum below the ceiling?). ``at``
+    (K, n): the angles of the incumbents' poses (nan: none), which tell where the norm bound
+    is reached (see the module).
     """
     evaluations = EVALUATIONS if evaluations is None else evaluations
     K = len(objectives)
@@ -118,6 +127,8 @@ def certify_maxima(
         ks = np.array(ks)
         climb = None if polish is None else (lambda local, theta, ks=ks: polish(ks[local], theta))
         group = _Group([objectives[k] for k in ks], lower[ks], upper[ks], incumbent[ks], tol[ks], climb)
+        if at is not None:
+            group.unreached = group.norm_unreached(np.asarray(at, dtype=float)[ks], incumbent[ks])
         if ceiling is not None:
             group.ceiling = np.asarray(ceiling, dtype=float)[ks]
         groups.append((ks, group))
@@ -151,6 +162,8 @@ class _Group:
         norm_error = np.array([np.sum(o.norm.error) for o in objectives])
         self.norm_slack = g * (norm_error + rounding(len(self.norm_dims)) * norm_size)
         self.gravity = g * (1 + 8 * U)
+        self.turning = [k for k in self.value_dims if k not in self.norm_dims]  # the joints turning gravity in frame j
+        self.unreached = np.zeros(len(objectives), dtype=bool)  # per objective: is the norm not reached?
         self.levers, self.lever_slack = None, np.zeros(len(objectives))
         if first.lever is not None:
             self.levers = np.array([o.lever.coefficients for o in objectives])  # (K, 2 P, 3^d): P pairs
@@ -258,7 +271,42 @@ class _Group:
             else:
                 by_norm[rows], floor[rows], norm_weight[rows] = self._norm_bound(*args)
         use_norm = (by_norm < by_value) & (floor <= target)
+        if self.turning:
+            away = self._turned_away(owner, centre, radius) if len(self.turning) == 1 else self.unreached[owner]
+            use_norm &= ~(away & (radius[:, self.turning] > TURNING).any(axis=1))
         return np.minimum(by_value, by_norm), value, np.where(use_norm[:, None], norm_weight, value_weight)
+
+    def norm_unreached(self, theta, incumbent) -> np.ndarray:
+        """Per objective: is its best value known, at angles theta (K, n), below REACHED of
+        the norm bound there (the joints up to j could not turn gravity to omega_j)?"""
+        known = np.isfinite(theta).all(axis=1) & np.isfinite(incumbent)
+        unreached = self.unreached.copy()
+        if self.turning and known.any():
+            rows = np.flatnonzero(known)
+            centre = theta[rows]
+            norm = self._norm_bound(rows, centre, np.zeros_like(centre), np.full(rows.size, np.inf))[1]
+            unreached[rows] |= incumbent[rows] < REACHED * norm
+        return unreached
+
+    def _turned_away(self, owner, centre, radius) -> np.ndarray:
+        """Per box, where one joint t alone turns gravity in frame j (on a circle): is the
+        angle of t that turns it to omega_j, at the box's centre, outside the box's range of
+        t? The value there is A + X cos(theta_t) + Y sin(theta_t), the other joints at the
+        centre; that angle is atan2(Y, X)."""
+        B, dims = len(owner), self.value_dims
+        p = dims.index(self.turning[0])
+        C = np.moveaxis(self.values[owner].reshape((B,) + (3,) * len(dims)), p + 1, -1).reshape(B, -1, 3)
+        basis = np.ones((B, 1))
+        for k in dims:
+            if k != self.turning[0]:
+                phi = np.stack([np.ones(B), np.cos(centre[:, k]), np.sin(centre[:, k])], axis=1)
+                basis = (basis[:, :, None] * phi[:, None, :]).reshape(B, -1)
+        _, X, Y = np.einsum("ba,bak->kb", basis, C)
+        best = np.arctan2(Y, X)
+        t = self.turning[0]
+        lo, hi = centre[:, t] - radius[:, t], centre[:, t] + radius[:, t]
+        turns = np.ceil((lo - best) / (2 * math.pi))
+        return best + 2 * math.pi * turns > hi
 
     def _value_bound(self, owner, centre, radius, target):
         """The value's own bound over the boxes, its value at the centres (rounded down),

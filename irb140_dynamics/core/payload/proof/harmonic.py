@@ -300,7 +300,7 @@ def without_wrist(parts: HarmonicSum) -> HarmonicSum | None:
         X0, Y0 = 0.5 * (X[:, 1] + sign * Y[:, 2]), 0.5 * (Y[:, 1] - sign * X[:, 2])
         misfit = np.abs(X[:, 0]).sum() + np.abs(Y[:, 0]).sum() + np.abs(X[:, 1] - X0).sum() + np.abs(Y[:, 1] - Y0).sum()
         misfit += np.abs(Y[:, 2] - sign * X0).sum() + np.abs(X[:, 2] + sign * Y0).sum()
-        if misfit <= NOISE * size:
+        if misfit <= NOISE * (size + np.abs(A).sum()):  # (X, Y) of a CoM on the axis: rounding noise
             kept = np.stack([A[:, 0], A[:, 1], A[:, 2], X0, Y0])
             error = np.zeros_like(kept)
             error[:3, 0] = rad[0].reshape(-1, 3).sum(axis=0) * (1 + 1e-12)
