@@ -13,7 +13,7 @@ The worst static torques over the joint ranges come in two halves: the search of
 branch and bound of ``certify`` proves how far above them the true maxima can be (the
 gap; CERTIFY_RTOL of the torque when it closes, always within the budget of
 ``certify.EVALUATIONS`` box bounds per proof). Models beyond harmonic.MAX_JOINTS joints
-get plain interval bounds within the budget of ``certify.interval_maxima``. Proofs are
+get plain interval bounds within the budget of ``interval_bounds.interval_maxima``. Proofs are
 remembered per payload mass and joint ranges, families per arm and payload shape; a proof
 the analysis' deadline cut short (see ``stop``) is not remembered.
 """
@@ -33,8 +33,9 @@ from irb140_dynamics.core.dynamics import gravity_batch, rnea
 from irb140_dynamics.core.model.rigid_body import RigidBody
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.payload.proof import certify
-from irb140_dynamics.core.payload.proof.certify import Objective, certify_maxima, interval_maxima
+from irb140_dynamics.core.payload.proof.certify import Objective, certify_maxima
 from irb140_dynamics.core.payload.proof.harmonic import NOISE, StaticForms, without_wrist
+from irb140_dynamics.core.payload.proof.interval_bounds import interval_maxima
 from irb140_dynamics.core.payload.stop import ran_out
 from irb140_dynamics.core.payload.workspace import JointRanges
 from irb140_dynamics.core.scalars.interval import Interval, bounds_of
