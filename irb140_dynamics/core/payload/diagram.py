@@ -52,6 +52,7 @@ ROUNDS = 4  # proofs per point (each after Dinkelbach from the worse poses the l
 PROOF_SHARE = 16.0  # of ``certify.EVALUATIONS`` per proof: a heavy arm's own torques leave a payload little room
 MOST_JOINTS = MAX_JOINTS  # moving joints the harmonic proof takes (and the direction: 3^10 terms; intervals beyond)
 DIRECTION = "load_direction"  # the name of the joint that turns the CoM about the flange axis
+SEARCH_RTOL = 1e-9  # the searches' ascent stops gaining this share of the torque: far below MARGINS (a third of the sweeps of 1e-12)
 
 
 @dataclass(frozen=True, eq=False)
@@ -235,7 +236,9 @@ def _point(family: PayloadFamily, ranges: JointRanges, L: np.ndarray, warm, z: f
     for _ in range(ROUNDS):
         while math.isfinite(best.mass):  # Dinkelbach, on the limited joints' torques only
             torque = _static_torque(family, min(best.mass, MAX_MASS))
-            poses = ranges.maximize(torque, weights, G0 + min(best.mass, MAX_MASS) * dG, warm=poses)[1]
+            poses = ranges.maximize(torque, weights, G0 + min(best.mass, MAX_MASS) * dG, warm=poses, rtol=SEARCH_RTOL)[
+                1
+            ]
             candidate = smallest_max_payload(family, poses, L)
             if not _below(candidate.mass, best.mass * (1 - 1e-12)):
                 break
