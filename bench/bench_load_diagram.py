@@ -22,10 +22,9 @@ import argparse
 import os
 import resource
 import time
-from pathlib import Path
 
 import numpy as np
-from common import Row, Target, Value, machine_info, print_table, write_results
+from common import REPO, Row, Target, Value, machine_info, print_table, write_results
 
 from irb140_dynamics.core import RigidBody, derive_torque_limits, irb140
 from irb140_dynamics.core.payload import workspace_load
@@ -33,7 +32,6 @@ from irb140_dynamics.core.payload.diagram import load_diagram, pivoted
 from irb140_dynamics.core.urdf import load_urdf
 
 Z, L = np.arange(31) * 0.01, np.arange(21) * 0.01
-REPO = Path(__file__).resolve().parents[1]
 
 
 def cpu_seconds() -> float:

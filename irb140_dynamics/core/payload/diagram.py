@@ -236,9 +236,8 @@ def _point(family: PayloadFamily, ranges: JointRanges, L: np.ndarray, warm, z: f
     for _ in range(ROUNDS):
         while math.isfinite(best.mass):  # Dinkelbach, on the limited joints' torques only
             torque = _static_torque(family, min(best.mass, MAX_MASS))
-            poses = ranges.maximize(torque, weights, G0 + min(best.mass, MAX_MASS) * dG, warm=poses, rtol=SEARCH_RTOL)[
-                1
-            ]
+            sampled = G0 + min(best.mass, MAX_MASS) * dG
+            _, poses = ranges.maximize(torque, weights, sampled, warm=poses, rtol=SEARCH_RTOL)
             candidate = smallest_max_payload(family, poses, L)
             if not _below(candidate.mass, best.mass * (1 - 1e-12)):
                 break

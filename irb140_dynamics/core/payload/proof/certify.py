@@ -54,7 +54,7 @@ from irb140_dynamics.core.payload.proof.bounds import (
     sizes_of_s,
     squared_model,
 )
-from irb140_dynamics.core.payload.proof.harmonic import Reduced
+from irb140_dynamics.core.payload.proof.harmonic import Reduced, basis
 from irb140_dynamics.core.payload.stop import out_of_time
 
 EVALUATIONS = 50_000  # box bounds per call, shared by the groups of objectives, counted in
@@ -280,12 +280,12 @@ class _Group:
         """Per objective: is its best value known, at angles theta (K, n), below REACHED of
         the norm bound there (the joints up to j could not turn gravity to omega_j)?"""
         known = np.isfinite(theta).all(axis=1) & np.isfinite(incumbent)
-        unreached = self.unreached.copy()
+        unreached = np.zeros(len(incumbent), dtype=bool)
         if self.turning and known.any():
             rows = np.flatnonzero(known)
             centre = theta[rows]
             norm = self._norm_bound(rows, centre, np.zeros_like(centre), np.full(rows.size, np.inf))[1]
-            unreached[rows] |= incumbent[rows] < REACHED * norm
+            unreached[rows] = incumbent[rows] < REACHED * norm
         return unreached
 
     def _turned_away(self, owner, centre, radius) -> np.ndarray:
@@ -293,17 +293,11 @@ class _Group:
         angle of t that turns it to omega_j, at the box's centre, outside the box's range of
         t? The value there is A + X cos(theta_t) + Y sin(theta_t), the other joints at the
         centre; that angle is atan2(Y, X)."""
-        B, dims = len(owner), self.value_dims
-        p = dims.index(self.turning[0])
+        B, dims, t = len(owner), self.value_dims, self.turning[0]
+        p = dims.index(t)
         C = np.moveaxis(self.values[owner].reshape((B,) + (3,) * len(dims)), p + 1, -1).reshape(B, -1, 3)
-        basis = np.ones((B, 1))
-        for k in dims:
-            if k != self.turning[0]:
-                phi = np.stack([np.ones(B), np.cos(centre[:, k]), np.sin(centre[:, k])], axis=1)
-                basis = (basis[:, :, None] * phi[:, None, :]).reshape(B, -1)
-        _, X, Y = np.einsum("ba,bak->kb", basis, C)
+        _, X, Y = np.einsum("ba,bak->kb", basis(centre[:, [k for k in dims if k != t]]), C)
         best = np.arctan2(Y, X)
-        t = self.turning[0]
         lo, hi = centre[:, t] - radius[:, t], centre[:, t] + radius[:, t]
         turns = np.ceil((lo - best) / (2 * math.pi))
         return best + 2 * math.pi * turns > hi

@@ -102,12 +102,17 @@ class HarmonicSum:
 
     def __call__(self, theta: np.ndarray) -> np.ndarray:
         """The midpoint sum at angles theta (N, n): (N, ...); for tests."""
-        theta = np.atleast_2d(theta)[:, list(self.dims)]
-        basis = np.ones((len(theta), 1))
-        for k in range(theta.shape[1]):
-            phi = np.stack([np.ones(len(theta)), np.cos(theta[:, k]), np.sin(theta[:, k])], axis=1)
-            basis = (basis[:, :, None] * phi[:, None, :]).reshape(len(theta), -1)
-        return np.einsum("pa,...a->p...", basis, self.coefficients.mid)
+        return np.einsum("pa,...a->p...", basis(np.atleast_2d(theta)[:, list(self.dims)]), self.coefficients.mid)
+
+
+def basis(theta) -> np.ndarray:
+    """prod_k phi[alpha_k](theta_k) for every alpha (the first joint slowest), at angles
+    theta (N, d): (N, 3^d), the terms a sum's coefficients multiply."""
+    terms = np.ones((len(theta), 1))
+    for k in range(theta.shape[1]):
+        phi = np.stack([np.ones(len(theta)), np.cos(theta[:, k]), np.sin(theta[:, k])], axis=1)
+        terms = (terms[:, :, None] * phi[:, None, :]).reshape(len(theta), -1)
+    return terms
 
 
 @dataclass(frozen=True, eq=False)
