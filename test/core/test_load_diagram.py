@@ -148,6 +148,18 @@ def talos_case():
     return model, 1.2 * np.array(derive_torque_limits(model).values), models
 
 
+def xarm7_case():
+    """A 7-joint arm whose shoulder the arm's own weight loads to about 70 % of its limit,
+    with its rolls (joints 3, 5, 7) turning whole turns: the xArm7 of example-robot-data,
+    its URDF efforts."""
+    text = example_robot_text("xarm7.urdf")
+    if text is None:
+        pytest.skip("example-robot-data is not installed")
+    loaded = load_urdf(text, tip_link="link_eef")
+    models = payload_models(lambda body: pinocchio_of(text, loaded.held_joints, "link_eef", body))
+    return loaded.model, loaded.model.torque_limits, models
+
+
 CASES = {
     "irb140": irb140_case,
     "gantry_irb140": gantry_case,
@@ -155,12 +167,14 @@ CASES = {
     "panda": lambda: urdf_case("panda"),
     "prismatic_arm": prismatic_case,
     "talos_arm": talos_case,
+    "xarm7": xarm7_case,
 }
 GRIDS = {
     "irb140": ([0.0, 0.12], [0.0, 0.08]),
     "ur5": ([0.0, 0.15], [0.0, 0.1]),
     "panda": ([0.0, 0.15], [0.0, 0.1]),
     "talos_arm": ([0.1], [0.0, 0.05]),
+    "xarm7": ([0.2], [0.15]),
     "gantry_irb140": ([0.0, 0.1], [0.0, 0.1]),
     "prismatic_arm": ([0.0, 0.2], [0.0, 0.1]),
 }

@@ -49,7 +49,7 @@ from irb140_dynamics.core.payload.workspace import JointRanges
 
 MARGINS = (0.005, 0.015)  # the proof aims at (1 - margin) of the mass the search finds; the next if it fails
 ROUNDS = 4  # proofs per point (each after Dinkelbach from the worse poses the last one found, or with the next margin)
-PROOF_SHARE = 16.0  # of ``certify.EVALUATIONS`` per proof: a heavy arm's own torques leave a payload little room
+PROOF_SHARE = 24.0  # of ``certify.EVALUATIONS`` per proof: a heavy arm's own torques leave a payload little room
 MOST_JOINTS = MAX_JOINTS  # moving joints the harmonic proof takes (and the direction: 3^10 terms; intervals beyond)
 DIRECTION = "load_direction"  # the name of the joint that turns the CoM about the flange axis
 SEARCH_RTOL = 1e-9  # the searches' ascent stops gaining this share of the torque: far below MARGINS (a third of the sweeps of 1e-12)

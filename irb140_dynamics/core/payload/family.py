@@ -20,6 +20,7 @@ the analysis' deadline cut short (see ``stop``) is not remembered.
 
 from __future__ import annotations
 
+import math
 import threading
 from collections import OrderedDict
 from dataclasses import dataclass, fields, replace
@@ -34,7 +35,7 @@ from irb140_dynamics.core.model.rigid_body import RigidBody
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.payload.proof import certify
 from irb140_dynamics.core.payload.proof.certify import Objective, certify_maxima
-from irb140_dynamics.core.payload.proof.harmonic import NOISE, StaticForms, without_wrist
+from irb140_dynamics.core.payload.proof.harmonic import NOISE, HarmonicSum, StaticForms, without_wrist
 from irb140_dynamics.core.payload.proof.interval_bounds import interval_maxima
 from irb140_dynamics.core.payload.stop import ran_out
 from irb140_dynamics.core.payload.workspace import JointRanges
@@ -165,7 +166,10 @@ class PayloadFamily:
         def joints_of(theta):  # joint values q of angles theta (prismatic: their displacements)
             return np.clip(forms.joints_of(theta) - offsets, ranges.lower, ranges.upper)
 
-        objectives = [self._objective(forms, j, sign, m) for j, sign in zip(joints, signs)]
+        objectives = [
+            self._objective(forms, j, s, m, found, room)
+            for j, s, found, room in zip(joints, signs, values[rows], tol[rows])
+        ]
         boxes = [objective.norm.box(*objective.value.box(lower, upper)) for objective in objectives]
 
         def angles(k, theta):  # the joint angles of objective k's box (parallel joints merged: before j, after j)
@@ -204,11 +208,17 @@ class PayloadFamily:
             values[found[higher]], poses[found[higher]] = value[higher], pose[higher]
         return Extremes(values, poses, np.maximum(bounds, values))
 
-    def _objective(self, forms: StaticForms, j: int, sign: float, m: float) -> Objective:
+    def _objective(
+        self, forms: StaticForms, j: int, sign: float, m: float, found: float = 0.0, room: float = 0.0
+    ) -> Objective:
         """+-tau_j at m kg as the proof's objective; with a ``direction`` joint, its worst
         value over the directions: A + |(X, Y)| (see ``Objective``), not one more angle;
         and without the last joint where it only turns the CoM about the flange axis (see
-        ``harmonic.without_wrist``: a lever more)."""
+        ``harmonic.without_wrist``: a lever more); its norm without the direction too
+        where that bound, off by at most (|g| m l)^2 / (2 |tau_j|) at poses where the CoM's
+        offset l cannot turn fully outward, is off by at most the ``room`` [N m] the proof
+        has above the torque ``found`` (see ``_norm``; else the norm with the direction as
+        an angle serves better)."""
         torque, omega = forms.torque[j] * sign, forms.omega[j]
         if self.direction is None or j == self.direction:
             return Objective(torque.reduced(merge=True), omega.reduced(), forms.gravity_norm)
@@ -227,10 +237,42 @@ class PayloadFamily:
         value = replace(value, error=value.error + vanished)
         lever = replace(parts, coefficients=parts.coefficients[keep], error=parts.error[keep]) if keep else None
         reached = tuple(reached[p] for p in pairs)
-        norm = omega.reduced(merge=True)  # (the direction an angle there, merged with a wrist it turns with)
+        offset = m * math.hypot(*self.unit.payload.com[:2]) * forms.gravity_norm  # N m: |g| m l
+        norm, turn = self._norm(omega, m, turned=offset**2 <= 2 * room * abs(found))
         if any(a in value.dims or b in value.dims for a, b, _ in norm.merges):  # (their box is the value's too)
-            norm = omega.reduced()
-        return Objective(value, norm, forms.gravity_norm, lever, reached)
+            norm, turn = self._norm(omega, m, merge=False, turned=turn is not None)
+        return Objective(value, norm, forms.gravity_norm, lever, reached, turn)
+
+    def _norm(self, omega, m: float, merge: bool = True, turned: bool = True):
+        """omega_j as the proof's norm: with the direction as an angle (merged with a wrist
+        it turns with), or, ``turned``, without it: (a, X, Y) (9 sums), omega = a + X cos(phi)
+        + Y sin(phi), and the most |X cos + Y sin| can be (``Objective.turn``).
+
+        That part is the payload's offset l off the flange axis turned by phi: per unit of
+        gravity a mass m at p loads joint j by m (z_j x p), so it is m l (z_j x u) for a unit
+        vector u, at most m l, exactly (plus the sums' errors). A wrist b that turns the
+        offset about the flange axis turns (X, Y) only (X + iY = exp(+-i theta_b) (X0 + iY0),
+        ``harmonic.without_wrist``): over a whole turn of phi, (X0, Y0) serve, and b is left
+        in a alone (its own link's CoM). Turned, the norm is over two angles fewer, and its
+        bound is exact at poses where the offset turns fully outward (see
+        ``bounds.turned_squared_max``)."""
+        if not turned or not omega.dims or omega.dims[-1] != self.direction:
+            return (omega.reduced(merge=True) if merge else omega.reduced()), None
+        parts = omega.over_direction()  # (3 parts, 3 axes, ...)
+        c = parts.coefficients
+        lo, hi = c.lo.reshape(3, 3, -1), c.hi.reshape(3, 3, -1)
+        folded = without_wrist(parts) if parts.dims and parts.dims[-1] == self.direction - 1 else None
+        if folded is not None:  # X + iY = exp(+-i theta_b) (X0 + iY0): (X0, Y0) serve, b turns them with phi
+            kept = folded.coefficients  # (5, 3 axes x 3^(d-1)): A0, P, Q, X0, Y0
+            lo, hi = lo.copy(), hi.copy()
+            lo[1:], hi[1:] = 0.0, 0.0
+            lo[1:, :, ::3] = kept.lo[3:].reshape(2, 3, -1)
+            hi[1:, :, ::3] = kept.hi[3:].reshape(2, 3, -1)
+        stacked = HarmonicSum(parts.dims, Interval(lo.reshape(9, -1), hi.reshape(9, -1)))
+        norm = stacked.reduced(merge=merge)
+        com = self.unit.payload.com
+        turn = float(m) * math.hypot(com[0], com[1]) * (1 + 1e-9) + float(np.sum(norm.error[3:]))
+        return norm, turn
 
     def _interval_torques(self, m, offsets):
         """(lo, hi) per joint (n, B) of the static torques at m kg over boxes of q (B, n)."""

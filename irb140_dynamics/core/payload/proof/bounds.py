@@ -191,3 +191,58 @@ def squared_model(N, W, sigma, radius):
     size = np.sqrt((middle**2).sum(axis=1))
     squared = size**2 + 2 * high_v + 2 * linear * rest + rest**2
     return size, squared, g_v, Q_v + np.einsum("bck,bcl->bkl", A, A), terms
+
+
+def turned_squared_max(N, W, sigma, radius, turn, enough=None):
+    """For vectors a + X cos(phi) + Y sin(phi), phi over a whole turn, given as the sums of
+    a, X, Y (3 each) re-expanded about the centres, N (B, 9, 3^d), with ``turn`` (B,) >=
+    |X cos(phi) + Y sin(phi)| everywhere: an upper bound of the largest |.|^2 over the boxes
+    and every phi, its limit at the centres (a bound there), each term's weight.
+
+    With B = [X Y] and u a unit vector, |a + B u|^2 <= |a|^2 + 2 |w| + turn^2, w = B^T a
+    (exact where the best u for w is B's first singular vector: a CoM offset turned fully
+    outward, or along the flange axis). With b = |w(c)| > 0, e = w(c) / b and delta = w -
+    w(c), |w| <= b/2 + |w|^2 / (2 b) = b + e . delta + |delta|^2 / (2 b): e . delta to second
+    order exactly (the products' linear and bilinear parts; the rest by sizes), |delta|^2 as
+    |J s|^2 plus terms of degree >= 3 (J: w's linear part), one quadratic model with |a|^2's
+    (``squared_model``), off by O(r^3) like it. Also, for b near 0: |a|^2's bound plus 2 (b +
+    sum |J_k| sigma_k + the size of w's terms of degree >= 2); the smaller of the two."""
+    B, _, size_d = N.shape
+    where = layout(radius.shape[1])
+    a, X = N[:, :3], N[:, 3:].reshape(B, 2, 3, size_d)
+    size, squared, g, Q, terms = squared_model(a, W, sigma, radius)
+    a0, X0 = a[:, :, 0], X[:, :, :, 0]
+    Aa, AX = a[:, :, where.single_s], X[:, :, :, where.single_s]
+    w0 = np.einsum("bc,bpc->bp", a0, X0)
+    J = np.einsum("bck,bpc->bpk", Aa, X0) + np.einsum("bc,bpck->bpk", a0, AX)
+    higher = np.ones(size_d, dtype=bool)
+    higher[0] = False
+    higher[where.single_s] = False
+    Ha, HX = (np.abs(a) * higher * W[:, None]).sum(axis=2), (np.abs(X) * higher * W[:, None, None]).sum(axis=3)
+    La, LX = np.einsum("bck,bk->bc", np.abs(Aa), sigma), np.einsum("bpck,bk->bpc", np.abs(AX), sigma)
+    first = np.einsum("bpa,ba->bp", np.abs(np.einsum("bc,bpca->bpa", a0, X * higher)), W)
+    first = first + np.einsum("bpa,ba->bp", np.abs(np.einsum("bpc,bca->bpa", X0, a * higher)), W)
+    products = np.einsum("bc,bpc->bp", La + Ha, LX + HX)  # |delta a . delta X_p|
+    rest = np.sqrt(((first + products) ** 2).sum(axis=1))  # |w - w(c) - J s|
+    b = np.sqrt((w0**2).sum(axis=1))
+    linear = (np.sqrt((J**2).sum(axis=1)) * sigma).sum(axis=1)
+    bound = squared + turn**2 + 2 * (b + linear + rest) + quadratic_max(2 * g, 2 * Q, sigma)
+    rows = np.flatnonzero((b > 0) & ~(bound <= (np.inf if enough is None else enough)))
+    if rows.size:
+        e, k = w0[rows] / b[rows, None], 1.0 / b[rows]
+        D = np.einsum("bp,bc,bpca->ba", e, a0[rows], X[rows]) + np.einsum("bp,bpc,bca->ba", e, X0[rows], a[rows])
+        g1, Q1, high1, _ = model(D, W[rows], radius[rows])  # e . (a(c) . X + X(c) . a): all but delta a . delta X
+        M = np.einsum("bp,bck,bpcl->bkl", e, Aa[rows], AX[rows])  # e . (delta a . delta X): its bilinear part...
+        bilinear_rest = np.einsum("bp,bc,bpc->b", np.abs(e), La[rows], HX[rows])  # ...and the rest
+        bilinear_rest = bilinear_rest + np.einsum("bp,bc,bpc->b", np.abs(e), Ha[rows], LX[rows] + HX[rows])
+        JJ = np.einsum("bpk,bpl->bkl", J[rows], J[rows]) * k[:, None, None]
+        g_all = 2 * g[rows] + 2 * g1
+        Q_all = 2 * Q[rows] + 2 * Q1 + 2 * (M + M.transpose(0, 2, 1)) + 2 * JJ
+        constant = squared[rows] + turn[rows] ** 2 + 2 * b[rows] + 2 * (high1 + bilinear_rest)
+        constant = constant + (2 * linear[rows] * rest[rows] + rest[rows] ** 2) * k
+        enough_rows = None if enough is None else enough[rows] - constant
+        modelled = constant + quadratic_max(g_all, Q_all, sigma[rows], enough_rows)
+        bound[rows] = np.fmin(bound[rows], modelled)  # (nan: the other)
+    bound = bound * (1 + 1e-12) + 1e-12 * (squared + turn**2 + 2 * b)  # (the rounding of the products)
+    weight = terms + (np.abs(X) * W[:, None, None]).sum(axis=(1, 2)) * size[:, None]
+    return np.sqrt(size**2 + 2 * b + turn**2), bound, weight

@@ -16,12 +16,16 @@ of two bounds: the sum's own, a second-order expansion about the box's centre (s
 ``bounds``: off by O(r^3) near a maximum), and |tau_j| <= |g| |omega_j(theta after j)|
 (Cauchy-Schwarz), which holds whatever the joints before j do: it closes the boxes along
 the curves of poses that share a maximum (a wrist turning about its own axis, joints that
-only turn gravity), where no expansion gets tight. A box is split where the bound it gets
-weighs most. The norm is reached only where the joints up to j can turn gravity in frame j
-to omega_j's direction; where they cannot at the best pose known (a shoulder whose range
-ends before the arm is level, a torso that leans a little), a box wider than TURNING in
-those joints is split by the value's terms: else the norm's joints are cut ever finer
-while the box stays wide in the joints that bound the maximum.
+only turn gravity), where no expansion gets tight. With a payload's direction phi (see
+``Objective``), omega_j = a + X cos(phi) + Y sin(phi) may be bounded without phi as an
+angle (``Objective.turn``, ``bounds.turned_squared_max``): a straight arm's rolls leave
+surfaces of near-maximum poses that the norm, over fewer joints, covers in far fewer boxes.
+A box is split where the bound it gets weighs most. The norm is reached only where the
+joints up to j can turn gravity in frame j to omega_j's direction; where they cannot at the
+best pose known (a shoulder whose range ends before the arm is level, a torso that leans a
+little), a box wider than TURNING in those joints is split by the value's terms: else the
+norm's joints are cut ever finer while the box stays wide in the joints that bound the
+maximum.
 
 Rigour: the sums' coefficients are enclosures (Interval arithmetic); their widths and the
 terms of the joints dropped are the sums' ``error``, and ``bounds.rounding`` covers the
@@ -53,6 +57,7 @@ from irb140_dynamics.core.payload.proof.bounds import (
     sizes,
     sizes_of_s,
     squared_model,
+    turned_squared_max,
 )
 from irb140_dynamics.core.payload.proof.harmonic import Reduced, basis
 from irb140_dynamics.core.payload.stop import out_of_time
@@ -74,13 +79,16 @@ class Objective:
     A lever is a payload's CoM turned about the flange axis in the worst direction phi:
     the torque A + X cos(phi) + Y sin(phi) is at most A + |(X, Y)|, reached at some phi
     (see ``harmonic.HarmonicSum.over_direction``); one of a joint whose range is not a whole
-    turn is not always reached (``reached``: the value at a box's centre counts -|lever|)."""
+    turn is not always reached (``reached``: the value at a box's centre counts -|lever|).
+    With a ``turn``, the norm's sums are a, X, Y, and |omega| is their worst over a whole
+    turn of the direction: at most sqrt(|a|^2 + 2 |(X . a, Y . a)| + turn^2)."""
 
     value: Reduced
     norm: Reduced
     gravity_norm: float
     lever: Reduced | None = None
     reached: tuple[bool, ...] = ()  # per pair: is |lever_p| reached in the box (a whole turn)? (else -|lever_p|)
+    turn: float | None = None  # the norm is (a, X, Y), 9 sums: |X cos + Y sin| <= turn
 
 
 @dataclass(frozen=True, eq=False)
@@ -121,7 +129,8 @@ def certify_maxima(
     n = lower.shape[1]
     members: dict[tuple, list[int]] = {}
     for k, objective in enumerate(objectives):
-        members.setdefault((objective.value.dims, objective.norm.dims, objective.lever is None), []).append(k)
+        key = (objective.value.dims, objective.norm.dims, objective.lever is None, objective.turn is None)
+        members.setdefault(key, []).append(k)
     groups = []
     for ks in members.values():
         ks = np.array(ks)
@@ -162,6 +171,7 @@ class _Group:
         norm_error = np.array([np.sum(o.norm.error) for o in objectives])
         self.norm_slack = g * (norm_error + rounding(len(self.norm_dims)) * norm_size)
         self.gravity = g * (1 + 8 * U)
+        self.turns = None if first.turn is None else np.array([o.turn for o in objectives])
         self.turning = [k for k in self.value_dims if k not in self.norm_dims]  # the joints turning gravity in frame j
         self.unreached = np.zeros(len(objectives), dtype=bool)  # per objective: is the norm not reached?
         self.levers, self.lever_slack = None, np.zeros(len(objectives))
@@ -172,7 +182,9 @@ class _Group:
             lever_error = np.array([np.sum(o.lever.error) for o in objectives])
             self.lever_slack = lever_error + rounding(len(self.value_dims)) * np.abs(self.levers).sum(axis=(1, 2))
         levers = 0 if self.levers is None else self.levers.shape[1] * 3 ** len(self.value_dims)
-        self.cost = max(1.0, (3 ** len(self.value_dims) + levers + 3 ** (len(self.norm_dims) + 1)) / TERMS)
+        self.cost = max(
+            1.0, (3 ** len(self.value_dims) + levers + self.norms.shape[1] * 3 ** len(self.norm_dims)) / TERMS
+        )
         K, n = lower.shape
         upper = np.minimum(upper, lower + 2 * math.pi)  # the sums repeat every turn
         self.tol = np.maximum(
@@ -366,13 +378,16 @@ class _Group:
         """|tau_j| <= |g| |omega_j| over the boxes, |g| |omega_j| at the centres, and the
         joints' weights in it (|omega_j|^2 by its quadratic model, ``bounds.squared_model``)."""
         B, n = centre.shape
-        e = self.norm_dims
-        N = expand(self.norms[owner].reshape(B * 3, -1), np.repeat(centre[:, e], 3, axis=0)).reshape(B, 3, -1)
+        e, c = self.norm_dims, self.norms.shape[1]
+        N = expand(self.norms[owner].reshape(B * c, -1), np.repeat(centre[:, e], c, axis=0)).reshape(B, c, -1)
         W, sigma = sizes(radius[:, e]), sizes_of_s(radius[:, e])
-        size, base, g, Q, terms = squared_model(N, W, sigma, radius[:, e])
         gravity, slack = self.gravity[owner], self.norm_slack[owner]
-        enough = ((target - slack) / gravity) ** 2 - base  # |omega|^2 that would do
-        squared = base + quadratic_max(2 * g, 2 * Q, sigma, enough)
+        enough = ((target - slack) / gravity) ** 2  # |omega|^2 that would do
+        if self.turns is None:
+            size, base, g, Q, terms = squared_model(N, W, sigma, radius[:, e])
+            squared = base + quadratic_max(2 * g, 2 * Q, sigma, enough - base)
+        else:  # (the payload's direction not an angle: see ``bounds.turned_squared_max``)
+            size, squared, terms = turned_squared_max(N, W, sigma, radius[:, e], self.turns[owner], enough)
         bound = gravity * np.sqrt(np.maximum(squared, 0.0)) * (1 + 4 * U) + slack
         weight = np.zeros((B, n))
         weight[:, e] = terms @ layout(len(e)).involves
