@@ -6,8 +6,10 @@ import re
 import pytest
 
 from irb140_dynamics.core import RigidBody
+from irb140_dynamics.core.io.urdf import load_urdf
 from irb140_dynamics.core.payload import check_payload, workspace_load
 
+from ..support.urdf_support import URDF_DATA
 from .test_payload import STATES, STRETCHED
 
 
@@ -96,3 +98,19 @@ def test_report_columns_stay_apart_at_any_use(model, limits):
         assert cells[1:6] == list(check.joint_figures(j).values())[:5] and len(cells) == 7, line
     assert float(rows[2].split()[3].rstrip("%")) > 1000  # joint_2 now
     assert len({len(line.split("  (")[0]) for line in rows[1:]}) == 1  # the pose column aligned
+
+
+def test_a_prismatic_joints_position_is_shown_in_metres():
+    """The worst poses and the largest payload's pose show a prismatic joint's position in
+    m, the revolute joints' angles in degrees. The payload, on the wrist's axis, loads no
+    joint of this arm (a vertical turn, a level slide): its largest mass is unbounded, not
+    what rounding noise would allow."""
+    model = load_urdf((URDF_DATA / "prismatic_arm.urdf").read_text()).model
+    slide = next(j for j, joint in enumerate(model.joints) if joint.prismatic)
+    check = check_payload(model, RigidBody(1.0, (0.0, 0.0, 0.05)), q=[0.1] * model.n)
+    figures = check.joint_figures(slide)
+    shown = figures["worst pose [deg]"].strip("()").split(", ")
+    assert shown[slide] == f"{check.workspace.pose[slide][slide]:.3f} m"
+    assert all(not entry.endswith(" m") for k, entry in enumerate(shown) if k != slide)
+    assert re.search(r"\d m[,)]", check.report())
+    assert "max payload: unbounded here, unbounded over the workspace" in check.report()

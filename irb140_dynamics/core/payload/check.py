@@ -52,6 +52,7 @@ class PayloadCheck:
     qd: np.ndarray | None = None
     torque: np.ndarray | None = None  # (n,) N m needed at (q, qd)
     max_payload_here: MaxPayload | None = None
+    sliding: tuple[bool, ...] = ()  # per joint: prismatic (its position shown in m, not degrees)
 
     @property
     def limit(self) -> np.ndarray:
@@ -137,7 +138,8 @@ class PayloadCheck:
         now = np.zeros_like(highest) if self.torque is None else np.abs(self.torque)
         worst = np.maximum(now, np.abs(self.workspace.torque))
         j = int(np.argmax(np.where(self.beyond, worst / np.where(highest > 0, highest, 1e-300), -np.inf)))
-        where = "now" if now[j] >= abs(self.workspace.torque[j]) else f"at {_degrees(self.workspace.pose[j])} deg"
+        pose = _degrees(self.workspace.pose[j], self.sliding)
+        where = "now" if now[j] >= abs(self.workspace.torque[j]) else f"at {pose} deg"
         text = (
             f"{self.joint_names[j]} needs {worst[j]:.3f} N m {where}, {_of_limit(worst[j], self.limit[j], highest[j])}"
         )
@@ -206,7 +208,7 @@ class PayloadCheck:
             "use now": _percent(self.use[j], L) if now else "-",
             "worst static torque [N m]": f"{load.torque[j]:.3f}",
             "worst use": worst_use,
-            "worst pose [deg]": _degrees(load.pose[j]),
+            "worst pose [deg]": _degrees(load.pose[j], self.sliding),
             "limit source": self.limits.reason(j),
             "worst static bound [N m]": f"{load.bound[j]:.3f}",
             "worst static gap [N m]": f"{load.gap[j]:.2g}",
@@ -217,7 +219,7 @@ class PayloadCheck:
         figures = {"payload mass [kg]": f"{self.payload.mass:.3f}", "payload com [m]": _vector(self.payload.com)}
         for where, best in (("here", self.max_payload_here), ("over the workspace", self.workspace.max_payload)):
             if best is not None:
-                mass, joint, pose = _max_payload_figures(best, self.joint_names, self.limits)
+                mass, joint, pose = _max_payload_figures(best, self.joint_names, self.limits, self.sliding)
                 label = f"max payload {where}"
                 figures.update({f"{label} [kg]": mass, f"{label}: limited by": joint, f"{label}: pose [deg]": pose})
         figures["max payload over the workspace: gap [kg]"] = f"{self.workspace.max_payload.gap:.2g}"
@@ -271,12 +273,13 @@ def check_payload(
     L = limit_values(limits, model.n)
     if workspace is None:
         workspace = workspace_load(model, payload, limits)
+    sliding = tuple(joint.prismatic for joint in model.joints)
     if q is None:
-        return PayloadCheck(model.joint_names, payload, limits, workspace)
+        return PayloadCheck(model.joint_names, payload, limits, workspace, sliding=sliding)
     tau0, dtau = payload_family(model, payload).torques(q, qd)
     here = max_payload_here(tau0, dtau, L, q)
     torque = tau0 + payload.mass * dtau
-    return PayloadCheck(model.joint_names, payload, limits, workspace, q, qd, torque, here)
+    return PayloadCheck(model.joint_names, payload, limits, workspace, q, qd, torque, here, sliding)
 
 
 # -- text ------------------------------------------------------------------------------------------
@@ -299,8 +302,13 @@ def _vector(x) -> str:
     return "(" + ", ".join(f"{v:.3f}" for v in x) + ")"
 
 
-def _degrees(q) -> str:
-    return "(" + ", ".join(f"{round(v, 1) + 0.0:g}" for v in np.degrees(q)) + ")"
+def _degrees(q, sliding=()) -> str:
+    """A pose in degrees, a prismatic joint's position in m: "(0, 45.2, 0.250 m)"."""
+    shown = [
+        f"{x:.3f} m" if k < len(sliding) and sliding[k] else f"{round(math.degrees(x), 1) + 0.0:g}"
+        for k, x in enumerate(q)
+    ]
+    return "(" + ", ".join(shown) + ")"
 
 
 def _percent_of(torque, limit):
@@ -327,7 +335,7 @@ def _percent(use: float, L: float) -> str:
     return "-" if math.inf == L else f"{use:.1f}%"
 
 
-def _max_payload_figures(best: MaxPayload, names, limits: TorqueLimits) -> tuple[str, str, str]:
+def _max_payload_figures(best: MaxPayload, names, limits: TorqueLimits, sliding=()) -> tuple[str, str, str]:
     """(mass [kg]: a number, "none", "none proven" (over a derived limit the proof left
     open) or "unbounded"; the joint at or over its limit; the pose [deg]), "-" where there
     is none."""
@@ -335,7 +343,7 @@ def _max_payload_figures(best: MaxPayload, names, limits: TorqueLimits) -> tuple
         return "unbounded", "-", "-"
     certain = limits.highest[best.joint] <= limits.values[best.joint] * (1 + RTOL)
     mass = ("none" if certain else "none proven") if math.isnan(best.mass) else f"{best.mass:.3f}"
-    return mass, names[best.joint], _degrees(best.q)
+    return mass, names[best.joint], _degrees(best.q, sliding)
 
 
 def _max_payload_text(figures: dict[str, str], where: str) -> str:

@@ -43,6 +43,7 @@ from irb140_dynamics.core.scalars.interval import Interval, bounds_of
 
 RTOL = 1e-9  # a torque within RTOL of its limit is within it
 CERTIFY_RTOL = 5e-10  # the gap the proof aims at, relative to the torque (half of RTOL)
+UNLOADED = 1e-12  # N m (N) per kg: a payload's torque on a joint below this is rounding noise (a lever of 1e-13 m)
 
 
 @dataclass(frozen=True, eq=False)
@@ -330,10 +331,12 @@ def mass_bounds(tau0, dtau, limits) -> tuple[np.ndarray, np.ndarray]:
     """Per joint, the payload masses m with |tau0 + m dtau| <= L: (lower, upper) [kg].
 
     Works on (..., n) arrays; L = inf is no limit. An empty interval has lower > upper.
-    A dtau_j below 1e-12 of the largest is rounding noise: the payload does not load joint j.
+    A dtau_j below 1e-12 of the largest, or below UNLOADED, is rounding noise: the payload
+    does not load joint j.
     """
     tau0, dtau, L = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (tau0, dtau, limits)))
-    dtau = np.where(np.abs(dtau) <= 1e-12 * np.max(np.abs(dtau), axis=-1, keepdims=True), 0.0, dtau)
+    noise = np.maximum(1e-12 * np.max(np.abs(dtau), axis=-1, keepdims=True), UNLOADED)
+    dtau = np.where(np.abs(dtau) <= noise, 0.0, dtau)
     with np.errstate(divide="ignore", invalid="ignore"):
         a, b = (-L - tau0) / dtau, (L - tau0) / dtau
     fits = np.abs(tau0) <= L
