@@ -207,3 +207,33 @@ def test_a_urdf_arm_s_markers_are_in_its_base_link():
     assert {m.header.frame_id for m in markers[-1].markers} == {"world"}  # the UR5 URDF's root link
     labels = [m.text for m in markers[-1].markers if m.ns == "joint_label"]
     assert [label.split()[0] for label in labels] == names and all("%" in label for label in labels)  # given limits
+
+
+def test_the_rated_payload_sets_the_limits_the_joints_are_coloured_by():
+    """rated_payload.mass (and .com) derive the markers' limits for joints without
+    torque_limit, as the payload check does; a change at runtime re-derives them; a bad
+    CoM is refused and the old limits stay."""
+    arm = irb140()
+    tau = gravity(arm, Q)  # the feed-forward torque at rest (no efforts in the joint states)
+
+    def expected(mass):
+        limit = derive_torque_limits(arm, RigidBody(mass)).values[4]
+        return f"joint_5 {100.0 * abs(tau[4]) / limit:.0f} % ({abs(tau[4]):.1f} N m)"
+
+    overrides = [Parameter("markers.rate", value=50.0), Parameter("rated_payload.mass", value=1.0)]
+    with running(IdNode, parameter_overrides=overrides) as harness:
+        markers = harness.listen(MarkerArray, "/id_node/markers")
+        states = harness.publisher(JointState, "joint_states")
+
+        def label():
+            states.publish(JointState(name=list(arm.joint_names), position=Q.tolist(), velocity=[0.0] * 6))
+            harness.spin_for(0.05)
+            return markers and by_key(markers[-1])[("joint_label", 4)].text
+
+        assert harness.spin_until(lambda: label() == expected(1.0)), markers and label()
+        assert harness.set_parameters([Parameter("rated_payload.mass", value=6.0)])[0].successful
+        assert harness.spin_until(lambda: label() == expected(6.0)), label()
+        refused = harness.set_parameters([Parameter("rated_payload.com", value=[0.0, float("nan"), 0.0])])[0]
+        assert not refused.successful and "rated_payload" in refused.reason
+        assert label() == expected(6.0)
+    assert expected(1.0) != expected(6.0)

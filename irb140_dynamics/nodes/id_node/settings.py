@@ -4,10 +4,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from irb140_dynamics.core import RobotModel
+from irb140_dynamics.core import RigidBody, RobotModel
 from irb140_dynamics.core.codegen import native
 from irb140_dynamics.core.codegen.kernels import WITH_FRICTION, Preparation, kernels_of, prepare
-from irb140_dynamics.core.payload.limits import derive_torque_limits
+from irb140_dynamics.core.model.rigid_body import MAX_MASS
+from irb140_dynamics.core.payload.limits import RATED_PAYLOAD, derive_torque_limits
 from irb140_dynamics.core.payload.stop import stopping
 from irb140_dynamics.nodes.id_node.collision import (
     COLLISION_PARAMETERS,
@@ -57,6 +58,16 @@ NODE_PARAMETERS = [
         "feedforward",
         "which torques go to effort_commands: 'feedforward', 'gravity' or 'computed_torque'",
     ),
+    Spec(
+        "rated_payload.mass",
+        6.0,
+        "the rated payload the markers' torque limits are derived from, for joints without torque_limit "
+        "(as payload_check_node's)",
+        "kg",
+        minimum=0.0,
+        maximum=MAX_MASS,
+    ),
+    Spec("rated_payload.com", [0.0, 0.0, 0.0], "its centre of mass, in the flange frame", "m"),
     *COLLISION_PARAMETERS,
     *WRENCH_PARAMETERS,
     *MARKER_PARAMETERS,
@@ -80,6 +91,7 @@ class IdNodeSettings:
     collision: CollisionSettings
     gains: Gains
     wrench_frame: str  # external_wrench.frame: "tip" or "base"
+    rated_payload: RigidBody = RATED_PAYLOAD  # the torque limits are derived from it (joints without torque_limit)
     torque_limits: tuple[float, ...] | None = None  # N m (inf: none), the payload check's; set by finish_settings
     kernels: Preparation | None = None  # how the model's kernels were made ready (set by finish_settings)
 
@@ -99,6 +111,7 @@ def check_settings(values: dict) -> IdNodeSettings:
         build_collision_settings(values, model.joint_names),
         build_gains(values, model.joint_names),
         check_wrench_frame(values),
+        RigidBody.validated("rated_payload", values["rated_payload.mass"], values["rated_payload.com"]),
     )
 
 
@@ -112,19 +125,22 @@ def finish_settings(settings: IdNodeSettings, previous: IdNodeSettings | None) -
     executor while the old model answers (see core.codegen.kernels.prepare). A compile
     longer than NATIVE_WAIT goes on in the background, the Python form answering meanwhile."""
     if previous is not None and previous.model == settings.model:
-        return replace(settings, model=previous.model, torque_limits=previous.torque_limits, kernels=previous.kernels)
+        limits = previous.torque_limits
+        if previous.rated_payload != settings.rated_payload:
+            limits = torque_limits(previous.model, settings.rated_payload)
+        return replace(settings, model=previous.model, torque_limits=limits, kernels=previous.kernels)
     kernels = prepare(settings.model, timeout=NATIVE_WAIT, names=KERNELS)
-    return replace(settings, torque_limits=torque_limits(settings.model), kernels=kernels)
+    return replace(settings, torque_limits=torque_limits(settings.model, settings.rated_payload), kernels=kernels)
 
 
 LIMITS_TIME = 5.0  # s: the search for derived limits stops by then (what it found stands)
 
 
-def torque_limits(model: RobotModel) -> tuple[float, ...]:
+def torque_limits(model: RobotModel, rated: RigidBody = RATED_PAYLOAD) -> tuple[float, ...]:
     """The limits the markers colour the joints by: the payload check's (given, else derived
-    from its default rated payload, searched for at most LIMITS_TIME; inf: none)."""
+    from the ``rated`` payload, searched for at most LIMITS_TIME; inf: none)."""
     with stopping(seconds=LIMITS_TIME):
-        return derive_torque_limits(model).values
+        return derive_torque_limits(model, rated).values
 
 
 def compiled(settings: IdNodeSettings, previous: IdNodeSettings | None) -> bool:
