@@ -187,12 +187,19 @@ def test_payload_check_node_waits_then_checks_on_the_urdf_model():
         assert client.wait_for_service(timeout_sec=10)
         reply = harness.call(lambda: client.call_async(Trigger.Request()))
         assert not reply.success and "no model yet" in reply.message
+        states = harness.publisher(JointState, "joint_states")  # before the model: kept for it
+        names = [
+            f"{part}_joint" for part in ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3")
+        ]
+        states.publish(JointState(name=names, position=[0.1, -0.8, 0.9, 0.2, 0.3, 0.4], velocity=[0.0] * 6))
+        assert harness.spin_until(lambda: harness.node.counts["joint_states.no_model_yet"] == 1)
         harness.description.publish(String(data=text))
         assert harness.spin_until(lambda: harness.node.settings is not None)
         reply = harness.call(lambda: client.call_async(Trigger.Request()))
-        assert "shoulder_lift_joint" in reply.message
+        assert "shoulder_lift_joint" in reply.message and "no joint_states received yet" not in reply.message
         result, _ = harness.node.check()
         assert result.limit.tolist() == [150.0, 150.0, 150.0, 28.0, 28.0, 28.0]  # the URDF's effort limits
+        assert result.q.tolist() == [0.1, -0.8, 0.9, 0.2, 0.3, 0.4]  # the joint state sent before the model
 
 
 def test_per_joint_node_parameters_are_declared_when_the_urdf_comes():

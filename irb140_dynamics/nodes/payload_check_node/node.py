@@ -211,6 +211,7 @@ class PayloadCheckNode(Node):
         self.settings: PayloadCheckSettings | None = None  # None: waiting for the model (robot_description topic)
         self._started = False
         self._state = None  # (q, qd, time received [node clock]) of the latest good joint state
+        self._early = None  # (the latest joint state, time received) before the first model
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
         recipe = Recipe(
@@ -251,6 +252,9 @@ class PayloadCheckNode(Node):
             self.tally.drop("joint_states", problem)
             self._state = None
         self.estimator.use(settings.rest_velocity, settings.rest_time, settings.model.friction)
+        if first and self._early is not None:  # the latest joint state before the first model
+            early, self._early = self._early, None
+            self._take(*early)
         if first and self._started:  # the model came after startup
             self._log_ready()
 
@@ -277,9 +281,15 @@ class PayloadCheckNode(Node):
     @guarded("joint_states")
     def _on_joint_state(self, msg: JointState) -> None:
         self.counts["joint_states.received"] += 1
-        if self.settings is None:
+        if self.settings is None:  # the latest is kept, and taken with the first model (see _use)
             self.counts["joint_states.no_model_yet"] += 1
+            self._early = (msg, self.get_clock().now())
             return
+        self._take(msg, self.get_clock().now())
+
+    def _take(self, msg: JointState, now) -> None:
+        """A joint state received at ``now`` (node clock): the state checks use, and the
+        payload estimate's sample; a bad one dropped, counted and warned about."""
         try:
             q, qd = read_joint_state(msg, self._order)
         except NotForThisModel:
@@ -292,7 +302,6 @@ class PayloadCheckNode(Node):
         if problem is not None:
             self.tally.drop("joint_states", problem)
             return
-        now = self.get_clock().now()
         self._state = (q, qd, now)
         try:
             effort = read_effort(msg, self._order)
