@@ -227,8 +227,8 @@ def run(tool: str, body: Callable[[Interrupts], int]) -> int:
     130 (143); a closed standard output (``tool | head``) nothing, and 141 as for SIGPIPE;
     the body's ``Outputs`` leave nothing behind in each case."""
     interrupts = Interrupts()
-    interrupts.install()
     try:
+        interrupts.install()  # (a signal may come half-way: one handler ours, the other still the entry's)
         early = take_noted_signals()
         if early:  # Ctrl-C while the tool was starting: nothing done yet
             interrupts.received = early[0]
@@ -239,6 +239,9 @@ def run(tool: str, body: Callable[[Interrupts], int]) -> int:
         return stop.code if isinstance(stop.code, int) else 0
     except BaseException as error:  # noqa: BLE001  (sorted in _failed)
         interrupts.finished = True
+        noted = take_noted_signals()  # the entry noted these before ours were in place: they came first
+        if noted and isinstance(error, KeyboardInterrupt):
+            interrupts.received = noted[0]
         return _failed(tool, error, interrupts)
     finally:
         interrupts.finished = True

@@ -54,6 +54,34 @@ def test_a_tool_signalled_while_starting_says_interrupted_once(tmp_path, signal_
     assert output == "sometool: interrupted\n", output
 
 
+def test_the_first_signal_decides_when_one_comes_while_the_tool_installs_its_handlers(tmp_path):
+    """SIGTERM while the tool installs its handlers (SIGINT's ours already, SIGTERM's still
+    the entry's, which notes it), then Ctrl-C: the status is SIGTERM's, which came first."""
+    code, output = run_program(
+        tmp_path,
+        """
+        import os, signal
+        from irb140_dynamics.entry import TOOL, finish, start
+        start("sometool", TOOL)
+        from irb140_dynamics.tools import cli
+
+        def install(self, original=cli.Interrupts.install):
+            self._previous[signal.SIGINT] = signal.signal(signal.SIGINT, self._on_signal)
+            os.kill(os.getpid(), signal.SIGTERM)  # noted by the entry
+            os.kill(os.getpid(), signal.SIGINT)  # raised by ours, here
+            original(self)
+
+        cli.Interrupts.install = install
+
+        def main():
+            return cli.run("sometool", lambda interrupts: print("worked") or 0)
+
+        finish(main)
+        """,
+    )
+    assert (code, output) == (143, "sometool: interrupted\n")
+
+
 def test_a_node_signalled_while_starting_stops_quietly_without_running(tmp_path):
     code, output = run_program(
         tmp_path,
