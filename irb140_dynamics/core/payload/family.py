@@ -272,7 +272,7 @@ class PayloadFamily:
         stacked = HarmonicSum(parts.dims, Interval(lo.reshape(9, -1), hi.reshape(9, -1)))
         norm = stacked.reduced(merge=merge)
         com = self.unit.payload.com
-        turn = float(m) * math.hypot(com[0], com[1]) * (1 + 1e-9) + float(np.sum(norm.error[3:]))
+        turn = abs(float(m)) * math.hypot(com[0], com[1]) * (1 + 1e-9) + float(np.sum(norm.error[3:]))
         return norm, turn
 
     def _interval_torques(self, m, offsets):

@@ -227,7 +227,7 @@ def turned_squared_max(N, W, sigma, radius, turn, enough=None):
     b = np.sqrt((w0**2).sum(axis=1))
     linear = (np.sqrt((J**2).sum(axis=1)) * sigma).sum(axis=1)
     bound = squared + turn**2 + 2 * (b + linear + rest) + quadratic_max(2 * g, 2 * Q, sigma)
-    rows = np.flatnonzero((b > 0) & ~(bound <= (np.inf if enough is None else enough)))
+    rows = np.flatnonzero((b > 0) & (True if enough is None else ~(bound <= enough)))
     if rows.size:
         e, k = w0[rows] / b[rows, None], 1.0 / b[rows]
         D = np.einsum("bp,bc,bpca->ba", e, a0[rows], X[rows]) + np.einsum("bp,bpc,bca->ba", e, X0[rows], a[rows])
