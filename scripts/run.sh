@@ -78,10 +78,17 @@ start() {  # start NAME ARGS...: a node in the background
     names+=("$name")
     pids+=("$!")
 }
+told=0  # how many of the nodes (in the order of pids) have had their Ctrl-C
+signal_nodes() {  # Ctrl-C to each node not told yet: once each (a second would cut its clean-up short)
+    while [ "$told" -lt ${#pids[@]} ]; do
+        kill -INT "${pids[$told]}" 2>/dev/null || true
+        told=$((told + 1))
+    done
+}
 stop_all() {  # Ctrl-C to every node still running; then SIGTERM, SIGKILL for those that hang
     local pid running
     if [ ${#pids[@]} -eq 0 ]; then return 0; fi
-    for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done
+    signal_nodes
     for _ in $(seq 600); do  # up to 60 s: demo_node writes its plot (slow on a busy machine)
         running=false
         for pid in "${pids[@]}"; do kill -0 "$pid" 2>/dev/null && running=true; done
@@ -93,7 +100,9 @@ stop_all() {  # Ctrl-C to every node still running; then SIGTERM, SIGKILL for th
     for pid in "${pids[@]}"; do kill -KILL "$pid" 2>/dev/null || true; done
 }
 interrupted=false
-trap 'interrupted=true' INT TERM
+# The nodes are told at once: a Ctrl-C between the loop's test and its wait cannot leave the
+# wait on nodes that never heard of it.
+trap 'interrupted=true; signal_nodes' INT TERM
 trap 'stop_all' EXIT  # whatever ends run.sh ends the nodes it started
 
 with_args=()
@@ -120,6 +129,7 @@ while ! $interrupted; do
     finished=""
     code=0
     wait -n -p finished "${pids[@]}" || code=$?
+    if $interrupted; then break; fi  # (a node that ended on the Ctrl-C did not stop by itself)
     if [ -n "${finished:-}" ]; then
         for i in "${!pids[@]}"; do
             if [ "${pids[$i]}" = "$finished" ]; then failed="${names[$i]} (exit $code)"; fi
