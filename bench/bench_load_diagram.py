@@ -26,7 +26,7 @@ import resource
 import time
 
 import numpy as np
-from common import REPO, Row, Target, Value, machine_info, print_table, write_results
+from common import REPO, Row, Target, Value, example_robot_urdf, machine_info, print_table, write_results
 
 from irb140_dynamics.core import RigidBody, derive_torque_limits, irb140
 from irb140_dynamics.core.payload import workspace_load
@@ -46,14 +46,13 @@ SEVEN: dict = {}  # per 7-joint arm: wall_s, cpu_s, masses_kg
 PROVEN = Target(90.0, at_least=True, absolute=True)
 
 
-def example_robot(name: str, tip: str):
-    """An example-robot-data URDF's model by its file name (None: not installed)."""
+def xarm7():
+    """example-robot-data's xArm7 to its ``link_eef`` (None: the package is not installed)."""
     try:
-        distribution = importlib.metadata.distribution("example-robot-data")
+        path = example_robot_urdf("xarm_description/urdf/xarm7.urdf")
     except importlib.metadata.PackageNotFoundError:
         return None
-    found = [f for f in distribution.files or () if str(f).endswith("/" + name)]
-    return load_urdf(distribution.locate_file(found[0]).read_text(), tip_link=tip).model if found else None
+    return load_urdf(path.read_text(), tip_link="link_eef").model
 
 
 def seven_joints(name: str, model, every: int, workers: int) -> list:
@@ -107,8 +106,8 @@ def main() -> None:
     ]
     panda = load_urdf((REPO / "test/data/urdf/panda.urdf").read_text(), tip_link="panda_hand_tcp").model
     rows += seven_joints("Panda", panda, 5, args.workers)
-    xarm7 = example_robot("xarm7.urdf", "link_eef")
-    rows += [] if xarm7 is None else seven_joints("xArm7", xarm7, 10, args.workers)
+    arm7 = xarm7()
+    rows += [] if arm7 is None else seven_joints("xArm7", arm7, 10, args.workers)
     load_after = os.getloadavg()[0]
     print_table(rows, "load diagram (baseline: the payload check's workspace_load per point, scaled)")
     print(f"load average {load_before:.1f} before, {load_after:.1f} after")
