@@ -136,6 +136,11 @@ class PayloadFamily:
         return {}
 
     @cached_property
+    def _off_axis(self) -> float:
+        """l [m]: the payload's CoM off the flange's z axis (the offset ``direction`` turns)."""
+        return math.hypot(*self.unit.payload.com[:2])
+
+    @cached_property
     def forms(self) -> tuple[StaticForms, StaticForms] | None:
         """The harmonic forms of the payload at 0 and 1 kg (None for too many joints)."""
         if self.given_forms is not None:
@@ -238,7 +243,7 @@ class PayloadFamily:
         value = replace(value, error=value.error + vanished)
         lever = replace(parts, coefficients=parts.coefficients[keep], error=parts.error[keep]) if keep else None
         reached = tuple(reached[p] for p in pairs)
-        offset = m * math.hypot(*self.unit.payload.com[:2]) * forms.gravity_norm  # N m: |g| m l
+        offset = m * self._off_axis * forms.gravity_norm  # N m: |g| m l
         norm, turn = self._norm(omega, m, turned=offset**2 <= 2 * room * abs(found))
         if any(a in value.dims or b in value.dims for a, b, _ in norm.merges):  # (their box is the value's too)
             norm, turn = self._norm(omega, m, merge=False, turned=turn is not None)
@@ -271,8 +276,7 @@ class PayloadFamily:
             hi[1:, :, ::3] = kept.hi[3:].reshape(2, 3, -1)
         stacked = HarmonicSum(parts.dims, Interval(lo.reshape(9, -1), hi.reshape(9, -1)))
         norm = stacked.reduced(merge=merge)
-        com = self.unit.payload.com
-        turn = abs(float(m)) * math.hypot(com[0], com[1]) * (1 + 1e-9) + float(np.sum(norm.error[3:]))
+        turn = abs(float(m)) * self._off_axis * (1 + 1e-9) + float(np.sum(norm.error[3:]))
         return norm, turn
 
     def _interval_torques(self, m, offsets):
