@@ -290,11 +290,11 @@ class SimNode(Node):
         if self.lockstep:
             self.counts["steps"], self.counts["republished"] = self.lockstep.steps, self.lockstep.republished
             self.counts["duplicates_dropped"] = self.lockstep.duplicates
-        if self.push.timed_out:
-            self.counts["external_wrench.timeouts"] = self.push.timed_out
         else:
             self.counts["steps"], self.counts["late_steps"] = self.schedule.steps, self.schedule.late
             self.counts["skipped_steps"] = self.schedule.skipped
+        if self.push.timed_out:
+            self.counts["external_wrench.timeouts"] = self.push.timed_out
         recent = self.counts - self._reported
         self._reported = self.counts.copy()
         hardware_id = self.parameters.robot_name or self.get_fully_qualified_name()
