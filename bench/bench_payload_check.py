@@ -31,7 +31,7 @@ from irb140_dynamics.core.payload import stop
 from irb140_dynamics.core.payload.family import forget_families
 from irb140_dynamics.core.urdf import export_urdf
 from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
-from irb140_dynamics.ros.parameters.model_source import DESCRIPTION_QOS
+from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS
 from test.support.chains import chain_urdf
 
 HEAD_START = 2.0  # s the slow model's analysis runs before the new model comes

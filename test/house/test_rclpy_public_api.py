@@ -33,10 +33,8 @@ RCLPY_CLASSES = (
     rclpy.publisher.Publisher,
     rclpy.timer.Timer,
 )
-# the one replacement the package makes, and why: rclpy's executors send a service's reply
-# through its send_response attribute, and offer no public way to answer a request later
-# from the EventsExecutor (it takes no coroutine callbacks)
-KNOWN_REPLACEMENTS = {("irb140_dynamics/ros/runtime/deferred_reply.py", "send_response")}
+# no method of an rclpy object is replaced
+KNOWN_REPLACEMENTS = set()
 
 
 def package_trees():

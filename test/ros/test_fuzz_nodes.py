@@ -67,7 +67,7 @@ def core_torques(function, model, *state):
 
 def apply_parameters(harness, params):
     node = harness.node
-    before = node.parameters.current
+    before = node.settings
     try:
         result = node.set_parameters_atomically(params)
     except ParameterNotDeclaredException:
@@ -83,9 +83,9 @@ def check_parameters(harness, params, valid):
     assert accepted == valid, (params, valid)
     values = node.parameters.values()
     if accepted:
-        assert node.parameters.current.model == RobotModel.from_params(values)
+        assert node.settings.model == RobotModel.from_params(values)
     else:
-        assert node.parameters.current is before
+        assert node.settings is before
     return accepted
 
 

@@ -16,6 +16,7 @@ from irb140_dynamics.core import RigidBody, gravity, irb140
 from irb140_dynamics.nodes.id_node import node as id_module
 from irb140_dynamics.nodes.id_node.node import IdNode
 from irb140_dynamics.nodes.payload_check_node import node as payload_module
+from irb140_dynamics.nodes.payload_check_node import settings as payload_settings
 from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
 
 from ..support.ros_harness import TIMEOUT, running
@@ -55,7 +56,7 @@ def gated_id_node(monkeypatch):
     """id_node whose builds wait at a gate, and are never quick (always off the executor)."""
     gate = Gate(id_module.finish_settings)
     monkeypatch.setattr(id_module, "finish_settings", gate)
-    monkeypatch.setattr(id_module, "compiled", lambda *args: False)
+    monkeypatch.setattr(id_module, "quick", lambda *args: False)
     with running(IdNode) as harness:
         harness.gate = gate
         harness.gravity = harness.listen(JointState, "gravity_torques")
@@ -75,36 +76,13 @@ def test_messages_flow_while_a_change_is_built(gated_id_node):
     node = gated_id_node
     node.gate.close()
     assert [r.successful for r in unsettled_set(node, [Parameter("payload.mass", value=5.0)])] == [True]
-    assert node.node.parameters.status().startswith("new parameters being applied")
+    assert node.node.rebuild.status().startswith("new parameters being applied")
     for _ in range(3):  # answered meanwhile, by the model before the change
         np.testing.assert_allclose(gravity_now(node), gravity(irb140(), Q), rtol=1e-12, atol=1e-12)
     node.gate.open()
     node.settle()
-    assert node.node.parameters.status() is None
+    assert node.node.rebuild.status() is None
     np.testing.assert_allclose(gravity_now(node), gravity(irb140(payload=RigidBody(5.0)), Q), rtol=1e-12, atol=1e-12)
-
-
-def test_a_change_is_checked_off_the_executor_and_answered_after(monkeypatch):
-    """The whole check of a change (here held at a gate) runs in a worker: joint states are
-    answered meanwhile by the model before, and the reply comes once it is checked and set."""
-    gate = Gate(id_module.check_settings)
-    monkeypatch.setattr(id_module, "check_settings", gate)
-    with running(IdNode) as harness:
-        harness.gravity = harness.listen(JointState, "gravity_torques")
-        harness.joint_states = harness.publisher(JointState, "joint_states")
-        gate.close()
-        client = harness.parameter_client()
-        future = client.set_parameters([Parameter("payload.mass", value=5.0)])
-        assert harness.spin_until(lambda: gate.calls == 2)  # startup, then this change
-        for _ in range(3):
-            np.testing.assert_allclose(gravity_now(harness), gravity(irb140(), Q), rtol=1e-12, atol=1e-12)
-        assert not future.done()
-        gate.open()
-        assert harness.spin_until(future.done)
-        assert [r.successful for r in future.result().results] == [True] and gate.calls == 2  # not checked again
-        harness.settle()
-        expected = gravity(irb140(payload=RigidBody(5.0)), Q)
-        np.testing.assert_allclose(gravity_now(harness), expected, rtol=1e-12, atol=1e-12)
 
 
 def test_changes_faster_than_builds_end_with_the_newest(gated_id_node):
@@ -120,21 +98,24 @@ def test_changes_faster_than_builds_end_with_the_newest(gated_id_node):
     np.testing.assert_allclose(gravity_now(node), gravity(irb140(payload=RigidBody(5.0)), Q), rtol=1e-12, atol=1e-12)
 
 
-def test_a_payload_or_gravity_change_is_in_force_when_the_call_returns():
-    """The kernels take the payload and gravity as an argument: nothing to compile."""
+def test_a_payload_change_is_in_force_when_the_call_returns_and_a_gravity_change_follows():
+    """The kernels take the payload and gravity as an argument: nothing to compile. A payload
+    change leaves the markers' torque limits as they are; gravity changes them: they are
+    derived off the executor, the change in force once they are."""
     with running(IdNode) as harness:
         node = harness.node
-        for change in ([Parameter("payload.mass", value=3.0)], [Parameter("gravity", value=[0.0, 0.0, -9.80665])]):
-            assert node.set_parameters(change)[0].successful
-            assert node.parameters.pending_since is None
+        assert node.set_parameters([Parameter("payload.mass", value=3.0)])[0].successful
+        assert node.rebuild.pending_since is None and node.settings.model == irb140(payload=RigidBody(3.0))
+        assert node.set_parameters([Parameter("gravity", value=[0.0, 0.0, -9.80665])])[0].successful
+        harness.settle()
         expected = irb140(payload=RigidBody(3.0)).with_gravity((0.0, 0.0, -9.80665))
         assert node.settings.model == expected
 
 
 @pytest.fixture
 def gated_payload_node(monkeypatch):
-    gate = Gate(payload_module.workspace_load)
-    monkeypatch.setattr(payload_module, "workspace_load", gate)
+    gate = Gate(payload_settings.workspace_load)
+    monkeypatch.setattr(payload_settings, "workspace_load", gate)
     overrides = [Parameter("diagnostics.period", value=0.0)]
     with running(PayloadCheckNode, parameter_overrides=overrides) as harness:
         harness.gate = gate
@@ -160,7 +141,7 @@ def test_check_right_after_a_change_waits_and_answers_for_the_new_parameters(gat
     assert node.call(lambda: client.get_parameters(["payload.mass"])).values[0].double_value == 7.0
     node.publisher(JointState, "joint_states").publish(JointState(name=NAMES, position=Q))
     assert node.spin_until(lambda: node.node._state is not None)
-    assert not future.done()
+    assert not future.done(), future.result()
     node.gate.open()
     assert node.spin_until(future.done)
     reply = future.result()
@@ -192,22 +173,22 @@ def test_check_wait_timeout_is_refused_outside_its_range(gated_payload_node, val
 
 def test_a_payload_change_reuses_the_limits_and_a_warn_use_change_the_analysis(gated_payload_node, monkeypatch):
     node = gated_payload_node
-    derived = Gate(payload_module.derive_torque_limits)
-    monkeypatch.setattr(payload_module, "derive_torque_limits", derived)
+    derived = Gate(payload_settings.derive_torque_limits)
+    monkeypatch.setattr(payload_settings, "derive_torque_limits", derived)
     limits = node.node.settings.limits
     assert [r.successful for r in node.set_parameters([Parameter("payload.mass", value=2.0)])] == [True]
     assert derived.calls == 0 and node.node.settings.limits is limits
     sweeps, workspace = node.gate.calls, node.node.settings.workspace
     assert node.node.set_parameters([Parameter("diagnostics.warn_use", value=50.0)])[0].successful
-    assert node.node.parameters.pending_since is None  # in force at once: nothing to analyse
+    assert node.node.rebuild.pending_since is None  # in force at once: nothing to analyse
     assert node.node.settings.warn_use == 50.0 and node.node.settings.workspace is workspace
     assert node.gate.calls == sweeps
 
 
 def test_a_slow_first_analysis_does_not_hold_up_startup(monkeypatch):
-    gate = Gate(payload_module.workspace_load)
+    gate = Gate(payload_settings.workspace_load)
     gate.close()
-    monkeypatch.setattr(payload_module, "workspace_load", gate)
+    monkeypatch.setattr(payload_settings, "workspace_load", gate)
     monkeypatch.setattr(payload_module, "STARTUP_WAIT", 0.2)
     overrides = [Parameter("diagnostics.period", value=0.0)]
     with running(PayloadCheckNode, parameter_overrides=overrides) as harness:

@@ -15,7 +15,7 @@ from rclpy.parameter import Parameter
 from irb140_dynamics.core import RigidBody, irb140
 from irb140_dynamics.nodes.id_node.node import IdNode
 from irb140_dynamics.nodes.sim_node.node import SimNode
-from irb140_dynamics.ros.parameters.live import declare_fixed
+from irb140_dynamics.ros.parameters.arm import declare_fixed
 from irb140_dynamics.ros.parameters.spec import Spec
 
 from ..support.ros_harness import running

@@ -14,6 +14,7 @@ from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import RigidBody, irb140, rnea, workspace_load
 from irb140_dynamics.nodes.payload_check_node import node as module
+from irb140_dynamics.nodes.payload_check_node import settings as settings_module
 from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
 
 from ..support.ros_harness import running
@@ -224,7 +225,7 @@ def test_a_failure_of_the_analysis_is_reported_and_the_next_change_recovers(node
     def failing(*args, **kwargs):
         raise ValueError("payload.com: the sweep failed")
 
-    monkeypatch.setattr(module, "workspace_load", failing)
+    monkeypatch.setattr(settings_module, "workspace_load", failing)
     assert [r.successful for r in node.set_parameters([Parameter("payload.mass", value=2.0)])] == [True]
     assert node.node.settings is settings
     reply = check(node)
@@ -237,7 +238,7 @@ def test_a_failure_of_the_analysis_is_reported_and_the_next_change_recovers(node
         built.append(workspace_load(*args))
         return built[-1]
 
-    monkeypatch.setattr(module, "workspace_load", sweep)
+    monkeypatch.setattr(settings_module, "workspace_load", sweep)
     assert [r.successful for r in node.set_parameters([Parameter("payload.mass", value=3.0)])] == [True]
     assert len(built) == 1 and node.node.settings.workspace is built[0]  # built once
     assert node.node.settings.model.payload.mass == 3.0

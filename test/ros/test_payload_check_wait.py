@@ -16,7 +16,7 @@ from irb140_dynamics.core import RigidBody, irb140
 from irb140_dynamics.core.payload import check_payload, stop
 from irb140_dynamics.core.urdf import export_urdf, load_urdf
 from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
-from irb140_dynamics.ros.parameters.model_source import DESCRIPTION_QOS
+from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS
 
 from ..support.chains import chain_urdf
 from ..support.ros_harness import TIMEOUT, running

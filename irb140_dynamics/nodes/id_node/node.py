@@ -5,7 +5,7 @@ Subscribes   joint_states          sensor_msgs/JointState (matched by joint name
                                    header.stamp, or on arrival (see nodes.id_node.tracking)
              robot_description     std_msgs/String (transient local): the model, with model.source
                                    robot_description and no URDF parameter or file
-                                   (see ros.parameters.model_source)
+                                   (see ros.parameters.arm)
 Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, qdd)
              gravity_torques       sensor_msgs/JointState, effort = g(q)
              effort_commands       std_msgs/Float64MultiArray (when enabled), model joint order:
@@ -35,9 +35,10 @@ from array import array
 
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray
+from std_msgs.msg import Float64MultiArray, String
 from trajectory_msgs.msg import JointTrajectory
 
 from irb140_dynamics.core import gravity, rnea
@@ -46,14 +47,14 @@ from irb140_dynamics.core.monitoring.filters import VelocityDifferentiator
 from irb140_dynamics.core.monitoring.observer import monitor_terms
 from irb140_dynamics.nodes.id_node.collision import RESTARTS, CollisionMonitor
 from irb140_dynamics.nodes.id_node.markers import MarkerPublisher
-from irb140_dynamics.nodes.id_node.settings import (  # noqa: F401 (finish_settings, compiled: looked up here, tests patch them)
+from irb140_dynamics.nodes.id_node.settings import (
     NODE_PARAMETERS,
     PER_JOINT_PARAMETERS,
     IdNodeSettings,
     check_settings,
-    compiled,
     finish_settings,
     kernels_text,
+    quick,
 )
 from irb140_dynamics.nodes.id_node.tracking import ReferenceTracker
 from irb140_dynamics.nodes.id_node.wrench import WrenchSensor
@@ -70,8 +71,7 @@ from irb140_dynamics.ros.messages.joint_messages import (
 )
 from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage, read_joint_state_cdr
 from irb140_dynamics.ros.messages.wrench import chain_links
-from irb140_dynamics.ros.parameters.live import Recipe
-from irb140_dynamics.ros.parameters.model_source import declare_model_source
+from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import joint_states_qos
 from irb140_dynamics.ros.parameters.usage import JOINT, model_sections, per_joint_section
@@ -79,6 +79,7 @@ from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.diagnostics import message_status
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
 from irb140_dynamics.ros.runtime.listened import ListenedPublisher
+from irb140_dynamics.ros.runtime.rebuild import Rebuild
 from irb140_dynamics.ros.runtime.spin import run
 
 
@@ -94,17 +95,22 @@ class IdNode(Node):
         self._reported = self.counts.copy()  # the counts at the last diagnostics
         self.tracker = ReferenceTracker()
         self._differentiator = None
-        recipe = Recipe(NODE_PARAMETERS, check_settings, PER_JOINT_PARAMETERS, finish=finish_settings, quick=compiled)
-        self.parameters = declare_model_source(self, recipe)
-        self.parameters.on_change(self._use)
-        self.collision = CollisionMonitor(self, [], self.get_parameter("qos.depth").value)  # joints: by _use
-        self.wrench = WrenchSensor(self, self.get_parameter("qos.depth").value)
+        self.parameters = ArmParameters(self, NODE_PARAMETERS, PER_JOINT_PARAMETERS)
+        self.rebuild = Rebuild(self, finish_settings, self._use)
+        self._reader = Rebuild(self, self.parameters.read_topic, self._take_urdf)
+        depth = self.get_parameter("qos.depth").value
+        self.collision = CollisionMonitor(self, [], depth)  # joints: by _use
+        self.wrench = WrenchSensor(self, depth)
         self.markers = MarkerPublisher(self, self.get_parameter("markers.rate").value)
         self._command_msg = Float64MultiArray()
-        if self.parameters.current is not None:
-            self._use(self.parameters.current)
+        first = self.parameters.draft(check_settings, self.parameters.values())
+        if first is not None:
+            self._use(finish_settings(first, None))
+            self.rebuild.previous = self.settings
+        self._draft = None  # the settings of a change accepted by _on_set, for _on_set_done
+        self.add_on_set_parameters_callback(self._on_set)
+        self.add_post_set_parameters_callback(self._on_set_done)
 
-        depth = self.get_parameter("qos.depth").value
         self.create_subscription(JointState, "joint_states", self._on_joint_state, joint_states_qos(self), raw=True)
         self.create_subscription(JointTrajectory, "~/reference", self._on_reference, depth)
         self._feedforward_pub = ListenedPublisher(self, JointState, "feedforward_torques", depth)
@@ -115,9 +121,43 @@ class IdNode(Node):
             self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands", depth)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self.create_timer(1.0, self._publish_diagnostics)
+        if self.parameters.from_topic:
+            self.create_subscription(String, "robot_description", self._on_description, DESCRIPTION_QOS)
         self._started = True
         if self.settings is not None:
             self._log_ready()
+
+    @property
+    def model(self):
+        """The model in force (None while waiting for a URDF)."""
+        return None if self.settings is None else self.settings.model
+
+    def _on_set(self, parameters) -> SetParametersResult:
+        """A change is accepted only if the whole new configuration checks."""
+        result, self._draft = self.parameters.check_change(parameters, check_settings)
+        return result
+
+    def _on_set_done(self, parameters) -> None:
+        """The change accepted: its settings in force at once when that is quick (no
+        compile, no derived limits to search), else built off the executor meanwhile."""
+        draft, self._draft = self._draft, None
+        if draft is None:
+            return
+        if quick(draft, self.rebuild.previous):
+            self.rebuild.build_here(draft)
+        else:
+            self.rebuild.submit(draft)
+
+    def _on_description(self, msg: String) -> None:
+        """A new URDF: read off the executor, then checked (``_take_urdf``)."""
+        self._reader.submit(msg.data)
+
+    def _take_urdf(self, urdf) -> None:
+        """The URDF read: checked whole with the parameters in force, built off the
+        executor and swapped in, or refused keeping the model in use."""
+        draft = self.parameters.take_urdf(urdf, check_settings)
+        if draft is not None:
+            self.rebuild.submit(draft)
 
     def _use(self, settings: IdNodeSettings) -> None:
         """Switch to new (validated, compiled) settings; new joints come with a new model. A
@@ -303,7 +343,7 @@ class IdNode(Node):
         recent = self.counts - self._reported
         self._reported = self.counts.copy()
         name, hardware_id = self.get_name(), self.parameters.robot_name or self.get_fully_qualified_name()
-        status = message_status(name, hardware_id, self.counts, recent, self.parameters, self.settings is None)
+        status = message_status(name, hardware_id, self.counts, recent, self.rebuild, self.settings is None)
         statuses = [status, self.collision.status(name, hardware_id), self.wrench.status(name, hardware_id)]
         msg = DiagnosticArray(status=statuses)
         msg.header.stamp = self.get_clock().now().to_msg()

@@ -1,4 +1,4 @@
-"""id_node's parameters and the settings it runs on, validated whole (see ros.parameters.live)."""
+"""id_node's parameters and the settings it runs on, validated whole (see nodes.id_node.node)."""
 
 from __future__ import annotations
 
@@ -122,15 +122,30 @@ NATIVE_WAIT = 30.0  # s: the longest a new model waits for its kernels' C (docs/
 def finish_settings(settings: IdNodeSettings, previous: IdNodeSettings | None) -> IdNodeSettings:
     """Make the kernels the messages use native (compiled as C, or loaded from the cache),
     here and not on a message: at startup before the first message, after a change off the
-    executor while the old model answers (see core.codegen.kernels.prepare). A compile
-    longer than NATIVE_WAIT goes on in the background, the Python form answering meanwhile."""
+    executor while the old model answers (see core.codegen.kernels.prepare), and derive the
+    markers' torque limits unless the arm and the rated payload are those of ``previous``.
+    A compile longer than NATIVE_WAIT goes on in the background, the Python form answering
+    meanwhile."""
     if previous is not None and previous.model == settings.model:
+        kernels = previous.kernels
+        settings = replace(settings, model=previous.model)
+    else:
+        kernels = prepare(settings.model, timeout=NATIVE_WAIT, names=KERNELS)
+    if _same_limits(settings, previous):
         limits = previous.torque_limits
-        if previous.rated_payload != settings.rated_payload:
-            limits = torque_limits(previous.model, settings.rated_payload)
-        return replace(settings, model=previous.model, torque_limits=limits, kernels=previous.kernels)
-    kernels = prepare(settings.model, timeout=NATIVE_WAIT, names=KERNELS)
-    return replace(settings, torque_limits=torque_limits(settings.model, settings.rated_payload), kernels=kernels)
+    else:
+        limits = torque_limits(settings.model, settings.rated_payload)
+    return replace(settings, torque_limits=limits, kernels=kernels)
+
+
+def _same_limits(settings: IdNodeSettings, previous: IdNodeSettings | None) -> bool:
+    """The torque limits of ``previous`` hold: the same joints, gravity and rated payload
+    (the payload in use does not enter them)."""
+    return previous is not None and (previous.model.joints, previous.model.gravity, previous.rated_payload) == (
+        settings.model.joints,
+        settings.model.gravity,
+        settings.rated_payload,
+    )
 
 
 LIMITS_TIME = 5.0  # s: the search for derived limits stops by then (what it found stands)
@@ -143,10 +158,13 @@ def torque_limits(model: RobotModel, rated: RigidBody = RATED_PAYLOAD) -> tuple[
         return derive_torque_limits(model, rated).values
 
 
-def compiled(settings: IdNodeSettings, previous: IdNodeSettings | None) -> bool:
-    """Whether finish_settings would be quick (the arm's code traced, and native already or
-    never): then it may run on the executor. On the way, a kernel whose arm has compiled
-    code already is bound to it (cheap; what prepare would do first)."""
+def quick(settings: IdNodeSettings, previous: IdNodeSettings | None) -> bool:
+    """Whether finish_settings would be quick: no torque limits to derive, the arm's code
+    traced, and native already or never. Then it may run on the executor. On the way, a
+    kernel whose arm has compiled code already is bound to it (cheap; what prepare would do
+    first)."""
+    if not _same_limits(settings, previous):
+        return False
     kernels = kernels_of(settings.model)
     if not kernels.compiled(*KERNELS):
         return False

@@ -9,7 +9,7 @@ Serves       ~/check        std_srvs/Trigger: the configured payload (payload.* 
              ~/estimate_payload, ~/clear_samples   std_srvs/Trigger: payload estimation from the
                             efforts at rest (see nodes/payload_check_node/payload_estimator.py)
 Subscribes   joint_states   sensor_msgs/JointState (matched by joint name, as in id_node)
-             robot_description  std_msgs/String: the model, as in id_node (see ros.parameters.model_source)
+             robot_description  std_msgs/String: the model, as in id_node (see ros.parameters.arm)
 Publishes    /diagnostics   diagnostic_msgs/DiagnosticArray: one status per joint and one for
                             the payload, after each check and every diagnostics.period
 
@@ -26,27 +26,29 @@ check.wait_timeout (see check_service).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
+from std_msgs.msg import String
 
-from irb140_dynamics.core import RigidBody, RobotModel, gravity, rnea
+from irb140_dynamics.core import RobotModel, gravity, rnea
 from irb140_dynamics.core.io.stamps import seconds
 from irb140_dynamics.core.payload import (
-    TorqueLimits,
-    WorkspaceLoad,
     check_payload,
-    derive_torque_limits,
-    workspace_load,
 )
 from irb140_dynamics.core.payload.mass_com_estimation import EstimationError
-from irb140_dynamics.core.payload.stop import stopping
 from irb140_dynamics.nodes.payload_check_node.check_service import CheckService
 from irb140_dynamics.nodes.payload_check_node.payload_estimator import (
-    ESTIMATION_PARAMETERS,
     PayloadEstimator,
+)
+from irb140_dynamics.nodes.payload_check_node.settings import (
+    NODE_PARAMETERS,
+    PayloadCheckSettings,
+    analysed,
+    check_settings,
+    finish_settings,
 )
 from irb140_dynamics.ros.messages.joint_messages import (
     BadMessage,
@@ -56,153 +58,20 @@ from irb140_dynamics.ros.messages.joint_messages import (
     read_effort,
     read_joint_state,
 )
-from irb140_dynamics.ros.parameters.live import Recipe
-from irb140_dynamics.ros.parameters.model_source import declare_model_source
+from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import (
-    MAX_MASS,
-    QOS_PARAMETERS,
-    RELIABILITIES,
-    Spec,
-    check_choice,
     joint_states_qos,
 )
 from irb140_dynamics.ros.parameters.usage import model_sections
 from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.diagnostics import payload_statuses
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
+from irb140_dynamics.ros.runtime.rebuild import Rebuild
 from irb140_dynamics.ros.runtime.spin import run
 
-MIN_DIAGNOSTICS_PERIOD, MAX_DIAGNOSTICS_PERIOD = 0.1, 3600.0  # s
-MAX_WARN_USE = 1e6  # %
-MIN_ANALYSIS_TIME, MAX_ANALYSIS_TIME = 0.1, 3600.0  # s: check.analysis_timeout
-MAX_WAIT = 600.0  # s: check.wait_timeout
-NODE_PARAMETERS = [
-    Spec(
-        "rated_payload.mass",
-        6.0,
-        "the rated payload the torque limits are derived from",
-        "kg",
-        minimum=0.0,
-        maximum=MAX_MASS,
-    ),
-    Spec("rated_payload.com", [0.0, 0.0, 0.0], "its centre of mass, in the flange frame", "m"),
-    Spec(
-        "diagnostics.warn_use",
-        90.0,
-        "a joint using more of its limit than this is a WARN",
-        "%",
-        minimum=0.0,
-        maximum=MAX_WARN_USE,
-    ),
-    Spec(
-        "diagnostics.period",
-        1.0,
-        f"check and publish /diagnostics this often, {MIN_DIAGNOSTICS_PERIOD:g} to {MAX_DIAGNOSTICS_PERIOD:g}; "
-        "0 = only on ~/check",
-        "s",
-        minimum=0.0,
-        maximum=MAX_DIAGNOSTICS_PERIOD,
-        read_only=True,
-    ),
-    Spec(
-        "check.analysis_timeout",
-        20.0,
-        f"the analysis of new parameters (limits, workspace) stops after this long, {MIN_ANALYSIS_TIME:g} to "
-        f"{MAX_ANALYSIS_TIME:g}; what it has not proven by then ~/check answers UNPROVEN",
-        "s",
-        minimum=MIN_ANALYSIS_TIME,
-        maximum=MAX_ANALYSIS_TIME,
-        read_only=True,
-    ),
-    Spec(
-        "check.wait_timeout",
-        30.0,
-        f"~/check waits this long for the analysis of new parameters in progress, 0 to {MAX_WAIT:g}; "
-        "after it answers UNPROVEN (still running)",
-        "s",
-        minimum=0.0,
-        maximum=MAX_WAIT,
-    ),
-    *ESTIMATION_PARAMETERS,
-    *QOS_PARAMETERS,
-]
 STALE_AFTER = 1.0  # s: a joint state older than this is reported as stale
 STARTUP_WAIT = 2.0  # s: at most this long for the first analysis before the node is ready
-
-
-@dataclass(frozen=True)
-class Draft:
-    """The validated parameters a check depends on, before the analysis."""
-
-    model: RobotModel  # with the payload under test
-    rated_payload: RigidBody
-    warn_use: float
-    rest_velocity: float  # rad/s, payload estimation
-    rest_time: float  # s
-    analysis_timeout: float = MAX_ANALYSIS_TIME  # s
-
-
-@dataclass(frozen=True)
-class PayloadCheckSettings:
-    """What a check needs that depends only on the parameters, the workspace sweep included."""
-
-    model: RobotModel  # with the payload under test
-    rated_payload: RigidBody
-    warn_use: float
-    limits: TorqueLimits
-    workspace: WorkspaceLoad  # the payload's worst static loads and largest mass
-    rest_velocity: float  # rad/s, payload estimation
-    rest_time: float  # s
-
-
-def check_settings(values: dict) -> Draft:
-    """Validate what the descriptors cannot (before a change is accepted)."""
-    model = RobotModel.from_params(values)
-    rated = RigidBody.validated("rated_payload", values["rated_payload.mass"], values["rated_payload.com"])
-    period = values["diagnostics.period"]
-    if period != 0.0 and not MIN_DIAGNOSTICS_PERIOD <= period <= MAX_DIAGNOSTICS_PERIOD:
-        raise ValueError(
-            f"diagnostics.period: must be 0 (only on ~/check) or between {MIN_DIAGNOSTICS_PERIOD:g} "
-            f"and {MAX_DIAGNOSTICS_PERIOD:g} s, got {period}"
-        )
-    check_choice("qos.reliability", values["qos.reliability"], RELIABILITIES)
-    return Draft(
-        model,
-        rated,
-        values["diagnostics.warn_use"],
-        values["estimation.rest_velocity"],
-        values["estimation.rest_time"],
-        values["check.analysis_timeout"],
-    )
-
-
-def finish_settings(draft: Draft, previous: PayloadCheckSettings | None) -> PayloadCheckSettings:
-    """Derive the limits and analyse the workspace (seconds for a large model: runs off the
-    executor, within draft.analysis_timeout); what the previous settings computed for the
-    same arm is reused."""
-    model, rated = draft.model, draft.rated_payload
-    with stopping(seconds=draft.analysis_timeout):
-        limits = previous.limits if _same_arm(draft, previous) else derive_torque_limits(model, rated)
-        if analysed(draft, previous):
-            workspace = previous.workspace
-        else:
-            workspace = workspace_load(model, model.payload, limits)
-    return PayloadCheckSettings(model, rated, draft.warn_use, limits, workspace, draft.rest_velocity, draft.rest_time)
-
-
-def _same_arm(draft: Draft, previous: PayloadCheckSettings | None) -> bool:
-    """The same torque limits as before: the same joints, gravity and rated payload."""
-    return previous is not None and (previous.model.joints, previous.model.gravity, previous.rated_payload) == (
-        draft.model.joints,
-        draft.model.gravity,
-        draft.rated_payload,
-    )
-
-
-def analysed(draft: Draft, previous: PayloadCheckSettings | None) -> bool:
-    """Nothing to analyse: the previous settings had the same arm and payload."""
-    return _same_arm(draft, previous) and previous.model.payload == draft.model.payload
 
 
 class PayloadCheckNode(Node):
@@ -214,17 +83,22 @@ class PayloadCheckNode(Node):
         self._early = None  # (the latest joint state, time received) before the first model
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
-        recipe = Recipe(
-            NODE_PARAMETERS, check_settings, finish=finish_settings, quick=analysed, startup_wait=STARTUP_WAIT
-        )
-        self.parameters = declare_model_source(self, recipe)
-        self.parameters.on_change(self._use)
+        self.parameters = ArmParameters(self, NODE_PARAMETERS)
         self.estimator = PayloadEstimator(self, self._model)
-        if self.parameters.current is not None:
-            self._use(self.parameters.current)
+        self.check_service = CheckService(self, self._on_check, lambda: self.rebuild.pending_since is not None)
+        self.rebuild = Rebuild(self, finish_settings, self._use, settled=self.check_service.settled)
+        self._reader = Rebuild(self, self.parameters.read_topic, self._take_urdf)
+        self._draft = None  # the draft of a change accepted by _on_set, for _on_set_done
+        first = self.parameters.draft(check_settings, self.parameters.values())
+        if first is not None:
+            self.rebuild.submit(first)
+            self.rebuild.wait(STARTUP_WAIT)  # the first analysis, if quick; else it follows
+        self.add_on_set_parameters_callback(self._on_set)
+        self.add_post_set_parameters_callback(self._on_set_done)
+        if self.parameters.from_topic:
+            self.create_subscription(String, "robot_description", self._on_description, DESCRIPTION_QOS)
 
         self.create_subscription(JointState, "joint_states", self._on_joint_state, joint_states_qos(self))
-        self.check_service = CheckService(self, self._on_check, lambda: self.parameters.pending_since is not None)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         period = self.get_parameter("diagnostics.period").value
         if period > 0.0:
@@ -232,12 +106,44 @@ class PayloadCheckNode(Node):
         self._started = True
         if self.settings is not None:
             self._log_ready()
-        elif self.parameters.pending_since is not None:
+        elif self.rebuild.pending_since is not None:
             mass, com = self.get_parameter("payload.mass").value, list(self.get_parameter("payload.com").value)
             self.get_logger().info(
                 f"ready: ~/check for a {mass} kg payload at {com} m "
                 "(its workspace analysis still running: ~/check waits for it)"
             )
+
+    @property
+    def model(self) -> RobotModel | None:
+        """The model in force (None while waiting for a URDF)."""
+        return None if self.settings is None else self.settings.model
+
+    def _on_set(self, parameters) -> SetParametersResult:
+        """A change is accepted only if the whole new configuration checks."""
+        result, self._draft = self.parameters.check_change(parameters, check_settings)
+        return result
+
+    def _on_set_done(self, parameters) -> None:
+        """The change accepted: in force at once when nothing is to be analysed, else
+        analysed off the executor (~/check waits for it)."""
+        draft, self._draft = self._draft, None
+        if draft is None:
+            return
+        if analysed(draft, self.rebuild.previous):
+            self.rebuild.build_here(draft)
+        else:
+            self.rebuild.submit(draft)
+
+    def _on_description(self, msg: String) -> None:
+        """A new URDF: read off the executor, then checked (``_take_urdf``)."""
+        self._reader.submit(msg.data)
+
+    def _take_urdf(self, urdf) -> None:
+        """The URDF read: checked whole with the parameters in force, analysed off the
+        executor and swapped in, or refused keeping the model in use."""
+        draft = self.parameters.take_urdf(urdf, check_settings)
+        if draft is not None:
+            self.rebuild.submit(draft)
 
     def _use(self, settings: PayloadCheckSettings) -> None:
         """Switch to new settings (built, limits and workspace sweep included, when checked)."""
@@ -336,12 +242,12 @@ class PayloadCheckNode(Node):
     def _not_ready(self) -> str | None:
         """None when the parameters in force have been analysed; else why not (yet), for
         /diagnostics and ~/check (which first waits while an analysis is pending)."""
-        status = self.parameters.status()
+        status = self.rebuild.status()
         if status is None and self.settings is not None:
             return None
-        if self.parameters.failure is not None:
+        if self.rebuild.failure is not None:
             return f"cannot check: {status}"
-        since = self.parameters.pending_since
+        since = self.rebuild.pending_since
         if since is None:
             return "no model yet: waiting for a URDF on the robot_description topic"
         return (
@@ -366,7 +272,7 @@ class PayloadCheckNode(Node):
         if why is None:
             self.check()
             return
-        level = DiagnosticStatus.ERROR if self.parameters.failure is not None else DiagnosticStatus.WARN
+        level = DiagnosticStatus.ERROR if self.rebuild.failure is not None else DiagnosticStatus.WARN
         name = self.get_name()
         self._publish([DiagnosticStatus(level=level, name=f"{name}: payload", hardware_id=name, message=why)])
 
@@ -392,7 +298,7 @@ def usage() -> Usage:
 
 
 def main(args=None):
-    raise SystemExit(run("payload_check_node", PayloadCheckNode, args, usage=usage))
+    raise SystemExit(run("payload_check_node", PayloadCheckNode, args, executor="single_threaded", usage=usage))
 
 
 if __name__ == "__main__":

@@ -30,24 +30,25 @@ from collections import Counter
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import WrenchStamped
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock as ClockMessage
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray
+from std_msgs.msg import Float64MultiArray, String
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.nodes.sim_node.push import HeldWrench
 from irb140_dynamics.nodes.sim_node.settings import NODE_PARAMETERS, SimNodeSettings, build_settings, read_command
 from irb140_dynamics.ros.messages.joint_messages import BadMessage
 from irb140_dynamics.ros.messages.wrench import chain_links
-from irb140_dynamics.ros.parameters.live import Recipe
-from irb140_dynamics.ros.parameters.model_source import declare_model_source
+from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.usage import model_sections
 from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
+from irb140_dynamics.ros.runtime.rebuild import Rebuild
 from irb140_dynamics.ros.runtime.spin import run
 from irb140_dynamics.sim.engine import SimulatedArm, SimulationError
 from irb140_dynamics.sim.lockstep import TICKS, LockstepClock
@@ -71,8 +72,9 @@ class SimNode(Node):
         self._lock = threading.Lock()  # the arm and settings: the stepping thread against callbacks
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
-        self.parameters = declare_model_source(self, Recipe(NODE_PARAMETERS, build_settings))
-        self.parameters.on_change(self._use)
+        self.parameters = ArmParameters(self, NODE_PARAMETERS)
+        self._reader = Rebuild(self, self.parameters.read_topic, self._take_urdf)
+        self._draft = None  # the settings of a change accepted by _on_set, for _on_set_done
         self._reported = Counter()  # the counts at the last diagnostics
         self._command = None  # (time received [s, monotonic], torques)
         self._command_stale = True
@@ -104,8 +106,38 @@ class SimNode(Node):
             )
         self.loop = RealTimeLoop(period, self._step, self._on_step_error)
         self.schedule = self.loop.schedule
-        if self.parameters.current is not None:
-            self._use(self.parameters.current)
+        first = self.parameters.draft(build_settings, self.parameters.values())
+        if first is not None:
+            self._use(first)
+        self.add_on_set_parameters_callback(self._on_set)
+        self.add_post_set_parameters_callback(self._on_set_done)
+        if self.parameters.from_topic:
+            self.create_subscription(String, "robot_description", self._on_description, DESCRIPTION_QOS)
+
+    @property
+    def model(self):
+        """The model in force (None while waiting for a URDF)."""
+        return None if self.settings is None else self.settings.model
+
+    def _on_set(self, parameters) -> SetParametersResult:
+        """A change is accepted only if the whole new configuration checks (the engine built)."""
+        result, self._draft = self.parameters.check_change(parameters, build_settings)
+        return result
+
+    def _on_set_done(self, parameters) -> None:
+        draft, self._draft = self._draft, None
+        if draft is not None:
+            self._use(draft)
+
+    def _on_description(self, msg: String) -> None:
+        """A new URDF: read off the executor, then checked (``_take_urdf``)."""
+        self._reader.submit(msg.data)
+
+    def _take_urdf(self, urdf) -> None:
+        """The URDF read: checked whole (its engine built), swapped in, or refused."""
+        draft = self.parameters.take_urdf(urdf, build_settings)
+        if draft is not None:
+            self._use(draft)
 
     def destroy_node(self):
         self.loop.stop()

@@ -1,4 +1,4 @@
-"""sim_node's parameters and the settings it runs on, validated whole (see ros.parameters.live)."""
+"""sim_node's parameters and the settings it runs on, validated whole (see the node)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from std_msgs.msg import Float64MultiArray
 
 from irb140_dynamics.core import RobotModel
 from irb140_dynamics.ros.messages.joint_messages import BadMessage
-from irb140_dynamics.ros.parameters.model_source import STAND_IN
+from irb140_dynamics.ros.parameters.arm import STAND_IN
 from irb140_dynamics.ros.parameters.specs import MAX_QOS_DEPTH, Spec, check_choice
 from irb140_dynamics.sim.engine import DEFAULT_INTEGRATOR, SimulatedArm
 from irb140_dynamics.sim.mjcf import INTEGRATORS

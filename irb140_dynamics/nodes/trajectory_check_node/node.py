@@ -26,7 +26,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from diagnostic_msgs.msg import DiagnosticStatus
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
+from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory
 
 from irb140_dynamics.core import RobotModel
@@ -45,13 +47,13 @@ from irb140_dynamics.nodes.trajectory_check_node.messages import (
     trajectory_message,
     trajectory_of,
 )
-from irb140_dynamics.ros.parameters.live import Recipe
-from irb140_dynamics.ros.parameters.model_source import declare_model_source
+from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import Spec
 from irb140_dynamics.ros.parameters.usage import model_sections
 from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
+from irb140_dynamics.ros.runtime.rebuild import Rebuild
 from irb140_dynamics.ros.runtime.spin import run
 
 MAX_WARN_USE = 1e6  # %
@@ -121,8 +123,19 @@ class TrajectoryCheckNode(Node):
         super().__init__("trajectory_check_node", **NODE_OPTIONS, **kwargs)
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
-        recipe = Recipe(NODE_PARAMETERS, check_settings, finish=finish_settings, quick=quick, startup_wait=STARTUP_WAIT)
-        self.parameters = declare_model_source(self, recipe)
+        self.settings: TrajectoryCheckSettings | None = None  # None: not built yet, or waiting for a URDF
+        self.parameters = ArmParameters(self, NODE_PARAMETERS)
+        self.rebuild = Rebuild(self, finish_settings, self._use)
+        self._reader = Rebuild(self, self.parameters.read_topic, self._take_urdf)
+        self._draft = None  # the draft of a change accepted by _on_set, for _on_set_done
+        first = self.parameters.draft(check_settings, self.parameters.values())
+        if first is not None:
+            self.rebuild.submit(first)
+            self.rebuild.wait(STARTUP_WAIT)  # the torque limits, if quick; else they follow
+        self.add_on_set_parameters_callback(self._on_set)
+        self.add_post_set_parameters_callback(self._on_set_done)
+        if self.parameters.from_topic:
+            self.create_subscription(String, "robot_description", self._on_description, DESCRIPTION_QOS)
         self._report_pub = self.create_publisher(DiagnosticStatus, "~/trajectory_report", 10)
         self._retimed_pub = self.create_publisher(JointTrajectory, "~/retimed", 10)
         self.create_subscription(JointTrajectory, "~/check_trajectory", self._on_check, 10)
@@ -133,13 +146,42 @@ class TrajectoryCheckNode(Node):
         self.get_logger().info("ready: ~/check_trajectory and ~/retime" + (f", watching {watch}" if watch else ""))
 
     @property
-    def settings(self) -> TrajectoryCheckSettings | None:
-        return self.parameters.current
+    def model(self) -> RobotModel | None:
+        """The model in force (None while waiting for a URDF)."""
+        return None if self.settings is None else self.settings.model
+
+    def _use(self, settings: TrajectoryCheckSettings) -> None:
+        self.settings = settings
+
+    def _on_set(self, parameters) -> SetParametersResult:
+        """A change is accepted only if the whole new configuration checks."""
+        result, self._draft = self.parameters.check_change(parameters, check_settings)
+        return result
+
+    def _on_set_done(self, parameters) -> None:
+        """The change accepted: in force at once when the torque limits stay, else derived
+        off the executor meanwhile."""
+        draft, self._draft = self._draft, None
+        if draft is None:
+            return
+        if quick(draft, self.rebuild.previous):
+            self.rebuild.build_here(draft)
+        else:
+            self.rebuild.submit(draft)
+
+    def _on_description(self, msg: String) -> None:
+        """A new URDF: read off the executor, then checked (``_take_urdf``)."""
+        self._reader.submit(msg.data)
+
+    def _take_urdf(self, urdf) -> None:
+        draft = self.parameters.take_urdf(urdf, check_settings)
+        if draft is not None:
+            self.rebuild.submit(draft)
 
     def _not_ready(self) -> str:
-        if self.parameters.failure is not None:
-            return f"cannot check: {self.parameters.status()}"
-        if self.parameters.pending_since is not None:
+        if self.rebuild.failure is not None:
+            return f"cannot check: {self.rebuild.status()}"
+        if self.rebuild.pending_since is not None:
             return "not checked: the torque limits are being derived; send it again shortly"
         return "no model yet: waiting for a URDF on the robot_description topic"
 

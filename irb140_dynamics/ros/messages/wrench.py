@@ -22,7 +22,7 @@ MAX_TORQUE = 1e4  # N m
 
 def chain_links(parameters) -> tuple[str, str]:
     """(base link, tip link) of a node's model: its URDF's chain when it came from one
-    (``chain_links`` set by ros.parameters.model_source), else export_urdf's names."""
+    (``chain_links`` of ros.parameters.arm), else export_urdf's names."""
     return getattr(parameters, "chain_links", None) or (BASE, FLANGE)
 
 

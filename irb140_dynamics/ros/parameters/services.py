@@ -1,22 +1,18 @@
 """A node's parameter services (the six of rcl_interfaces, as ``ros2 param`` calls them),
 answered through the node's public parameter API, and safe against any request.
 
-The node is made without rclpy's own (``NODE_OPTIONS``), whose set services let a name
-that is not declared through ('' even reaches rclpy's internals) and raise inside the
-callback on a parameter type they do not know (a ParameterValue.type of 99, from a
-hand-made client), which ends the node's spin. Here a set request refuses such a parameter
-by name, and an unknown name naming the nearest known one, and hands the rest to
-``submit`` (``set_parameters_atomically``, after a check off the executor: see
-``checked_sets``) as rclpy does: one by one (SetParameters) or all or none
-(SetParametersAtomically), the reply sent when all are set. Any other failure is answered with an empty response and
+rclpy's own set services raise inside the callback on a parameter type they do not know (a
+ParameterValue.type of 99, from a hand-made client), which ends the node's spin, and let
+''  through to its internals. Here a set request refuses such a parameter by name, and an
+unknown name naming the nearest known one; the rest is set as rclpy does, one by one
+(SetParameters) or all or none (SetParametersAtomically), each change checked whole by the
+node's own on-set callback. Any other failure is answered with an empty response and
 warned about (throttled): the node goes on.
 """
 
 from __future__ import annotations
 
 import contextlib
-import functools
-from collections.abc import Callable
 
 from rcl_interfaces.msg import SetParametersResult
 from rcl_interfaces.srv import (
@@ -33,21 +29,15 @@ from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_parameters
 
 from irb140_dynamics.ros.parameters.overrides import nearest_hint
-from irb140_dynamics.ros.runtime.deferred_reply import DeferredService, Later
-
-Answer = Callable[[SetParametersResult], None]
 
 PARAMETER_TYPES = {kind.value for kind in Parameter.Type}
 
 
 class ParameterServices:
-    """The six parameter services of ``node`` (``~/set_parameters``, ...). ``submit(parameters,
-    answer)`` sets a change and calls ``answer`` with its result, now or later (see
-    ``checked_sets``); by default at once."""
+    """The six parameter services of ``node`` (``~/set_parameters``, ...)."""
 
-    def __init__(self, node: Node, submit: Callable[[list[Parameter], Answer], None] | None = None):
+    def __init__(self, node: Node):
         self._node = node
-        self._submit = submit or (lambda parameters, answer: answer(node.set_parameters_atomically(parameters)))
         for srv_type, name, answer in (
             (DescribeParameters, "describe_parameters", self._describe),
             (GetParameters, "get_parameters", self._get),
@@ -56,8 +46,7 @@ class ParameterServices:
             (SetParameters, "set_parameters", self._set),
             (SetParametersAtomically, "set_parameters_atomically", self._set_atomically),
         ):
-            DeferredService(
-                node,
+            node.create_service(
                 srv_type,
                 f"{node.get_name()}/{name}",
                 self._answered(srv_type, answer),
@@ -97,37 +86,16 @@ class ParameterServices:
         with contextlib.suppress(TypeError, ValueError):  # as rclpy: a bad request, an empty list
             response.result = self._node.list_parameters(list(request.prefixes), request.depth)
 
-    def _set(self, request, response) -> Later | None:
-        """Each parameter set on its own, in order; answered when all are."""
-        later, results = Later(), [None] * len(request.parameters)
+    def _set(self, request, response) -> None:
+        """Each parameter set on its own, in order."""
+        response.results = [self._set_all([message]) for message in request.parameters]
 
-        def done(index: int, result: SetParametersResult) -> None:
-            results[index] = result
-            if all(result is not None for result in results):
-                response.results = results
-                later.answer(response)
+    def _set_atomically(self, request, response) -> None:
+        response.result = self._set_all(request.parameters)
 
-        for index, message in enumerate(request.parameters):
-            refusal = self._refusal([message])
-            if refusal is not None:
-                done(index, refusal)
-            else:
-                self._submit(_parameters([message]), functools.partial(done, index))
-        return later if request.parameters else None
-
-    def _set_atomically(self, request, response) -> Later:
-        later = Later()
-
-        def done(result: SetParametersResult) -> None:
-            response.result = result
-            later.answer(response)
-
-        refusal = self._refusal(request.parameters)
-        if refusal is not None:
-            done(refusal)
-        else:
-            self._submit(_parameters(request.parameters), done)
-        return later
+    def _set_all(self, messages) -> SetParametersResult:
+        refusal = self._refusal(messages)
+        return refusal or self._node.set_parameters_atomically(_parameters(messages))
 
     def _refusal(self, messages) -> SetParametersResult | None:
         """A parameter of no known type, or a name not declared, refused by name; else None."""

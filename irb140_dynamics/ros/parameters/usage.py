@@ -6,7 +6,7 @@ from dataclasses import replace
 
 from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.package_files import default_config_path
-from irb140_dynamics.ros.parameters.model_source import DESCRIPTION_PARAMETERS, SOURCE
+from irb140_dynamics.ros.parameters.arm import DESCRIPTION_PARAMETERS, SOURCE
 from irb140_dynamics.ros.parameters.spec import Spec
 from irb140_dynamics.ros.parameters.specs import MODEL_NAME, joint_names_spec, model_specs
 
