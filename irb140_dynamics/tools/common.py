@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -44,6 +45,18 @@ def model_of(args: argparse.Namespace):
 
     overrides = dict(parse_override(text) for text in args.overrides)
     return tool_model(args.params_file, args.urdf, args.base, args.tip, overrides, default_config_path())
+
+
+def model_inputs(args: argparse.Namespace) -> list[tuple[str, Path]]:
+    """The files a tool reads its model from, as (shown, absolute path): --params-file and
+    --urdf as given, and the package's default parameter file (no output may replace it)."""
+    given = []
+    for option in ("params_file", "urdf"):
+        value = getattr(args, option, None)
+        if value:
+            given.append((f"--{option.replace('_', '-')} {value}", Path(os.path.abspath(value))))
+    default = default_config_path()
+    return [*given, (str(default), Path(os.path.abspath(default)))]
 
 
 class ProgressBar:
