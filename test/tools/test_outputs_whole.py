@@ -106,6 +106,15 @@ def test_identify_with_a_folder_where_a_plot_goes_keeps_the_other_plot_and_write
     ]
 
 
+@pytest.mark.slow  # a whole identification
+def test_identify_names_its_plots_as_typed_in_one_path(recording, tmp_path, capsys, monkeypatch):
+    """--plots plots/ (the folder with its slash): 'wrote plots/torques.png', no '//'."""
+    monkeypatch.chdir(tmp_path)
+    assert identify.main([str(recording), "--out", "identified.yaml", "--plots", "plots/", "--quiet"]) == 0
+    wrote = [line for line in capsys.readouterr().out.splitlines() if line.startswith("wrote ")]
+    assert wrote == ["wrote identified.yaml", "wrote plots/torques.png", "wrote plots/residuals.png"], wrote
+
+
 # no output over an input
 
 
