@@ -32,7 +32,7 @@ from ..core.errors import one_line
 from ..core.io.atomic import replace_all
 from ..core.urdf import load_urdf
 from .cli import ToolError, refuse_input_as_output, run
-from .common import model_inputs
+from .common import in_option_words, model_inputs
 
 NAME = "equations"
 QUIET_SECONDS = 2.0  # a progress line on stderr once the work takes longer than this
@@ -117,7 +117,8 @@ def _model(args):
         if args.payload_mass is not None:
             model = model.with_payload(RigidBody(args.payload_mass))
     except (ValueError, OSError) as error:  # ModelError, UrdfError, YAML errors are ValueErrors
-        raise ToolError(f"{path}: {one_line(error) or type(error).__name__}") from None
+        message = in_option_words(one_line(error), args.params_file, args.base, args.tip)
+        raise ToolError(f"{path}: {message or type(error).__name__}") from None
     return model, path
 
 

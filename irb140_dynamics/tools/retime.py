@@ -45,7 +45,7 @@ from ..core.trajectories import (
     trajectory_limits,
 )
 from .cli import ToolError, refuse_input_as_output, run
-from .common import model_inputs
+from .common import in_option_words, model_inputs
 
 NAME = "retime"
 OVER_LIMIT = 3
@@ -84,7 +84,7 @@ def model_of(params_file: str, urdf: str | None, payload_mass: float | None, cha
     try:
         model = tool_model(params_file, urdf, *chain).model
     except ValueError as error:
-        raise ToolError(str(error).splitlines()[0]) from None
+        raise ToolError(in_option_words(str(error).splitlines()[0], params_file, *chain)) from None
     if payload_mass is not None:
         if not (math.isfinite(payload_mass) and payload_mass >= 0):
             raise ToolError(f"--payload-mass: must be a mass >= 0 kg, got {payload_mass}")
