@@ -43,6 +43,7 @@ from irb140_dynamics.tools.cli import (
 MAX_POINTS = 1_000_000  # points written: 100 MB of YAML
 POINTS_PER_CYCLE = 4  # of the highest harmonic: fewer points do not show the motion
 SHELL_ARGUMENT_LIMIT = 128 * 1024  # bytes: Linux's MAX_ARG_STRLEN
+PUBLISH = "  ros2 topic pub --once /joint_trajectory_controller/joint_trajectory trajectory_msgs/msg/JointTrajectory {argument}"
 
 
 def parser() -> Parser:
@@ -182,11 +183,13 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
         f"{args.periods} x {args.period:g} s period, {counted(args.harmonics, 'harmonic')}, {args.rate:g} Hz, "
         f"{counted(len(times), 'point')}; starts and ends at rest at the first point",
         "Move the arm to the first point first. Publish it, e.g.:",
-        "  ros2 topic pub --once /joint_trajectory_controller/joint_trajectory "
-        'trajectory_msgs/msg/JointTrajectory "$(cat FILE)"   (or --yaml-file FILE)',
+        PUBLISH.format(argument='"$(cat FILE)"   (or --yaml-file FILE)'),
         "and record: ros2 bag record /joint_states",
     ]
     text = joint_trajectory_text(model.joint_names, times, Q, QD, QDD, comments)
+    if len(text) > SHELL_ARGUMENT_LIMIT:  # too long for "$(cat FILE)": the header says the way that works
+        comments[-2] = PUBLISH.format(argument="--yaml-file FILE   (too long for one shell argument)")
+        text = joint_trajectory_text(model.joint_names, times, Q, QD, QDD, comments)
     with Outputs(interrupts) as outputs:
         outputs.text(out, args.out, text)
         print(  # before the commit: `| head` stops the tool with nothing written
