@@ -166,14 +166,19 @@ def input_path(path: str, what: str = "file") -> Path:
 
 def refuse_input_as_output(inputs, outputs) -> None:
     """ToolError, before any work, when an output is one of the inputs by any path (as
-    typed, through a linked folder, a hard link): writing it would replace the input.
-    ``inputs`` and ``outputs``: (as shown to the user, absolute path or None) pairs."""
+    typed, through a linked folder, a hard link), or lies in an input that is a folder (a
+    bag): writing it would replace or change the input. ``inputs`` and ``outputs``: (as
+    shown to the user, absolute path or None) pairs."""
     given = [(shown_as, path) for shown_as, path in inputs if path is not None]
     for written_as, output in outputs:
         for shown_as, path in given if output is not None else ():
             if _same_file(path, output):
                 raise ToolError(
                     f"{shown(written_as)}: would replace the input {shown(shown_as)}; give the output another name"
+                )
+            if _inside(output, path):
+                raise ToolError(
+                    f"{shown(written_as)}: would write into the input {shown(shown_as)}; give the output another place"
                 )
 
 
@@ -184,6 +189,13 @@ def _same_file(a: Path, b: Path) -> bool:
     except OSError:  # the output is not there yet
         pass
     return os.path.realpath(a) == os.path.realpath(b)
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    """``path`` lies in the folder ``folder`` (followed through links)."""
+    if not os.path.isdir(folder):
+        return False
+    return os.path.realpath(path).startswith(os.path.join(os.path.realpath(folder), ""))
 
 
 def _nearest_file(path: Path) -> Path:

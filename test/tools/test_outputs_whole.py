@@ -162,6 +162,12 @@ CASES = {
         ["run.csv", "--params-file", "plots/torques.png", "--out", "identified.yaml", "--plots", "plots"],
         ("--params-file plots/torques.png", "plots/torques.png"),
     ),
+    "identify into its bag": (
+        identify.main,
+        {"bag/metadata.yaml": CONFIG},
+        ["bag", "--out", "bag/identified.yaml"],
+        ("bag", "bag/identified.yaml"),
+    ),
     "equations": (
         equations.main,
         {"gen/arm_eom.py": CONFIG},
@@ -200,7 +206,12 @@ def test_no_tool_writes_over_one_of_its_inputs(case, recording, tmp_path, capsys
     assert main(arguments) == 1
     err = capsys.readouterr().err.splitlines()
     tool = main.__module__.rsplit(".", 1)[1]
-    assert err == [f"{tool}: error: {written}: would replace the input {given}; give the output another name"], err
+    why = (
+        "write into the input {}; give the output another place"
+        if "into" in case
+        else "replace the input {}; give the output another name"
+    )
+    assert err == [f"{tool}: error: {written}: would {why.format(given)}"], err
     assert {name: (tmp_path / name).read_bytes() for name in files} == before
     folders = {os.path.dirname(name) for name in files} - {""}
     assert left_in(tmp_path) == sorted({*files, *folders})
