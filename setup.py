@@ -4,6 +4,37 @@ from setuptools import find_packages, setup
 
 package_name = "irb140_dynamics"
 
+# The executables colcon installs (`setup.py develop`/`install`) as light scripts: the
+# program's function imported and called, as pip's wheels make them. setuptools' own
+# easy-install script first imports importlib.metadata and scans every installed
+# distribution (0.1 to 0.2 s), before the executable's entry (irb140_dynamics.entry) can
+# note a Ctrl-C: one then was a traceback.
+LIGHT_SCRIPT = """# -*- coding: utf-8 -*-
+import sys
+
+from {module} import {function}
+
+if __name__ == "__main__":
+    sys.exit({function}())
+"""
+
+
+def _light_scripts(cls, dist, header=None):
+    header = cls.get_header() if header is None else header
+    for kind in ("console", "gui"):
+        for name, entry_point in dist.get_entry_map(f"{kind}_scripts").items():
+            cls._ensure_safe_name(name)
+            text = LIGHT_SCRIPT.format(module=entry_point.module_name, function=entry_point.attrs[0])
+            yield from cls._get_script_args(kind, name, header, text)
+
+
+try:  # setuptools without easy_install (pip's wheels): its scripts are light already
+    from setuptools.command.easy_install import ScriptWriter
+
+    ScriptWriter.get_args = classmethod(_light_scripts)
+except ImportError:
+    pass
+
 setup(
     name=package_name,
     version="0.1.0",

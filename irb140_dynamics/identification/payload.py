@@ -17,7 +17,11 @@ phi_hat and its covariance. The recording is refused, naming the parameters, whe
 not excite one: its column (in units of a 1 kg body 0.1 m out) vanishes to rounding or
 lies in the others' span (``excitation``), or its standard deviation exceeds
 MAX_RELATIVE_STD of the payload's own scale (m, m L, m L^2; see ``_check_excitation``);
-and when its mass comes out negative beyond the noise (``_check_mass``). The payload is then the physical body closest to phi_hat in its covariance's metric:
+and when its mass comes out negative beyond the noise (``_check_mass``), or when the efforts
+are a multiple of the torques the arm's model gives (``_check_effort_scale``: tau = s
+tau_arm + Y_last T phi fitted with s free, s away from 1 beyond MAX_EFFORT_SCALE_ERROR and
+the noise: efforts not in N m, where phi would absorb (s - 1) tau_arm, 37 t for 3.5 kg in
+N mm). The payload is then the physical body closest to phi_hat in its covariance's metric:
 phi = phi(theta) through the log-Cholesky pseudo-inertia of ``consistent`` (mass > 0,
 inertia about the CoM positive definite, triangle inequality hold for any theta), so a
 phi_hat that is physical is kept as it is.
@@ -65,10 +69,13 @@ WEAK_EXCITATION = 1e-3  # named (with the least excited) when the regressor is s
 MAX_RELATIVE_STD = 0.05  # of the payload's own scale (see _check_excitation)
 MIN_MASS = 0.1  # kg
 NEGATIVE_MASS_SIGMAS = 5.0  # a mass estimate below -5 standard deviations: no payload (see _check_mass)
+MAX_EFFORT_SCALE_ERROR = 0.05  # the efforts / the arm model's torques, beyond 1 +- this: refused
+EFFORT_SCALE_SIGMAS = 5.0  # ... and beyond this many standard deviations of that ratio
 MIN_LENGTH = 0.1  # m
 UNIT_SCALE = np.array([1.0, 0.1, 0.1, 0.1, 0.01, 0.01, 0.01, 0.01, 0.01, 0.01])  # 1 kg, 0.1 m out
 PARAMETER_LABELS = ("mass", "m*cx", "m*cy", "m*cz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")  # phi's, as printed
 _ALL_INDEPENDENT = BaseParameters(tuple(LINK_PARAMETERS), np.arange(10), np.arange(0), np.zeros((10, 0)), np.arange(0))
+_WITH_SCALE = BaseParameters((*LINK_PARAMETERS, "s"), np.arange(11), np.arange(0), np.zeros((11, 0)), np.arange(0))
 
 
 def _moved(pi10: np.ndarray, R: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -162,14 +169,18 @@ def fit_payload(
     span = tally.selection.train
     points, fast = points.take(span), fast[span]
     use = fast | ~fast.any(axis=0)  # a joint held still throughout: all its rows
-    equations = NormalEquations(arm.n, 10)
+    with_scale = NormalEquations(arm.n, 11)  # the payload's ten columns, then the arm's torques
     for start in range(0, len(points), FIT_BATCH):
         batch = points.take(slice(start, start + FIT_BATCH))
         Y, tau_arm = payload_regressor(arm, batch.q, batch.qd, batch.qdd)
-        equations.add(Y, batch.tau - tau_arm, use[start : start + FIT_BATCH])
+        with_scale.add(
+            np.concatenate([Y, tau_arm[..., None]], axis=2), batch.tau - tau_arm, use[start : start + FIT_BATCH]
+        )
+    equations = _payload_columns(with_scale)
     estimate = _estimate(tally.path, equations, tally.design.noise_correlation())
     _check_mass(tally.path, estimate)
     _check_excitation(tally.path, estimate)
+    _check_effort_scale(tally.path, with_scale, tally.design.noise_correlation())
     phi, misfit = _nearest_physical(estimate)
     return PayloadFit(
         payload_of(phi),
@@ -220,6 +231,39 @@ def _check_mass(path, estimate: Estimate) -> None:
             path,
             f"the torques give the payload a mass of {mass:.3g} +- {std:.2g} kg: no physical payload explains "
             "them; check the efforts (their sign, N m) and the arm's own parameters (`identify` it first)",
+        )
+
+
+def _payload_columns(with_scale: NormalEquations) -> NormalEquations:
+    """The sums of the payload's ten columns alone (tau - tau_arm = Y_last T phi)."""
+    equations = NormalEquations(*with_scale.b.shape[:1], 10)
+    equations.A, equations.b = with_scale.A[:, :10, :10].copy(), with_scale.b[:, :10].copy()
+    equations.s, equations.t = with_scale.s[:, :10].copy(), with_scale.t.copy()
+    equations.c, equations.rows, equations.peak = with_scale.c.copy(), with_scale.rows.copy(), with_scale.peak.copy()
+    return equations
+
+
+def _check_effort_scale(path, with_scale: NormalEquations, correlation: float) -> None:
+    """RecordingError when the efforts are s times the arm model's torques, s away from 1
+    beyond MAX_EFFORT_SCALE_ERROR and EFFORT_SCALE_SIGMAS standard deviations (fitted with
+    the payload: tau - tau_arm = (s - 1) tau_arm + Y_last T phi). A payload cannot scale
+    the torques of the arm's own links: the efforts are in other units (N mm: s = 1000),
+    or the arm's own parameters are far off. Without a fit (the scale not told apart from
+    the payload), nothing is said here: the payload's own fit names what it misses."""
+    scaled = NormalEquations(*with_scale.b.shape)
+    weights = np.append(UNIT_SCALE, 1.0)
+    scaled.A = with_scale.A * np.outer(weights, weights)
+    scaled.b, scaled.c, scaled.rows = with_scale.b * weights, with_scale.c, with_scale.rows
+    try:
+        estimate = weighted_least_squares(scaled, _WITH_SCALE, correlation)
+    except ValueError:
+        return
+    scale, std = 1.0 + float(estimate.beta[10]), float(estimate.std[10])
+    if abs(scale - 1.0) > max(MAX_EFFORT_SCALE_ERROR, EFFORT_SCALE_SIGMAS * std):
+        raise RecordingError(
+            path,
+            f"the efforts are {scale:.4g} +- {std:.2g} times the torques of the arm's model: check their units "
+            "(N m, not N mm) and sign, and the arm's own parameters (`identify` it first)",
         )
 
 

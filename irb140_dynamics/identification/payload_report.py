@@ -7,6 +7,7 @@ from datetime import UTC, datetime
 
 import numpy as np
 
+from irb140_dynamics.core.errors import counted
 from irb140_dynamics.core.io.params_file import parameter_file_text
 from irb140_dynamics.core.model.rigid_body import inertia_matrix
 from irb140_dynamics.core.model.robot_model import RobotModel
@@ -35,7 +36,8 @@ def payload_summary(fit: PayloadFit, arm: RobotModel) -> str:
             f"{np.sqrt(fit.misfit):.2g} standard deviations away)"
         )
     residual = ", ".join(
-        f"{name} {rms:.3g} N m ({rows} rows)" for name, rms, rows in zip(arm.joint_names, fit.residual_rms, fit.rows)
+        f"{name} {rms:.3g} N m ({counted(int(rows), 'row')})"
+        for name, rms, rows in zip(arm.joint_names, fit.residual_rms, fit.rows)
     )
     lines.append(f"residual RMS torque per joint: {residual}")
     return "\n".join(lines)

@@ -6,6 +6,7 @@ from datetime import UTC, datetime
 
 import numpy as np
 
+from irb140_dynamics.core.errors import counted
 from irb140_dynamics.core.io.params_file import parameter_file_text
 from irb140_dynamics.core.io.urdf import export_urdf
 from irb140_dynamics.identification.consistent import PHYSICAL_CONFIDENCE
@@ -23,7 +24,7 @@ def _tally_lines(tally: SampleTally, names) -> list[str]:
         f"{_count(tally.edges)} at gaps and ends",
     ]
     lines = [
-        f"{tally.path}: {_count(tally.read)} samples read, {_count(tally.used)} used, {_count(left_out)} left out "
+        f"{tally.path}: {counted(tally.read, 'sample')} read, {_count(tally.used)} used, {_count(left_out)} left out "
         f"({', '.join(reasons)})"
     ]
     if tally.skipped:
@@ -35,8 +36,8 @@ def _tally_lines(tally: SampleTally, names) -> list[str]:
     if design is not None:
         source = "measured velocities" if tally.has_velocity else "differentiated positions"
         lines.append(
-            f"  {design.rate:.1f} Hz, filtered to {design.cutoff:g} Hz (window {design.window} samples), "
-            f"fit at {design.rate / design.stride:.1f} Hz: {_count(tally.fit_points)} points; qd from {source}"
+            f"  {design.rate:.1f} Hz, filtered to {design.cutoff:g} Hz (window {counted(design.window, 'sample')}), "
+            f"fit at {design.rate / design.stride:.1f} Hz: {counted(tally.fit_points, 'point')}; qd from {source}"
         )
         slow = ", ".join(
             f"{name} {100.0 * k / max(tally.fit_points, 1):.1f} %" for name, k in zip(names, tally.slow_rows)

@@ -29,6 +29,7 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rclpy.validate_full_topic_name import validate_full_topic_name
 
+from irb140_dynamics.core.errors import counted
 from irb140_dynamics.identification.recording import bag_connection, open_bag
 from irb140_dynamics.ros.runtime.spin import init_error
 
@@ -221,11 +222,11 @@ class Recorder(Node):
         """What is recorded so far, in a line."""
         span = 0.0 if self.first is None else (self.last - self.first) * 1e-9
         goal = f" of {self.duration:g} s" if self.duration else ""
-        return f"recording {self.topic}: {self.count:,} messages, {span:.1f} s{goal}"
+        return f"recording {self.topic}: {counted(self.count, 'message')}, {span:.1f} s{goal}"
 
     def close(self) -> str:
         """Close the bag (call once, with signals held off: a bag half closed is unreadable);
         what it holds, in a line."""
         self._writer.close()
         span = 0.0 if self.first is None else (self.last - self.first) * 1e-9
-        return f"wrote {self.out}: {self.count} messages of {self.topic} over {span:.3f} s"
+        return f"wrote {self.out}: {counted(self.count, 'message')} of {self.topic} over {span:.3f} s"

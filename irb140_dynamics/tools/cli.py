@@ -136,6 +136,17 @@ def output_directory(path: str, must_be_new: bool = False) -> Path:
     return target
 
 
+def files_in(directory: Path, typed: str, names) -> list[tuple[str, Path]]:
+    """The files ``names`` a tool writes in the folder ``directory`` (from
+    ``output_directory``; ``typed`` as the user gave it), as (as typed, absolute path)
+    pairs: each one absent or a regular file, else a ToolError before any work."""
+    files = [(os.path.normpath(os.path.join(typed, name)), directory / name) for name in names]
+    for written_as, path in files:
+        if os.path.lexists(path) and not path.is_file():
+            raise _refuse(written_as, "is a directory" if path.is_dir() else "exists and is not a regular file")
+    return files
+
+
 def check_model_paths(args: argparse.Namespace) -> None:
     """The model's input files (``--params-file``, ``--urdf``) exist, before any work."""
     for path in (getattr(args, "params_file", None), getattr(args, "urdf", None)):
@@ -154,13 +165,21 @@ def input_path(path: str, what: str = "file") -> Path:
 
 
 def refuse_input_as_output(inputs, outputs) -> None:
-    """ToolError when an output is one of the inputs by any path (as typed, through a linked
-    folder, a hard link): writing it would replace the input. ``inputs``: (as typed,
-    absolute path or None) pairs; ``outputs``: absolute paths or None."""
-    written = [path for path in outputs if path is not None]
-    for given, path in inputs:
-        if path is not None and any(_same_file(path, output) for output in written):
-            raise ToolError(f"{given}: is an input and an output; give the output another name")
+    """ToolError, before any work, when an output is one of the inputs by any path (as
+    typed, through a linked folder, a hard link), or lies in an input that is a folder (a
+    bag): writing it would replace or change the input. ``inputs`` and ``outputs``: (as
+    shown to the user, absolute path or None) pairs."""
+    given = [(shown_as, path) for shown_as, path in inputs if path is not None]
+    for written_as, output in outputs:
+        for shown_as, path in given if output is not None else ():
+            if _same_file(path, output):
+                raise ToolError(
+                    f"{shown(written_as)}: would replace the input {shown(shown_as)}; give the output another name"
+                )
+            if _inside(output, path):
+                raise ToolError(
+                    f"{shown(written_as)}: would write into the input {shown(shown_as)}; give the output another place"
+                )
 
 
 def _same_file(a: Path, b: Path) -> bool:
@@ -170,6 +189,13 @@ def _same_file(a: Path, b: Path) -> bool:
     except OSError:  # the output is not there yet
         pass
     return os.path.realpath(a) == os.path.realpath(b)
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    """``path`` lies in the folder ``folder`` (followed through links)."""
+    if not os.path.isdir(folder):
+        return False
+    return os.path.realpath(path).startswith(os.path.join(os.path.realpath(folder), ""))
 
 
 def _nearest_file(path: Path) -> Path:

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
+import re
 import sys
 import time
 from pathlib import Path
@@ -43,7 +46,46 @@ def model_of(args: argparse.Namespace):
     from irb140_dynamics.core.io.model_source import parse_override, tool_model
 
     overrides = dict(parse_override(text) for text in args.overrides)
-    return tool_model(args.params_file, args.urdf, args.base, args.tip, overrides, default_config_path())
+    try:
+        return tool_model(args.params_file, args.urdf, args.base, args.tip, overrides, default_config_path())
+    except ValueError as error:
+        raise ValueError(in_option_words(str(error), args.params_file, args.base, args.tip, overrides)) from None
+
+
+# the core's names of the chain's ends where they name the option: the element of a URDF
+# error ("URDF tip_link: ..."), "below base_link 'x'", "(tip_link)"; never a link's name
+_CHAIN_END = re.compile(r"URDF (base|tip)_link(?=:)|(?<=below )(base|tip)_link(?= ')|(?<=\()(base|tip)_link(?=\))")
+
+
+def in_option_words(message: str, params_file=None, base=None, tip=None, overrides=None) -> str:
+    """A model error in a tool's words: the URDF chain's ends are its --base and --tip
+    options (the core names them base_link and tip_link, as the nodes' model.base_link and
+    model.tip_link); model.<end>_link where only the params file (or -p) named that end."""
+    named = dict(overrides or {})
+    if params_file:
+        from irb140_dynamics.core.io.params_file import read_parameter_file
+
+        with contextlib.suppress(OSError, ValueError):
+            named = {**read_parameter_file(params_file), **named}
+    given = {"base": base, "tip": tip}
+
+    def option(match: re.Match) -> str:
+        end = next(group for group in match.groups() if group)
+        return f"model.{end}_link" if given[end] is None and named.get(f"model.{end}_link") else f"--{end}"
+
+    return _CHAIN_END.sub(option, message)
+
+
+def model_inputs(args: argparse.Namespace) -> list[tuple[str, Path]]:
+    """The files a tool reads its model from, as (shown, absolute path): --params-file and
+    --urdf as given, and the package's default parameter file (no output may replace it)."""
+    given = []
+    for option in ("params_file", "urdf"):
+        value = getattr(args, option, None)
+        if value:
+            given.append((f"--{option.replace('_', '-')} {value}", Path(os.path.abspath(value))))
+    default = default_config_path()
+    return [*given, (str(default), Path(os.path.abspath(default)))]
 
 
 class ProgressBar:

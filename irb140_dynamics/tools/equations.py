@@ -27,10 +27,12 @@ import time
 from pathlib import Path
 
 from ..core import RigidBody, load_model
-from ..core.equations import DEFAULT_QUANTITIES, FORMS, QUANTITIES, generate
+from ..core.equations import DEFAULT_QUANTITIES, FORMS, QUANTITIES, file_names, generate
 from ..core.errors import one_line
+from ..core.io.atomic import replace_all
 from ..core.urdf import load_urdf
-from .cli import ToolError, run
+from .cli import ToolError, refuse_input_as_output, run
+from .common import in_option_words, model_inputs
 
 NAME = "equations"
 QUIET_SECONDS = 2.0  # a progress line on stderr once the work takes longer than this
@@ -84,14 +86,18 @@ def _main(argv: list[str]) -> int:
     if not prefix.isidentifier() or not prefix.isascii():
         raise ToolError(f"--prefix {prefix!r} is not a C identifier")
     out = Path(args.out)
+    written = [(str(out / name), Path(os.path.abspath(out / name))) for name in file_names((args.form,), prefix)]
+    refuse_input_as_output(model_inputs(args), written)
     staging = _staging_folder(out)
     try:
         with _Progress() as progress:
             files = generate(model, (args.form,), what, args.symbolic_parameters, prefix, path.name, progress)
         for name, text in files.items():
             _write_synced(staging / name, text)
-        for name in files:
-            os.replace(staging / name, out / name)
+        try:  # all or none
+            replace_all((staging / name, out / name) for name in files)
+        except OSError as error:
+            raise ToolError(f"{error.filename}: cannot write ({error.strerror or error}); nothing written") from None
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     for name in files:
@@ -111,7 +117,8 @@ def _model(args):
         if args.payload_mass is not None:
             model = model.with_payload(RigidBody(args.payload_mass))
     except (ValueError, OSError) as error:  # ModelError, UrdfError, YAML errors are ValueErrors
-        raise ToolError(f"{path}: {one_line(error) or type(error).__name__}") from None
+        message = in_option_words(one_line(error), args.params_file, args.base, args.tip)
+        raise ToolError(f"{path}: {message or type(error).__name__}") from None
     return model, path
 
 

@@ -29,11 +29,21 @@ if __name__ == "__main__":  # python -m: the entry first, before the heavy impor
 import argparse
 import sys
 
-from irb140_dynamics.tools.cli import Parser, ToolError, check_model_paths, number, output_file, run
+from irb140_dynamics.core.errors import counted
+from irb140_dynamics.tools.cli import (
+    Parser,
+    ToolError,
+    check_model_paths,
+    number,
+    output_file,
+    refuse_input_as_output,
+    run,
+)
 
 MAX_POINTS = 1_000_000  # points written: 100 MB of YAML
 POINTS_PER_CYCLE = 4  # of the highest harmonic: fewer points do not show the motion
 SHELL_ARGUMENT_LIMIT = 128 * 1024  # bytes: Linux's MAX_ARG_STRLEN
+PUBLISH = "  ros2 topic pub --once /joint_trajectory_controller/joint_trajectory trajectory_msgs/msg/JointTrajectory {argument}"
 
 
 def parser() -> Parser:
@@ -129,8 +139,11 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
             f"--period x --periods: a payload motion lasts at most {MAX_PAYLOAD_DURATION:g} s, "
             f"got {args.period * args.periods:g} s"
         )
+    from irb140_dynamics.tools.common import model_inputs
+
     check_model_paths(args)
     out = output_file(args.out)
+    refuse_input_as_output(model_inputs(args), [(args.out, out)])
 
     import numpy as np
 
@@ -146,7 +159,11 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
         result, regressor = _payload_excitation(model, path, args), "the payload's regressor"
     else:
         base = find_base_parameters(model)
-        print(f"model: {path}; {base.count} base parameters; optimising ({args.iterations} iterations)...", flush=True)
+        print(
+            f"model: {path}; {counted(base.count, 'base parameter')}; "
+            f"optimising ({counted(args.iterations, 'iteration')})...",
+            flush=True,
+        )
         result = optimise_excitation(
             model, args.period, args.harmonics, args.seed, args.iterations, margin=args.margin, base=base
         )
@@ -163,14 +180,16 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
         f"model {path}",
         f"condition number of {regressor}: {result.condition_number:.2f} (random start: "
         f"{result.start_condition_number:.2f})",
-        f"{args.periods} x {args.period:g} s period, {args.harmonics} harmonics, {args.rate:g} Hz, "
-        f"{len(times)} points; starts and ends at rest at the first point",
+        f"{args.periods} x {args.period:g} s period, {counted(args.harmonics, 'harmonic')}, {args.rate:g} Hz, "
+        f"{counted(len(times), 'point')}; starts and ends at rest at the first point",
         "Move the arm to the first point first. Publish it, e.g.:",
-        "  ros2 topic pub --once /joint_trajectory_controller/joint_trajectory "
-        'trajectory_msgs/msg/JointTrajectory "$(cat FILE)"   (or --yaml-file FILE)',
+        PUBLISH.format(argument='"$(cat FILE)"   (or --yaml-file FILE)'),
         "and record: ros2 bag record /joint_states",
     ]
     text = joint_trajectory_text(model.joint_names, times, Q, QD, QDD, comments)
+    if len(text) > SHELL_ARGUMENT_LIMIT:  # too long for "$(cat FILE)": the header says the way that works
+        comments[-2] = PUBLISH.format(argument="--yaml-file FILE   (too long for one shell argument)")
+        text = joint_trajectory_text(model.joint_names, times, Q, QD, QDD, comments)
     with Outputs(interrupts) as outputs:
         outputs.text(out, args.out, text)
         print(  # before the commit: `| head` stops the tool with nothing written
@@ -179,7 +198,7 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
         )
         outputs.commit()
     print(
-        f"wrote {args.out}: {len(times)} points over {times[-1]:g} s; start at "
+        f"wrote {args.out}: {counted(len(times), 'point')} over {times[-1]:g} s; start at "
         f"[{', '.join(f'{x:.4f}' for x in Q[0])}] rad"
     )
     if len(text) > SHELL_ARGUMENT_LIMIT:
@@ -205,7 +224,10 @@ def _payload_excitation(model, path: str, args: argparse.Namespace):
         message = str(error)
         raise ToolError(f"--{message}" if message.startswith("pose:") else message) from None
     moving = ", ".join(model.joint_names[j] for j in wrist(model))
-    print(f"model: {path}; payload motion of {moving}; optimising ({args.iterations} iterations)...", flush=True)
+    print(
+        f"model: {path}; payload motion of {moving}; optimising ({counted(args.iterations, 'iteration')})...",
+        flush=True,
+    )
     try:
         return optimise_payload_excitation(
             model, args.period, args.harmonics, args.seed, args.iterations, margin=args.margin, pose=args.pose

@@ -31,8 +31,8 @@ if __name__ == "__main__":  # python -m: the entry first, before the heavy impor
 import math
 import sys
 
-from irb140_dynamics.tools.cli import Parser, ToolError, check_model_paths, output_file, run
-from irb140_dynamics.tools.common import add_model_arguments
+from irb140_dynamics.tools.cli import Parser, ToolError, check_model_paths, output_file, refuse_input_as_output, run
+from irb140_dynamics.tools.common import add_model_arguments, model_inputs
 
 NAME = "export_urdf"
 ROS_MARKERS = ("--ros-args", "--")  # the ROS form's markers: its --params-file and -p are ours
@@ -137,6 +137,7 @@ def _export(args: list[str], interrupts) -> int:
     options = parser().parse_args([a for a in args[1:] if a not in ROS_MARKERS])
     check_model_paths(options)
     out = output_file(options.out) if options.out else None
+    refuse_input_as_output(model_inputs(options), [(options.out, out)])
 
     from irb140_dynamics.tools.common import model_of
     from irb140_dynamics.tools.outputs import Outputs

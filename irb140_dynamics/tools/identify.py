@@ -42,6 +42,8 @@ from pathlib import Path
 from irb140_dynamics.tools.cli import (
     Parser,
     ToolError,
+    check_model_paths,
+    files_in,
     input_path,
     number,
     output_directory,
@@ -49,10 +51,11 @@ from irb140_dynamics.tools.cli import (
     refuse_input_as_output,
     run,
 )
-from irb140_dynamics.tools.common import add_model_arguments
+from irb140_dynamics.tools.common import add_model_arguments, model_inputs
 
 DEFAULT_HELD_OUT = 0.2
 DEFAULT_PRIOR_WEIGHT = 1.0
+PLOTS = ("torques.png", "residuals.png")  # what identification.plots.write_plots writes
 
 
 def parser() -> Parser:
@@ -137,13 +140,14 @@ def _identify(argv: list[str], interrupts) -> int:
         raise ToolError(f"--held-out: must be < 1, got {args.held_out:g}")
     recording = input_path(args.recording)
     validate = input_path(args.validate) if args.validate else None
-    params = input_path(args.params_file) if args.params_file else None
-    urdf = input_path(args.urdf) if args.urdf else None
+    check_model_paths(args)
     out = output_file(args.out)
     urdf_out = output_file(args.urdf_out) if args.urdf_out else None
     plots = output_directory(args.plots) if args.plots else None
-    inputs = ((args.recording, recording), (args.validate, validate), (args.params_file, params), (args.urdf, urdf))
-    refuse_input_as_output(inputs, (out, urdf_out, plots))
+    plot_files = files_in(plots, args.plots, PLOTS) if plots is not None else []
+    inputs = [(args.recording, recording), (args.validate, validate), *model_inputs(args)]
+    outputs = [(args.out, out), (args.urdf_out, urdf_out), (args.plots, plots), *plot_files]
+    refuse_input_as_output(inputs, outputs)
 
     import shlex
 
@@ -157,6 +161,7 @@ def _identify(argv: list[str], interrupts) -> int:
     if urdf_out is None and source.urdf is not None:
         args.urdf_out = str(Path(args.out).with_suffix(".urdf"))
         urdf_out = output_file(args.urdf_out)
+        refuse_input_as_output(inputs, [(args.urdf_out, urdf_out)])
     settings = IdentificationSettings(
         topic=args.topic,
         cutoff=args.cutoff,
@@ -178,7 +183,8 @@ def _identify(argv: list[str], interrupts) -> int:
             from irb140_dynamics.identification.plots import write_plots
 
             outputs.directory(plots, args.plots)
-            names = write_plots(result, lambda name, save: outputs.stage(plots / name, f"{args.plots}/{name}", save))
+            shown = {path.name: typed for typed, path in plot_files}
+            names = write_plots(result, lambda name, save: outputs.stage(plots / name, shown[name], save))
             if not names:
                 print(f"no held-out points to plot: nothing written in {args.plots}")
         for typed in outputs.commit():

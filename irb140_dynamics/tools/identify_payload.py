@@ -10,7 +10,8 @@ from __future__ import annotations
 import argparse
 import shlex
 
-from irb140_dynamics.tools.cli import ToolError, input_path, output_file, refuse_input_as_output
+from irb140_dynamics.tools.cli import ToolError, check_model_paths, input_path, output_file, refuse_input_as_output
+from irb140_dynamics.tools.common import model_inputs
 
 NOT_WITH_PAYLOAD_ONLY = ("validate", "plots", "urdf_out", "offsets", "held_out", "prior_weight")  # None: not given
 
@@ -22,9 +23,9 @@ def identify_payload(args: argparse.Namespace, argv: list[str], interrupts) -> i
         if getattr(args, name):
             raise ToolError(f"--{name.replace('_', '-')}: not with --payload-only")
     recording = input_path(args.recording)
-    model_files = [(given, input_path(given)) for given in (args.params_file, args.urdf) if given]
+    check_model_paths(args)
     out = output_file(args.out)
-    refuse_input_as_output([(args.recording, recording), *model_files], [out])
+    refuse_input_as_output([(args.recording, recording), *model_inputs(args)], [(args.out, out)])
 
     from irb140_dynamics.identification.payload import fit_payload
     from irb140_dynamics.identification.payload_report import payload_file, payload_summary

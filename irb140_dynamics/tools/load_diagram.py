@@ -30,7 +30,16 @@ import math
 import os
 import sys
 
-from irb140_dynamics.tools.cli import Parser, ToolError, check_model_paths, number, output_directory, run
+from irb140_dynamics.tools.cli import (
+    Parser,
+    ToolError,
+    check_model_paths,
+    files_in,
+    number,
+    output_directory,
+    refuse_input_as_output,
+    run,
+)
 
 NAME = "load_diagram"
 MAX_POINTS = 20_000  # grid points: a diagram beyond this is a typo of --step
@@ -74,8 +83,12 @@ def main(argv: list[str] | None = None) -> int:
 
 def _diagram(argv: list[str], interrupts) -> int:
     args = parser().parse_args(argv)
+    from irb140_dynamics.tools.common import model_inputs
+
     check_model_paths(args)
     out = output_directory(args.out)
+    files = files_in(out, args.out, FILES)
+    refuse_input_as_output(model_inputs(args), files)
     z, l = grid(args.z_max, args.step), grid(args.l_max, args.step)
     if z.size * l.size > MAX_POINTS:
         raise ToolError(
@@ -99,8 +112,8 @@ def _diagram(argv: list[str], interrupts) -> int:
     csv, png = diagram_csv(diagram).encode(), diagram_png(diagram, rated.mass, os.path.basename(source.origin))
     with Outputs(interrupts) as outputs:
         outputs.directory(out, args.out)
-        for name, data in zip(FILES, (csv, png)):
-            outputs.stage(out / name, os.path.join(args.out, name), lambda stream, data=data: stream.write(data))
+        for (typed, path), data in zip(files, (csv, png)):
+            outputs.stage(path, typed, lambda stream, data=data: stream.write(data))
         written = outputs.commit()
     print(_summary(diagram, written))
     return 0
@@ -137,6 +150,8 @@ def _workers(rows: int) -> int:
 def _summary(diagram, written) -> str:
     import numpy as np
 
+    from irb140_dynamics.core.errors import counted
+
     proven = [p.mass for p in diagram.points if p.proven]
     share = 100 * len(proven) / len(diagram.points)
     span = f", {min(proven):.3f} to {max(proven):.3f} kg" if proven else ""
@@ -146,7 +161,7 @@ def _summary(diagram, written) -> str:
         first = next(p for p in diagram.points if not p.proven)
         worst = f" (e.g. z {first.z:.3f} m, l {first.l:.3f} m: {first.reason})"
     return (
-        f"{NAME}: {len(diagram.points)} points ({diagram.z.size} z x {diagram.l.size} l), "
+        f"{NAME}: {counted(len(diagram.points), 'point')} ({diagram.z.size} z x {diagram.l.size} l), "
         f"{len(proven)} proven ({share:.1f} %){span}; {unproven} unproven{worst}; "
         f"at z = l = 0: {np.round(diagram.masses()[0, 0], 3)} kg; wrote {', '.join(written)}"
     )

@@ -1,22 +1,24 @@
 """A tool's output files, written whole or not at all, and all together.
 
-Each file is first written to a temporary file in its target folder and fsync'd; ``commit``
-renames them all into place (signals held off meanwhile) and fsyncs their folders. Until
-then nothing is visible under the target names; ``discard`` (or an exception leaving the
-``with`` block, Ctrl-C included) removes the temporary files and any folder made for them.
-An error names the path as the user typed it, never a temporary file.
+Each file is first written to a temporary file in its target folder (its mode as the umask
+makes it) and fsync'd; ``commit`` renames them all into place, all or none
+(``core.io.atomic.replace_all``: when one cannot be, the files already replaced are put
+back), with signals held off meanwhile, and fsyncs their folders. Until then nothing is
+visible under the target names; ``discard`` (or an exception leaving the ``with`` block,
+Ctrl-C included) removes the temporary files and any folder made for them. An error names
+the path as the user typed it, never a temporary file.
 """
 
 from __future__ import annotations
 
 import os
 import signal
-import tempfile
 from collections.abc import Callable
 from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import BinaryIO
 
+from irb140_dynamics.core.io.atomic import new_temporary, replace_all
 from irb140_dynamics.tools.cli import Interrupts, ToolError
 
 HELD = {signal.SIGINT, signal.SIGTERM}
@@ -66,8 +68,8 @@ class Outputs:
         target = Path(target)
         try:
             with signals_held():  # the name is known before the file can be left behind
-                descriptor, name = tempfile.mkstemp(prefix=".irb140-", suffix=".tmp", dir=target.parent)
-                self._staged.append((Path(name), target, typed))
+                descriptor, name = new_temporary(target.parent)
+                self._staged.append((name, target, typed))
             with os.fdopen(descriptor, "wb") as stream:
                 write(stream)
                 stream.flush()
@@ -87,14 +89,13 @@ class Outputs:
                     self.discard()
                     raise KeyboardInterrupt
                 self.interrupts.finished = True
-            written = []
-            for temporary, target, typed in self._staged:
-                try:
-                    os.replace(temporary, target)
-                except OSError as error:
-                    self.discard()
-                    raise ToolError(f"{typed}: cannot write ({error.strerror or error})") from None
-                written.append(typed)
+            try:
+                replace_all((temporary, target) for temporary, target, _ in self._staged)
+            except OSError as error:
+                typed = next((t for _, target, t in self._staged if str(target) == error.filename), "output")
+                self.discard()
+                raise ToolError(f"{typed}: cannot write ({error.strerror or error}); nothing written") from None
+            written = [typed for _, _, typed in self._staged]
             for folder in {target.parent for _, target, _ in self._staged}:
                 _fsync_directory(folder)
             self._staged, self._created = [], []

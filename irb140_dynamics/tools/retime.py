@@ -27,9 +27,12 @@ if __name__ == "__main__":  # python -m: the entry first, before the heavy impor
 
 import argparse
 import math
+import os
 import sys
+from pathlib import Path
 
 from ..core import RigidBody, RobotModel
+from ..core.errors import counted
 from ..core.io.atomic import write_files
 from ..core.io.model_source import tool_model
 from ..core.io.trajectory_file import joint_trajectory_yaml, read_joint_trajectory
@@ -41,7 +44,8 @@ from ..core.trajectories import (
     torque_limit_notes,
     trajectory_limits,
 )
-from .cli import ToolError, run
+from .cli import ToolError, refuse_input_as_output, run
+from .common import in_option_words, model_inputs
 
 NAME = "retime"
 OVER_LIMIT = 3
@@ -80,7 +84,7 @@ def model_of(params_file: str, urdf: str | None, payload_mass: float | None, cha
     try:
         model = tool_model(params_file, urdf, *chain).model
     except ValueError as error:
-        raise ToolError(str(error).splitlines()[0]) from None
+        raise ToolError(in_option_words(str(error).splitlines()[0], params_file, *chain)) from None
     if payload_mass is not None:
         if not (math.isfinite(payload_mass) and payload_mass >= 0):
             raise ToolError(f"--payload-mass: must be a mass >= 0 kg, got {payload_mass}")
@@ -124,6 +128,10 @@ def main(argv=None) -> int:
 def _retime(args: argparse.Namespace) -> int:
     if not args.check_only and not args.output:
         raise ToolError("OUT.yaml: missing (or give --check-only)")
+    inputs = [*model_inputs(args), (args.input, Path(os.path.abspath(args.input)))]
+    written = (args.plot,) if args.check_only else (args.output, args.plot)
+    outputs = [(path, Path(os.path.abspath(path))) for path in written if path]
+    refuse_input_as_output(inputs, outputs)
     model = model_of(args.params_file, args.urdf, args.payload_mass, (args.base_link, args.tip_link))
     tr = read_trajectory(args.input, model)
     limits = trajectory_limits(model)
@@ -149,7 +157,7 @@ def _retime(args: argparse.Namespace) -> int:
                 *notes,
                 report_text("input", before),
                 report_text("re-timed", after),
-                f"{len(result.trajectory.t)} points, {result.rounds} round(s); wrote {', '.join(files)}",
+                f"{counted(len(result.trajectory.t), 'point')}, {counted(result.rounds, 'round')}; wrote {', '.join(files)}",
             ]
         )
     )

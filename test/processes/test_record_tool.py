@@ -3,6 +3,7 @@ the topic, takes its type from the graph, adapts to a best-effort publisher, sto
 --duration, and writes a bag that `identify` reads; an existing bag is refused in one line."""
 
 import os
+import stat
 import sys
 import time
 
@@ -44,7 +45,11 @@ def test_record_writes_what_was_published_for_the_duration(probe, tmp_path):  # 
     chunks = list(Recording(out, NAMES).chunks())
     effort = np.concatenate([chunk.effort for chunk in chunks])[:, 0]
     time_ = np.concatenate([chunk.time for chunk in chunks])
-    assert f"wrote {out}: {len(effort)} messages of /joint_states" in output
+    assert f"wrote {out}: {len(effort):,} messages of /joint_states" in output
+    mask = os.umask(0o022)  # the umask record inherited (read back at once)
+    os.umask(mask)
+    written = {p.name: stat.S_IMODE(p.stat().st_mode) for p in [out, *out.iterdir()]}
+    assert written == {p: (0o777 if p == out.name else 0o666) & ~mask for p in written}, written  # as the umask says
     assert 10 < len(effort) < 0.5 * RATE * 1.2  # 0.5 s of a 200 Hz stream (slower when the machine is busy)
     assert np.all(np.diff(effort) == 1.0)  # every message, in order, none lost
     np.testing.assert_allclose(np.diff(time_), 0.005, atol=1e-9)  # the header stamps

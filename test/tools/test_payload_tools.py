@@ -287,3 +287,26 @@ def test_the_load_file_of_a_urdf_arm_says_how_the_nodes_take_it(tmp_path):
     comments = " ".join(line for line in out.read_text().splitlines() if line.startswith("#"))
     assert "the nodes take this arm from its URDF (model.source: robot_description" in comments
     assert "Load it into the nodes" not in comments
+
+
+@pytest.mark.parametrize("factor", [1000.0, 2.0])
+def test_efforts_not_in_newton_metres_are_refused_naming_their_scale(workflow, tmp_path, capsys, factor):
+    """Efforts in N mm (x1000: a payload of tonnes before) or doubled (x2: 40 kg for 3.5 kg):
+    a payload cannot scale the torques of the arm's own links, and the fit says by how much."""
+    _, _, _, recording, _ = workflow
+    scaled = _changed("scaled.csv", _scale(slice(13, 19), factor))(recording, tmp_path)
+    out = tmp_path / "load.yaml"
+    capsys.readouterr()
+    assert (
+        identify_tool.main(["--payload-only", "--quiet", "--params-file", str(ARM), str(scaled), "--out", str(out)])
+        == 1
+    )
+    err = capsys.readouterr().err.strip().splitlines()
+    found = re.fullmatch(
+        r"identify: error: .*scaled\.csv: the efforts are (\S+) \+- (\S+) times the torques of the arm's model: "
+        r"check their units \(N m, not N mm\) and sign, and the arm's own parameters \(`identify` it first\)",
+        err[0],
+    )
+    assert len(err) == 1 and found, err
+    assert float(found[1]) == pytest.approx(factor, rel=0.01) and float(found[2]) < 0.01 * factor
+    assert not out.exists()

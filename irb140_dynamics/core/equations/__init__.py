@@ -20,8 +20,14 @@ from .traced import traced_bodies
 
 FORMS = ("latex", "sympy", "c", "python")
 _TRACED_EMITTERS = {"c": c_code.render, "python": python_code.render}  # numbers: the programs' bodies
+FILE_ENDINGS = {"latex": ("_eom.tex",), "sympy": ("_eom_sympy.py",), "c": ("_eom.h", "_eom.c"), "python": ("_eom.py",)}
 
-__all__ = ["DEFAULT_QUANTITIES", "Equations", "FORMS", "QUANTITIES", "derive", "generate"]
+__all__ = ["DEFAULT_QUANTITIES", "Equations", "FORMS", "QUANTITIES", "derive", "file_names", "generate"]
+
+
+def file_names(forms, prefix: str) -> list[str]:
+    """The names of the files ``generate`` writes for ``forms``, known before the work."""
+    return [prefix + ending for form in forms for ending in FILE_ENDINGS[form]]
 
 
 def generate(

@@ -57,11 +57,8 @@ class JointPeak:
 
     def line(self) -> str:
         where = "before point 0" if self.point < 0 else f"segment from point {self.point}"
-        limit = f"{self.limit:.4g}" if np.isfinite(self.limit) else "none"
-        return (
-            f"{self.joint} {self.quantity}: {self.value:+.4g} {UNITS[self.quantity]} of {limit} "
-            f"({100 * self.ratio:.1f} %) at t = {self.time:.4f} s, {where}"
-        )
+        of = f"of {self.limit:.4g} ({100 * self.ratio:.1f} %)" if np.isfinite(self.limit) else "(no limit)"
+        return f"{self.joint} {self.quantity}: {self.value:+.4g} {UNITS[self.quantity]} {of} at t = {self.time:.4f} s, {where}"
 
 
 @dataclass(frozen=True, eq=False)
