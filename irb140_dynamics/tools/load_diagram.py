@@ -15,6 +15,8 @@ Writes DIR/load_diagram.csv (z_m, l_m, max_mass_kg, status, limiting_joint, reas
 a pose found, above which nothing holds, or empty) and DIR/load_diagram.png (mass contours
 over the Z-L plane, the rated mass's curve in bold), both or neither, and prints one line
 (on a terminal, the rows done so far on stderr meanwhile).
+The grid has at most 20,000 points (MAX_POINTS): a step that needs more is refused from
+its size alone, before any work, naming --step.
 Exit status 0; 1 with one line (a bad file, nothing written); 2 for a bad argument; 130
 after Ctrl-C.
 """
@@ -56,6 +58,16 @@ def parser() -> Parser:
     return p
 
 
+def grid_size(maximum: float, step: float) -> float:
+    """How many values ``grid(maximum, step)`` has, counted without making them (a float:
+    inf where the step is too small to count in; the size is checked before any work)."""
+    count = maximum / step
+    if not count < 1e15:  # (inf: a step too small to divide by)
+        return math.inf
+    values = math.floor(count + 1e-9) + 1
+    return values + (maximum - (values - 1) * step > 1e-9 * step)
+
+
 def grid(maximum: float, step: float):
     """0, step, ..., maximum (its last value included: a maximum within 1e-9 steps of the grid)."""
     import numpy as np
@@ -73,14 +85,15 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _diagram(argv: list[str], interrupts) -> int:
-    args = parser().parse_args(argv)
+    arguments = parser()
+    args = arguments.parse_args(argv)
+    sizes = grid_size(args.z_max, args.step), grid_size(args.l_max, args.step)
+    if sizes[0] * sizes[1] > MAX_POINTS:  # a bad argument, refused before any work: a tiny step costs nothing
+        shown = " x ".join(f"{s:.0f}" if math.isfinite(s) else "too many" for s in sizes)
+        arguments.error(f"--step {args.step:g}: {shown} points, more than {MAX_POINTS:,}: give a larger step")
     check_model_paths(args)
     out = output_directory(args.out)
     z, l = grid(args.z_max, args.step), grid(args.l_max, args.step)
-    if z.size * l.size > MAX_POINTS:
-        raise ToolError(
-            f"--step {args.step:g}: {z.size} x {l.size} points, more than {MAX_POINTS:,}: give a larger step"
-        )
 
     from irb140_dynamics.core.model.rigid_body import RigidBody
     from irb140_dynamics.core.payload import derive_torque_limits

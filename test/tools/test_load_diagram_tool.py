@@ -5,6 +5,7 @@ import csv
 import math
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -64,6 +65,9 @@ def test_the_grid_holds_both_ends():
         (["--l-max", "nan"], "argument --l-max: must be a finite number"),
         (["--step", "0"], "argument --step: must be > 0, got 0"),
         (["--step", "1e-5"], "--step 1e-05: 30001 x 20001 points, more than 20,000: give a larger step"),
+        (["--step", "1e-10"], "--step 1e-10: 3000000001 x 2000000001 points, more than 20,000"),
+        (["--step", "5e-324"], "--step 4.94066e-324: too many x too many points, more than 20,000"),
+        (["--urdf", "huge_effort.urdf"], 'huge_effort.urdf: URDF joint "shoulder_pan_joint" <limit>: effort must be'),
         (["--params-file", "missing.yaml"], "missing.yaml: no such file or directory"),
         (["--urdf", "bad.urdf"], "bad.urdf"),
         (["--params-file", "bad.yaml"], "bad.yaml"),
@@ -74,10 +78,25 @@ def test_bad_input_is_one_line_a_nonzero_status_and_nothing_written(tmp_path, ca
     monkeypatch.chdir(tmp_path)
     (tmp_path / "bad.urdf").write_text("<robot name='x'><link name='a'/>")
     (tmp_path / "bad.yaml").write_text("/**:\n  ros__parameters:\n    joint_2.link.mass: -3.0\n")
-    code = main(["--out", "out", *arguments])
+    ur5 = (URDF_DATA / "ur5.urdf").read_text()
+    (tmp_path / "huge_effort.urdf").write_text(ur5.replace('effort="150.0"', 'effort="1e300"', 1))
+    arguments = [*arguments, "--tip", "tool0"] if "huge_effort.urdf" in arguments else arguments
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow on the way to the refusal
+        code = main(["--out", "out", *arguments])
     err = capsys.readouterr().err
     assert code != 0 and err.count("\n") == 1 and says in err and "Traceback" not in err, err
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.urdf", "bad.yaml"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.urdf", "bad.yaml", "huge_effort.urdf"]
+
+
+def test_a_step_too_small_is_refused_before_any_work(monkeypatch, capsys):
+    """A grid beyond 20,000 points is refused from its size alone: the grid is never made."""
+    from irb140_dynamics.tools import load_diagram as tool
+
+    monkeypatch.setattr(tool, "grid", lambda *_: pytest.fail("the grid was made"))
+    assert main(["--out", "never", "--step", "1e-9"]) == 2
+    assert "--step 1e-09: 300000001 x 200000001 points" in capsys.readouterr().err
+    assert tool.grid_size(0.3, 0.01) == 31 and tool.grid_size(0.25, 0.1) == 4 and tool.grid_size(0.0, 0.1) == 1
 
 
 def test_an_output_that_cannot_be_a_folder_is_refused_before_any_work(tmp_path, capsys):
