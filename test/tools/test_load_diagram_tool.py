@@ -52,6 +52,51 @@ def test_a_urdf_arm_with_its_own_effort_limits(tmp_path, capsys):
     assert len(rows) == 2 and all(r["status"] == "proven" for r in rows)
 
 
+@pytest.mark.parametrize(
+    "mass, code, starts",
+    [
+        ("2", 0, "load_diagram: inside: 2 kg at Z 0.1 m, L 0.05 m holds in every pose and direction (proven); margin "),
+        ("3", 1, "load_diagram: outside: 3 kg at Z 0.1 m, L 0.05 m exceeds joint_4's limit in a pose found; margin -"),
+    ],
+)
+def test_check_says_inside_or_outside_in_one_line(tmp_path, capsys, monkeypatch, mass, code, starts):
+    """The IRB-140 at Z 0.1 m, L 0.05 m holds 2.289 kg proven, 2.300 kg at a pose found."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["--check", mass, "0.1", "0.05"]) == code
+    printed = capsys.readouterr()
+    assert printed.out.count("\n") == 1 and printed.out.startswith(starts), printed
+    assert printed.out.rstrip().endswith("limiting joint joint_4") and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "arguments, says",
+    [
+        (["--check", "2", "0.1"], "argument --check: expected 3 arguments"),
+        (["--check", "-1", "0.1", "0"], "--check -1 0.1 0: MASS must be within 0..1e+06 kg"),
+        (["--check", "1", "0.1", "-0.1"], "L (a distance off the axis) within 0..10 m"),
+        ([], "the following arguments are required: --out (or --check MASS Z L)"),
+    ],
+)
+def test_a_bad_check_is_a_bad_argument(capsys, arguments, says):
+    assert main(arguments) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and says in err, err
+
+
+def test_the_rated_payload_is_the_arms_own():
+    """--rated-mass over rated_payload.mass over nothing stated (the limits then derived
+    from the nodes' default, 6 kg at the flange, and no curve marked)."""
+    from irb140_dynamics.core.payload import RATED_PAYLOAD
+    from irb140_dynamics.tools.load_diagram import rated_payload
+
+    assert rated_payload({}, None) == (RATED_PAYLOAD, False)
+    body, stated = rated_payload({"rated_payload.mass": 3.0, "rated_payload.com": [0.0, 0.0, 0.05]}, None)
+    assert stated and body.mass == 3.0 and body.com == (0.0, 0.0, 0.05)
+    assert rated_payload({"rated_payload.mass": 3.0}, 2.5)[0].mass == 2.5
+    with pytest.raises(ValueError, match="rated_payload.mass"):
+        rated_payload({"rated_payload.mass": -1.0}, None)
+
+
 def test_the_grid_holds_both_ends():
     np.testing.assert_allclose(grid(0.3, 0.01), np.arange(31) * 0.01)
     np.testing.assert_allclose(grid(0.25, 0.1), [0.0, 0.1, 0.2, 0.25])
