@@ -4,7 +4,8 @@ nothing of the package, serves every floor).
 
 ``fit_text`` wraps each text wider than the figure at spaces (a title naming a long path,
 a label) and then lays the figure out tight; ``round_steps`` gives round, evenly spaced
-values (contour levels, colour keys); ``upright`` turns labels that read upside down.
+values (contour levels, colour keys); ``label_curves`` labels contours upright where the
+labels fit.
 ``figure_problems`` names what keeps a figure from reading well, which tests check is
 nothing: narrower than MIN_WIDTH pixels as saved, no title, a text outside the figure
 (``texts_outside``) or over another text, a text upside down, tick values that are not
@@ -97,15 +98,6 @@ def round_steps(low: float, high: float, most: int = 10):
     from matplotlib.ticker import MaxNLocator
 
     return MaxNLocator(most, steps=[1, 2, 2.5, 5, 10]).tick_values(low, high)
-
-
-def upright(texts) -> None:
-    """Turn each text that would read upside down (rotated beyond a quarter turn) by half
-    a turn: contour labels follow their curve, either way."""
-    for text in texts:
-        angle = text.get_rotation() % 360
-        if 90 < angle < 270:
-            text.set_rotation(angle - 180)
 
 
 def figure_problems(figure, dpi=None) -> list[str]:

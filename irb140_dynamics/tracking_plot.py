@@ -45,7 +45,7 @@ def write_tracking_plot(path, t, reference, actual, joint_names, label: str) -> 
                 axis.tick_params(labelbottom=False)
     since = f"the last {WINDOW:g} s" if t[-1] - t[0] > WINDOW else "the whole run"
     axes[0, 0].set_title(f"positions over {since}", fontsize=10)
-    axes[0, 0].legend(loc="upper left", fontsize=9, ncol=2, framealpha=0.9)
+    axes[0, 0].legend(loc="best", fontsize=9, ncol=2, framealpha=0.9)
     axes[-1, 0].set_xlabel("t [s]")
     axes[-1, 1].set_xlabel("t [s]")
     figure.suptitle(
