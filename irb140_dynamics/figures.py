@@ -1,16 +1,27 @@
-"""Figures whose every title and label shows whole: what each plot of the package calls
-instead of ``tight_layout`` (matplotlib; imports nothing of the package, serves every floor).
+"""Figures that read at a glance: what each plot of the package calls instead of
+``tight_layout``, and the check its tests apply to every figure (matplotlib; imports
+nothing of the package, serves every floor).
 
 ``fit_text`` wraps each text wider than the figure at spaces (a title naming a long path,
-a label) and then lays the figure out tight; ``texts_outside`` names the texts whose tight
-bounding box leaves the figure's, which tests check is none.
+a label) and then lays the figure out tight; ``round_steps`` gives round, evenly spaced
+values (contour levels, colour keys); ``label_curves`` labels contours upright where the
+labels fit.
+``figure_problems`` names what keeps a figure from reading well, which tests check is
+nothing: narrower than MIN_WIDTH pixels as saved, no title, a text outside the figure
+(``texts_outside``) or over another text, a text upside down, tick values that are not
+round (evenly spaced by 1, 2, 2.5 or 5 times a power of ten, on a log axis each such a
+multiple).
 """
 
 from __future__ import annotations
 
+import math
 import textwrap
 
 MARGIN = 0.96  # of the figure's width a text may take
+MIN_WIDTH = 1000  # px: the narrowest figure saved
+ROUND = (1.0, 2.0, 2.5, 5.0)  # round steps, times a power of ten
+OVERLAP = 1.0  # px: two texts' boxes may share this much each way (antialiasing)
 
 
 def _texts(figure):
@@ -79,3 +90,129 @@ def texts_outside(figure) -> list[str]:
         ):
             outside.append(text.get_text())
     return outside
+
+
+def round_steps(low: float, high: float, most: int = 10):
+    """Round values covering [low, high]: evenly spaced by 1, 2, 2.5 or 5 times a power of
+    ten, at most ``most`` + 1 of them (matplotlib's MaxNLocator)."""
+    from matplotlib.ticker import MaxNLocator
+
+    return MaxNLocator(most, steps=[1, 2, 2.5, 5, 10]).tick_values(low, high)
+
+
+def figure_problems(figure, dpi=None) -> list[str]:
+    """What keeps ``figure`` from reading well, saved at ``dpi`` (default: the figure's);
+    see the module. An empty list: nothing."""
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    problems = []
+    width = figure.get_figwidth() * (dpi if isinstance(dpi, (int, float)) else figure.dpi)
+    if width < MIN_WIDTH - 0.5:
+        problems.append(f"{width:.0f} px wide, under {MIN_WIDTH}")
+    texts = _texts(figure)
+    titles = [figure.get_suptitle()] + [a.get_title(loc) for a in figure.axes for loc in ("left", "center", "right")]
+    if not any(t.strip() for t in titles):
+        problems.append("no title")
+    problems += [f"outside the figure: {t!r}" for t in texts_outside(figure)]
+    from matplotlib.text import Text
+
+    boxes = [(t, Text.get_window_extent(t, renderer)) for t in texts]  # (an annotation's text, not its arrow)
+    for text, box in boxes:
+        clip = text.get_clip_box() if text.get_clip_on() else None
+        if clip is not None and not _inside(box, clip):
+            problems.append(f"cut by its axes: {text.get_text()!r}")
+    for i, (a, box_a) in enumerate(boxes):
+        for b, box_b in boxes[i + 1 :]:
+            wide = min(box_a.x1, box_b.x1) - max(box_a.x0, box_b.x0)
+            high = min(box_a.y1, box_b.y1) - max(box_a.y0, box_b.y0)
+            if wide > OVERLAP and high > OVERLAP:
+                problems.append(f"over each other: {a.get_text()!r} and {b.get_text()!r}")
+    problems += [f"upside down: {t.get_text()!r}" for t in texts if 90 < t.get_rotation() % 360 < 270]
+    for axes in figure.axes:
+        for axis in (axes.xaxis, axes.yaxis):
+            values = _labelled_ticks(axis)
+            if not _round(values, axis.get_scale()):
+                name = axes.get_title() or axes.get_label() or "axes"
+                problems.append(f"ticks not round on {name} ({axis.axis_name}): {[float(f'{v:.6g}') for v in values]}")
+    return problems
+
+
+def _inside(box, frame, slack: float = 0.5) -> bool:
+    return (
+        box.x0 >= frame.x0 - slack
+        and box.y0 >= frame.y0 - slack
+        and box.x1 <= frame.x1 + slack
+        and box.y1 <= frame.y1 + slack
+    )
+
+
+def label_curves(axes, curves, texts, **style) -> list:
+    """Label each curve of ``curves`` (a ContourSet: one path per level) with its text of
+    ``texts`` (None: no label), level, upright, on a light box where the curve lies
+    farthest from the axes' edges and from the labels already placed; a curve with no
+    such place gets none. Call after the layout (labels are placed in pixels). The labels."""
+    import numpy as np
+
+    figure = axes.figure
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    frame = axes.get_window_extent(renderer)
+    style = {"fontsize": 9, "ha": "center", "va": "center", "zorder": 6, **style}
+    style.setdefault("bbox", dict(boxstyle="round,pad=0.15", facecolor="white", edgecolor="none", alpha=0.85))
+    placed, boxes = [], [t.get_window_extent(renderer) for t in _texts(figure)]
+    for path, text in zip(curves.get_paths(), texts):
+        if text is None or len(path.vertices) == 0:
+            continue
+        points = axes.transData.transform(path.vertices)
+        edge = np.min(
+            np.abs(
+                np.stack(
+                    [points[:, 0] - frame.x0, frame.x1 - points[:, 0], points[:, 1] - frame.y0, frame.y1 - points[:, 1]]
+                )
+            ),
+            axis=0,
+        )
+        for k in np.argsort(-edge)[:: max(1, len(points) // 60)]:
+            label = axes.text(*path.vertices[k], text, **style)
+            box = label.get_window_extent(renderer).padded(2)
+            if _inside(box, frame) and not any(box.overlaps(other) for other in boxes):
+                placed.append(label)
+                boxes.append(box)
+                break
+            label.remove()
+    return placed
+
+
+def _labelled_ticks(axis) -> list[float]:
+    """The values of the major ticks in view that show a label."""
+    low, high = sorted(axis.get_view_interval())
+    slack = 1e-9 * max(abs(low), abs(high), 1.0)
+    return [
+        float(location)
+        for tick, location in zip(axis.get_major_ticks(), axis.get_majorticklocs())
+        if low - slack <= location <= high + slack
+        and any(label.get_visible() and label.get_text().strip() for label in (tick.label1, tick.label2))
+    ]
+
+
+def _round(values, scale: str) -> bool:
+    """Are the values round: each a round multiple (log), or evenly spaced by a round step
+    and multiples of it (linear; a single value: round itself)?"""
+    if not values:
+        return True
+    if scale == "log" or len(values) == 1:
+        return all(v == 0 or _round_number(abs(v)) for v in values)
+    steps = [b - a for a, b in zip(values, values[1:])]
+    step = steps[0]
+    if step <= 0 or any(abs(s - step) > 1e-6 * step for s in steps) or not _round_number(step):
+        return False
+    return all(abs(v / step - round(v / step)) < 1e-6 for v in values)
+
+
+def _round_number(x: float) -> bool:
+    """Is x > 0 one of ROUND times a power of ten?"""
+    if not (x > 0 and math.isfinite(x)):
+        return False
+    power = 10.0 ** math.floor(math.log10(x))
+    mantissa = x / power
+    return any(abs(mantissa - k) < 1e-6 * k or abs(mantissa - 10 * k) < 1e-5 * k for k in ROUND)

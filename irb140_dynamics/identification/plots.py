@@ -12,6 +12,7 @@ from irb140_dynamics.core.regressor import inertial_parameters, regressor_batch
 from irb140_dynamics.figures import fit_text
 from irb140_dynamics.identification.pipeline import Result
 
+DPI = 100
 Save = Callable[[str, Callable[[BinaryIO], None]], None]  # (file name, writer of its bytes)
 
 
@@ -45,38 +46,30 @@ def write_plots(result: Result, directory: str | Path | Save) -> list[str]:
     n = len(names)
     written = []
     for kind in ("torques", "residuals"):
-        figure, axes = plt.subplots(n, 1, figsize=(11, 2.0 * n + 1), sharex=True, squeeze=False)
+        figure, axes = plt.subplots(n, 1, figsize=(12, 1.9 * n + 1.8), sharex=True, squeeze=False, dpi=DPI)
         for j, axis in enumerate(axes[:, 0]):
             if kind == "torques":
-                axis.plot(time, measured[:, j], "k.", markersize=1.5, label="measured")
-                axis.plot(time, predicted["prior"][:, j], color="tab:orange", linewidth=0.8, label="prior model")
-                axis.plot(time, predicted["identified"][:, j], color="tab:blue", linewidth=0.8, label="identified")
+                axis.plot(time, measured[:, j], "k.", markersize=2, label="measured")
+                axis.plot(time, predicted["prior"][:, j], color="tab:orange", linewidth=1, label="prior model")
+                axis.plot(time, predicted["identified"][:, j], color="tab:blue", linewidth=1, label="identified")
             else:
-                axis.plot(
-                    time,
-                    measured[:, j] - predicted["prior"][:, j],
-                    ".",
-                    color="tab:orange",
-                    markersize=1.5,
-                    label="measured - prior",
-                )
-                axis.plot(
-                    time,
-                    measured[:, j] - predicted["identified"][:, j],
-                    ".",
-                    color="tab:blue",
-                    markersize=1.5,
-                    label="measured - identified",
-                )
+                for model, colour in (("prior", "tab:orange"), ("identified", "tab:blue")):
+                    residual = measured[:, j] - predicted[model][:, j]
+                    axis.plot(time, residual, ".", color=colour, markersize=2, label=f"measured - {model}")
                 axis.axhline(0.0, color="k", linewidth=0.5)
             axis.set_ylabel(f"{names[j]}\n[N m]")
             axis.grid(True, linewidth=0.3)
-        axes[0, 0].legend(loc="upper right", fontsize="small", ncol=3)
-        axes[0, 0].set_title(f"{kind.capitalize()} on held-out data: {result.held_out_source}")
+            axis.margins(y=0.08)  # every point inside, none on the frame
         axes[-1, 0].set_xlabel("time [s] (held-out fit points)")
-        fit_text(figure)  # the title names the held-out recording's path: wrapped, never cut
+        figure.suptitle(f"{kind.capitalize()} on held-out data: {result.held_out_source}", fontsize=12)
+        handles, labels = axes[0, 0].get_legend_handles_labels()
+        fit_text(figure, rect=(0, 0, 1, 0.95))  # the title names the held-out recording's path: wrapped, never cut
+        top = max(axis.get_position().y1 for axis in axes[:, 0])
+        figure.legend(  # above the panels, over no data
+            handles, labels, loc="lower center", bbox_to_anchor=(0.5, top), ncol=3, markerscale=4, frameon=False
+        )
         try:
-            save(f"{kind}.png", lambda stream, figure=figure: figure.savefig(stream, format="png", dpi=110))
+            save(f"{kind}.png", lambda stream, figure=figure: figure.savefig(stream, format="png", dpi=DPI))
         finally:
             plt.close(figure)
         written.append(f"{kind}.png")

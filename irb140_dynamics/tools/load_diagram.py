@@ -15,6 +15,8 @@ Writes DIR/load_diagram.csv (z_m, l_m, max_mass_kg, status, limiting_joint, reas
 a pose found, above which nothing holds, or empty) and DIR/load_diagram.png (mass contours
 over the Z-L plane, the rated mass's curve in bold), both or neither, and prints one line
 (on a terminal, the rows done so far on stderr meanwhile).
+The grid has at most 20,000 points (MAX_POINTS): a step that needs more is refused from
+its size alone, before any work, naming --step.
 Exit status 0; 1 with one line (a bad file, nothing written); 2 for a bad argument; 130
 after Ctrl-C.
 """
@@ -42,6 +44,7 @@ from irb140_dynamics.tools.cli import (
 )
 
 NAME = "load_diagram"
+MAX_MASS = 1e6  # kg: the model's own cap of a mass
 MAX_POINTS = 20_000  # grid points: a diagram beyond this is a typo of --step
 FILES = ("load_diagram.csv", "load_diagram.png")
 
@@ -50,7 +53,7 @@ def parser() -> Parser:
     from irb140_dynamics.tools.common import add_model_arguments
 
     p = Parser(prog=NAME, description=__doc__.split("\n\n")[0].split(": ", 1)[1])
-    p.add_argument("--out", required=True, metavar="DIR", help="the folder to write the CSV and PNG into")
+    p.add_argument("--out", metavar="DIR", help="the folder to write the CSV and PNG into")
     add_model_arguments(p)
     p.add_argument("--z-max", type=number(0.0, 10.0), default=0.3, metavar="M", help="Z's last value [m] (0.3)")
     p.add_argument("--l-max", type=number(0.0, 10.0), default=0.2, metavar="M", help="L's last value [m] (0.2)")
@@ -58,11 +61,29 @@ def parser() -> Parser:
     p.add_argument(
         "--rated-mass",
         type=number(0.0, 1e6, above=True),
-        default=6.0,
         metavar="KG",
-        help="the rated payload: limits not given are derived from it; its curve is marked (6.0)",
+        help="the arm's rated payload, over its rated_payload.mass: limits not given are derived from it, "
+        "its curve is marked (without either: limits derived from 6 kg, nothing marked)",
+    )
+    p.add_argument(
+        "--check",
+        nargs=3,
+        type=number(),
+        metavar=("MASS", "Z", "L"),
+        help="only say whether a tool of MASS kg with its CoM at Z, L [m] is inside the proven diagram "
+        "(exit 0) or not (1), with the margin and the limiting joint; --out is then not needed",
     )
     return p
+
+
+def grid_size(maximum: float, step: float) -> float:
+    """How many values ``grid(maximum, step)`` has, counted without making them (a float:
+    inf where the step is too small to count in; the size is checked before any work)."""
+    count = maximum / step
+    if not count < 1e15:  # (inf: a step too small to divide by)
+        return math.inf
+    values = math.floor(count + 1e-9) + 1
+    return values + (maximum - (values - 1) * step > 1e-9 * step)
 
 
 def grid(maximum: float, step: float):
@@ -82,20 +103,31 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _diagram(argv: list[str], interrupts) -> int:
-    args = parser().parse_args(argv)
-    from irb140_dynamics.tools.common import model_inputs
-
+    arguments = parser()
+    args = arguments.parse_args(argv)
+    sizes = grid_size(args.z_max, args.step), grid_size(args.l_max, args.step)
+    if sizes[0] * sizes[1] > MAX_POINTS:  # a bad argument, refused before any work: a tiny step costs nothing
+        shown = " x ".join(f"{s:.0f}" if math.isfinite(s) else "too many" for s in sizes)
+        arguments.error(f"--step {args.step:g}: {shown} points, more than {MAX_POINTS:,}: give a larger step")
+    if args.check is None and args.out is None:
+        arguments.error("the following arguments are required: --out (or --check MASS Z L)")
+    if args.check is not None:
+        mass, z, l = args.check
+        if not (0.0 <= mass <= MAX_MASS and abs(z) <= 10.0 and 0.0 <= l <= 10.0):
+            arguments.error(
+                f"--check {mass:g} {z:g} {l:g}: MASS must be within 0..{MAX_MASS:g} kg, Z within -10..10 m "
+                "and L (a distance off the axis) within 0..10 m"
+            )
     check_model_paths(args)
-    out = output_directory(args.out)
-    files = files_in(out, args.out, FILES)
-    refuse_input_as_output(model_inputs(args), files)
-    z, l = grid(args.z_max, args.step), grid(args.l_max, args.step)
-    if z.size * l.size > MAX_POINTS:
-        raise ToolError(
-            f"--step {args.step:g}: {z.size} x {l.size} points, more than {MAX_POINTS:,}: give a larger step"
-        )
+    out = output_directory(args.out) if args.check is None else None
+    files = None
+    if out is not None:
+        from irb140_dynamics.tools.common import model_inputs
 
-    from irb140_dynamics.core.model.rigid_body import RigidBody
+        files = files_in(out, args.out, FILES)
+        refuse_input_as_output(model_inputs(args), files)
+    z, l = grid(args.z_max, args.step), grid(args.l_max, args.step)
+
     from irb140_dynamics.core.payload import derive_torque_limits
     from irb140_dynamics.core.payload.diagram import load_diagram
     from irb140_dynamics.tools.common import model_of
@@ -104,12 +136,16 @@ def _diagram(argv: list[str], interrupts) -> int:
 
     try:
         source = model_of(args)
+        rated, stated = rated_payload(source.parameters or {}, args.rated_mass)
     except ValueError as error:
         raise ToolError(str(error).splitlines()[0]) from None
-    model, rated = source.model, RigidBody(args.rated_mass)
+    model = source.model
     limits = derive_torque_limits(model, rated)
+    if args.check is not None:
+        return _check(model, limits.values, *args.check)
     diagram = load_diagram(model, limits.values, z, l, _progress(z.size * l.size), _workers(z.size))
-    csv, png = diagram_csv(diagram).encode(), diagram_png(diagram, rated.mass, os.path.basename(source.origin))
+    rated_mass = rated.mass if stated else None
+    csv, png = diagram_csv(diagram).encode(), diagram_png(diagram, os.path.basename(source.origin), rated_mass)
     with Outputs(interrupts) as outputs:
         outputs.directory(out, args.out)
         for (typed, path), data in zip(files, (csv, png)):
@@ -117,6 +153,30 @@ def _diagram(argv: list[str], interrupts) -> int:
         written = outputs.commit()
     print(_summary(diagram, written))
     return 0
+
+
+def rated_payload(parameters, rated_mass: float | None):
+    """(the rated payload, whether the arm states it): ``--rated-mass`` kg, else the
+    parameters' rated_payload.mass (and .com), else the default the nodes derive limits from
+    (6 kg at the flange origin), not stated. ValueError in one line for a bad parameter."""
+    from irb140_dynamics.core.model.rigid_body import RigidBody
+    from irb140_dynamics.core.payload import RATED_PAYLOAD
+
+    com = parameters.get("rated_payload.com", RATED_PAYLOAD.com)
+    if rated_mass is not None:
+        return RigidBody.validated("rated_payload", rated_mass, com), True
+    if "rated_payload.mass" in parameters:
+        return RigidBody.validated("rated_payload", parameters["rated_payload.mass"], com), True
+    return RATED_PAYLOAD, False
+
+
+def _check(model, limits, mass: float, z: float, l: float) -> int:
+    """One line: is ``mass`` kg at (z, l) inside the proven diagram; exit 0 inside, 1 not."""
+    from irb140_dynamics.core.payload.diagram import check_point
+
+    check = check_point(model, limits, mass, z, l)
+    print(f"{NAME}: {check.sentence()}")
+    return 0 if check.inside else 1
 
 
 def _progress(points: int):

@@ -33,61 +33,104 @@ def diagram_csv(diagram) -> str:
     return "\n".join(lines) + "\n"
 
 
-def diagram_png(diagram, rated_mass: float, arm: str) -> bytes:
-    """PNG bytes: filled mass contours over L (across) and Z (up), labelled lines, the rated
-    mass's curve in bold (or, where no point holds it, the note of where it does), unproven
-    points crossed; ``arm`` names the arm in the title."""
+def diagram_png(diagram, arm: str, rated_mass: float | None = None) -> bytes:
+    """PNG bytes (1300 x 650 px), two panels: the mass contours over L (across) and Z (up),
+    labelled, a colour key of round, even steps, unproven points crossed; and the spec-sheet
+    form, the largest mass against Z for a few L (one line each, a legend). ``rated_mass``
+    [kg], where the arm states one: its curve in bold red (or a note where no point holds
+    it) and a dashed line at it. ``arm`` names the arm in the title."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from irb140_dynamics.figures import fit_text, label_curves
+
     masses = np.where(np.isfinite(diagram.masses()), diagram.masses(), np.nan)
-    fig, ax = plt.subplots(figsize=(6.4, 6.4), layout="constrained")
-    L, Z = np.meshgrid(diagram.l, diagram.z)
     finite = masses[np.isfinite(masses)]
-    if diagram.z.size > 1 and diagram.l.size > 1 and finite.size and finite.max() > finite.min():
-        levels = _levels(finite.min(), finite.max())
-        filled = ax.contourf(L, Z, masses, levels=levels, cmap="viridis_r", extend="both")
-        lines = ax.contour(L, Z, masses, levels=levels, colors="k", linewidths=0.6)
-        ax.clabel(lines, fmt="%g kg", fontsize=7)
-        fig.colorbar(filled, ax=ax, label="largest payload [kg]", shrink=0.8)
-        if finite.min() <= rated_mass <= finite.max():
-            rated = ax.contour(L, Z, masses, levels=[rated_mass], colors="tab:red", linewidths=2.5)
-            ax.clabel(rated, fmt=f"rated {rated_mass:g} kg", fontsize=8)
-    if not (finite.size and finite.min() <= rated_mass <= finite.max()):
-        if finite.size and rated_mass > finite.max():
-            where = f"more than any point holds (at most {finite.max():.3f} kg)"
-        else:
-            where = "less than every point holds"
-        ax.plot([0], [0], "o", color="tab:red", label=f"rated {rated_mass:g} kg: {where}")
-    else:
-        points = ax.scatter(L, Z, c=masses, cmap="viridis_r")
-        fig.colorbar(points, ax=ax, label="largest payload [kg]", shrink=0.8)
     unproven = np.array([not p.proven for p in diagram.points]).reshape(masses.shape)
+    fig, (plane, sheet) = plt.subplots(1, 2, figsize=(13, 6.5), dpi=DPI)
+    fig.suptitle(_title(diagram, arm, rated_mass, finite), fontsize=12)
+    L, Z = np.meshgrid(diagram.l, diagram.z)
+    contoured = diagram.z.size > 1 and diagram.l.size > 1 and finite.size and finite.max() > finite.min()
+    if contoured:
+        levels = _levels(finite.min(), finite.max())
+        filled = plane.contourf(L, Z, masses, levels=levels, cmap="viridis_r")
+        lines = plane.contour(L, Z, masses, levels=levels, colors="k", linewidths=0.6)
+        fig.colorbar(filled, ax=plane, label="largest payload [kg]", ticks=levels)
+    elif finite.size:
+        points = plane.scatter(L, Z, c=masses, cmap="viridis_r", s=60)
+        fig.colorbar(points, ax=plane, label="largest payload [kg]")
+    rated = None
+    if contoured and rated_mass is not None and finite.min() <= rated_mass <= finite.max():
+        rated = plane.contour(L, Z, masses, levels=[rated_mass], colors="tab:red", linewidths=2.5)
+        plane.plot([], [], color="tab:red", linewidth=2.5, label=f"rated payload {rated_mass:g} kg")
     if unproven.any():
-        ax.plot(L[unproven], Z[unproven], "x", color="tab:red", label="unproven")
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), fontsize="small")
-    ax.set_xlabel("L: CoM off the flange axis, any direction [m]")
-    ax.set_ylabel("Z: CoM along the flange axis [m]")
-    ax.set_aspect("equal", adjustable="box")
-    ax.set_title(
-        f"Load diagram: {arm} ({len(diagram.joint_names)} joints), at rest in every pose\n"
-        f"largest payload [kg], {100 * diagram.proven_share:.0f} % proven",
-        fontsize=10,
-    )
+        plane.plot(L[unproven], Z[unproven], "x", color="tab:red", label="unproven (the mass a pose found)")
+    plane.set_xlabel("L: CoM off the flange axis, any direction [m]")
+    plane.set_ylabel("Z: CoM along the flange axis [m]")
+    plane.set_title("largest payload [kg] over the CoM's position")
+    if plane.get_legend_handles_labels()[0]:
+        plane.legend(loc="upper right", fontsize=9, framealpha=0.9)
+    _sheet(sheet, diagram, masses, unproven, rated_mass)
+    fit_text(fig)
+    if contoured:  # after the layout: the labels are placed where they fit
+        label_curves(plane, lines, [f"{level:g} kg" for level in levels])
+        if rated is not None:
+            label_curves(plane, rated, [f"rated {rated_mass:g} kg"], color="tab:red", fontweight="bold")
     out = io.BytesIO()
-    fig.savefig(out, format="png", dpi=80)
+    fig.savefig(out, format="png", dpi=DPI)
     plt.close(fig)
     return out.getvalue()
 
 
+DPI = 100
+SHEET_LINES = 5  # the spec-sheet form: at most this many values of L
+
+
+def _title(diagram, arm: str, rated_mass, finite) -> str:
+    joints = len(diagram.joint_names)
+    first = f"Load diagram of {arm} ({joints} joints): the largest payload held at rest in every pose"
+    second = f"{100 * diagram.proven_share:.0f} % of {len(diagram.points)} points proven"
+    if rated_mass is None:
+        second += "; no rated payload stated"
+    elif finite.size and rated_mass > finite.max():
+        second += f"; rated payload {rated_mass:g} kg: more than any point holds (at most {finite.max():.3g} kg)"
+    elif finite.size and rated_mass < finite.min():
+        second += f"; rated payload {rated_mass:g} kg: less than every point holds"
+    else:
+        second += f"; rated payload {rated_mass:g} kg"
+    return first + "\n" + second
+
+
+def _sheet(axes, diagram, masses, unproven, rated_mass) -> None:
+    """The spec-sheet form: mass against Z, a line per L (a few, evenly chosen)."""
+    columns = np.unique(np.linspace(0, diagram.l.size - 1, min(SHEET_LINES, diagram.l.size)).round().astype(int))
+    colours = matplotlib_colours(len(columns))
+    for colour, k in zip(colours, columns):
+        axes.plot(diagram.z, masses[:, k], "o-", color=colour, markersize=4, label=f"L = {diagram.l[k]:g} m")
+        crossed = unproven[:, k]
+        if crossed.any():
+            axes.plot(diagram.z[crossed], masses[crossed, k], "x", color="tab:red", markersize=8)
+    if rated_mass is not None:
+        axes.axhline(rated_mass, color="tab:red", linestyle="--", linewidth=1.5, label=f"rated {rated_mass:g} kg")
+    axes.set_xlabel("Z: CoM along the flange axis [m]")
+    axes.set_ylabel("largest payload [kg]")
+    axes.set_title("spec-sheet form: largest payload against Z, per L")
+    axes.grid(True, linewidth=0.3)
+    axes.legend(loc="best", fontsize=9, framealpha=0.9)
+
+
+def matplotlib_colours(count: int):
+    """``count`` colours of the diagram's colour map, dark (near the flange) to light."""
+    import matplotlib
+
+    return [matplotlib.colormaps["plasma"](x) for x in np.linspace(0.0, 0.8, max(count, 1))]
+
+
 def _levels(low: float, high: float) -> np.ndarray:
-    """Round masses spread evenly on a log scale over [low, high], at most a dozen (as a
-    vendor labels the curves: dense where the masses are small)."""
-    ladder = np.array([k * 10.0**e for e in range(-3, 7) for k in (1, 1.25, 1.5, 2, 2.5, 3, 4, 5, 6, 8)])
-    inside = ladder[(ladder >= low) & (ladder <= high)]
-    if inside.size < 3:
-        return np.linspace(low, high, 6)
-    return inside[np.unique(np.linspace(0, inside.size - 1, min(12, inside.size)).round().astype(int))]
+    """Round masses, evenly spaced (1, 2, 2.5 or 5 times a power of ten), covering [low,
+    high]: at most a dozen."""
+    from irb140_dynamics.figures import round_steps
+
+    return round_steps(low, high, 10)

@@ -138,7 +138,7 @@ def _retime(args: argparse.Namespace) -> int:
     notes = list(torque_limit_notes(model, limits))
     before = check_trajectory(model, tr, limits)
     if args.check_only:
-        files = {args.plot: _plot(model, limits, tr, None)} if args.plot else {}
+        files = {args.plot: _plot(model, limits, tr, None, args)} if args.plot else {}
         write_all(files)
         print("\n".join([*notes, report_text("input", before)]))
         return 0 if before.ok else OVER_LIMIT
@@ -149,7 +149,7 @@ def _retime(args: argparse.Namespace) -> int:
     after = check_trajectory(model, result.trajectory, limits)
     files = {args.output: joint_trajectory_yaml(result.trajectory.to_message()).encode()}
     if args.plot:
-        files[args.plot] = _plot(model, limits, tr, result.trajectory)
+        files[args.plot] = _plot(model, limits, tr, result.trajectory, args)
     write_all(files)
     print(
         "\n".join(
@@ -164,10 +164,11 @@ def _retime(args: argparse.Namespace) -> int:
     return 0
 
 
-def _plot(model, limits, before, after) -> bytes:
-    from .retime_plot import limit_use_png
+def _plot(model, limits, before, after, args) -> bytes:
+    from .retime_plot import limit_use_png, what_was_drawn
 
-    return limit_use_png(model, limits, before, after)
+    arm = os.path.basename(args.urdf or args.params_file or "the IRB-140")
+    return limit_use_png(model, limits, before, after, what_was_drawn(os.path.basename(args.input), arm, model.payload))
 
 
 if __name__ == "__main__":

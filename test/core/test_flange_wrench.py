@@ -173,3 +173,16 @@ def test_payload_sphere_and_arrow_sizes():
     np.testing.assert_allclose(display.arrow_end([1.0, 0.0, 0.0], [0.0, 20.0, 0.0]), [1.0, 0.2, 0.0])
     long = display.arrow_end([0.0, 0.0, 0.0], [1e6, 0.0, 0.0])
     np.testing.assert_allclose(long, [display.MAX_ARROW, 0.0, 0.0])
+
+
+def test_huge_forces_and_torques_are_labelled_with_finite_numbers():
+    """Efforts near 1e300 give forces whose length overflows: the label stays a finite
+    number (with an exponent, not 300 digits), the arrow its longest along the force."""
+    huge = [1e300, -1e300, 5e299]
+    assert display.force_label(huge) == "1.5e+300 N"
+    assert display.force_label([1.5e308, 1.5e308, 1.5e308]) == f"{display.LARGEST:.3g} N"
+    assert display.force_label([30.0, 40.0, 0.0]) == "50.0 N"
+    end = display.arrow_end([1.0, 0.0, 0.0], huge)
+    np.testing.assert_allclose(end, [1.0, 0.0, 0.0] + display.MAX_ARROW * np.array(huge) / 1.5e300)
+    assert display.load_label("joint_2", 1e300, None) == "joint_2 (1e+300 N m, no limit)"
+    assert display.load_label("joint_2", -2e300, 1e298) == "joint_2 1e+300 % (-2e+300 N m)"

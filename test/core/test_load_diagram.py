@@ -309,3 +309,37 @@ def test_an_arm_that_cannot_hold_itself_has_no_mass_anywhere():
     diagram = load_diagram(model, limits, [0.0, 0.1], [0.0])
     assert diagram.proven_share == 0.0
     assert all(math.isnan(p.mass) and p.reason for p in diagram.points), [p.reason for p in diagram.points]
+
+
+@pytest.mark.parametrize("arm, z, l", [("irb140", 0.1, 0.05), ("ur5", 0.15, 0.1)])
+def test_a_check_of_one_point_is_the_proof_there_and_agrees_with_the_independent_search(arm, z, l):
+    """``check_point`` proves the point itself: its proven mass is the diagram's there, a
+    mass a little under the independent search's is inside, one a little over it is not
+    (a real pose then exceeds a limit), with the limiting joint and the margin in kg."""
+    from irb140_dynamics.core.payload.diagram import check_point
+
+    model, limits, models = CASES[arm]()
+    lower, upper = np.array([j.position_limits for j in model.joints]).T
+    found = Independent(models, limits, lower, upper).search(z, l, np.random.default_rng(13))
+    point = load_diagram(model, limits, [z], [l]).points[0]
+    inside = check_point(model, limits, 0.97 * found, z, l)
+    assert inside.inside and inside.proven == point.mass and inside.joint == model.joint_names[point.joint]
+    assert inside.margin == pytest.approx(point.mass - 0.97 * found)
+    assert inside.proven <= found * (1 + 1e-9)  # a lower bound of what a real pose holds
+    outside = check_point(model, limits, 1.01 * found, z, l)
+    assert not outside.inside and outside.margin < 0 and outside.joint == inside.joint
+    assert outside.margin == pytest.approx(outside.found - 1.01 * found)
+    assert outside.sentence().startswith(f"outside: {1.01 * found:g} kg at Z {z:g} m, L {l:g} m")
+
+
+def test_a_mass_between_the_proven_and_the_found_is_proven_at_itself():
+    """Between the grid proof's mass (99.5 % of the found one) and the found mass, the
+    check proves the asked mass itself: inside where that proof closes."""
+    from irb140_dynamics.core.payload.diagram import check_point
+
+    model, limits, _ = irb140_case()
+    point = load_diagram(model, limits, [0.1], [0.0]).points[0]
+    between = point.mass + 0.3 * (point.found - point.mass)
+    check = check_point(model, limits, between, 0.1, 0.0)
+    assert check.inside and check.proven == between and check.margin == 0.0
+    assert "holds in every pose and direction (proven)" in check.sentence()

@@ -270,6 +270,7 @@ def test_with_payload_merges_into_the_last_link_only():
         ("payload.inertia", [1e7, 1e7, 1e7, 0.0, 0.0, 0.0], "|entry| must be <= 1e+06 kg m^2"),
         ("joint_3.dh", [0.0, 0.0, 1e200, 0.0], "|a| and |d| must be <= 1000 m"),
         ("gravity", [0.0, 0.0, -1e200], "|g| must be <= 1000 m/s^2"),
+        ("joint_2.torque_limit", 1e300, "must be <= 1e+07 N m"),
     ],
 )
 def test_values_beyond_the_sanity_caps_are_refused(key, value, reason):

@@ -102,6 +102,11 @@ REFUSED = {
         {},
         'URDF joint "j1" <limit>: effort must be >= 0',
     ),
+    "effort_beyond_the_cap": (  # as the torque_limit parameter: no 1e300 to overflow the proofs
+        edited((LIMIT, '<limit lower="-1" upper="1" effort="1e300" velocity="1"/>')),
+        {},
+        'URDF joint "j1" <limit>: effort must be <= 1e+07 (sanity cap), got 1e+300',
+    ),
     "negative_damping": (
         edited((LIMIT, LIMIT + '<dynamics damping="-0.5"/>')),
         {},

@@ -1,6 +1,8 @@
-"""Every picture the package writes shows its whole title and labels: each figure saved by
-the demo's plot, identify's plots, retime's plot and the docs' marker preview has every
-text's tight bounding box inside the figure's (checked as savefig is called)."""
+"""Every picture the package writes reads at a glance: each figure saved by the load
+diagram, the demo's plot, identify's plots, retime's plot and the docs' marker preview
+passes ``figures.figure_problems`` as savefig is called (at least 1000 px wide, a title,
+every text inside the figure and its axes, none over another or upside down, round ticks),
+names what it drew in its title, and keys its colours (a legend, a colour bar)."""
 
 import runpy
 from types import SimpleNamespace
@@ -13,15 +15,17 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
-from irb140_dynamics.core import irb140  # noqa: E402
+from irb140_dynamics.core import RigidBody, irb140  # noqa: E402
 from irb140_dynamics.core.io.trajectory_file import read_joint_trajectory  # noqa: E402
+from irb140_dynamics.core.payload.diagram import DiagramPoint, LoadDiagram  # noqa: E402
 from irb140_dynamics.core.regressor import inertial_parameters  # noqa: E402
 from irb140_dynamics.core.trajectories.limits import trajectory_limits  # noqa: E402
 from irb140_dynamics.core.trajectories.message import Trajectory  # noqa: E402
-from irb140_dynamics.figures import fit_text, texts_outside  # noqa: E402
+from irb140_dynamics.figures import figure_problems, fit_text, texts_outside  # noqa: E402
 from irb140_dynamics.identification.plots import write_plots  # noqa: E402
 from irb140_dynamics.nodes.demo_node.node import DemoNode  # noqa: E402
-from irb140_dynamics.tools.retime_plot import limit_use_png  # noqa: E402
+from irb140_dynamics.tools.load_diagram_plot import diagram_png  # noqa: E402
+from irb140_dynamics.tools.retime_plot import limit_use_png, what_was_drawn  # noqa: E402
 
 from ..support.paths import ROOT  # noqa: E402
 
@@ -31,15 +35,53 @@ LABEL = f"id_node on {LONG}, sim_node a 'true' IRB-140 (config/true_arm.yaml)"  
 
 @pytest.fixture
 def saved(monkeypatch):
-    """The texts outside each figure saved from now on (one list per figure)."""
+    """Each figure saved from now on: its problems (one list per figure), and the figure."""
     checked, save = [], Figure.savefig
 
     def checking(figure, *args, **kwargs):
-        checked.append(texts_outside(figure))
+        checked.append(figure_problems(figure, kwargs.get("dpi")))
+        figures.append(figure)
         return save(figure, *args, **kwargs)
 
+    figures = []
     monkeypatch.setattr(Figure, "savefig", checking)
-    return checked
+    checking.figures = figures
+    return SimpleNamespace(problems=checked, figures=figures)
+
+
+def titles_of(figure) -> str:
+    return " ".join([figure.get_suptitle()] + [a.get_title() for a in figure.axes])
+
+
+def legends_of(figure) -> list[str]:
+    legends = figure.legends + [a.get_legend() for a in figure.axes if a.get_legend() is not None]
+    return [t.get_text() for legend in legends for t in legend.get_texts()]
+
+
+def test_the_check_finds_each_defect():
+    """The defects of the pictures before this check, each found; a clean figure passes."""
+    figure, axis = plt.subplots(figsize=(6.4, 4.8))
+    axis.set_title("a title")
+    axis.plot([7.932, 8.297, 8.662], [1.0, 1.25, 2.0])
+    axis.set_xticks([7.932, 8.297, 8.662])
+    axis.set_yticks([1.0, 1.25, 1.5, 2.0])  # uneven, as the colour bar's steps were
+    axis.text(8.3, 1.5, "8.66268 kg", rotation=170)
+    axis.text(8.3, 1.5, "over it")
+    axis.text(8.66, 2.0, "cut by the axes", clip_on=True)
+    problems = figure_problems(figure, dpi=80)
+    assert "512 px wide, under 1000" in problems
+    assert any(p.startswith("ticks not round") and "(x): [7.932, 8.297, 8.662]" in p for p in problems)
+    assert any(p.startswith("ticks not round") and "(y): [1.0, 1.25, 1.5, 2.0]" in p for p in problems)
+    assert "upside down: '8.66268 kg'" in problems
+    assert "over each other: '8.66268 kg' and 'over it'" in problems
+    assert "cut by its axes: 'cut by the axes'" in problems
+    plt.close(figure)
+    clean, axis = plt.subplots(figsize=(10, 5))
+    axis.plot([0.0, 0.3], [2.5, 2.75])
+    assert figure_problems(clean) == ["no title"]
+    axis.set_title("clean")
+    assert figure_problems(clean) == []
+    plt.close(clean)
 
 
 def test_the_check_fails_on_a_title_wider_than_its_figure():
@@ -58,7 +100,11 @@ def test_the_demo_plot(saved, tmp_path):
     history = [(x, np.full(6, np.sin(x)), np.full(6, np.sin(x) + 0.01)) for x in t]
     demo = SimpleNamespace(_history=history, _recent=[1], label=LABEL, plot_file=str(tmp_path / "demo.png"))
     assert DemoNode.write_plot(demo) == demo.plot_file
-    assert saved == [[]]
+    assert saved.problems == [[]]
+    figure = saved.figures[0]
+    assert "tracking" in titles_of(figure) and "error" in titles_of(figure)
+    assert sum("error [mrad]" in a.get_ylabel() for a in figure.axes) == 6  # the error over time, per joint
+    assert {"reference", "actual"} <= set(legends_of(figure))
 
 
 def test_identify_plots(saved, tmp_path):
@@ -77,8 +123,14 @@ def test_identify_plots(saved, tmp_path):
         fit=SimpleNamespace(pi=inertial_parameters(model)),
         held_out_source=LONG,
     )
+    points.tau[10, 0] = 3.5  # a point above the rest: shown, not cut, not under the legend
     assert write_plots(result, tmp_path) == ["torques.png", "residuals.png"]
-    assert saved == [[], []]
+    assert saved.problems == [[], []]
+    for figure in saved.figures:
+        top = figure.axes[0]
+        assert top.get_ylim()[1] >= 3.5 - 0.0  # (the residuals: 3.5 less a prediction, within the view)
+        legend = legends_of(figure)
+        assert legend and all(a.get_legend() is None for a in figure.axes)  # one legend, above the panels
 
 
 def test_retime_plot(saved):
@@ -86,8 +138,11 @@ def test_retime_plot(saved):
     trajectory = Trajectory.from_message(
         read_joint_trajectory(ROOT / "docs" / "trajectory_example.yaml"), model.joint_names
     )
-    assert limit_use_png(model, trajectory_limits(model), trajectory, trajectory)[:4] == b"\x89PNG"
-    assert saved == [[]]
+    title = what_was_drawn("trajectory_example.yaml", "irb140.yaml", RigidBody(2.0, (0.0, 0.0, 0.1)))
+    assert limit_use_png(model, trajectory_limits(model), trajectory, trajectory, title)[:4] == b"\x89PNG"
+    assert saved.problems == [[]]
+    assert "trajectory_example.yaml on irb140.yaml, payload 2 kg, CoM (0, 0, 0.1) m" in titles_of(saved.figures[0])
+    assert {"torque (% of its limit)", "velocity (% of its limit)"} <= set(legends_of(saved.figures[0]))
 
 
 def test_the_marker_preview(saved, tmp_path):
@@ -96,7 +151,58 @@ def test_the_marker_preview(saved, tmp_path):
     preview = runpy.run_path(str(script))
     out = tmp_path / "preview.png"
     preview["draw"](recording, out)
-    assert out.stat().st_size > 0 and saved == [[]]
+    assert out.stat().st_size > 0 and saved.problems == [[]]
+    figure = saved.figures[0]
+    assert "markers.json" in titles_of(figure)
+    assert any("payload" in text for text in legends_of(figure))  # what each colour means
+    assert any(a.get_label() == "<colorbar>" for a in figure.axes)  # the load's colour scale
+
+
+def synthetic_diagram(z, l, low, high, unproven=()):
+    """A diagram whose masses fall from ``high`` at the flange to ``low`` at the far corner,
+    as an arm's do (the figure's checks need not wait for proofs)."""
+    points = []
+    for zi in z:
+        for li in l:
+            share = np.hypot(zi / max(z[-1], 1e-9), li / max(l[-1], 1e-9)) / np.sqrt(2)
+            mass = high - (high - low) * share**0.7
+            points.append(DiagramPoint(zi, li, mass, (zi, li) not in unproven, 3, "", mass * 1.005))
+    names = tuple(f"joint_{k}" for k in range(1, 7))
+    return LoadDiagram(names, np.ones(6), np.asarray(z), np.asarray(l), tuple(points))
+
+
+ARMS = {  # the mass ranges of the arms whose pictures read badly: UR5 7.932-8.663 kg, Panda 2.5985-2.7276 kg
+    "irb140.yaml": (1.0, 5.97, 6.0),
+    "ur5.urdf (world -> tool0)": (7.932, 8.66268, None),
+    "panda.urdf (panda_link0 -> panda_hand_tcp)": (2.5985, 2.7276, 3.0),
+}
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_the_load_diagram(saved, arm):
+    low, high, rated = ARMS[arm]
+    z, l = np.arange(31) * 0.01, np.arange(21) * 0.01
+    png = diagram_png(synthetic_diagram(z, l, low, high, unproven={(0.3, 0.2)}), arm, rated)
+    assert png[:4] == b"\x89PNG"
+    assert saved.problems == [[]]
+    figure = saved.figures[0]
+    assert arm in titles_of(figure) and "spec-sheet form" in titles_of(figure)
+    if rated is None:  # marked only where the arm states one
+        assert "no rated payload stated" in titles_of(figure)
+        assert not any("rated" in text for text in legends_of(figure))
+    else:
+        assert f"rated {rated:g} kg" in legends_of(figure)
+    assert "unproven (the mass a pose found)" in legends_of(figure)
+    assert sum(t.startswith("L = ") for t in legends_of(figure)) == 5  # the spec-sheet form: a few L
+    assert any(a.get_label() == "<colorbar>" for a in figure.axes)
+    contour_labels = [t.get_text() for t in figure.axes[0].texts if t.get_text().endswith(" kg")]
+    assert len(contour_labels) >= 3, contour_labels
+
+
+def test_a_load_diagram_of_one_row_and_of_one_point(saved):
+    for z, l in (([0.0, 0.1, 0.2], [0.0]), ([0.1], [0.05])):
+        diagram_png(synthetic_diagram(z, l, 2.0, 3.0), "arm.urdf", None)
+    assert saved.problems == [[], []]
 
 
 class _Sized:

@@ -5,6 +5,7 @@ import csv
 import math
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -51,6 +52,51 @@ def test_a_urdf_arm_with_its_own_effort_limits(tmp_path, capsys):
     assert len(rows) == 2 and all(r["status"] == "proven" for r in rows)
 
 
+@pytest.mark.parametrize(
+    "mass, code, starts",
+    [
+        ("2", 0, "load_diagram: inside: 2 kg at Z 0.1 m, L 0.05 m holds in every pose and direction (proven); margin "),
+        ("3", 1, "load_diagram: outside: 3 kg at Z 0.1 m, L 0.05 m exceeds joint_4's limit in a pose found; margin -"),
+    ],
+)
+def test_check_says_inside_or_outside_in_one_line(tmp_path, capsys, monkeypatch, mass, code, starts):
+    """The IRB-140 at Z 0.1 m, L 0.05 m holds 2.289 kg proven, 2.300 kg at a pose found."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["--check", mass, "0.1", "0.05"]) == code
+    printed = capsys.readouterr()
+    assert printed.out.count("\n") == 1 and printed.out.startswith(starts), printed
+    assert printed.out.rstrip().endswith("limiting joint joint_4") and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "arguments, says",
+    [
+        (["--check", "2", "0.1"], "argument --check: expected 3 arguments"),
+        (["--check", "-1", "0.1", "0"], "--check -1 0.1 0: MASS must be within 0..1e+06 kg"),
+        (["--check", "1", "0.1", "-0.1"], "L (a distance off the axis) within 0..10 m"),
+        ([], "the following arguments are required: --out (or --check MASS Z L)"),
+    ],
+)
+def test_a_bad_check_is_a_bad_argument(capsys, arguments, says):
+    assert main(arguments) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and says in err, err
+
+
+def test_the_rated_payload_is_the_arms_own():
+    """--rated-mass over rated_payload.mass over nothing stated (the limits then derived
+    from the nodes' default, 6 kg at the flange, and no curve marked)."""
+    from irb140_dynamics.core.payload import RATED_PAYLOAD
+    from irb140_dynamics.tools.load_diagram import rated_payload
+
+    assert rated_payload({}, None) == (RATED_PAYLOAD, False)
+    body, stated = rated_payload({"rated_payload.mass": 3.0, "rated_payload.com": [0.0, 0.0, 0.05]}, None)
+    assert stated and body.mass == 3.0 and body.com == (0.0, 0.0, 0.05)
+    assert rated_payload({"rated_payload.mass": 3.0}, 2.5)[0].mass == 2.5
+    with pytest.raises(ValueError, match="rated_payload.mass"):
+        rated_payload({"rated_payload.mass": -1.0}, None)
+
+
 def test_the_grid_holds_both_ends():
     np.testing.assert_allclose(grid(0.3, 0.01), np.arange(31) * 0.01)
     np.testing.assert_allclose(grid(0.25, 0.1), [0.0, 0.1, 0.2, 0.25])
@@ -64,6 +110,9 @@ def test_the_grid_holds_both_ends():
         (["--l-max", "nan"], "argument --l-max: must be a finite number"),
         (["--step", "0"], "argument --step: must be > 0, got 0"),
         (["--step", "1e-5"], "--step 1e-05: 30001 x 20001 points, more than 20,000: give a larger step"),
+        (["--step", "1e-10"], "--step 1e-10: 3000000001 x 2000000001 points, more than 20,000"),
+        (["--step", "5e-324"], "--step 4.94066e-324: too many x too many points, more than 20,000"),
+        (["--urdf", "huge_effort.urdf"], 'huge_effort.urdf: URDF joint "shoulder_pan_joint" <limit>: effort must be'),
         (["--params-file", "missing.yaml"], "missing.yaml: no such file or directory"),
         (["--urdf", "bad.urdf"], "bad.urdf"),
         (["--params-file", "bad.yaml"], "bad.yaml"),
@@ -74,10 +123,25 @@ def test_bad_input_is_one_line_a_nonzero_status_and_nothing_written(tmp_path, ca
     monkeypatch.chdir(tmp_path)
     (tmp_path / "bad.urdf").write_text("<robot name='x'><link name='a'/>")
     (tmp_path / "bad.yaml").write_text("/**:\n  ros__parameters:\n    joint_2.link.mass: -3.0\n")
-    code = main(["--out", "out", *arguments])
+    ur5 = (URDF_DATA / "ur5.urdf").read_text()
+    (tmp_path / "huge_effort.urdf").write_text(ur5.replace('effort="150.0"', 'effort="1e300"', 1))
+    arguments = [*arguments, "--tip", "tool0"] if "huge_effort.urdf" in arguments else arguments
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow on the way to the refusal
+        code = main(["--out", "out", *arguments])
     err = capsys.readouterr().err
     assert code != 0 and err.count("\n") == 1 and says in err and "Traceback" not in err, err
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.urdf", "bad.yaml"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.urdf", "bad.yaml", "huge_effort.urdf"]
+
+
+def test_a_step_too_small_is_refused_before_any_work(monkeypatch, capsys):
+    """A grid beyond 20,000 points is refused from its size alone: the grid is never made."""
+    from irb140_dynamics.tools import load_diagram as tool
+
+    monkeypatch.setattr(tool, "grid", lambda *_: pytest.fail("the grid was made"))
+    assert main(["--out", "never", "--step", "1e-9"]) == 2
+    assert "--step 1e-09: 300000001 x 200000001 points" in capsys.readouterr().err
+    assert tool.grid_size(0.3, 0.01) == 31 and tool.grid_size(0.25, 0.1) == 4 and tool.grid_size(0.0, 0.1) == 1
 
 
 def test_an_output_that_cannot_be_a_folder_is_refused_before_any_work(tmp_path, capsys):

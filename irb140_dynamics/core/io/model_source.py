@@ -48,6 +48,7 @@ class ToolModel:
     origin: str  # for messages: 'params.yaml', 'arm.urdf (base -> tip)'
     urdf: LoadedUrdf | None = None  # the URDF's chain, when the model is a URDF's
     urdf_text: str | None = None
+    parameters: Mapping[str, Any] | None = None  # the parameters read (the defaults' only for their own arm)
 
 
 def description_values(values: Mapping[str, Any], joint_names=()) -> dict[str, Any]:
@@ -114,7 +115,8 @@ def tool_model(
         defaults = description_values(defaults)  # other joints: every per-joint value must be given
     origin = str(params_file or defaults_file or "parameters")
     try:
-        return ToolModel(RobotModel.from_params({**defaults, **values}), origin)
+        merged = {**defaults, **values}
+        return ToolModel(RobotModel.from_params(merged), origin, parameters=merged)
     except ValueError as error:  # it names the parameter; the file, when there is one
         raise ValueError(f"{params_file}: {error}" if params_file else str(error)) from None
 
@@ -139,7 +141,7 @@ def _from_urdf(values, params_file, urdf_file, base_link, tip_link) -> ToolModel
         model = urdf_model(loaded, values)
     except ValueError as error:
         raise ValueError(f"{where}: {error}") from None
-    return ToolModel(model, f"{where} ({loaded.base_link} -> {loaded.tip_link})", loaded, text)
+    return ToolModel(model, f"{where} ({loaded.base_link} -> {loaded.tip_link})", loaded, text, values)
 
 
 def _parameters(path) -> dict[str, Any]:

@@ -48,6 +48,10 @@ from irb140_dynamics.core.model.rigid_body import (
 Z_AXIS: Vector3 = (0.0, 0.0, 1.0)
 KINDS = ("revolute", "prismatic")
 MAX_FRICTION = 1e6  # sanity cap of viscous [N m s/rad], Coulomb [N m] friction and armature [kg m^2]
+# Sanity cap of a torque limit (a prismatic joint's force [N]): wide, to keep 1e300 out (it
+# overflows the payload proofs' sums), not to judge the robot. The nodes' torque_limit
+# parameters have this range, so a parameter and a URDF's effort are refused alike.
+MAX_TORQUE_LIMIT = 1e7  # N m
 
 
 _validated = Validated()  # the placements and joints validated here
@@ -245,8 +249,13 @@ def _validate_joint(j: Joint) -> Joint:
         if x < 0.0:
             raise ModelError(f"{name}.{field}", f"must be >= 0 {note}, got {x}".replace("  ", " "))
         values[field] = x
-    for field, unit in (("friction.viscous", "N m s/rad"), ("friction.coulomb", "N m"), ("armature", "kg m^2")):
-        capped(f"{name}.{field}", "", values[field], MAX_FRICTION, unit)
+    for field, cap, unit in (
+        ("torque_limit", MAX_TORQUE_LIMIT, "N m"),
+        ("friction.viscous", MAX_FRICTION, "N m s/rad"),
+        ("friction.coulomb", MAX_FRICTION, "N m"),
+        ("armature", MAX_FRICTION, "kg m^2"),
+    ):
+        capped(f"{name}.{field}", "", values[field], cap, unit)
     link = RigidBody.validated(f"{name}.link", j.link.mass, j.link.com, j.link.inertia, physical=bool(j.physical))
     return Joint(
         j.name,

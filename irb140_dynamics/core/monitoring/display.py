@@ -46,8 +46,36 @@ def load_colour(load: float | None) -> tuple[float, float, float]:
 def load_label(name: str, tau: float, load: float | None) -> str:
     """E.g. ``joint_3 81 % (85.2 N m)``; without a limit ``joint_1 (85.2 N m, no limit)``."""
     if load is None:
-        return f"{name} ({tau:.1f} N m, no limit)"
-    return f"{name} {100.0 * load:.0f} % ({tau:.1f} N m)"
+        return f"{name} ({amount(tau)} N m, no limit)"
+    return f"{name} {percent(100.0 * load)} % ({amount(tau)} N m)"
+
+
+def force_label(force) -> str:
+    """The text of a force's arrow: its magnitude, e.g. ``50.0 N`` (finite whatever the
+    components: ``1.2e+300 N``)."""
+    return f"{amount(magnitude(force))} N"
+
+
+def magnitude(vector) -> float:
+    """|vector| without overflow on its way (math.hypot scales); the largest float where
+    the length itself is beyond it."""
+    length = math.hypot(*np.asarray(vector, dtype=float).tolist())
+    return length if math.isfinite(length) else LARGEST
+
+
+LARGEST = float(np.finfo(float).max)
+PLAIN_BELOW = 1e6  # a number's magnitude from which a label writes it with an exponent
+
+
+def amount(x: float) -> str:
+    """A number for a label, one decimal (``85.2``); from PLAIN_BELOW with an exponent
+    (``1.23e+300``, never 300 digits); ``nan`` or ``inf`` only for those."""
+    return f"{x:.1f}" if abs(x) < PLAIN_BELOW else f"{x:.3g}"
+
+
+def percent(x: float) -> str:
+    """A load in percent for a label: ``81``, or with an exponent from PLAIN_BELOW."""
+    return f"{x:.0f}" if abs(x) < PLAIN_BELOW else f"{x:.3g}"
 
 
 def payload_diameter(mass: float) -> float:
@@ -60,9 +88,12 @@ def arrow_end(start, force) -> np.ndarray:
     """Where a force's arrow from ``start`` ends [m]: ARROW_PER_NEWTON per newton along it,
     at most MAX_ARROW."""
     force = np.asarray(force, dtype=float)
-    length = ARROW_PER_NEWTON * float(np.linalg.norm(force))
-    scale = ARROW_PER_NEWTON if length <= MAX_ARROW else MAX_ARROW / float(np.linalg.norm(force))
-    return np.asarray(start, dtype=float) + scale * force
+    start = np.asarray(start, dtype=float)
+    if ARROW_PER_NEWTON * magnitude(force) <= MAX_ARROW:
+        return start + ARROW_PER_NEWTON * force
+    largest = float(np.max(np.abs(force)))  # huge forces: the direction without overflow
+    direction = force / largest
+    return start + MAX_ARROW * direction / magnitude(direction)
 
 
 def _mix(a, b, share: float) -> tuple[float, float, float]:

@@ -59,7 +59,8 @@ SEARCH_RTOL = 1e-9  # the searches' ascent stops gaining this share of the torqu
 class DiagramPoint:
     """One CoM position: z, l [m]; ``mass`` [kg] proven to hold in every pose and direction
     (``proven``), else the mass the search found (nothing above it holds; nan: none; inf:
-    no limited joint is loaded); the joint at its limit (index; None: none); why unproven."""
+    no limited joint is loaded); the joint at its limit (index; None: none); why unproven;
+    ``found``, the mass at which a pose found brings that joint to its limit (no more holds)."""
 
     z: float
     l: float
@@ -67,6 +68,7 @@ class DiagramPoint:
     proven: bool
     joint: int | None
     reason: str = ""
+    found: float = math.nan
 
 
 @dataclass(frozen=True, eq=False)
@@ -243,9 +245,10 @@ def _point(family: PayloadFamily, ranges: JointRanges, L: np.ndarray, warm, z: f
                 break
             best = candidate
         if math.isnan(best.mass):
-            return DiagramPoint(z, l, math.nan, False, best.joint, "a pose exceeds a limit without any payload"), poses
+            why = "a pose exceeds a limit without any payload"
+            return DiagramPoint(z, l, math.nan, False, best.joint, why, math.nan), poses
         if math.isinf(best.mass):
-            return DiagramPoint(z, l, math.inf, False, None, "no limited joint is loaded"), poses
+            return DiagramPoint(z, l, math.inf, False, None, "no limited joint is loaded", math.inf), poses
         m = min(best.mass, MAX_MASS) * fraction
         ceiling = np.tile(L, 2)
         every = np.repeat(poses[:1], 2 * n, axis=0)  # rows not proven: a real pose's torque
@@ -253,7 +256,7 @@ def _point(family: PayloadFamily, ranges: JointRanges, L: np.ndarray, warm, z: f
         found = (np.einsum("kn,kn->k", _static_torque(family, m)(every), np.vstack([np.eye(n), -np.eye(n)])), every)
         proof = family.extremes(m, ranges, rows=limited, found=found, ceiling=ceiling, share=PROOF_SHARE)
         if np.all(proof.bounds[limited] <= ceiling[limited]):
-            return DiagramPoint(z, l, m, True, best.joint), poses
+            return DiagramPoint(z, l, m, True, best.joint, "", best.mass), poses
         candidate = smallest_max_payload(family, proof.poses[limited], L)
         if _below(candidate.mass, best.mass * (1 - 1e-12)):
             best, poses = candidate, proof.poses[limited]  # the search missed a worse pose
@@ -262,7 +265,7 @@ def _point(family: PayloadFamily, ranges: JointRanges, L: np.ndarray, warm, z: f
         if math.isnan(fraction):
             break
     reason = f"the proof's budget ran out at {m:.4g} kg (no more than {best.mass:.4g} kg holds)"
-    return DiagramPoint(z, l, best.mass, False, best.joint, reason), poses
+    return DiagramPoint(z, l, best.mass, False, best.joint, reason, best.mass), poses
 
 
 def _static_torque(family: PayloadFamily, m: float):
@@ -273,3 +276,82 @@ def _static_torque(family: PayloadFamily, m: float):
 
 def _below(a: float, b: float) -> bool:
     return a < b or (math.isnan(a) and not math.isnan(b))
+
+
+@dataclass(frozen=True, eq=False)
+class PointCheck:
+    """Whether a payload of ``mass`` kg with its CoM at (z, l) [m] lies inside the proven
+    diagram: ``inside`` only when proven to hold in every pose and direction; ``proven``
+    the largest mass proven at the point (nan: none), ``found`` the mass at which a pose
+    found brings ``joint`` (its name) to its limit; why not, when not."""
+
+    mass: float
+    z: float
+    l: float
+    inside: bool
+    proven: float
+    found: float
+    joint: str | None
+    reason: str = ""
+
+    @property
+    def margin(self) -> float:
+        """kg: inside, the mass proven to hold beyond ``mass`` (at least this much more
+        holds); outside, how far ``mass`` is beyond what holds (negative): beyond ``found``
+        where a pose exceeds a limit, else beyond what is proven."""
+        if self.inside:
+            return max(self.proven - self.mass, 0.0)
+        if self.mass >= self.found:
+            return self.found - self.mass
+        return self.proven - self.mass if math.isfinite(self.proven) else math.nan
+
+    def sentence(self) -> str:
+        """The check in one line."""
+        at = f"{self.mass:g} kg at Z {self.z:g} m, L {self.l:g} m"
+        joint = f"limiting joint {self.joint}" if self.joint else "no limiting joint"
+        known = [f"{self.proven:.3f} kg proven"] if math.isfinite(self.proven) else []
+        if math.isfinite(self.found):
+            known.append(f"a pose reaches the limit at {self.found:.3f} kg")
+        detail = f" ({'; '.join(known)})" if known else ""
+        if self.inside:
+            return (
+                f"inside: {at} holds in every pose and direction (proven); margin {self.margin:.3f} kg{detail}; {joint}"
+            )
+        margin = f"margin {self.margin:.3f} kg" if math.isfinite(self.margin) else "no margin"
+        return f"outside: {at} {self.reason}; {margin}{detail}; {joint}"
+
+
+def check_point(model: RobotModel, limits: Sequence[float], mass: float, z: float, l: float) -> PointCheck:
+    """Is ``mass`` [kg] with its CoM at (z, l) [m] inside the load diagram of ``model``
+    against ``limits`` (n,) [N m, inf: none], proven for that point (as ``load_diagram``
+    proves a grid point, then, where the mass lies between the proven mass and the one a
+    pose reaches a limit with, the proof at ``mass`` itself)?"""
+    L = limit_values(limits, model.n)
+    _, shapes, ranges = _arm_of(model)
+    L_arm = np.append(L, np.inf)
+    point, _ = _point(shapes.family(float(z), float(l)), ranges, L_arm, None, float(z), float(l))
+    name = None if point.joint is None else model.joint_names[point.joint]
+    proven = point.mass if point.proven else math.nan
+    result = PointCheck(float(mass), float(z), float(l), False, proven, point.found, name)
+    if math.isnan(point.found):
+        return replace(result, reason=point.reason or "no mass holds there")
+    if mass >= point.found:
+        return replace(result, reason=f"exceeds {name}'s limit in a pose found")
+    alone = _holds_alone(shapes.family(0.0, 0.0), ranges, L_arm)
+    if point.proven and alone and mass <= point.mass:  # torques affine in the mass: every lighter one holds
+        return replace(result, inside=True)
+    if _proven_at(shapes.family(float(z), float(l)), ranges, L_arm, float(mass)):
+        return replace(result, inside=True, proven=max(float(mass), proven if alone else math.nan))
+    return replace(result, reason="is not proven to hold in every pose (too near the limit for the proof)")
+
+
+def _proven_at(family: PayloadFamily, ranges: JointRanges, L: np.ndarray, mass: float) -> bool:
+    """Is every limited joint's worst static torque with the payload at ``mass`` proven
+    within its limit, over every pose and direction?"""
+    ceiling = np.tile(L, 2)
+    limited = np.flatnonzero(np.isfinite(ceiling))
+    found = family.search(mass, ranges)
+    if np.any(found[0][limited] > ceiling[limited]):
+        return False
+    proof = family.extremes(mass, ranges, rows=limited, found=found, ceiling=ceiling, share=PROOF_SHARE)
+    return bool(np.all(proof.bounds[limited] <= ceiling[limited]))

@@ -152,36 +152,17 @@ class DemoNode(Node):
         self.context.try_shutdown()  # main() then destroys the node, which writes the plot
 
     def write_plot(self) -> str | None:
-        """Reference and actual positions per joint, as a PNG; its path, or None without data
-        (then it says so)."""
+        """Reference and actual positions and the tracking error per joint, as a PNG
+        (``tracking_plot``); its path, or None without data (then it says so)."""
         if not self._history:
             missing = "tracking error from id_node" if not self._recent else "joint_states from sim_node"
             print(f"no plot: no {missing} received yet ({self.plot_file} not written)", flush=True)
             return None
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        from irb140_dynamics.figures import fit_text
+        from irb140_dynamics.tracking_plot import write_tracking_plot
 
         t = np.array([h[0] for h in self._history])
         reference, actual = np.array([h[1] for h in self._history]), np.array([h[2] for h in self._history])
-        figure, axes = plt.subplots(3, 2, figsize=(11, 8), sharex=True)
-        for j, axis in enumerate(axes.flat):
-            axis.plot(t, reference[:, j], label="reference")
-            axis.plot(t, actual[:, j], "--", label="actual")
-            axis.set_title(
-                f"{NAMES[j]}: error RMS {np.sqrt(np.mean((reference[:, j] - actual[:, j]) ** 2)) * 1e3:.2f} mrad"
-            )
-            axis.set_ylabel("q [rad]")
-        axes.flat[0].legend()
-        figure.suptitle(f"demo_node: reference and actual joint positions ({self.label})")
-        for axis in axes[-1]:
-            axis.set_xlabel("t [s]")
-        fit_text(figure)  # the label can be long (a config path): wrapped, never cut
-        figure.savefig(self.plot_file)
-        plt.close(figure)
+        write_tracking_plot(self.plot_file, t, reference, actual, NAMES, self.label)
         print(f"plot written: {self.plot_file}", flush=True)
         return self.plot_file
 

@@ -148,7 +148,7 @@ class MarkerScene:
             start, tip = self._arrow.points
             start.x, start.y, start.z = fx, fy, fz
             tip.x, tip.y, tip.z = end.tolist()
-            self._force_text.text = f"{float(np.linalg.norm(force)):.1f} N"
+            self._force_text.text = display.force_label(force)
             ex, ey, ez = end.tolist()
             _place(self._force_text, ex, ey, ez + LABEL_RISE)
             shown += (self._arrow, self._force_text)

@@ -11,16 +11,16 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-from irb140_dynamics.core.model.joints import MAX_FRICTION, param_prefix
+from irb140_dynamics.core.model.joints import MAX_FRICTION, MAX_TORQUE_LIMIT, param_prefix
 from irb140_dynamics.core.model.rigid_body import MAX_MASS as CORE_MAX_MASS
 from irb140_dynamics.ros.parameters.spec import Spec
 
 # The finite ranges of the model's numbers (ParameterDescriptor ranges, `ros2 param describe`):
 # wide, to keep inf, nan and 1e308 out, not to judge the robot.
-# Masses and friction: the core's own caps (core.model), so that the descriptor and the
-# model refuse the same values.
+# Masses, torque limits and friction: the core's own caps (core.model), so that the
+# descriptor and the model (a URDF's effort included) refuse the same values.
 MAX_MASS = CORE_MAX_MASS  # kg
-MAX_TORQUE = 1e7  # N m (torque limits, collision thresholds)
+MAX_TORQUE = MAX_TORQUE_LIMIT  # N m (torque limits, collision thresholds)
 MAX_VELOCITY = 1e4  # rad/s
 MAX_ACCELERATION = 1e7  # rad/s^2
 MAX_VISCOUS = MAX_FRICTION  # N m s/rad

@@ -46,7 +46,13 @@ from irb140_dynamics.core.io.urdf.tree import (
     number,
     parse_tree,
 )
-from irb140_dynamics.core.model.joints import Friction, Joint, Placement, matrix_rpy
+from irb140_dynamics.core.model.joints import (
+    MAX_TORQUE_LIMIT,
+    Friction,
+    Joint,
+    Placement,
+    matrix_rpy,
+)
 from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, combine, placed
 from irb140_dynamics.core.model.robot_model import RobotModel
 
@@ -257,6 +263,8 @@ def _joint(joint: UrdfJoint, origin: Placement, body: RigidBody, physical: bool)
     ):
         if value < 0.0:
             raise UrdfError(f"{joint.label} <{element}>", f"{what} must be >= 0, got {value}")
+    if effort > MAX_TORQUE_LIMIT:  # the model's own sanity cap, as the nodes' parameter: named as URDF names it
+        raise UrdfError(where, f"effort must be <= {MAX_TORQUE_LIMIT:g} (sanity cap), got {effort:g}")
     return Joint(
         joint.name,
         link=body,
