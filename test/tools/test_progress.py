@@ -165,3 +165,24 @@ def test_load_diagram_on_a_terminal_draws_its_bar(tmp_path):
     assert frames[0].startswith(f"load_diagram: [{' ' * 30}]   0 % 0/6 points, time left not known yet"), text
     assert re.search(r"load_diagram: \[#{30}\] 100 % 6/6 points, done in \d+ s", frames[-1]), text
     assert out.decode().startswith("load_diagram: 6 points")
+
+
+def test_retime_on_a_long_input_says_its_steps(monkeypatch, capsys, tmp_path):
+    """From LONG_INPUT bytes on (here lowered to the example's size), a line per step; below, none."""
+    from irb140_dynamics.tools import retime
+
+    example = ROOT / "docs" / "trajectory_example.yaml"
+    arguments = ["--params-file", str(ROOT / "config" / "irb140.yaml"), str(example), str(tmp_path / "out.yaml")]
+    assert retime.main(arguments) == 0
+    assert capsys.readouterr().err == ""  # a short input: done in a moment, nothing said
+    monkeypatch.setattr(retime, "LONG_INPUT", example.stat().st_size)
+    assert retime.main(arguments) == 0
+    lines = capsys.readouterr().err.splitlines()
+    assert [line.split(" (")[0] for line in lines] == [
+        "retime: checking the input: 20 %",
+        "retime: re-timing: 40 %",
+        "retime: checking the result: 60 %",
+        "retime: writing: 80 %",
+        "retime: 100 %",
+    ], lines
+    assert lines[-1].startswith("retime: 100 % (5/5 steps), done in ")
