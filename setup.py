@@ -38,7 +38,7 @@ except ImportError:
 setup(
     name=package_name,
     version="0.1.0",
-    packages=find_packages(exclude=["test", "bench"]),
+    packages=find_packages(exclude=["test", "test.*", "bench", "bench.*"]),
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{package_name}"]),
         (f"share/{package_name}", ["package.xml"]),

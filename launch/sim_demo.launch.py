@@ -8,7 +8,7 @@ Launch arguments (all with defaults):
   params_file     id_node's model (default: the installed config/irb140.yaml)
   plot_file       where demo_node writes its plot at the end (default demo_tracking.png,
                   in the directory ros2 launch was started from)
-  duration        s, demo_node stops after this long; 0 = until Ctrl-C (default 0.0)
+  duration        s, demo_node stops this long after its first figures; 0 = until Ctrl-C (default 0.0)
   rviz            true: start rviz2 with share/irb140_dynamics/rviz/dynamics.rviz (the
                   arm, TF, id_node's ~/markers; docs/visualization.md), where RViz is installed
                   (default false)

@@ -5,7 +5,7 @@ set -euo pipefail
 
 usage() {
     cat <<'USAGE'
-usage: scripts/run.sh [-h] [--demo] [ROS ARGUMENTS ...]
+usage: scripts/run.sh [-h] [--demo [--duration S]] [ROS ARGUMENTS ...]
 
 Sets up .venv and builds the package (colcon, into ./install), then starts the nodes with the
 built-in IRB-140 model until Ctrl-C:
@@ -16,6 +16,8 @@ built-in IRB-140 model until Ctrl-C:
               and demo_node sending a reference motion and printing the tracking error;
               Ctrl-C ends it and demo_node writes its plot, demo_tracking.png, in the
               current directory
+  --duration S  with --demo: end by itself S seconds after the first tracking figures
+              (sim_node and id_node running), the plot written, exit 0
 
 ROS ARGUMENTS go to id_node and payload_check_node (--ros-args is added), e.g.
   scripts/run.sh --params-file my_robot.yaml -p payload.mass:=2.0
@@ -27,17 +29,26 @@ When a node stops by itself (a bad params file, a bad model), run.sh says which,
 others and exits 1. Options:
   -h, --help  this text
   --demo      the simulated closed loop (above)
+  --duration S  the demo's length [s] (above); without it, until Ctrl-C
 USAGE
 }
 
 caller=$PWD
 repo=$(cd "$(dirname "$0")/.." && pwd)
 demo=false
+duration=""
 ros_args=()
 while [ $# -gt 0 ]; do
     case "$1" in
         -h | --help) usage; exit 0 ;;
         --demo) demo=true ;;
+        --duration)
+            if [ $# -lt 2 ] || ! [[ $2 =~ ^[0-9]+([.][0-9]+)?$ ]] || [[ $2 =~ ^0+([.]0+)?$ ]]; then
+                echo "run.sh: --duration needs a number of seconds > 0, e.g. --duration 30" >&2
+                exit 2
+            fi
+            duration=$2
+            shift ;;
         --ros-args) ;;  # every argument is a ROS argument already
         --params-file)
             if [ $# -lt 2 ]; then echo "run.sh: --params-file needs a FILE" >&2; exit 2; fi
@@ -54,12 +65,12 @@ while [ $# -gt 0 ]; do
     shift
 done
 
-(
-    cd "$repo"
-    source scripts/env.sh run
-    colcon --log-base build/log build --paths . --build-base build --install-base install >build.log 2>&1 \
-        || { cat build.log >&2; echo "run.sh: the build failed (build.log above)" >&2; exit 1; }
-) || exit 1
+if [ -n "$duration" ] && ! $demo; then
+    echo "run.sh: --duration is for --demo (the nodes alone run until Ctrl-C)" >&2
+    exit 2
+fi
+
+"$repo/scripts/setup.sh" || exit 1
 source "$repo/$(source "$repo/scripts/python.sh" && venv_dir)/bin/activate"
 set +u  # colcon's setup scripts read unset variables
 # shellcheck disable=SC1091
@@ -117,7 +128,8 @@ if $demo; then
     for ((i = 0; i < ${#ros_args[@]}; i++)); do
         if [ "${ros_args[$i]}" = --params-file ]; then model="the model of ${ros_args[$((i + 1))]}"; fi
     done
-    start demo_node --ros-args -p model_label:="id_node on $model, sim_node a 'true' IRB-140 (config/true_arm.yaml)"
+    start demo_node --ros-args -p model_label:="id_node on $model, sim_node a 'true' IRB-140 (config/true_arm.yaml)" \
+        ${duration:+-p duration:="$duration"}
 else
     start id_node ${with_args[@]+"${with_args[@]}"}
     start payload_check_node ${with_args[@]+"${with_args[@]}"}
@@ -125,6 +137,7 @@ fi
 
 # Until Ctrl-C, or until a node stops by itself
 failed=""
+ended=false
 while ! $interrupted; do
     finished=""
     code=0
@@ -132,11 +145,22 @@ while ! $interrupted; do
     if $interrupted; then break; fi  # (a node that ended on the Ctrl-C did not stop by itself)
     if [ -n "${finished:-}" ]; then
         for i in "${!pids[@]}"; do
-            if [ "${pids[$i]}" = "$finished" ]; then failed="${names[$i]} (exit $code)"; fi
+            if [ "${pids[$i]}" = "$finished" ]; then
+                failed="${names[$i]} (exit $code)"
+                # --duration: demo_node ends by itself, its plot written: the demo is over
+                if [ -n "$duration" ] && [ "${names[$i]}" = demo_node ] && [ "$code" = 0 ]; then ended=true; fi
+            fi
         done
         break
     fi
 done
+if $ended; then
+    echo "run.sh: the demo's ${duration} s are over; stopping the nodes" >&2
+    stop_all
+    wait 2>/dev/null || true
+    pids=()
+    exit 0
+fi
 if $interrupted; then
     stop_all
     wait 2>/dev/null || true

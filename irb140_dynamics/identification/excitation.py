@@ -21,6 +21,7 @@ in SI units), minimised by SciPy's L-BFGS-B from a seeded random start.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -135,9 +136,11 @@ def optimise_excitation(
     samples: int | None = None,
     margin: float = DEFAULT_MARGIN,
     base: BaseParameters | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Excitation:
     """A trajectory within the model's limits minimising the base regressor's condition number;
-    ValueError naming the joints whose position range (less ``margin``) is empty."""
+    ValueError naming the joints whose position range (less ``margin``) is empty.
+    ``progress(done, iterations)`` after each of the optimiser's iterations."""
     if not period > 0.0:
         raise ValueError(f"period: must be > 0 s, got {period}")
     if harmonics < 2:
@@ -161,10 +164,34 @@ def optimise_excitation(
     start_cost = cost(start)
     best = start
     if iterations > 0:  # (minimize spends a gradient, 2 n (harmonics - 1) evaluations, even on none)
-        result = minimize(cost, start, method="L-BFGS-B", options={"maxiter": iterations, "eps": 1e-6})
+        result = minimize(
+            cost,
+            start,
+            method="L-BFGS-B",
+            options={"maxiter": iterations, "eps": 1e-6},
+            callback=iterations_to(progress, iterations),
+        )
+        if progress is not None:
+            progress(iterations, iterations)  # (the optimiser may stop before its last iteration)
         best = result.x if result.fun < start_cost else start
     trajectory = shaped(best, n, harmonics, period, limits)
     return Excitation(trajectory, condition_number(model, base, trajectory, samples), math.exp(start_cost), evaluations)
+
+
+def iterations_to(progress: Callable[[int, int], None] | None, iterations: int):
+    """The optimiser's callback: ``progress(iterations done, iterations)`` after each one
+    (None without ``progress``); the first call, (0, iterations), at once."""
+    if progress is None:
+        return None
+    progress(0, iterations)
+    done = 0
+
+    def iterated(*_):
+        nonlocal done
+        done += 1
+        progress(min(done, iterations), iterations)
+
+    return iterated
 
 
 def check_limits(model: RobotModel, trajectory: FourierTrajectory, rate: float, tolerance: float = 1e-9) -> list[str]:

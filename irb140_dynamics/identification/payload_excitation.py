@@ -16,12 +16,20 @@ seeded random start.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from scipy.optimize import minimize
 
 from irb140_dynamics.core.model.robot_model import RobotModel
-from irb140_dynamics.identification.excitation import DEFAULT_MARGIN, Excitation, FourierTrajectory, Limits, shaped
+from irb140_dynamics.identification.excitation import (
+    DEFAULT_MARGIN,
+    Excitation,
+    FourierTrajectory,
+    Limits,
+    iterations_to,
+    shaped,
+)
 from irb140_dynamics.identification.payload import PARAMETER_LABELS, excitation, payload_regressor
 
 WRIST_JOINTS = 3
@@ -92,10 +100,12 @@ def optimise_payload_excitation(
     iterations: int = 40,
     margin: float = DEFAULT_MARGIN,
     pose=None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Excitation:
     """A wrist motion within the model's limits minimising the payload regressor's condition
     number; ValueError when the wrist's limits leave a joint less than MIN_WRIST_TRAVEL, or
-    when the pose leaves the condition number above MAX_CONDITION (naming the parameters)."""
+    when the pose leaves the condition number above MAX_CONDITION (naming the parameters).
+    ``progress(done, iterations)`` after each of the optimiser's iterations."""
     if not 0.0 < period <= MAX_PAYLOAD_DURATION:
         raise ValueError(f"period: must be within (0, {MAX_PAYLOAD_DURATION:g}] s, got {period}")
     if harmonics < 2:
@@ -113,7 +123,15 @@ def optimise_payload_excitation(
     start_cost = cost(start)
     best = start
     if iterations > 0:
-        result = minimize(cost, start, method="L-BFGS-B", options={"maxiter": iterations, "eps": 1e-6})
+        result = minimize(
+            cost,
+            start,
+            method="L-BFGS-B",
+            options={"maxiter": iterations, "eps": 1e-6},
+            callback=iterations_to(progress, iterations),
+        )
+        if progress is not None:
+            progress(iterations, iterations)  # (the optimiser may stop before its last iteration)
         best = result.x if result.fun < start_cost else start
     trajectory = _trajectory(best, model, harmonics, period, limits)
     travel = np.ptp(trajectory.evaluate(np.linspace(0.0, period, 100 * harmonics))[0], axis=0)

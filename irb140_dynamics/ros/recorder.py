@@ -5,7 +5,9 @@ The messages are written as they arrive, serialized (CDR), with the receive time
 node's clock (simulated time with use_sim_time, as `ros2 bag record --use-sim-time`). The
 message type comes from the graph: the recorder waits until the topic has a publisher.
 Its subscription offers what every publisher gives: reliable when all of them are
-reliable, else best effort (as rosbag2 adapts).
+reliable, else best effort (as rosbag2 adapts). While none comes, after NAME_TOPICS_AFTER
+seconds one line on stderr names the topics that have a publisher (a typo shows), and the
+recorder keeps waiting: the publisher may start later. No message at all: no bag is left.
 
 It finishes by itself (``finished`` says why) ``duration`` s after the first message, or
 ``tail`` s after the end of the motion last sent on a ``reference`` topic (a
@@ -17,6 +19,7 @@ unstamped; a single point, a hold, is no motion). Nothing here stops the process
 from __future__ import annotations
 
 import importlib
+import shutil
 import time
 from pathlib import Path
 
@@ -37,6 +40,9 @@ DEFAULT_DEPTH = 1000  # the subscription's queue: a burst the writer may lag beh
 POLL_PERIOD = 0.1  # s between looks at the graph while waiting for the topic
 DRAIN_TIME = 1.0  # s: after a stop is asked for, messages already received are written, for at most this long
 DRAIN_QUIET = 0.05  # s: until none has come for this long
+NAME_TOPICS_AFTER = 3.0  # s without a publisher of the topic: name the topics that have one (once)
+TOPICS_NAMED = 12  # at most this many in that line
+EVERY_NODES = ("/rosout", "/parameter_events")  # every node publishes these: no answer to a typo
 
 
 class CannotRecord(Exception):
@@ -149,6 +155,7 @@ class Recorder(Node):
             self.create_subscription(JointTrajectory, self.reference, self._on_reference, 10)
         self._writer = open_bag(self.out)
         self._connection = None
+        self._waiting_since, self._named = time.monotonic(), False
         self.count, self.first, self.last = 0, None, None  # messages, receive times [ns]
         # on the steady clock: with use_sim_time, simulated time may stand still until then
         self._waiting = self.create_timer(
@@ -158,7 +165,12 @@ class Recorder(Node):
 
     def _subscribe_when_published(self) -> None:
         publishers = self.get_publishers_info_by_topic(self.topic)
-        if not publishers or self.failure:
+        if self.failure:
+            return
+        if not publishers:
+            if not self._named and time.monotonic() - self._waiting_since >= NAME_TOPICS_AFTER:
+                self._named = True
+                self.get_logger().warning(f"{self._others()}; still waiting for {self.topic} (Ctrl-C stops)")
             return
         self._waiting.cancel()
         type_name = publishers[0].topic_type
@@ -176,6 +188,18 @@ class Recorder(Node):
         self.get_logger().info(
             f"recording {self.topic} ({type_name}, {'reliable' if reliable else 'best effort'}) to {self.out}"
         )
+
+    def _others(self) -> str:
+        """The topics with a publisher (those of every node left out), in a line."""
+        names = sorted(
+            f"{name} ({', '.join(types)})"
+            for name, types in self.get_topic_names_and_types()
+            if name not in EVERY_NODES and self.count_publishers(name) > 0
+        )
+        if not names:
+            return f"no publisher of {self.topic}, nor of any other topic (is the publisher's ROS_DOMAIN_ID this one?)"
+        more = f" and {len(names) - TOPICS_NAMED} more" if len(names) > TOPICS_NAMED else ""
+        return f"no publisher of {self.topic}; topics with one: {', '.join(names[:TOPICS_NAMED])}{more}"
 
     def _on_message(self, raw: bytes) -> None:
         if self.finished or self.failure:
@@ -220,13 +244,19 @@ class Recorder(Node):
 
     def progress(self) -> str:
         """What is recorded so far, in a line."""
+        if self._connection is None:
+            return f"waiting for a publisher of {self.topic}: {time.monotonic() - self._waiting_since:.0f} s"
         span = 0.0 if self.first is None else (self.last - self.first) * 1e-9
         goal = f" of {self.duration:g} s" if self.duration else ""
         return f"recording {self.topic}: {counted(self.count, 'message')}, {span:.1f} s{goal}"
 
     def close(self) -> str:
         """Close the bag (call once, with signals held off: a bag half closed is unreadable);
-        what it holds, in a line."""
+        what it holds, in a line. A bag without a message is removed (the recorder made it:
+        the folder was new)."""
         self._writer.close()
+        if self.count == 0:
+            shutil.rmtree(self.out, ignore_errors=True)
+            return f"no message came on {self.topic}: nothing written"
         span = 0.0 if self.first is None else (self.last - self.first) * 1e-9
         return f"wrote {self.out}: {counted(self.count, 'message')} of {self.topic} over {span:.3f} s"

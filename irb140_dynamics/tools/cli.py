@@ -17,8 +17,7 @@ from pathlib import Path
 
 from irb140_dynamics.core.errors import LINE_LIMIT, one_line  # noqa: F401 (the tools import them from here)
 from irb140_dynamics.entry import take_noted_signals
-
-open_line = [False]  # a progress bar's line on stderr is unfinished: end it before an error
+from irb140_dynamics.tools.progress import open_line
 
 
 class ToolError(Exception):

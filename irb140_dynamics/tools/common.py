@@ -1,4 +1,5 @@
-"""What the command-line tools share: the model's arguments and a progress bar (see cli.py for the rest)."""
+"""What the command-line tools share: the model's arguments and the progress of reading a recording (see
+cli.py for the rest)."""
 
 from __future__ import annotations
 
@@ -6,12 +7,10 @@ import argparse
 import contextlib
 import os
 import re
-import sys
-import time
 from pathlib import Path
 
 from irb140_dynamics.package_files import default_config_path
-from irb140_dynamics.tools.cli import ToolError, open_line  # noqa: F401 (ToolError: the tools import it from here too)
+from irb140_dynamics.tools.cli import ToolError  # noqa: F401 (the tools import it from here too)
 
 
 def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model") -> None:
@@ -88,32 +87,17 @@ def model_inputs(args: argparse.Namespace) -> list[tuple[str, Path]]:
     return [*given, (str(default), Path(os.path.abspath(default)))]
 
 
-class ProgressBar:
-    """'reading FILE: [#####     ] 52 % 1,234/2,345 samples, 3 s' on stderr, redrawn at most 5 times a second."""
+def reading_progress(tool: str):
+    """``progress(path, done, total)``, the identification pipeline's form, for the samples of
+    a recording read: 'identify: reading run.mcap: [###   ] 1,234/2,345 samples, 3 s left'
+    (see ``progress``)."""
+    from irb140_dynamics.tools.progress import Progress
 
-    WIDTH = 30
+    bars: dict[str, Progress] = {}
 
-    def __init__(self, stream=None, interval: float = 0.2):
-        self.stream = stream or sys.stderr
-        self.interval = interval
-        self.start = time.monotonic()
-        self.last = -1e9
+    def show(path: str, done: int, total: int) -> None:
+        if path not in bars:
+            bars[path] = Progress(f"{tool}: reading {Path(path).name}", "samples")
+        bars[path](done, total)
 
-    def __call__(self, path: str, done: int, total: int) -> None:
-        now = time.monotonic()
-        if done == 0:
-            self.start = now
-        finished = total > 0 and done >= total
-        if not finished and now - self.last < self.interval:
-            return
-        self.last = now
-        fraction = min(done / total, 1.0) if total > 0 else 0.0
-        bar = "#" * int(self.WIDTH * fraction)
-        self.stream.write(
-            f"\rreading {Path(path).name}: [{bar:<{self.WIDTH}}] {100 * fraction:3.0f} % "
-            f"{done:,}/{total:,} samples, {now - self.start:.0f} s"
-        )
-        open_line[0] = not finished and self.stream is sys.stderr
-        if finished:
-            self.stream.write("\n")
-        self.stream.flush()
+    return show

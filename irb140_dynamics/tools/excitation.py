@@ -11,7 +11,8 @@ and prints the condition number of the base regressor it reached (also a comment
 The trajectory stays within the model's position (less a margin), velocity and
 acceleration limits, starts and ends at rest at its first point, and repeats seamlessly.
 Every argument and FILE's folder are checked before the work; FILE is written whole or
-not at all. Exit status 0; 1 with one line; 2 for a bad argument; 130 after Ctrl-C.
+not at all. The optimisation's progress goes to stderr (a bar with the time left on a
+terminal, else a line per 10 %). Exit status 0; 1 with one line; 2 for a bad argument; 130 after Ctrl-C.
 
 With --payload, a load identification motion for `identify --payload-only`: the last three
 joints move (each over more than 0.1 rad), the others hold --pose (default: the middle of
@@ -165,7 +166,14 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
             flush=True,
         )
         result = optimise_excitation(
-            model, args.period, args.harmonics, args.seed, args.iterations, margin=args.margin, base=base
+            model,
+            args.period,
+            args.harmonics,
+            args.seed,
+            args.iterations,
+            margin=args.margin,
+            base=base,
+            progress=_progress(),
         )
         regressor = "the base regressor"
     trajectory = result.trajectory
@@ -230,11 +238,25 @@ def _payload_excitation(model, path: str, args: argparse.Namespace):
     )
     try:
         return optimise_payload_excitation(
-            model, args.period, args.harmonics, args.seed, args.iterations, margin=args.margin, pose=args.pose
+            model,
+            args.period,
+            args.harmonics,
+            args.seed,
+            args.iterations,
+            margin=args.margin,
+            pose=args.pose,
+            progress=_progress(),
         )
     except ValueError as error:
         message = str(error)
         raise ToolError(f"--{message}" if message.startswith("pose:") else message) from None
+
+
+def _progress():
+    """The optimiser's iterations on stderr (see ``tools.progress``)."""
+    from irb140_dynamics.tools.progress import Progress
+
+    return Progress("excitation: optimising", "iterations")
 
 
 if __name__ == "__main__":

@@ -153,7 +153,7 @@ def _identify(argv: list[str], interrupts) -> int:
 
     from irb140_dynamics.identification.pipeline import IdentificationSettings, identify
     from irb140_dynamics.identification.report import identified_file, identified_urdf, summary
-    from irb140_dynamics.tools.common import ProgressBar, model_of
+    from irb140_dynamics.tools.common import model_of, reading_progress
     from irb140_dynamics.tools.outputs import Outputs
 
     source = model_of(args)
@@ -170,7 +170,7 @@ def _identify(argv: list[str], interrupts) -> int:
         prior_weight=args.prior_weight,
         offsets=args.offsets,
     )
-    progress = None if args.quiet else ProgressBar()
+    progress = None if args.quiet else reading_progress("identify")
     with Outputs(interrupts) as outputs:
         result = identify(prior, args.recording, settings, validate=args.validate, progress=progress)
         print(f"prior: {prior_path}")

@@ -14,7 +14,8 @@ Writes DIR/load_diagram.csv (z_m, l_m, max_mass_kg, status, limiting_joint, reas
 ``proven`` mass is a certified lower bound of the true maximum; an ``unproven`` one the mass
 a pose found, above which nothing holds, or empty) and DIR/load_diagram.png (mass contours
 over the Z-L plane, the rated mass's curve in bold), both or neither, and prints one line
-(on a terminal, the rows done so far on stderr meanwhile).
+Meanwhile its progress on stderr: a bar with the points done and the time left on a
+terminal, else a line per 10 %.
 The grid has at most 20,000 points (MAX_POINTS): a step that needs more is refused from
 its size alone, before any work, naming --step.
 Exit status 0; 1 with one line (a bad file, nothing written); 2 for a bad argument; 130
@@ -143,7 +144,7 @@ def _diagram(argv: list[str], interrupts) -> int:
     limits = derive_torque_limits(model, rated)
     if args.check is not None:
         return _check(model, limits.values, *args.check)
-    diagram = load_diagram(model, limits.values, z, l, _progress(z.size * l.size), _workers(z.size))
+    diagram = load_diagram(model, limits.values, z, l, _progress(z.size, l.size), _workers(z.size))
     rated_mass = rated.mass if stated else None
     csv, png = diagram_csv(diagram).encode(), diagram_png(diagram, os.path.basename(source.origin), rated_mass)
     with Outputs(interrupts) as outputs:
@@ -179,24 +180,13 @@ def _check(model, limits, mass: float, z: float, l: float) -> int:
     return 0 if check.inside else 1
 
 
-def _progress(points: int):
-    """On a terminal: 'load_diagram: row 3 of 31 (651 points), 12 s' on stderr, redrawn."""
-    if not sys.stderr.isatty():
-        return None
-    import time
+def _progress(z_size: int, l_size: int):
+    """The rows of z done, shown as points (see ``tools.progress``), from now on."""
+    from irb140_dynamics.tools.progress import Progress
 
-    from irb140_dynamics.tools.cli import open_line
-
-    started = time.monotonic()
-
-    def show(done: int, total: int) -> None:
-        sys.stderr.write(f"\r{NAME}: row {done} of {total} ({points} points), {time.monotonic() - started:.0f} s")
-        open_line[0] = done < total
-        if done == total:
-            sys.stderr.write("\n")
-        sys.stderr.flush()
-
-    return show
+    bar = Progress(NAME, "points")
+    bar(0, z_size * l_size)
+    return lambda done, total: bar(done * l_size, total * l_size)
 
 
 def _workers(rows: int) -> int:

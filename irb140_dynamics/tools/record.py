@@ -10,7 +10,9 @@ publisher on, stamped with the node's clock (simulated time with use_sim_time). 
 itself --duration seconds after the first message recorded, or --tail seconds after the
 motion last sent on --reference ends (a JointTrajectory, as id_node follows it: from its
 header stamp, or from its arrival when unstamped), or at Ctrl-C (SIGINT, SIGTERM, SIGHUP);
-shows its progress on stderr, then prints what it wrote.
+shows its progress on stderr, then prints what it wrote. While the topic has no publisher,
+after 3 s a line on stderr names the topics that have one, and it waits on (the publisher
+may start later). When no message came, no bag is left ("nothing written").
 
 Never loses what it received: a signal, at any moment and however many, only asks it to
 stop; the bag is then closed whole. Exit status 0 for a finished or requested stop; 1

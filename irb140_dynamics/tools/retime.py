@@ -13,7 +13,9 @@ of 0 are derived as the payload check derives them (said in the report).
 Re-timing writes OUT.yaml (the same path, a point per grid point, timed time-optimally, as
 ``ros2 topic pub`` takes it) and prints the check of the input and of the output.
 --check-only prints the check: per joint the peak torque, velocity and acceleration against
-the limits, when and in which segment. Exit status: 0; 3 when --check-only finds a limit
+the limits, when and in which segment. On an input of a megabyte or more (about 3,000
+points) its steps show on stderr (a bar with the time left on a terminal, else a line per
+step). Exit status: 0; 3 when --check-only finds a limit
 exceeded; 1 with one line on bad input (nothing written: the output and the plot are
 written both or neither).
 """
@@ -133,24 +135,35 @@ def _retime(args: argparse.Namespace) -> int:
     outputs = [(path, Path(os.path.abspath(path))) for path in written if path]
     refuse_input_as_output(inputs, outputs)
     model = model_of(args.params_file, args.urdf, args.payload_mass, (args.base_link, args.tip_link))
+    steps = _Steps(args.input, (2 if args.check_only else 5) + bool(args.plot))
+    steps("reading the input")
     tr = read_trajectory(args.input, model)
     limits = trajectory_limits(model)
     notes = list(torque_limit_notes(model, limits))
+    steps("checking the input")
     before = check_trajectory(model, tr, limits)
     if args.check_only:
+        if args.plot:
+            steps("plotting")
         files = {args.plot: _plot(model, limits, tr, None, args)} if args.plot else {}
         write_all(files)
+        steps.end()
         print("\n".join([*notes, report_text("input", before)]))
         return 0 if before.ok else OVER_LIMIT
+    steps("re-timing")
     try:
         result = retime(model, tr, limits, grid=args.grid, accelerations=args.accelerations)
     except TrajectoryError as error:
         raise ToolError(f"{args.input}: {error}") from None
+    steps("checking the result")
     after = check_trajectory(model, result.trajectory, limits)
+    steps("writing")
     files = {args.output: joint_trajectory_yaml(result.trajectory.to_message()).encode()}
     if args.plot:
+        steps("plotting")
         files[args.plot] = _plot(model, limits, tr, result.trajectory, args)
     write_all(files)
+    steps.end()
     print(
         "\n".join(
             [
@@ -162,6 +175,38 @@ def _retime(args: argparse.Namespace) -> int:
         )
     )
     return 0
+
+
+LONG_INPUT = 1_000_000  # bytes of IN.yaml (about 3,000 points): from here the work takes seconds, and says so
+
+
+class _Steps:
+    """The tool's steps on stderr (``tools.progress``: a bar on a terminal, else a line per
+    step) for a long input; nothing for a short one, done in a moment."""
+
+    def __init__(self, path: str, total: int):
+        import os
+
+        from .progress import Progress
+
+        try:
+            long = os.path.getsize(path) >= LONG_INPUT
+        except OSError:  # (read_trajectory says why, in one line)
+            long = False
+        self.bar = Progress(NAME, "steps") if long else None
+        self.total, self.done = total, 0
+
+    def __call__(self, step: str) -> None:
+        """``step`` begins (the ones before it are done)."""
+        if self.bar is not None:
+            self.bar.label = f"{NAME}: {step}"
+            self.bar(self.done, self.total)
+            self.done += 1
+
+    def end(self) -> None:
+        if self.bar is not None:
+            self.bar.label = NAME
+            self.bar(self.total, self.total)
 
 
 def _plot(model, limits, before, after, args) -> bytes:

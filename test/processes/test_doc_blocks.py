@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import os
 import shutil
 import subprocess
@@ -17,7 +18,7 @@ from ..support.doc_blocks import (
     first_word,
     is_synopsis,
     logical_lines,
-    make_bin,
+    make_ros2,
     read_blocks,
     synopsis_options,
 )
@@ -42,13 +43,49 @@ def runnable(doc: Path) -> list[Block]:
     return [b for b in read_blocks(doc, set(SCRIPTS) | {"ros2"}) if b.kind in ("shell", "python")]
 
 
+SETUP = ROOT / "scripts" / "setup.sh"
+SETUP_TIMEOUT = 1800.0  # s: the README's set-up on a fresh clone (pip downloads, colcon build)
+SHELL_ONLY = ("PWD", "OLDPWD", "SHLVL", "_")  # what bash sets for itself
+
+
+def users_shell() -> dict:
+    """The environment of a new terminal: the test's own, less what puts its interpreter
+    or a workspace on the paths (a user's shell has neither before the set-up)."""
+    own = {str(Path(sys.executable).parent), os.path.join(sys.prefix, "bin")}
+    if os.environ.get("VIRTUAL_ENV"):
+        own.add(os.path.join(os.environ["VIRTUAL_ENV"], "bin"))
+    shell = {
+        key: value
+        for key, value in os.environ.items()
+        if key not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV", "AMENT_PREFIX_PATH", "COLCON_PREFIX_PATH")
+    }
+    shell["PATH"] = os.pathsep.join(d for d in os.environ["PATH"].split(os.pathsep) if d and d not in own)
+    return shell
+
+
 @pytest.fixture(scope="module")
 def environment(tmp_path_factory) -> dict:
-    bin_dir = make_bin(tmp_path_factory.mktemp("bin"), sys.executable, SCRIPTS)
+    """The shell the README leaves: its set-up run (scripts/setup.sh, what run.sh runs
+    first), then `source .venv/bin/activate && source install/setup.bash`. The harness adds
+    only the ros2 stand-in (after everything else on PATH) and settings of no executable."""
+    shell = users_shell()
+    done = subprocess.run([str(SETUP)], cwd=ROOT, env=shell, capture_output=True, text=True, timeout=SETUP_TIMEOUT)
+    assert done.returncode == 0, f"scripts/setup.sh exited {done.returncode}:\n{done.stdout}{done.stderr}"
+    sourced = subprocess.run(
+        ["bash", "-c", "source .venv/bin/activate && source install/setup.bash && env -0"],
+        cwd=ROOT,
+        env=shell,
+        capture_output=True,
+        timeout=60,
+    )
+    assert sourced.returncode == 0, sourced.stderr.decode(errors="replace")
+    env = dict(item.split("=", 1) for item in sourced.stdout.decode().split("\0") if "=" in item)
+    for key in SHELL_ONLY:
+        env.pop(key, None)
+    ros2 = make_ros2(tmp_path_factory.mktemp("ros2"))
     return {
-        **os.environ,
-        "PATH": f"{bin_dir}{os.pathsep}{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
-        "PYTHONPATH": str(ROOT),
+        **env,
+        "PATH": f"{env['PATH']}{os.pathsep}{ros2}",
         "PYTHONUNBUFFERED": "1",
         "MPLBACKEND": "Agg",
         # a benchmark a doc shows writes its figures here, not over the clone's bench/results
@@ -66,6 +103,9 @@ def node_of(line: str) -> str | None:
     return words[0] if words and words[0] in NODES else None
 
 
+NOT_FOUND = 127  # bash's exit status for a command not found
+
+
 def run_shell(script: str, cwd: Path, env: dict, timeout: float = LINE_TIMEOUT) -> tuple[int, str]:
     try:
         done = subprocess.run(
@@ -78,6 +118,8 @@ def run_shell(script: str, cwd: Path, env: dict, timeout: float = LINE_TIMEOUT) 
         )
     except subprocess.TimeoutExpired as error:
         return -1, f"still running after {timeout:g} s: {error.output or ''}"
+    if done.returncode == NOT_FOUND:
+        return NOT_FOUND, f"command not found (exit 127) after the README's set-up:\n{done.stdout}{done.stderr}"
     return done.returncode, done.stdout + done.stderr
 
 
@@ -96,8 +138,8 @@ def check_synopsis(line: str, cwd: Path, env: dict) -> str | None:
 def run_block(block: Block, cwd: Path, env: dict) -> str | None:
     """None when the block ran as the doc says, else what went wrong."""
     if block.kind == "python":
-        done = subprocess.run(
-            [sys.executable, "-c", block.text], cwd=cwd, env=env, capture_output=True, text=True, timeout=LINE_TIMEOUT
+        done = subprocess.run(  # the python of the user's shell: .venv's
+            ["python", "-c", block.text], cwd=cwd, env=env, capture_output=True, text=True, timeout=LINE_TIMEOUT
         )
         return None if done.returncode == 0 else f"exit {done.returncode}:\n{done.stdout}{done.stderr}"
     nodes, pending = [], []
@@ -140,49 +182,60 @@ def run_block(block: Block, cwd: Path, env: dict) -> str | None:
     return None
 
 
-CLONE = (".venv", "config", "urdf", "bench", "test", "scripts")  # what a block may name as in the clone (linked)
+def tracked_files() -> list[str]:
+    """The clone's files, as its developer has them: tracked, and new ones not ignored (those
+    present: one deleted in the working tree is not copied)."""
+    listed = subprocess.run(
+        ["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"],
+        cwd=ROOT,
+        capture_output=True,
+        check=True,
+        timeout=60,
+    )
+    return [name for name in listed.stdout.decode().split("\0") if name and (ROOT / name).is_file()]
 
 
-def clone_view(directory: Path) -> Path:
-    """A working directory where the doc's relative paths to the clone work (.venv, config, ...)."""
-    for name in CLONE:
-        target = Path(sys.prefix) if name == ".venv" else ROOT / name
-        (directory / name).symlink_to(target, target_is_directory=True)
-    return directory
+def digest(path: Path) -> str | None:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return None
 
 
-def clone_files() -> dict[str, tuple[int, int]]:
-    """path -> (size, mtime) of the clone's files a block can reach through its links."""
-    files = {}
-    for name in CLONE[1:]:
-        for folder, subfolders, names in os.walk(ROOT / name):
-            subfolders[:] = [d for d in subfolders if d != "__pycache__"]
-            for file in names:
-                stat = (Path(folder) / file).stat()
-                files[os.path.join(folder, file)] = (stat.st_size, stat.st_mtime_ns)
-    return files
+def clone_copy(directory: Path) -> dict[str, str | None]:
+    """The user's clone, in ``directory``: a copy of the tracked files as they are now (so
+    that what a walkthrough writes cannot reach this clone), with the set-up's .venv and
+    install/ linked. Returns each tracked file's digest."""
+    digests = {}
+    for name in tracked_files():
+        target = directory / name
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(ROOT / name, target)
+        digests[name] = digest(target)
+    for name in (".venv", "install"):
+        (directory / name).symlink_to(ROOT / name, target_is_directory=True)
+    return digests
 
 
 @pytest.mark.parametrize("doc", DOCS, ids=lambda path: path.name)
 def test_every_command_block_runs_as_typed(doc, environment, tmp_path):
-    """Each block as typed; what it writes goes to the user's working folder, never into
-    the clone (a second run would meet it, and git would see it)."""
+    """Each block as typed, in the clone's folder (a copy of it); what it writes goes beside
+    the tracked files, never over one (git would see it, and the next user meet it)."""
     failures, ran = [], 0
-    before = clone_files()
-    clone_view(tmp_path)
+    clone = tmp_path / "clone"
+    tracked = clone_copy(clone)
     for name in doc_files(doc):
-        shutil.copy(ROOT / name, tmp_path / Path(name).name)
+        shutil.copy(ROOT / name, clone / Path(name).name)
     for block in runnable(doc):
         if block.skip:
             continue
-        problem = run_block(block, tmp_path, environment)
+        problem = run_block(block, clone, environment)
         ran += 1
         if problem:
             failures.append(f"{block.where} ({first_word(block.text)} ...): {problem}")
     assert not failures, "\n\n".join(failures)
-    after = clone_files()
-    written = sorted(path for path in after if after[path] != before.get(path))
-    assert not written, f"{doc.name}'s blocks wrote into the clone: {written}"
+    changed = sorted(name for name, before in tracked.items() if digest(clone / name) != before)
+    assert not changed, f"{doc.name}'s blocks wrote over tracked files: {changed}"
 
 
 def test_most_command_blocks_really_run():

@@ -1,8 +1,10 @@
 """record, the bag recorder for installs without rosbag2, as its own process: it waits for
 the topic, takes its type from the graph, adapts to a best-effort publisher, stops after
---duration, and writes a bag that `identify` reads; an existing bag is refused in one line."""
+--duration, and writes a bag that `identify` reads; an existing bag is refused in one line;
+a topic nobody publishes: the topics that have a publisher named, and no bag left."""
 
 import os
+import signal
 import stat
 import sys
 import time
@@ -13,7 +15,7 @@ from sensor_msgs.msg import JointState
 
 from irb140_dynamics.identification.recording import Recording
 
-from ..support.node_process import TIMEOUT, run_to_exit, start
+from ..support.node_process import TIMEOUT, run_to_exit, start, wait_for_line
 
 NAMES = [f"joint_{i}" for i in range(1, 7)]
 RATE = 200.0  # Hz
@@ -97,3 +99,25 @@ def test_record_stops_by_itself_after_the_reference_motion_not_at_a_hold(probe, 
     assert "stopped: 0.2 s after the end of the motion on /ref" in output, output
     effort = np.concatenate([chunk.effort for chunk in Recording(out, NAMES).chunks()])[:, 0]
     assert f"wrote {out}: {len(effort)} messages" in output and np.all(np.diff(effort) == 1.0)
+
+
+def test_a_topic_nobody_publishes_names_those_published_and_leaves_no_bag(probe, tmp_path):  # noqa: F811
+    """`record --topic /nosuch`: one line naming the topics that have a publisher (here the
+    probe's /joint_states; not every node's /rosout), still waiting; Ctrl-C: no bag, exit 0."""
+    probe.create_publisher(JointState, "joint_states", 10)
+    out = tmp_path / "run"
+    process = start(record_command(out, "--topic", "/nosuch"))
+    lines: list[str] = []
+    try:
+        assert wait_for_line(process, "still waiting for /nosuch", lines, TIMEOUT), "".join(lines)
+        assert process.poll() is None, "".join(lines)  # it waits on: the publisher may start later
+        process.send_signal(signal.SIGINT)
+        rest, _ = process.communicate(timeout=TIMEOUT)
+    finally:
+        process.kill()
+    output = "".join(lines) + rest
+    named = [line for line in lines if "still waiting" in line]
+    assert len(named) == 1 and "no publisher of /nosuch; topics with one: " in named[0], output
+    assert "/joint_states (sensor_msgs/msg/JointState)" in named[0] and "/rosout" not in named[0], output
+    assert process.returncode == 0 and "Traceback" not in output, output
+    assert "no message came on /nosuch: nothing written" in output and not out.exists(), output

@@ -110,3 +110,33 @@ def test_the_demo_stops_on_ctrl_c_and_writes_its_plot_where_it_says(tmp_path):
     assert f"plot written: {plot}" in output and plot.stat().st_size > 0, output
     assert "tracking error RMS over the last second, per joint [mrad] (id_node on the built-in IRB-140" in output
     assert leftovers == [], output
+
+
+@pytest.mark.slow
+def test_the_demo_with_a_duration_ends_by_itself_with_its_plot(tmp_path):
+    """--duration S: S seconds of tracking figures, then the plot, every node stopped, exit 0."""
+    seconds = 3
+    process = run_script("--demo", "--duration", str(seconds), cwd=tmp_path)
+    try:
+        output, _ = communicate(process, BUILD_AND_START + 120)
+    finally:
+        leftovers = left_behind(process)
+        kill_session(process)
+    assert process.returncode == 0 and "Traceback" not in output, output
+    plot = tmp_path / "demo_tracking.png"
+    assert f"plot written: {plot}" in output and plot.stat().st_size > 0, output
+    assert f"run.sh: the demo's {seconds} s are over; stopping the nodes" in output, output
+    figures = [line for line in output.splitlines() if line.startswith("t=") and "mrad" in line]
+    assert figures, output  # the loop ran: its figures came before the end
+    assert "stopped by itself" not in output and leftovers == [], output
+
+
+def test_a_duration_needs_the_demo_and_a_positive_number(tmp_path):
+    for arguments, message in (
+        (["--duration", "5"], "run.sh: --duration is for --demo (the nodes alone run until Ctrl-C)"),
+        (["--demo", "--duration", "0"], "run.sh: --duration needs a number of seconds > 0, e.g. --duration 30"),
+        (["--demo", "--duration", "soon"], "run.sh: --duration needs a number of seconds > 0, e.g. --duration 30"),
+        (["--demo", "--duration"], "run.sh: --duration needs a number of seconds > 0, e.g. --duration 30"),
+    ):
+        done = subprocess.run([str(RUN), *arguments], cwd=tmp_path, capture_output=True, text=True, timeout=60)
+        assert (done.returncode, done.stdout, done.stderr.strip()) == (2, "", message), (arguments, done)

@@ -17,10 +17,13 @@ An HTML comment on the line(s) just before a block steers it:
 URDF of test/data) the doc's blocks use, copied into its directory first, as the user has
 them in theirs.
 
-A shell block is run in a directory of its doc's own (the doc's blocks in order, so that a
-walkthrough's files carry over), with the package's executables on PATH as console
-scripts, and ``ros2`` a stand-in that maps ``ros2 run irb140_dynamics X ARGS`` to ``X ARGS``
-(anything else it refuses: such blocks need a skip with its reason). A line starting a node
+A shell block is run as a user who followed the README types it: in the shell the set-up
+leaves (``scripts/setup.sh`` run, ``.venv`` activated, ``install/setup.bash`` sourced:
+nothing else on PATH), in the clone's folder (a copy of its tracked files per doc, the
+doc's blocks in order, so that a walkthrough's files carry over), with ``ros2`` a stand-in
+that runs ``ros2 run irb140_dynamics X ARGS`` as ros2 does, from install/ (anything else it
+refuses: such blocks need a skip with its reason). A command not found fails the block
+(exit 127), and so does a tracked file the blocks changed. A line starting a node
 is run in the background, as in a terminal of its own: the next line waits for its
 ``ready``; at the end of the block every node is stopped with Ctrl-C and must exit 0
 without a traceback. A usage synopsis (a line with ``[--option ...]``) is checked against
@@ -186,14 +189,20 @@ def synopsis_options(line: str) -> list[str]:
     return sorted(set(re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*|-[a-zA-Z])\b", line)))
 
 
-ROS2_STANDIN = '''#!{python}
-"""ros2, as far as the doc-test harness has it: `ros2 run irb140_dynamics X ARGS` runs X
-ARGS; `ros2 param set|get NODE NAME [VALUE]` and `ros2 service call SERVICE
-std_srvs/srv/Trigger` through rclpy, as ros2cli does them."""
+ROS2_STANDIN = '''#!/usr/bin/env python3
+"""ros2, as far as the doc-test harness has it: `ros2 run PACKAGE X ARGS` runs X where ros2
+run looks for it (PREFIX/lib/PACKAGE/X for each PREFIX of AMENT_PREFIX_PATH, which
+install/setup.bash sets); `ros2 param set|get NODE NAME [VALUE]` and `ros2 service call
+SERVICE std_srvs/srv/Trigger` through rclpy, as ros2cli does them."""
 import os, sys
 args = sys.argv[1:]
-if len(args) >= 3 and args[0] == "run" and args[1] == "irb140_dynamics":
-    os.execvp(args[2], args[2:])
+if len(args) >= 3 and args[0] == "run":
+    for prefix in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep):
+        found = os.path.join(prefix, "lib", args[1], args[2])
+        if prefix and os.access(found, os.X_OK):
+            os.execv(found, [found, *args[3:]])
+    sys.stderr.write(f"No executable found ({{args[1]}} {{args[2]}}: is install/setup.bash sourced?)\\n")
+    sys.exit(1)
 if args[:2] in (["param", "set"], ["param", "get"], ["service", "call"]):
     sys.path.insert(0, {root!r})
     from test.support.ros2_calls import main
@@ -203,23 +212,12 @@ sys.stderr.write("ros2 " + " ".join(args[:2]) + ": needs the ros2 CLI, which thi
 sys.exit(127)
 '''
 
-CONSOLE_SCRIPT = """#!{python}
-import sys
-from {module} import {function}
-sys.exit({function}())
-"""
 
-
-def make_bin(directory: Path, python: str, scripts: dict[str, str]) -> Path:
-    """A directory of console scripts for the package's executables, and the ros2 stand-in."""
+def make_ros2(directory: Path) -> Path:
+    """A directory holding only the ros2 stand-in (the package's executables come from the
+    set-up, never from here)."""
     directory.mkdir(parents=True, exist_ok=True)
-    for name, target in scripts.items():
-        module, function = target.split(":")
-        _executable(directory / name, CONSOLE_SCRIPT.format(python=python, module=module, function=function))
-    _executable(directory / "ros2", ROS2_STANDIN.format(python=python, root=str(Path(__file__).resolve().parents[2])))
-    return directory
-
-
-def _executable(path: Path, text: str) -> None:
-    path.write_text(text)
+    path = directory / "ros2"
+    path.write_text(ROS2_STANDIN.format(root=str(Path(__file__).resolve().parents[2])))
     path.chmod(0o755)
+    return directory

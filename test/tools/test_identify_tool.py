@@ -314,17 +314,16 @@ def test_excitation_piped_to_head_writes_nothing(tmp_path, payload):
     assert status == 141 and not (tmp_path / "t.yaml").exists()
 
 
-def test_progress_bar_ends_at_100_percent_on_its_own_line():
-    from irb140_dynamics.tools.common import ProgressBar
+def test_reading_progress_names_the_file_and_ends_at_100_percent(capsys):
+    """Off a terminal (here: captured), a line per 10 % of the samples read, the file named."""
+    from irb140_dynamics.tools.common import reading_progress
 
-    stream = io.StringIO()
-    bar = ProgressBar(stream, interval=3600.0)
+    show = reading_progress("identify")
     for done in (0, 400, 700, 1000):
-        bar("/data/run.mcap", done, 1000)
-    frames = stream.getvalue().split("\r")[1:]
-    assert len(frames) == 2  # the first and the last: the others fall within the interval
-    assert frames[0].startswith("reading run.mcap: [") and " 0 % 0/1,000 samples" in frames[0]
-    assert "[" + "#" * 30 + "] 100 % 1,000/1,000 samples" in frames[1] and frames[1].endswith("\n")
+        show("/data/run.mcap", done, 1000)
+    lines = capsys.readouterr().err.splitlines()
+    assert [line.split(" (")[0] for line in lines] == [f"identify: reading run.mcap: {p} %" for p in (40, 70, 100)]
+    assert lines[-1].startswith("identify: reading run.mcap: 100 % (1,000/1,000 samples), done in ")
 
 
 def test_plots_and_result_are_written_together_or_not_at_all(workflow, tmp_path, monkeypatch, capsys):

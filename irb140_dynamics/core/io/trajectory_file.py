@@ -30,8 +30,9 @@ def read_joint_trajectory(path) -> object:
     import yaml
 
     try:
-        with open(path) as stream:
-            return next((d for d in yaml.safe_load_all(stream) if d is not None), None)
+        with open(path) as stream:  # (libyaml's loader where PyYAML has it: 5x faster on a long file)
+            loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+            return next((d for d in yaml.load_all(stream, Loader=loader) if d is not None), None)
     except OSError as error:
         raise ValueError(f"{path}: cannot read: {error.strerror}") from None
     except yaml.YAMLError as error:
@@ -43,4 +44,5 @@ def joint_trajectory_yaml(message: dict) -> str:
     ``ros2 topic echo`` both read: a point's lists on one line each, numbers exact."""
     import yaml
 
-    return yaml.safe_dump(message, sort_keys=False, default_flow_style=None, width=10**6)
+    dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # (libyaml's emitter: the same text, faster)
+    return yaml.dump(message, Dumper=dumper, sort_keys=False, default_flow_style=None, width=10**6)

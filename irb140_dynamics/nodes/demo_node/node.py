@@ -5,8 +5,8 @@ Publishes    /id_node/reference         trajectory_msgs/JointTrajectory: one per
                                         smooth motion of every joint, sent again each period
 Subscribes   joint_states, /id_node/tracking_error (sensor_msgs/JointState)
 Prints       the tracking error RMS per joint [mrad] over the last second, every second,
-             each figure labelled with its joint; at the end (Ctrl-C, or after
-             ``duration``) a plot of reference and actual positions per joint is written to
+             each figure labelled with its joint; at the end (Ctrl-C, or ``duration``
+             after the first figures) a plot of reference and actual positions per joint is written to
              ``plot_file`` (PNG; a relative path is from the directory the node started in;
              the full path is printed at the start and when written)
 """
@@ -38,7 +38,15 @@ HISTORY_STEP = 0.01  # s between the samples kept for the plot
 NODE_PARAMETERS = [
     Spec("period", 8.0, "the reference motion's period", "s", read_only=True, minimum=1.0, maximum=3600.0),
     Spec("plot_file", "demo_tracking.png", "the plot written at the end (PNG)", read_only=True),
-    Spec("duration", 0.0, "stop after this long; 0 = until Ctrl-C", "s", read_only=True, minimum=0.0, maximum=1e6),
+    Spec(
+        "duration",
+        0.0,
+        "stop this long after the first figures (sim_node and id_node heard); 0 = until Ctrl-C",
+        "s",
+        read_only=True,
+        minimum=0.0,
+        maximum=1e6,
+    ),
     Spec(
         "model_label",
         "id_node's model on sim_node's arm",
@@ -76,7 +84,7 @@ def reference_message(period: float) -> JointTrajectory:
 class DemoNode(Node):
     def __init__(self, **kwargs):
         super().__init__("demo_node", **NODE_OPTIONS, **kwargs)
-        self.period, plot_file, duration, self.label = declare_fixed(self, NODE_PARAMETERS)
+        self.period, plot_file, self.duration, self.label = declare_fixed(self, NODE_PARAMETERS)
         self.plot_file = str(Path(plot_file).expanduser().resolve())
         self._reference_pub = self.create_publisher(JointTrajectory, "/id_node/reference", 10)
         self._positions = {}  # stamp [ns] -> q, of the latest joint states
@@ -90,8 +98,6 @@ class DemoNode(Node):
         self._headed = False  # the printout's header printed
         self._sender = self.create_timer(0.1, self._start_when_heard)
         self.create_timer(1.0, self._print)
-        if duration > 0.0:
-            self.create_timer(duration, self._finish)
         self.get_logger().info(
             f"ready: a {self.period:g} s reference motion of {', '.join(NAMES)} for id_node, sent every period "
             f"({self.label}); the plot goes to {self.plot_file} at the end"
@@ -144,6 +150,8 @@ class DemoNode(Node):
             return
         if not self._headed:
             self._headed = True
+            if self.duration > 0.0:  # the demo's length counts from here: the loop's start-up is not in it
+                self.create_timer(self.duration, self._finish)
             print(f"tracking error RMS over the last second, per joint [mrad] ({self.label}):", flush=True)
         figures = "  ".join(f"{name} {x:7.3f}" for name, x in zip(NAMES, rms))
         print(f"t={t:6.1f} s  {figures}  mrad", flush=True)

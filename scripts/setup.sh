@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The set-up alone (run.sh does it first): .venv with the ROS 2 Jazzy wheels, NumPy, SciPy,
+# MuJoCo and the package itself (its executables in .venv/bin), then colcon build into
+# ./install (the layout ros2 run uses). After it, in a shell of yours:
+#   source .venv/bin/activate && source install/setup.bash
+# puts every executable of the package on PATH (load_diagram, identify, id_node, ...).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+mkdir -p build
+# One set-up at a time: two (run.sh twice, or tests) would build into the same install/.
+exec 9>build/setup.lock
+flock 9
+source scripts/env.sh run
+echo "building the package with colcon into install/ ..." >&2
+colcon --log-base build/log build --paths . --build-base build --install-base install >build.log 2>&1 \
+    || { cat build.log >&2; echo "setup.sh: the build failed (build.log above)" >&2; exit 1; }
