@@ -14,6 +14,7 @@ from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import RigidBody, gravity, irb140
 from irb140_dynamics.nodes.id_node import node as id_module
+from irb140_dynamics.nodes.id_node import settings as id_settings
 from irb140_dynamics.nodes.id_node.node import IdNode
 from irb140_dynamics.nodes.payload_check_node import node as payload_module
 from irb140_dynamics.nodes.payload_check_node import settings as payload_settings
@@ -53,10 +54,9 @@ def unsettled_set(harness, params):
 
 @pytest.fixture
 def gated_id_node(monkeypatch):
-    """id_node whose builds wait at a gate, and are never quick (always off the executor)."""
+    """id_node whose builds (always off the executor) wait at a gate."""
     gate = Gate(id_module.finish_settings)
     monkeypatch.setattr(id_module, "finish_settings", gate)
-    monkeypatch.setattr(id_module, "quick", lambda *args: False)
     with running(IdNode) as harness:
         harness.gate = gate
         harness.gravity = harness.listen(JointState, "gravity_torques")
@@ -98,16 +98,21 @@ def test_changes_faster_than_builds_end_with_the_newest(gated_id_node):
     np.testing.assert_allclose(gravity_now(node), gravity(irb140(payload=RigidBody(5.0)), Q), rtol=1e-12, atol=1e-12)
 
 
-def test_a_payload_change_is_in_force_when_the_call_returns_and_a_gravity_change_follows():
+def test_a_payload_or_gravity_change_compiles_nothing_and_keeps_or_derives_the_limits(monkeypatch):
     """The kernels take the payload and gravity as an argument: nothing to compile. A payload
-    change leaves the markers' torque limits as they are; gravity changes them: they are
-    derived off the executor, the change in force once they are."""
+    change leaves the markers' torque limits as they are; gravity changes them."""
+    derived = Gate(id_settings.derive_torque_limits)
+    monkeypatch.setattr(id_settings, "derive_torque_limits", derived)
     with running(IdNode) as harness:
         node = harness.node
+        kernels, calls = node.settings.kernels, derived.calls
         assert node.set_parameters([Parameter("payload.mass", value=3.0)])[0].successful
-        assert node.rebuild.pending_since is None and node.settings.model == irb140(payload=RigidBody(3.0))
+        harness.settle()
+        assert node.settings.model == irb140(payload=RigidBody(3.0)) and derived.calls == calls
+        assert node.settings.kernels.native == kernels.native
         assert node.set_parameters([Parameter("gravity", value=[0.0, 0.0, -9.80665])])[0].successful
         harness.settle()
+        assert derived.calls == calls + 1
         expected = irb140(payload=RigidBody(3.0)).with_gravity((0.0, 0.0, -9.80665))
         assert node.settings.model == expected
 

@@ -85,9 +85,9 @@ class Probe:
         if msg.name == self._logger_name:  # other tests may run in the same domain
             self.log.append(msg.msg)
 
-    def stream(self, names=UR5_JOINTS + PANDA_JOINTS) -> None:
-        """Joint states of ``names`` (both arms' joints) at up to RATE, until ``streaming`` is cleared."""
-        msg = JointState(name=list(names), position=[0.1] * len(names), velocity=[0.0] * len(names))
+    def stream(self) -> None:
+        """Joint states of both arms' joints at up to RATE, until ``streaming`` is cleared."""
+        msg = JointState(name=UR5_JOINTS + PANDA_JOINTS, position=[0.1] * 13, velocity=[0.0] * 13)
         next_time = time.monotonic()
         while self.streaming.is_set():
             stamp = 1_000_000_000 + len(self.sent) * 1_000_000
@@ -177,56 +177,6 @@ def test_no_joint_state_goes_unanswered_while_a_urdf_is_refused_or_swapped_in():
         assert probe.answered[probe.sent[-1]] == tuple(PANDA_JOINTS)
         refusal = next(line for line in probe.log if "refused a robot_description" in line)
         assert "keeping the model of 6 joints" in refusal and "more than the limit of 100" in refusal, refusal
-    finally:
-        probe.streaming.clear()
-        rclpy.try_shutdown(context=context)
-        for thread in threads:
-            thread.join(TIMEOUT)
-        probe_executor.shutdown()
-        probe.node.destroy_node()
-        node.destroy_node()
-
-
-IRB140_JOINTS = [f"joint_{i}" for i in range(1, 7)]
-CHANGES = 50  # payload.mass changed every CHANGE_PERIOD: 5 s of changes
-CHANGE_PERIOD = 0.1  # s
-
-
-def test_no_joint_state_goes_unanswered_while_the_payload_changes_every_100_ms():
-    """At 1 kHz, reliable, the default queue depth (qos.depth 10): payload.mass set every
-    100 ms for 5 s through the parameter service; every joint state is answered."""
-    context = Context()
-    rclpy.init(context=context)
-    namespace = f"/changes_{uuid.uuid4().hex[:8]}"
-    overrides = [Parameter("qos.reliability", value="reliable")]
-    node = IdNode(context=context, parameter_overrides=overrides, cli_args=["--ros-args", "-r", f"__ns:={namespace}"])
-    probe = Probe(context, node.get_logger().name, namespace)
-    probe_executor = SingleThreadedExecutor(context=context)
-    probe_executor.add_node(probe.node)
-    threads = [
-        threading.Thread(target=spin_node, args=(node,), daemon=True),
-        threading.Thread(target=spin_probe, args=(probe_executor, context), daemon=True),
-    ]
-    streamer = threading.Thread(target=probe.stream, args=(IRB140_JOINTS,), daemon=True)
-    try:
-        for thread in threads:
-            thread.start()
-        assert wait_for(lambda: probe.states.get_subscription_count() > 0, TIMEOUT)
-        probe.streaming.set()
-        streamer.start()
-        assert wait_for(lambda: len(probe.answered) >= 100, TIMEOUT), "no torques for the stream"
-        client = AsyncParameterClient(probe.node, node.get_fully_qualified_name())
-        for k in range(CHANGES):
-            future = client.set_parameters([Parameter("payload.mass", value=1.0 + k % 7)])
-            assert wait_for(future.done, TIMEOUT) and future.result().results[0].successful
-            time.sleep(CHANGE_PERIOD)
-        assert wait_for(lambda: node.settings.model.payload.mass == 1.0 + (CHANGES - 1) % 7, TIMEOUT)
-        probe.streaming.clear()
-        streamer.join(TIMEOUT)
-        wait_for(lambda: len(probe.answered) >= len(probe.sent), TIMEOUT)
-        missing = [stamp for stamp in probe.sent if stamp not in probe.answered]
-        assert len(probe.sent) > 4000
-        assert missing == [], f"{len(missing)} of {len(probe.sent)} joint states unanswered"
     finally:
         probe.streaming.clear()
         rclpy.try_shutdown(context=context)

@@ -1,7 +1,7 @@
 """The model a tool runs on, from files: a parameter file, a URDF, parameter overrides.
 
 One place turns what a user gives a tool into a RobotModel, the way the nodes read theirs
-(``ros/parameters/model_source.py``):
+(``ros/parameters/arm.py``):
 
 - a parameter file whose ``model.source`` is ``parameters`` (the default): its joints
   (DH rows or URDF-form ``origin``/``axis``), merged over a defaults file (the tools give

@@ -54,7 +54,6 @@ from irb140_dynamics.nodes.id_node.settings import (
     check_settings,
     finish_settings,
     kernels_text,
-    quick,
 )
 from irb140_dynamics.nodes.id_node.tracking import ReferenceTracker
 from irb140_dynamics.nodes.id_node.wrench import WrenchSensor
@@ -138,14 +137,10 @@ class IdNode(Node):
         return result
 
     def _on_set_done(self, parameters) -> None:
-        """The change accepted: its settings in force at once when that is quick (no
-        compile, no derived limits to search), else built off the executor meanwhile."""
+        """The change accepted: its settings built off the executor (kernels bound or
+        compiled, limits derived), the model before answering meanwhile."""
         draft, self._draft = self._draft, None
-        if draft is None:
-            return
-        if quick(draft, self.rebuild.previous):
-            self.rebuild.build_here(draft)
-        else:
+        if draft is not None:
             self.rebuild.submit(draft)
 
     def _on_description(self, msg: String) -> None:
@@ -163,7 +158,7 @@ class IdNode(Node):
         """Switch to new (validated, compiled) settings; new joints come with a new model. A
         held reference the new model gives no finite torques for is let go."""
         first, names = self.settings is None, list(settings.model.joint_names)
-        if not first and self._started and settings.kernels is not self.settings.kernels:
+        if not first and self._started and settings.model.joints != self.settings.model.joints:
             self.get_logger().info(f"new model in force; {kernels_text(settings.kernels)}")
         if first or names != list(self.settings.model.joint_names):
             self._order = JointOrder(names)

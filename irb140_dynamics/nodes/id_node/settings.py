@@ -6,7 +6,7 @@ from dataclasses import dataclass, replace
 
 from irb140_dynamics.core import RigidBody, RobotModel
 from irb140_dynamics.core.codegen import native
-from irb140_dynamics.core.codegen.kernels import WITH_FRICTION, Preparation, kernels_of, prepare
+from irb140_dynamics.core.codegen.kernels import WITH_FRICTION, Preparation, prepare
 from irb140_dynamics.core.model.rigid_body import MAX_MASS
 from irb140_dynamics.core.payload.limits import RATED_PAYLOAD, derive_torque_limits
 from irb140_dynamics.core.payload.stop import stopping
@@ -156,22 +156,6 @@ def torque_limits(model: RobotModel, rated: RigidBody = RATED_PAYLOAD) -> tuple[
     from the ``rated`` payload, searched for at most LIMITS_TIME; inf: none)."""
     with stopping(seconds=LIMITS_TIME):
         return derive_torque_limits(model, rated).values
-
-
-def quick(settings: IdNodeSettings, previous: IdNodeSettings | None) -> bool:
-    """Whether finish_settings would be quick: no torque limits to derive, the arm's code
-    traced, and native already or never. Then it may run on the executor. On the way, a
-    kernel whose arm has compiled code already is bound to it (cheap; what prepare would do
-    first)."""
-    if not _same_limits(settings, previous):
-        return False
-    kernels = kernels_of(settings.model)
-    if not kernels.compiled(*KERNELS):
-        return False
-    return not native.enabled() or all(
-        kernel.native is not None or native.COMPILER.bind_built(kernel)
-        for kernel in (kernels.kernel(name) for name in KERNELS)
-    )
 
 
 def kernels_text(kernels: Preparation | None) -> str:

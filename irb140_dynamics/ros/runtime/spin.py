@@ -75,7 +75,6 @@ def _run(make_node: Callable[[], Node], args: list[str], executor: str, logger) 
         rclpy.try_shutdown()
         return code
     try:
-        freeze_startup_objects()
         spin(node, executor)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
@@ -149,8 +148,10 @@ def spin(node: Node, executor: str = "events") -> None:
     message of the default executor (bench/bench_nodes.py). Driven by spin_once: its
     spin() in the 7.1 wheels busy-loops without running callbacks; Ctrl-C is read between
     spin_once calls (``ctrl_c_as_a_flag``). ``single_threaded``:
-    rclpy.spin, the default SingleThreadedExecutor.
+    rclpy.spin, the default SingleThreadedExecutor. The objects made so far are frozen
+    first (``freeze_startup_objects``).
     """
+    freeze_startup_objects()
     try:
         from rclpy.experimental import EventsExecutor
     except ImportError:
