@@ -32,7 +32,7 @@ import math
 import sys
 
 from irb140_dynamics.tools.cli import Parser, ToolError, check_model_paths, output_file, run
-from irb140_dynamics.tools.common import add_model_arguments
+from irb140_dynamics.tools.common import add_model_arguments, arm_of
 
 NAME = "export_urdf"
 ROS_MARKERS = ("--ros-args", "--")  # the ROS form's markers: its --params-file and -p are ours
@@ -138,10 +138,9 @@ def _export(args: list[str], interrupts) -> int:
     check_model_paths(options)
     out = output_file(options.out) if options.out else None
 
-    from irb140_dynamics.tools.common import model_of
     from irb140_dynamics.tools.outputs import Outputs
 
-    text = urdf_of(model_of(options).model)
+    text = urdf_of(arm_of(options).model)
     if out is None:
         sys.stdout.write(text)
         sys.stdout.flush()

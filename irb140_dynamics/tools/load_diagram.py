@@ -31,6 +31,7 @@ import os
 import sys
 
 from irb140_dynamics.tools.cli import Parser, ToolError, check_model_paths, number, output_directory, run
+from irb140_dynamics.tools.common import add_model_arguments, arm_of
 
 NAME = "load_diagram"
 MAX_POINTS = 20_000  # grid points: a diagram beyond this is a typo of --step
@@ -38,8 +39,6 @@ FILES = ("load_diagram.csv", "load_diagram.png")
 
 
 def parser() -> Parser:
-    from irb140_dynamics.tools.common import add_model_arguments
-
     p = Parser(prog=NAME, description=__doc__.split("\n\n")[0].split(": ", 1)[1])
     p.add_argument("--out", required=True, metavar="DIR", help="the folder to write the CSV and PNG into")
     add_model_arguments(p)
@@ -85,14 +84,10 @@ def _diagram(argv: list[str], interrupts) -> int:
     from irb140_dynamics.core.model.rigid_body import RigidBody
     from irb140_dynamics.core.payload import derive_torque_limits
     from irb140_dynamics.core.payload.diagram import load_diagram
-    from irb140_dynamics.tools.common import model_of
     from irb140_dynamics.tools.load_diagram_plot import diagram_csv, diagram_png
     from irb140_dynamics.tools.outputs import Outputs
 
-    try:
-        source = model_of(args)
-    except ValueError as error:
-        raise ToolError(str(error).splitlines()[0]) from None
+    source = arm_of(args)
     model, rated = source.model, RigidBody(args.rated_mass)
     limits = derive_torque_limits(model, rated)
     diagram = load_diagram(model, limits.values, z, l, _progress(z.size * l.size), _workers(z.size))

@@ -40,7 +40,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
-from irb140_dynamics.core import gravity, rnea
+from irb140_dynamics.core import RobotModel, gravity, rnea
 from irb140_dynamics.core.io.stamps import seconds
 from irb140_dynamics.core.monitoring.filters import VelocityDifferentiator
 from irb140_dynamics.core.monitoring.observer import monitor_terms
@@ -118,6 +118,11 @@ class IdNode(Node):
         self._started = True
         if self.settings is not None:
             self._log_ready()
+
+    @property
+    def model(self) -> RobotModel | None:
+        """The RobotModel in force; None while waiting for a URDF."""
+        return None if self.settings is None else self.settings.model
 
     def _use(self, settings: IdNodeSettings) -> None:
         """Switch to new (validated, compiled) settings; new joints come with a new model. A

@@ -44,10 +44,7 @@ from irb140_dynamics.core.payload import (
 from irb140_dynamics.core.payload.mass_com_estimation import EstimationError
 from irb140_dynamics.core.payload.stop import stopping
 from irb140_dynamics.nodes.payload_check_node.check_service import CheckService
-from irb140_dynamics.nodes.payload_check_node.payload_estimator import (
-    ESTIMATION_PARAMETERS,
-    PayloadEstimator,
-)
+from irb140_dynamics.nodes.payload_check_node.payload_estimator import ESTIMATION_PARAMETERS, PayloadEstimator
 from irb140_dynamics.ros.messages.joint_messages import (
     BadMessage,
     JointOrder,
@@ -238,6 +235,10 @@ class PayloadCheckNode(Node):
                 f"ready: ~/check for a {mass} kg payload at {com} m "
                 "(its workspace analysis still running: ~/check waits for it)"
             )
+
+    @property
+    def model(self) -> RobotModel | None:  # the RobotModel in force; None while waiting for a URDF
+        return None if self.settings is None else self.settings.model
 
     def _use(self, settings: PayloadCheckSettings) -> None:
         """Switch to new settings (built, limits and workspace sweep included, when checked)."""

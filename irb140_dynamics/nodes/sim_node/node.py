@@ -38,6 +38,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 
+from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.nodes.sim_node.push import HeldWrench
 from irb140_dynamics.nodes.sim_node.settings import NODE_PARAMETERS, SimNodeSettings, build_settings, read_command
 from irb140_dynamics.ros.messages.joint_messages import BadMessage
@@ -106,6 +107,11 @@ class SimNode(Node):
         self.schedule = self.loop.schedule
         if self.parameters.current is not None:
             self._use(self.parameters.current)
+
+    @property
+    def model(self) -> RobotModel | None:
+        """The RobotModel in force; None while waiting for a URDF."""
+        return None if self.settings is None else self.settings.model
 
     def destroy_node(self):
         self.loop.stop()

@@ -136,6 +136,11 @@ class TrajectoryCheckNode(Node):
     def settings(self) -> TrajectoryCheckSettings | None:
         return self.parameters.current
 
+    @property
+    def model(self) -> RobotModel | None:
+        """The RobotModel in force; None while waiting for a URDF."""
+        return None if self.settings is None else self.settings.model
+
     def _not_ready(self) -> str:
         if self.parameters.failure is not None:
             return f"cannot check: {self.parameters.status()}"

@@ -2,5 +2,5 @@
 (``spec``), the values given at startup (``overrides``), the parameters every node shares
 (``specs``), a node's configuration kept in step with its parameters (``live``), where the
 model comes from (``model_source``: parameters or URDF), the parameter services
-(``services``), the names of the nodes' own parameters (``catalog``) and ``--help``'s model
-sections (``usage``)."""
+(``services``) and ``--help``'s model sections (``usage``). The names of the nodes' own
+parameters are below, in ``core.io.parameter_names`` (the tools know them too)."""

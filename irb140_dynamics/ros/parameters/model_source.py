@@ -1,4 +1,5 @@
-"""Where a node's model comes from: its parameters, or a URDF (robot_description).
+"""Where a node's model comes from: its parameters, or a URDF (robot_description); the model
+itself is read by ``core.io.arm_source.read_arm``, as every tool reads it.
 
 ``model.source`` (read-only):
 
@@ -22,7 +23,6 @@
 
 from __future__ import annotations
 
-import contextlib
 from typing import Any
 
 from rclpy.node import Node
@@ -31,6 +31,7 @@ from std_msgs.msg import String
 
 from irb140_dynamics.core import Joint, RigidBody, RobotModel
 from irb140_dynamics.core.errors import one_line
+from irb140_dynamics.core.io.arm_source import SOURCES, read_arm
 from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.core.io.text_files import size_limit
 from irb140_dynamics.core.io.urdf import MAX_URDF_CHARS, LoadedUrdf, UrdfError, load_urdf, read_urdf
@@ -43,7 +44,6 @@ from irb140_dynamics.ros.parameters.specs import MODEL_NAME, check_choice, joint
 from irb140_dynamics.ros.runtime.builder import Builder, Failed
 from irb140_dynamics.ros.runtime.command_line import params_files_given
 
-SOURCES = ("parameters", "robot_description")
 DESCRIPTION_QOS = QoSProfile(
     depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
 )
@@ -102,7 +102,11 @@ def declare_model_source(node: Node, recipe: Recipe) -> LiveParameters:
     )  # they become parameter prefixes: check them first
     robot_name = overrides.declare(MODEL_NAME)
     specs = [*model_specs(names, defaults), *recipe.specs, *recipe.per_joint(names)]
-    parameters = LiveParameters(node, overrides, specs, recipe.check, recipe)
+
+    def check(values: dict) -> Any:  # the model as read_arm reads it, then the node's own rules
+        return recipe.check({**values, **read_arm(values, defaults).model.to_params()})
+
+    parameters = LiveParameters(node, overrides, specs, check, recipe)
     parameters.robot_name = robot_name
     return parameters
 
@@ -165,11 +169,9 @@ class RobotDescription:
         return self._build_with(self.urdf, values)
 
     def _build_with(self, urdf: LoadedUrdf, values: dict) -> Any:
-        """``gravity`` is given in the URDF's root frame: the model takes it in base_link's."""
-        values = dict(values)
-        with contextlib.suppress(KeyError, TypeError, ValueError):  # absent or not 3 numbers: the check names it
-            values["gravity"] = urdf.in_base(values["gravity"])
-        return self._recipe.check({**urdf.model.to_params(), **values})
+        """The URDF chain's model as ``read_arm`` reads it (``gravity`` given in the URDF's root
+        frame, taken in base_link's), then the node's own rules."""
+        return self._recipe.check({**values, **read_arm(values, urdf=urdf).model.to_params()})
 
     def _on_description(self, msg: String) -> None:
         """A new URDF: read off the executor (``_read_topic``), then ``_use``d; a text over
