@@ -10,7 +10,7 @@ from typing import Any
 
 from irb140_dynamics.core.errors import one_line
 from irb140_dynamics.package_files import default_config_path
-from irb140_dynamics.tools.cli import BadArgument, ToolError, open_line
+from irb140_dynamics.tools.cli import BadArgument, ToolError, open_line, shown
 
 
 def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model") -> None:
@@ -57,7 +57,7 @@ def arm_of(args: argparse.Namespace):
     ToolError in one line for a bad file or value; BadArgument (exit status 2) for a name no
     executable of the package knows, with the nearest known one."""
     from irb140_dynamics.core.io.arm_source import given_values, read_arm, read_urdf_file
-    from irb140_dynamics.core.io.parameter_names import known_parameter_names, unknown_lines, unknown_names
+    from irb140_dynamics.core.io.parameter_names import known_parameter_names, unknown_names
     from irb140_dynamics.core.io.params_file import read_parameter_file
 
     params_file = getattr(args, "params_file", None)
@@ -77,11 +77,23 @@ def arm_of(args: argparse.Namespace):
     except ValueError as error:
         raise ToolError(one_line(error)) from None
     known = known_parameter_names(arm.model.joint_names, from_urdf=arm.urdf is not None)
-    lines = unknown_lines(unknown_names(values, known))
-    if lines:
-        where = f" (in {params_file} or -p)" if params_file else " (-p)"
-        raise BadArgument("; ".join(lines) + where)
+    unknown = unknown_names(values, known, arm.model.joint_names)
+    if unknown:
+        raise BadArgument(_unknown_text(unknown, dict(overrides), params_file))
     return arm
+
+
+def _unknown_text(unknown, overrides: dict, params_file) -> str:
+    """'unknown parameters in arm.yaml: payload.masss (did you mean payload.mass?); -p:
+    joint_6.torque_limt (did you mean joint_6.torque_limit?)'."""
+    by_source: dict[str, list[str]] = {}
+    for entry in unknown:
+        source = "-p" if entry.name in overrides else f"in {shown(params_file)}"
+        by_source.setdefault(source, []).append(f"{entry.name} ({entry.why()})")
+    plural = "s" if len(unknown) > 1 else ""
+    return f"unknown parameter{plural} " + "; ".join(
+        f"{source}: {', '.join(names)}" for source, names in by_source.items()
+    )
 
 
 def parse_override(text: str) -> tuple[str, Any]:

@@ -48,7 +48,7 @@ class _ArgumentParser(argparse.ArgumentParser):
         raise ToolError(message)
 
 
-def _parser() -> argparse.ArgumentParser:
+def parser() -> argparse.ArgumentParser:
     parser = _ArgumentParser(prog=NAME, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_model_arguments(parser, "the model (default: the package's IRB-140)")
     parser.add_argument("--form", required=True, help=f"one of {', '.join(FORMS)}")
@@ -71,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _main(argv: list[str]) -> int:
-    args = _parser().parse_args(argv)
+    args = parser().parse_args(argv)
     if args.form not in FORMS:
         raise ToolError(f"unknown form {args.form!r}: choose from {', '.join(FORMS)}")
     what = tuple(w.strip() for w in args.what.split(",") if w.strip())

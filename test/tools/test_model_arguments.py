@@ -185,3 +185,19 @@ def test_the_offline_tools_run_without_ros():
     assert done.returncode == 0, done.stderr
     model = load_urdf(done.stdout).model
     assert model.joint_names == true_ur5().joint_names
+
+
+def test_the_names_a_tool_knows_follow_the_arm(tmp_path, capsys):
+    """A URDF arm's own joints take limits, friction and armature (and the nodes' per-joint
+    parameters); the IRB-140's joint names are unknown there; a sibling's name is known."""
+    from irb140_dynamics.tools import export_urdf
+
+    urdf = ["--urdf", str(UR5_URDF), "--base", BASE, "--tip", TIP, "--out", str(tmp_path / "a.urdf")]
+    known = ["shoulder_pan_joint.armature:=0.1", "shoulder_pan_joint.kp:=10.0", "qos.depth:=5", "payload.mass:=1.0"]
+    assert export_urdf.main(["export_urdf", *urdf, *(f"-p{text}" for text in known)]) == 0
+    capsys.readouterr()
+    assert export_urdf.main(["export_urdf", *urdf, "-p", "joint_1.armature:=0.1"]) == 2
+    error = capsys.readouterr().err
+    assert "-p: joint_1.armature (the arm has no joint joint_1; did you mean" in error and error.count("\n") == 1
+    assert export_urdf.main(["export_urdf", *urdf, "-p", "shoulder_pan_joint.dh:=[0,0,0,0]"]) == 2
+    assert "shoulder_pan_joint.dh" in capsys.readouterr().err  # a URDF's joints take no DH row

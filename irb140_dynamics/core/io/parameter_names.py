@@ -64,6 +64,7 @@ NODE_PARAMETER_NAMES = frozenset(
 )
 # per-joint parameters of a node: <joint><suffix>
 PER_JOINT_SUFFIXES = (".collision_threshold", ".kd", ".kp")
+PER_JOINT_FIELDS = frozenset(JOINT_FIELDS) | {suffix[1:] for suffix in PER_JOINT_SUFFIXES}  # <joint>.<field>
 # the model's parameters that are not per joint, and where it comes from
 MODEL_PARAMETER_NAMES = (
     "joint_names",
@@ -104,17 +105,28 @@ def known_parameter_names(joint_names, from_urdf: bool = False) -> set[str]:
 @dataclass(frozen=True)
 class UnknownName:
     """A name given that is no known parameter: the nearest known name, or the known
-    parameter it lies under (a list written as a mapping)."""
+    parameter it lies under (a list written as a mapping); ``joint``: the joint it names
+    when the arm has no such joint (``joint_7`` of ``joint_7.torque_limit``)."""
 
     name: str
     nearest: str | None = None
     parent: str | None = None
+    joint: str | None = None
+
+    def why(self) -> str:
+        """'did you mean joint_6.torque_limit?', 'joint_1.dh is one parameter, not a mapping', ..."""
+        if self.parent is not None:
+            return f"{self.parent} is one parameter, not a mapping"
+        nearest = f"did you mean {self.nearest}?" if self.nearest else "no known name is near it"
+        return f"the arm has no joint {self.joint}; {nearest}" if self.joint else nearest
 
 
-def unknown_names(given: Iterable[str], known: Iterable[str]) -> list[UnknownName]:
-    """The names of ``given`` not in ``known``, sorted, each with its nearest known name."""
+def unknown_names(given: Iterable[str], known: Iterable[str], joint_names=None) -> list[UnknownName]:
+    """The names of ``given`` not in ``known``, sorted, each with its nearest known name;
+    ``joint_names``: the arm's (a per-joint name of another joint is told so)."""
     known = set(known)
     ordered = sorted(known)
+    joints = {name for joint in joint_names or () for name in (joint, param_prefix(joint))}
     unknown = []
     for name in sorted(set(given) - known):
         parent = _known_parent(name, known)
@@ -122,7 +134,9 @@ def unknown_names(given: Iterable[str], known: Iterable[str]) -> list[UnknownNam
             unknown.append(UnknownName(name, parent=parent))
             continue
         nearest = difflib.get_close_matches(name, ordered, n=1, cutoff=0.6)
-        unknown.append(UnknownName(name, nearest=nearest[0] if nearest else None))
+        joint, _, field = name.partition(".")
+        other_joint = joint_names is not None and joint not in joints and field in PER_JOINT_FIELDS
+        unknown.append(UnknownName(name, nearest[0] if nearest else None, joint=joint if other_joint else None))
     return unknown
 
 
@@ -134,6 +148,8 @@ def unknown_lines(unknown: list[UnknownName], ignored: str = "", describe: Calla
     for entry in unknown:
         if entry.parent is not None:
             by_parent.setdefault(entry.parent, []).append(entry.name)
+        elif entry.joint is not None:
+            lines.append(f"unknown parameter {entry.name}{ignored}: {entry.why()}")
         else:
             hint = f"; did you mean {entry.nearest}?" if entry.nearest else ""
             lines.append(f"unknown parameter {entry.name}{ignored}{hint}")

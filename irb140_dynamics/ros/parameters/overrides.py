@@ -62,7 +62,7 @@ class Overrides:
             for name in self.given
             if not (joint_names is None and name.endswith(PER_JOINT_SUFFIXES))  # a joint of a model still to come
         ]
-        lines = unknown_lines(unknown_names(given, known), " (ignored)", self._description)
+        lines = unknown_lines(unknown_names(given, known, joint_names), " (ignored)", self._description)
         logger = self._node.get_logger()
         for line in lines[:MAX_UNKNOWN_WARNINGS]:
             logger.warning(line)
