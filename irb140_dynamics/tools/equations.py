@@ -1,15 +1,14 @@
 """equations: the equations of motion in closed form, as LaTeX, SymPy, C99 or NumPy Python.
 
     equations --form c --out gen/                      (the package's IRB-140)
-    equations [--params-file F] [--urdf arm.urdf [--base LINK --tip LINK]] [-p NAME:=VALUE]
-              --form latex|sympy|c|python --out DIR
+    equations [--params-file F] [--urdf arm.urdf [--base LINK --tip LINK]] [-p NAME:=VALUE] --form FORM --out DIR
               [--what tau,M,C,g,regressor] [--symbolic-parameters] [--payload-mass KG] [--prefix NAME]
 
 The model is read as every tool and node reads it (``core.io.arm_source``): the package's
 IRB-140, the params file's ``/**`` section over it, then -p; or the URDF's chain.
 
 Derived by running the package's own recursions on symbols (irb140_dynamics.core.equations).
---what defaults to tau,M,C,g (C: the torques C(q, qd) qd). --out may exist: the tool's files
+FORM: latex, sympy, c or python. --what defaults to tau,M,C,g (C: the torques C(q, qd) qd). --out may exist: the tool's files
 in it are replaced, nothing else is touched; on any error nothing is written there.
 """
 
