@@ -23,6 +23,14 @@ from irb140_dynamics.tools.progress import open_line
 class ToolError(Exception):
     """An error the tool reports in one line (exit status 1)."""
 
+    status = 1
+
+
+class BadArgument(ToolError):
+    """A bad argument found after parsing (an unknown parameter name): one line, exit status 2."""
+
+    status = 2
+
 
 class Parser(argparse.ArgumentParser):
     """argparse, its errors in one line (``prog: error: ...; see --help``, status 2)."""
@@ -285,6 +293,7 @@ def _failed(tool: str, error: BaseException, interrupts: Interrupts) -> int:
         return 128 + signal.SIGPIPE
     if isinstance(error, ToolError):
         _say(f"{tool}: error: {error}")
+        return error.status
     elif isinstance(error, (ValueError, OSError, ArithmeticError, MemoryError, RecursionError)):
         _say(f"{tool}: error: {_describe(error)}")
     elif isinstance(error, Exception):  # a defect of ours: still one line, not a traceback

@@ -1,4 +1,4 @@
-"""What the command-line tools share: the model's arguments and the progress of reading a recording (see
+"""What the command-line tools share: the arm's arguments and the progress of reading a recording (see
 cli.py for the rest)."""
 
 from __future__ import annotations
@@ -7,29 +7,44 @@ import argparse
 import contextlib
 import os
 import re
+from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
+from irb140_dynamics.core.errors import one_line
 from irb140_dynamics.package_files import default_config_path
-from irb140_dynamics.tools.cli import ToolError  # noqa: F401 (the tools import it from here too)
+from irb140_dynamics.tools.cli import BadArgument, ToolError, shown
 
 
 def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model") -> None:
-    """--params-file, --urdf, --base, --tip and -p: the model, read as ``core.io.model_source`` says."""
+    """--params-file, --urdf, --base, --tip and -p: the arm, read as ``core.io.arm_source`` says."""
     group = parser.add_argument_group(role)
     group.add_argument(
         "--params-file",
         metavar="F",
-        help="a ROS 2 parameter file: the model's parameters, or "
+        help="a ROS 2 parameter file: the model's parameters over the package's IRB-140, or "
         "model.source: robot_description with model.urdf_file (default: the package's IRB-140)",
     )
     group.add_argument(
         "--urdf",
         metavar="FILE",
         help="the model from this URDF's chain (the parameter file, if "
-        "any, gives gravity, payload.* and the chain's limits, friction, armature)",
+        "any, gives gravity in the root link's frame, payload.* and the chain's limits, friction, armature)",
     )
-    group.add_argument("--base", metavar="LINK", help="the URDF link the chain starts from (default: the root)")
-    group.add_argument("--tip", metavar="LINK", help="the URDF link the chain ends at (default: the only leaf)")
+    group.add_argument(
+        "--base",
+        "--base-link",
+        dest="base",
+        metavar="LINK",
+        help="the URDF link the chain starts from (default: the root)",
+    )
+    group.add_argument(
+        "--tip",
+        "--tip-link",
+        dest="tip",
+        metavar="LINK",
+        help="the URDF link the chain ends at (default: the only leaf)",
+    )
     group.add_argument(
         "-p",
         dest="overrides",
@@ -40,15 +55,61 @@ def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model"
     )
 
 
-def model_of(args: argparse.Namespace):
-    """The model of the arguments that ``add_model_arguments`` declared (ValueError in one line)."""
-    from irb140_dynamics.core.io.model_source import parse_override, tool_model
+def arm_of(args: argparse.Namespace):
+    """The arm (``core.io.arm_source.Arm``) of the arguments ``add_model_arguments`` declared:
+    ToolError in one line for a bad file or value; BadArgument (exit status 2) for a name no
+    executable of the package knows, with the nearest known one."""
+    from irb140_dynamics.core.io.arm_source import given_values, read_arm, read_urdf_file
+    from irb140_dynamics.core.io.parameter_names import known_parameter_names, unknown_names
+    from irb140_dynamics.core.io.params_file import read_parameter_file
 
-    overrides = dict(parse_override(text) for text in args.overrides)
+    params_file = getattr(args, "params_file", None)
     try:
-        return tool_model(args.params_file, args.urdf, args.base, args.tip, overrides, default_config_path())
+        overrides = [parse_override(text) for text in getattr(args, "overrides", None) or []]
+        values = given_values([params_file] if params_file else [], overrides)
+        urdf = read_urdf_file(args.urdf) if getattr(args, "urdf", None) else None
+        arm = read_arm(
+            values,
+            read_parameter_file(default_config_path()),
+            urdf,
+            getattr(args, "base", None),
+            getattr(args, "tip", None),
+            origin=params_file,
+            relative_to=Path(params_file).parent if params_file else None,
+        )
     except ValueError as error:
-        raise ValueError(in_option_words(str(error), args.params_file, args.base, args.tip, overrides)) from None
+        raise ToolError(in_option_words(one_line(error), params_file, args.base, args.tip, dict(overrides))) from None
+    known = known_parameter_names(arm.model.joint_names, from_urdf=arm.urdf is not None)
+    unknown = unknown_names(values, known, arm.model.joint_names)
+    if unknown:
+        raise BadArgument(_unknown_text(unknown, dict(overrides), params_file))
+    return replace(arm, given=values)
+
+
+def _unknown_text(unknown, overrides: dict, params_file) -> str:
+    """'unknown parameters in arm.yaml: payload.masss (did you mean payload.mass?); -p:
+    joint_6.torque_limt (did you mean joint_6.torque_limit?)'."""
+    by_source: dict[str, list[str]] = {}
+    for entry in unknown:
+        source = "-p" if entry.name in overrides else f"in {shown(params_file)}"
+        by_source.setdefault(source, []).append(f"{entry.name} ({entry.why()})")
+    plural = "s" if len(unknown) > 1 else ""
+    return f"unknown parameter{plural} " + "; ".join(
+        f"{source}: {', '.join(names)}" for source, names in by_source.items()
+    )
+
+
+def parse_override(text: str) -> tuple[str, Any]:
+    """``name:=value`` (value as YAML, as ``ros2 run ... -p`` reads it) -> (name, value)."""
+    import yaml
+
+    name, separator, value = text.partition(":=")
+    if not separator or not name.strip():
+        raise ValueError(f"-p {text}: expected NAME:=VALUE")
+    try:
+        return name.strip(), yaml.safe_load(value)
+    except yaml.YAMLError as error:
+        raise ValueError(f"-p {text}: the value is not YAML ({str(error).splitlines()[0]})") from None
 
 
 # the core's names of the chain's ends where they name the option: the element of a URDF

@@ -1,11 +1,14 @@
 """equations: the equations of motion in closed form, as LaTeX, SymPy, C99 or NumPy Python.
 
-    equations --params-file config/irb140.yaml --form c --out gen/
-    equations --urdf arm.urdf [--base LINK --tip LINK] --form latex|sympy|c|python --out DIR
+    equations --form c --out gen/                      (the package's IRB-140)
+    equations [--params-file F] [--urdf arm.urdf [--base LINK --tip LINK]] [-p NAME:=VALUE] --form FORM --out DIR
               [--what tau,M,C,g,regressor] [--symbolic-parameters] [--payload-mass KG] [--prefix NAME]
 
+The model is read as every tool and node reads it (``core.io.arm_source``): the package's
+IRB-140, the params file's ``/**`` section over it, then -p; or the URDF's chain.
+
 Derived by running the package's own recursions on symbols (irb140_dynamics.core.equations).
---what defaults to tau,M,C,g (C: the torques C(q, qd) qd). --out may exist: the tool's files
+FORM: latex, sympy, c or python. --what defaults to tau,M,C,g (C: the torques C(q, qd) qd). --out may exist: the tool's files
 in it are replaced, nothing else is touched; on any error nothing is written there.
 """
 
@@ -24,15 +27,17 @@ import sys
 import tempfile
 import threading
 import time
+from dataclasses import replace
 from pathlib import Path
 
-from ..core import RigidBody, load_model
+from ..core import RigidBody
 from ..core.equations import DEFAULT_QUANTITIES, FORMS, QUANTITIES, file_names, generate
 from ..core.errors import one_line
 from ..core.io.atomic import replace_all
-from ..core.urdf import load_urdf
-from .cli import ToolError, refuse_input_as_output, run
-from .common import in_option_words, model_inputs
+from ..package_files import default_config_path
+from .cli import ToolError, check_model_paths, refuse_input_as_output, run
+from .common import add_model_arguments, model_inputs
+from .common import arm_of as _arm_of
 
 NAME = "equations"
 QUIET_SECONDS = 2.0  # a progress line on stderr once the work takes longer than this
@@ -43,13 +48,9 @@ class _ArgumentParser(argparse.ArgumentParser):
         raise ToolError(message)
 
 
-def _parser() -> argparse.ArgumentParser:
+def parser() -> argparse.ArgumentParser:
     parser = _ArgumentParser(prog=NAME, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    source = parser.add_mutually_exclusive_group(required=True)
-    source.add_argument("--params-file", help="a parameter file (YAML) of the model")
-    source.add_argument("--urdf", help="a URDF file")
-    parser.add_argument("--base", help="the URDF chain's base link (default: the root)")
-    parser.add_argument("--tip", help="the URDF chain's tip link (default: the only leaf)")
+    add_model_arguments(parser, "the model (default: the package's IRB-140)")
     parser.add_argument("--form", required=True, help=f"one of {', '.join(FORMS)}")
     parser.add_argument("--out", required=True, help="the folder to write into")
     parser.add_argument("--what", default=",".join(DEFAULT_QUANTITIES), help=f"of {','.join(QUANTITIES)}")
@@ -70,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _main(argv: list[str]) -> int:
-    args = _parser().parse_args(argv)
+    args = parser().parse_args(argv)
     if args.form not in FORMS:
         raise ToolError(f"unknown form {args.form!r}: choose from {', '.join(FORMS)}")
     what = tuple(w.strip() for w in args.what.split(",") if w.strip())
@@ -79,9 +80,9 @@ def _main(argv: list[str]) -> int:
         raise ToolError(
             f"unknown quantity {unknown[0] if unknown else args.what!r}: choose from {','.join(QUANTITIES)}"
         )
-    if args.urdf is None and (args.base or args.tip):
-        raise ToolError("--base and --tip go with --urdf")
-    model, path = _model(args)
+    check_model_paths(args)
+    model = arm_of(args).model
+    path = Path(args.urdf or args.params_file or default_config_path())
     prefix = args.prefix or _identifier(path.stem)
     if not prefix.isidentifier() or not prefix.isascii():
         raise ToolError(f"--prefix {prefix!r} is not a C identifier")
@@ -105,21 +106,16 @@ def _main(argv: list[str]) -> int:
     return 0
 
 
-def _model(args):
-    path = Path(args.params_file or args.urdf)
-    if not path.is_file():
-        raise ToolError(f"{path}: no such file")
+def arm_of(args: argparse.Namespace):
+    """The arm of the arguments (``common.arm_of``, as every tool reads it), with
+    --payload-mass at the flange origin, replacing the model's payload, when given."""
+    arm = _arm_of(args)
+    if args.payload_mass is None:
+        return arm
     try:
-        if args.params_file:
-            model = load_model(path)
-        else:
-            model = load_urdf(path.read_text(), args.base, args.tip).model
-        if args.payload_mass is not None:
-            model = model.with_payload(RigidBody(args.payload_mass))
-    except (ValueError, OSError) as error:  # ModelError, UrdfError, YAML errors are ValueErrors
-        message = in_option_words(one_line(error), args.params_file, args.base, args.tip)
-        raise ToolError(f"{path}: {message or type(error).__name__}") from None
-    return model, path
+        return replace(arm, model=arm.model.with_payload(RigidBody(args.payload_mass)))
+    except ValueError as error:
+        raise ToolError(f"--payload-mass: {one_line(error)}") from None
 
 
 def _identifier(stem: str) -> str:

@@ -40,6 +40,7 @@ from irb140_dynamics.tools.cli import (
     refuse_input_as_output,
     run,
 )
+from irb140_dynamics.tools.common import add_model_arguments, arm_of
 
 MAX_POINTS = 1_000_000  # points written: 100 MB of YAML
 POINTS_PER_CYCLE = 4  # of the highest harmonic: fewer points do not show the motion
@@ -49,7 +50,6 @@ PUBLISH = "  ros2 topic pub --once /joint_trajectory_controller/joint_trajectory
 
 def parser() -> Parser:
     from irb140_dynamics.identification.excitation import DEFAULT_HARMONICS, DEFAULT_MARGIN, DEFAULT_PERIOD
-    from irb140_dynamics.tools.common import add_model_arguments
 
     p = Parser(prog="excitation", description=__doc__.split("\n\n")[0].split(": ", 1)[1])
     p.add_argument("--out", required=True, metavar="FILE", help="JointTrajectory YAML file to write")
@@ -151,10 +151,9 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
     from irb140_dynamics.core.io.trajectory_file import joint_trajectory_text
     from irb140_dynamics.identification.base import find_base_parameters
     from irb140_dynamics.identification.excitation import check_limits, optimise_excitation
-    from irb140_dynamics.tools.common import model_of
     from irb140_dynamics.tools.outputs import Outputs
 
-    source = model_of(args)
+    source = arm_of(args)
     model, path = source.model, source.origin
     if args.payload:
         result, regressor = _payload_excitation(model, path, args), "the payload's regressor"

@@ -4,7 +4,7 @@
                        [-p NAME:=VALUE ...] > arm.urdf
     (or: ros2 run irb140_dynamics export_urdf ..., python -m irb140_dynamics.tools.export_urdf ...)
 
-The model is read as the other tools read it (``core.io.model_source``): the default
+The model is read as every tool and node reads it (``core.io.arm_source``): the default
 config/irb140.yaml, then the params file (``model.source: robot_description`` with
 ``robot_description`` or ``model.urdf_file`` works too), then -p; or a URDF's chain. The
 ROS form ``--ros-args --params-file FILE -p NAME:=VALUE`` is taken as well (parameters
@@ -18,7 +18,8 @@ check derives for the rated payload (6 kg: its worst static torque over the join
 else, for a joint no static payload loads (axes 1 and 6), the largest torque found for the
 joint's acceleration limit with the rated payload. Where none applies (a velocity limit
 of another arm) the tool refuses in one line. Exit status 0; 1 with one line; 2 for a bad
-argument; 130 after Ctrl-C, nothing written.
+argument (a parameter name no executable of the package knows, with the nearest known
+one); 130 after Ctrl-C, nothing written.
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ import math
 import sys
 
 from irb140_dynamics.tools.cli import Parser, ToolError, check_model_paths, output_file, refuse_input_as_output, run
-from irb140_dynamics.tools.common import add_model_arguments, model_inputs
+from irb140_dynamics.tools.common import add_model_arguments, arm_of, model_inputs
 
 NAME = "export_urdf"
 ROS_MARKERS = ("--ros-args", "--")  # the ROS form's markers: its --params-file and -p are ours
@@ -139,10 +140,9 @@ def _export(args: list[str], interrupts) -> int:
     out = output_file(options.out) if options.out else None
     refuse_input_as_output(model_inputs(options), [(options.out, out)])
 
-    from irb140_dynamics.tools.common import model_of
     from irb140_dynamics.tools.outputs import Outputs
 
-    text = urdf_of(model_of(options).model)
+    text = urdf_of(arm_of(options).model)
     if out is None:
         sys.stdout.write(text)
         sys.stdout.flush()

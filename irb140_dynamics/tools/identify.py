@@ -51,7 +51,7 @@ from irb140_dynamics.tools.cli import (
     refuse_input_as_output,
     run,
 )
-from irb140_dynamics.tools.common import add_model_arguments, model_inputs
+from irb140_dynamics.tools.common import add_model_arguments, arm_of, model_inputs
 
 DEFAULT_HELD_OUT = 0.2
 DEFAULT_PRIOR_WEIGHT = 1.0
@@ -153,10 +153,10 @@ def _identify(argv: list[str], interrupts) -> int:
 
     from irb140_dynamics.identification.pipeline import IdentificationSettings, identify
     from irb140_dynamics.identification.report import identified_file, identified_urdf, summary
-    from irb140_dynamics.tools.common import model_of, reading_progress
+    from irb140_dynamics.tools.common import reading_progress
     from irb140_dynamics.tools.outputs import Outputs
 
-    source = model_of(args)
+    source = arm_of(args)
     prior, prior_path = source.model, source.origin
     if urdf_out is None and source.urdf is not None:
         args.urdf_out = str(Path(args.out).with_suffix(".urdf"))

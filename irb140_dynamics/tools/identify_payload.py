@@ -30,10 +30,10 @@ def identify_payload(args: argparse.Namespace, argv: list[str], interrupts) -> i
     from irb140_dynamics.identification.payload import fit_payload
     from irb140_dynamics.identification.payload_report import payload_file, payload_summary
     from irb140_dynamics.identification.pipeline import IdentificationSettings
-    from irb140_dynamics.tools.common import model_of, reading_progress
+    from irb140_dynamics.tools.common import arm_of, reading_progress
     from irb140_dynamics.tools.outputs import Outputs
 
-    source = model_of(args)
+    source = arm_of(args)
     arm = source.model
     settings = IdentificationSettings(topic=args.topic, cutoff=args.cutoff, min_speed=args.min_speed)
     progress = None if args.quiet else reading_progress("identify")

@@ -43,6 +43,7 @@ from irb140_dynamics.tools.cli import (
     refuse_input_as_output,
     run,
 )
+from irb140_dynamics.tools.common import add_model_arguments, arm_of
 
 NAME = "load_diagram"
 MAX_MASS = 1e6  # kg: the model's own cap of a mass
@@ -51,8 +52,6 @@ FILES = ("load_diagram.csv", "load_diagram.png")
 
 
 def parser() -> Parser:
-    from irb140_dynamics.tools.common import add_model_arguments
-
     p = Parser(prog=NAME, description=__doc__.split("\n\n")[0].split(": ", 1)[1])
     p.add_argument("--out", metavar="DIR", help="the folder to write the CSV and PNG into")
     add_model_arguments(p)
@@ -131,13 +130,12 @@ def _diagram(argv: list[str], interrupts) -> int:
 
     from irb140_dynamics.core.payload import derive_torque_limits
     from irb140_dynamics.core.payload.diagram import load_diagram
-    from irb140_dynamics.tools.common import model_of
     from irb140_dynamics.tools.load_diagram_plot import diagram_csv, diagram_png
     from irb140_dynamics.tools.outputs import Outputs
 
+    source = arm_of(args)
     try:
-        source = model_of(args)
-        rated, stated = rated_payload(source.parameters or {}, args.rated_mass)
+        rated, stated = rated_payload(source.given, args.rated_mass)
     except ValueError as error:
         raise ToolError(str(error).splitlines()[0]) from None
     model = source.model

@@ -1,13 +1,15 @@
 """retime: check a JointTrajectory against the arm's limits, or re-time it time-optimally.
 
-    retime --params-file F [--urdf U [--base L] [--tip L]] [--payload-mass M] IN.yaml OUT.yaml [--plot P.png]
-    retime --check-only --params-file F [--urdf U [--base L] [--tip L]] [--payload-mass M] IN.yaml [--plot P.png]
+    retime [--params-file F] [--urdf U [--base L] [--tip L]] [-p NAME:=VALUE] [--payload-mass M] IN.yaml OUT.yaml
+           [--plot P.png]
+    retime --check-only [--params-file F] [--urdf U ...] [-p NAME:=VALUE] [--payload-mass M] IN.yaml [--plot P.png]
 
 IN.yaml: a trajectory_msgs/JointTrajectory as ``ros2 topic echo --once`` prints it (header,
 joint_names, points with positions, velocities, accelerations, effort, time_from_start
-{sec, nanosec}); joints in any order, matched to the model's by name. The model: the params
-file (its ``/**`` section), or the URDF's chain with the params file's limits, friction and
-armature for its joints; --payload-mass puts that mass at the flange origin. Torque limits
+{sec, nanosec}); joints in any order, matched to the model's by name. The model, read as
+every tool and node reads it (``core.io.arm_source``): the package's IRB-140, the params
+file's ``/**`` section over it, then -p; or the URDF's chain with the params file's limits,
+friction and armature for its joints; --payload-mass puts that mass at the flange origin. Torque limits
 of 0 are derived as the payload check derives them (said in the report).
 
 Re-timing writes OUT.yaml (the same path, a point per grid point, timed time-optimally, as
@@ -31,12 +33,12 @@ import argparse
 import math
 import os
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from ..core import RigidBody, RobotModel
 from ..core.errors import counted
 from ..core.io.atomic import write_files
-from ..core.io.model_source import tool_model
 from ..core.io.trajectory_file import joint_trajectory_yaml, read_joint_trajectory
 from ..core.trajectories import (
     Trajectory,
@@ -47,7 +49,8 @@ from ..core.trajectories import (
     trajectory_limits,
 )
 from .cli import ToolError, refuse_input_as_output, run
-from .common import in_option_words, model_inputs
+from .common import add_model_arguments, model_inputs
+from .common import arm_of as _arm_of
 
 NAME = "retime"
 OVER_LIMIT = 3
@@ -57,17 +60,7 @@ def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog=NAME, description=__doc__.split("\n\n")[0].split(": ", 1)[1])
     p.add_argument("input", metavar="IN.yaml", help="the JointTrajectory (ros2 topic echo layout)")
     p.add_argument("output", metavar="OUT.yaml", nargs="?", help="the re-timed JointTrajectory to write")
-    p.add_argument("--params-file", required=True, metavar="F", help="the model's parameter file")
-    p.add_argument("--urdf", metavar="U", help="take the kinematics and inertials from this URDF")
-    p.add_argument(  # --base/--tip as in the other tools; --base-link/--tip-link kept
-        "--base", "--base-link", dest="base_link", help="the URDF link the chain starts from (default: the root)"
-    )
-    p.add_argument(
-        "--tip",
-        "--tip-link",
-        dest="tip_link",
-        help="the URDF's chain end, the payload's frame (default: the only leaf)",
-    )
+    add_model_arguments(p, "the model and its limits (default: the package's IRB-140)")
     p.add_argument("--payload-mass", type=float, metavar="KG", help="payload at the flange origin (default: F's)")
     p.add_argument("--check-only", action="store_true", help="only check IN.yaml; write nothing but --plot")
     p.add_argument("--plot", metavar="P.png", help="per joint the use of each limit over time, before and after")
@@ -80,21 +73,18 @@ def parser() -> argparse.ArgumentParser:
     return p
 
 
-def model_of(params_file: str, urdf: str | None, payload_mass: float | None, chain=(None, None)) -> RobotModel:
-    """The model of the params file, or of the URDF with the file's limits and friction
-    (``core.io.model_source``, as every tool reads its model)."""
+def arm_of(args: argparse.Namespace):
+    """The arm of the arguments (``common.arm_of``, as every tool reads it), with
+    --payload-mass at the flange origin when given."""
+    arm = _arm_of(args)
+    if args.payload_mass is None:
+        return arm
+    if not (math.isfinite(args.payload_mass) and args.payload_mass >= 0):
+        raise ToolError(f"--payload-mass: must be a mass >= 0 kg, got {args.payload_mass}")
     try:
-        model = tool_model(params_file, urdf, *chain).model
+        return replace(arm, model=arm.model.with_payload(RigidBody(args.payload_mass)))
     except ValueError as error:
-        raise ToolError(in_option_words(str(error).splitlines()[0], params_file, *chain)) from None
-    if payload_mass is not None:
-        if not (math.isfinite(payload_mass) and payload_mass >= 0):
-            raise ToolError(f"--payload-mass: must be a mass >= 0 kg, got {payload_mass}")
-        try:
-            model = model.with_payload(RigidBody(payload_mass))
-        except ValueError as error:
-            raise ToolError(f"--payload-mass: {error}") from None
-    return model
+        raise ToolError(f"--payload-mass: {error}") from None
 
 
 def read_trajectory(path: str, model: RobotModel) -> Trajectory:
@@ -134,7 +124,7 @@ def _retime(args: argparse.Namespace) -> int:
     written = (args.plot,) if args.check_only else (args.output, args.plot)
     outputs = [(path, Path(os.path.abspath(path))) for path in written if path]
     refuse_input_as_output(inputs, outputs)
-    model = model_of(args.params_file, args.urdf, args.payload_mass, (args.base_link, args.tip_link))
+    model = arm_of(args).model
     steps = _Steps(args.input, (2 if args.check_only else 5) + bool(args.plot))
     steps("reading the input")
     tr = read_trajectory(args.input, model)

@@ -14,7 +14,7 @@ import lzma
 import numpy as np
 import pytest
 
-from irb140_dynamics.core.io.model_source import tool_model
+from irb140_dynamics.core.io.arm_source import read_arm, read_urdf_file
 from irb140_dynamics.core.regressor import inertial_parameters
 from irb140_dynamics.identification.pipeline import IdentificationSettings, identify
 
@@ -32,7 +32,7 @@ def result(tmp_path_factory):
     folder = tmp_path_factory.mktemp("kuka")
     for name in ("traj1", "traj3"):
         (folder / f"{name}.csv").write_bytes(lzma.decompress((KUKA / f"{name}.csv.xz").read_bytes()))
-    prior = tool_model(urdf_file=KUKA / "kuka_lwr4.urdf").model
+    prior = read_arm({}, urdf=read_urdf_file(KUKA / "kuka_lwr4.urdf")).model
     return identify(prior, folder / "traj1.csv", validate=folder / "traj3.csv"), folder
 
 

@@ -1,12 +1,13 @@
-"""The catalog of the nodes' parameter names (ros.parameters.catalog) is what the nodes
-declare: the warning about unknown parameters knows every sibling's parameter."""
+"""The catalog of the nodes' parameter names (core.io.parameter_names) is what the nodes
+declare: the warning (nodes) and refusal (tools) of unknown parameters knows every sibling's
+parameter."""
 
+from irb140_dynamics.core.io.parameter_names import NODE_PARAMETER_NAMES, PER_JOINT_SUFFIXES, sibling_parameter_names
 from irb140_dynamics.nodes.demo_node import node as demo_node
 from irb140_dynamics.nodes.id_node import settings as id_node
 from irb140_dynamics.nodes.payload_check_node import node as payload_check_node
 from irb140_dynamics.nodes.sim_node import settings as sim_node
 from irb140_dynamics.nodes.trajectory_check_node import node as trajectory_check_node
-from irb140_dynamics.ros.parameters.catalog import NODE_PARAMETER_NAMES, PER_JOINT_SUFFIXES, sibling_parameter_names
 
 NODE_MODULES = (id_node, payload_check_node, sim_node, demo_node, trajectory_check_node)
 

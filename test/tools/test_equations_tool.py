@@ -72,8 +72,7 @@ def test_urdf_chain_and_prefix(tmp_path, capsys):
         (["--params-file", CONFIG, "--form", "c", "--what", "tau,D"], "unknown quantity 'D'"),
         (["--params-file", CONFIG, "--form", "c", "--prefix", "2fast"], "not a C identifier"),
         (["--params-file", CONFIG, "--form", "c", "--payload-mass", "-1"], "payload"),
-        (["--params-file", CONFIG, "--form", "c", "--base", "world"], "--base and --tip go with --urdf"),
-        (["--form", "c"], "one of the arguments --params-file --urdf is required"),
+        (["--params-file", CONFIG, "--form", "c", "--base", "world"], "--base and --tip choose a URDF's chain"),
     ],
 )
 def test_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys, args, reason):

@@ -1,19 +1,21 @@
 """The model of the tools: a parameter file (parameters or robot_description), a URDF with
-base and tip, -p overrides (core/io/model_source.py); excitation, identify and export_urdf
-on a URDF arm, identify's outputs loaded back, and the offline tools without ROS."""
+base and tip, -p overrides (core/io/arm_source.py, through tools.common.arm_of); excitation,
+identify and export_urdf on a URDF arm, identify's outputs loaded back, and the offline
+tools without ROS."""
 
 import contextlib
 import io
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 
 from irb140_dynamics.core import rnea_batch
-from irb140_dynamics.core.io.model_source import tool_model
-from irb140_dynamics.core.io.params_file import load_model
+from irb140_dynamics.core.io.arm_source import given_values, read_arm, read_urdf_file
+from irb140_dynamics.core.io.params_file import load_model, read_parameter_file
 from irb140_dynamics.core.regressor import inertial_parameters
 from irb140_dynamics.core.urdf import load_urdf
 from irb140_dynamics.tools import excitation as excitation_tool
@@ -23,6 +25,15 @@ from ..support.paths import CONFIG, ROOT
 from ..support.simulated_ur5 import BASE, TIP, UR5_URDF, excitation, true_ur5, write_csv
 
 RATE = 200.0
+
+
+def tool_model(params_file=None, urdf_file=None, base_link=None, tip_link=None, overrides=None, defaults_file=None):
+    """The arm as a tool reads it: the params file over the defaults, then the overrides."""
+    values = given_values([params_file] if params_file else [], (overrides or {}).items())
+    urdf = read_urdf_file(urdf_file) if urdf_file is not None else None
+    defaults = read_parameter_file(defaults_file) if defaults_file else None
+    folder = Path(params_file).parent if params_file else None
+    return read_arm(values, defaults, urdf, base_link, tip_link, str(params_file) if params_file else None, folder)
 
 
 def described(folder, **extra) -> str:
@@ -174,3 +185,19 @@ def test_the_offline_tools_run_without_ros():
     assert done.returncode == 0, done.stderr
     model = load_urdf(done.stdout).model
     assert model.joint_names == true_ur5().joint_names
+
+
+def test_the_names_a_tool_knows_follow_the_arm(tmp_path, capsys):
+    """A URDF arm's own joints take limits, friction and armature (and the nodes' per-joint
+    parameters); the IRB-140's joint names are unknown there; a sibling's name is known."""
+    from irb140_dynamics.tools import export_urdf
+
+    urdf = ["--urdf", str(UR5_URDF), "--base", BASE, "--tip", TIP, "--out", str(tmp_path / "a.urdf")]
+    known = ["shoulder_pan_joint.armature:=0.1", "shoulder_pan_joint.kp:=10.0", "qos.depth:=5", "payload.mass:=1.0"]
+    assert export_urdf.main(["export_urdf", *urdf, *(f"-p{text}" for text in known)]) == 0
+    capsys.readouterr()
+    assert export_urdf.main(["export_urdf", *urdf, "-p", "joint_1.armature:=0.1"]) == 2
+    error = capsys.readouterr().err
+    assert "-p: joint_1.armature (the arm has no joint joint_1; did you mean" in error and error.count("\n") == 1
+    assert export_urdf.main(["export_urdf", *urdf, "-p", "shoulder_pan_joint.dh:=[0,0,0,0]"]) == 2
+    assert "shoulder_pan_joint.dh" in capsys.readouterr().err  # a URDF's joints take no DH row

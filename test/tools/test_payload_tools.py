@@ -19,7 +19,7 @@ from irb140_dynamics.tools import excitation as excitation_tool
 from irb140_dynamics.tools import identify as identify_tool
 from irb140_dynamics.tools import retime as retime_tool
 
-from ..support.paths import ROOT
+from ..support.paths import CONFIG, ROOT
 from ..support.simulated_ur5 import write_csv
 
 pytestmark = pytest.mark.slow  # optimises an excitation and identifies a payload
@@ -269,13 +269,13 @@ def test_excitation_payload_refuses_more_than_30_s_and_a_bad_pose(tmp_path, caps
 def test_the_load_file_of_a_urdf_arm_says_how_the_nodes_take_it(tmp_path):
     """The nodes declare DH joints only: a URDF arm's LOAD.yaml (origin/axis joints) is for the
     tools; its comment tells how the nodes take the payload (the arm from the URDF)."""
-    from irb140_dynamics.core.io.model_source import tool_model
+    from irb140_dynamics.core.io.arm_source import given_values, read_arm, read_urdf_file
     from irb140_dynamics.identification.payload_excitation import optimise_payload_excitation
 
     from ..support.paths import URDF_DATA
 
     urdf = ["--urdf", str(URDF_DATA / "ur5.urdf"), "--base", "base_link", "--tip", "tool0"]
-    arm = tool_model(None, urdf[1], "base_link", "tool0").model
+    arm = read_arm({}, urdf=read_urdf_file(urdf[1]), base_link="base_link", tip_link="tool0").model
     trajectory = optimise_payload_excitation(arm, iterations=0).trajectory
     t = np.arange(0.0, 2 * trajectory.period, 0.004)
     Q, QD, QDD = trajectory.evaluate(t)
@@ -283,7 +283,8 @@ def test_the_load_file_of_a_urdf_arm_says_how_the_nodes_take_it(tmp_path):
     recording = write_csv(tmp_path / "ur5.csv", arm.joint_names, t, Q, QD, tau)
     out = tmp_path / "load.yaml"
     assert identify_tool.main(["--payload-only", "--quiet", *urdf, str(recording), "--out", str(out)]) == 0
-    assert tool_model(out).model.payload.mass == pytest.approx(PAYLOAD.mass, rel=1e-3)  # the tools take it
+    taken = read_arm(given_values([out]), read_parameter_file(CONFIG)).model  # the tools take it
+    assert taken.payload.mass == pytest.approx(PAYLOAD.mass, rel=1e-3)
     comments = " ".join(line for line in out.read_text().splitlines() if line.startswith("#"))
     assert "the nodes take this arm from its URDF (model.source: robot_description" in comments
     assert "Load it into the nodes" not in comments

@@ -130,7 +130,11 @@ def test_a_urdf_arm_with_the_params_files_globals(tmp_path, capsys):
     tr = smooth_trajectory(model.joint_names, np.array([0.0, -1.2, 1.0, -1.0, 0.5, 0.0]), np.full(6, 0.5), 12, 4.0)
     source = _write(tmp_path / "in.yaml", tr.to_message())
     out = tmp_path / "out.yaml"
-    args = ["--params-file", str(CONFIG), "--urdf", str(urdf), "--tip", "tool0", "--payload-mass", "3"]
+    params = tmp_path / "globals.yaml"  # what a URDF's model takes from a params file: no IRB-140 joints
+    params.write_text(
+        "/**:\n  ros__parameters:\n    gravity: [0.0, 0.0, -9.81]\n    friction: {smoothing_velocity: 0.02}\n"
+    )
+    args = ["--params-file", str(params), "--urdf", str(urdf), "--tip", "tool0", "--payload-mass", "3"]
     assert main([*args, source, str(out)]) == 0
     printed = capsys.readouterr().out
     assert "re-timed:" in printed and "within every limit" in printed and "derived" not in printed  # URDF efforts
@@ -143,4 +147,4 @@ def test_the_chain_is_named_with_base_and_tip_as_in_the_other_tools_or_the_old_n
 
     new = parser().parse_args(["in.yaml", "--params-file", "p.yaml", "--base", "b", "--tip", "t"])
     old = parser().parse_args(["in.yaml", "--params-file", "p.yaml", "--base-link", "b", "--tip-link", "t"])
-    assert (new.base_link, new.tip_link) == (old.base_link, old.tip_link) == ("b", "t")
+    assert (new.base, new.tip) == (old.base, old.tip) == ("b", "t")

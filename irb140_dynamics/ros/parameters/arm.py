@@ -24,7 +24,6 @@ builds what it runs on.
 
 from __future__ import annotations
 
-import contextlib
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -35,6 +34,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from irb140_dynamics.core import Joint, RigidBody, RobotModel
 from irb140_dynamics.core.errors import one_line
+from irb140_dynamics.core.io.arm_source import read_arm
 from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.core.io.text_files import size_limit
 from irb140_dynamics.core.io.urdf import MAX_URDF_CHARS, LoadedUrdf, UrdfError, load_urdf, read_urdf
@@ -152,16 +152,14 @@ class ArmParameters:
         return values | {p.name: p.value for p in changes}
 
     def model_values(self, values: dict[str, Any], urdf: LoadedUrdf | None = None) -> dict[str, Any] | None:
-        """What the model is built from: ``values``, or the URDF's (``urdf``, else the one in
-        use) model under them, ``gravity`` turned from the URDF's root frame into base_link's;
-        None while no URDF has come."""
+        """What the model is built from: ``values`` with the model's own parameters those of
+        the arm they give (``core.io.arm_source.read_arm``, as every tool reads it: a URDF's
+        chain, ``urdf`` or else the one in use, under the values it takes, ``gravity`` turned
+        from the URDF's root frame into base_link's); None while no URDF has come."""
         urdf = urdf or self.urdf
-        if urdf is None:
-            return None if self.from_topic else values
-        values = dict(values)
-        with contextlib.suppress(KeyError, TypeError, ValueError):  # absent or not 3 numbers: the check names it
-            values["gravity"] = urdf.in_base(values["gravity"])
-        return {**urdf.model.to_params(), **values}
+        if urdf is None and self.from_topic:
+            return None
+        return {**values, **read_arm(values, urdf=urdf).model.to_params()}
 
     def read(self, text: str, origin: str = "robot_description topic") -> LoadedUrdf:
         """The URDF's chain (thread-safe: parsing only), or ValueError naming ``origin``."""

@@ -15,13 +15,17 @@ warned about.
 
 from __future__ import annotations
 
-import difflib
 from typing import Any
 
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from irb140_dynamics.ros.parameters.catalog import PER_JOINT_SUFFIXES, sibling_parameter_names
+from irb140_dynamics.core.io.parameter_names import (
+    PER_JOINT_SUFFIXES,
+    sibling_parameter_names,
+    unknown_lines,
+    unknown_names,
+)
 from irb140_dynamics.ros.parameters.spec import Spec, declare
 
 # how every node of the package is made: the values given read as parameters (see above);
@@ -49,42 +53,21 @@ class Overrides:
 
     def warn_unknown(self, joint_names) -> None:
         """Warn about each value given that no node of the package has (``joint_names``:
-        the model's, None while a URDF is awaited)."""
+        the model's, None while a URDF is awaited), naming the nearest known name
+        (``core.io.parameter_names``, as the tools refuse them)."""
         declared = set(self._node.list_parameters([], 0).names)
         known = sibling_parameter_names(joint_names) | declared
-        lines, by_parent = [], {}
-        for name in sorted(self.given):
-            if name in known or (joint_names is None and name.endswith(PER_JOINT_SUFFIXES)):
-                continue  # a sibling's, or a per-joint one of a model still to come (a URDF topic)
-            parent = _known_parent(name, declared)
-            if parent is not None:
-                by_parent.setdefault(parent, []).append(name)
-                continue
-            lines.append(f"unknown parameter {name} (ignored){nearest_hint(name, known)}")
-        for parent, names in by_parent.items():
-            what = self._node.describe_parameter(parent).description
-            lines.append(
-                f"unknown parameter{'s' if len(names) > 1 else ''} {', '.join(names)} (ignored): "
-                f"{parent} is one parameter, not a mapping: {what}"
-            )
+        given = [
+            name
+            for name in self.given
+            if not (joint_names is None and name.endswith(PER_JOINT_SUFFIXES))  # a joint of a model still to come
+        ]
+        lines = unknown_lines(unknown_names(given, known, joint_names), " (ignored)", self._description)
         logger = self._node.get_logger()
         for line in lines[:MAX_UNKNOWN_WARNINGS]:
             logger.warning(line)
         if len(lines) > MAX_UNKNOWN_WARNINGS:
             logger.warning(f"... and {len(lines) - MAX_UNKNOWN_WARNINGS} more unknown parameters")
 
-
-def nearest_hint(name: str, known) -> str:
-    """'; did you mean <the nearest known name>?', or '' when none is near."""
-    nearest = difflib.get_close_matches(name, sorted(known), n=1, cutoff=0.6)
-    return f"; did you mean {nearest[0]}?" if nearest else ""
-
-
-def _known_parent(name: str, declared: set[str]) -> str | None:
-    """The declared parameter ``name`` lies under (``joint_1.dh`` for ``joint_1.dh.a``), if any."""
-    parent = name
-    while "." in parent:
-        parent = parent.rsplit(".", 1)[0]
-        if parent in declared:
-            return parent
-    return None
+    def _description(self, name: str) -> str:
+        return self._node.describe_parameter(name).description if self._node.has_parameter(name) else ""

@@ -28,7 +28,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_parameters
 
-from irb140_dynamics.ros.parameters.overrides import nearest_hint
+from irb140_dynamics.core.io.parameter_names import nearest_hint
 
 PARAMETER_TYPES = {kind.value for kind in Parameter.Type}
 

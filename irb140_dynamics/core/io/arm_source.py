@@ -1,0 +1,179 @@
+"""The arm a user gives, read one way for every node and every tool (``read_arm``).
+
+What a user gives: parameter values (params files merged in order, then ``-p``, as flat
+dotted names, as rcl gives them to a node: ``given_values``), over the default arm's values
+(config/irb140.yaml), and maybe a URDF. The arm is:
+
+- with ``model.source: parameters`` (the default) and no URDF: the model of the values
+  merged over the defaults; the default's per-joint values only for the default's own
+  joints (a params file naming other joints gives every value of them: nothing is silently
+  borrowed); its name ``model.name`` (default ``irb140``);
+- with a URDF (a tool's ``--urdf``; a node's text from the topic; or ``model.source:
+  robot_description`` with the text in ``robot_description``, else the file
+  ``model.urdf_file``, relative to the working directory or else to the params file's
+  folder): the chain from ``model.base_link`` (or ``--base``; default: the root link) to
+  ``model.tip_link`` (``--tip``; default: the only leaf), its name the URDF's ``<robot
+  name>``. Its model takes from the values only what URDF has no (or no sure) place for,
+  and only when given: ``gravity`` (in the URDF root link's frame, turned into base_link's
+  as docs/urdf.md states; absent: 9.81 m/s^2 along the root's -z),
+  ``friction.smoothing_velocity``, ``payload.*`` (in the tip link's frame), and for the
+  chain's own joints ``position_limits``, ``torque_limit``, ``velocity_limit``,
+  ``acceleration_limit``, ``friction.viscous``, ``friction.coulomb``, ``armature``.
+
+Names given that are no parameter of the package: ``core.io.parameter_names``.
+Errors: a ValueError in one line naming the file or the parameter. No ROS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from irb140_dynamics.core.errors import one_line
+from irb140_dynamics.core.io.params_file import read_parameter_file
+from irb140_dynamics.core.io.urdf import LoadedUrdf, UrdfError, load_urdf, read_urdf
+from irb140_dynamics.core.model.joints import param_prefix
+from irb140_dynamics.core.model.rigid_body import finite_numbers
+from irb140_dynamics.core.model.robot_model import JOINT_DRIVE_FIELDS, RobotModel
+
+SOURCES = ("parameters", "robot_description")
+DEFAULT_ROBOT_NAME = "irb140"  # model.name when none is given (the nodes' default too)
+URDF_ROBOT_NAME = "robot"  # a URDF's name when its <robot> has none
+ARM_PARAMETERS = ("gravity", "friction.smoothing_velocity", "payload.mass", "payload.com", "payload.inertia")
+
+
+@dataclass(frozen=True)
+class UrdfText:
+    """A URDF's text and where it came from (for messages: a path, 'robot_description topic')."""
+
+    text: str
+    origin: str
+
+
+@dataclass(frozen=True, eq=False)
+class Arm:
+    """The arm read: its model, its name, where it came from, and its URDF chain when it is a URDF's."""
+
+    model: RobotModel
+    robot_name: str
+    origin: str  # 'params.yaml', 'arm.urdf (base_link -> tool0)'
+    urdf: LoadedUrdf | None = None  # base and tip link, held joints, warnings, notes
+    urdf_text: str | None = None
+    given: Mapping[str, Any] = field(default_factory=dict)  # the values it was read from (a tool's rated_payload.*)
+
+
+def given_values(params_files: Iterable = (), overrides: Iterable[tuple[str, Any]] = ()) -> dict[str, Any]:
+    """The values given: each params file's ``/**`` section merged in order, then the overrides."""
+    values: dict[str, Any] = {}
+    for path in params_files:
+        try:  # a ValueError naming the file and why when it is none (missing, a folder, a device, bad YAML)
+            values.update(read_parameter_file(path))
+        except OSError as error:
+            raise ValueError(f"{path}: cannot be read ({error.strerror or error})") from None
+    values.update(overrides)
+    return values
+
+
+def read_urdf_file(path, what: str = "URDF") -> UrdfText:
+    """A URDF file's text (``urdf.read_urdf``: bounded, a regular file, UTF-8), or a ValueError
+    in one line starting with ``what``."""
+    try:
+        return UrdfText(read_urdf(path), str(path))
+    except UrdfError as error:
+        raise ValueError(f"{what}: {error.reason}") from None
+
+
+def read_arm(
+    values: Mapping[str, Any],
+    defaults: Mapping[str, Any] | None = None,
+    urdf: UrdfText | LoadedUrdf | None = None,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    origin: str | None = None,
+    relative_to: str | Path | None = None,
+) -> Arm:
+    """The arm of the module's docstring.
+
+    ``values``: the parameter values given (a node's: all it has); ``defaults``: the default
+    arm's values; ``urdf``: a URDF given besides the values (text, or a chain read already:
+    then ``base_link``/``tip_link`` are its own); ``base_link``/``tip_link``: the chain's ends
+    over ``model.base_link``/``model.tip_link``; ``origin``: where the values came from (a
+    params file), named in errors; ``relative_to``: the folder ``model.urdf_file`` may be
+    relative to.
+    """
+    source = values.get("model.source", "parameters")
+    if source not in SOURCES:
+        raise ValueError(f"model.source: must be one of {', '.join(SOURCES)}, got {source!r}")
+    if urdf is None and source == "robot_description":
+        urdf = _described_urdf(values, origin, relative_to)
+    if urdf is not None:
+        return _urdf_arm(values, urdf, base_link or values.get("model.base_link") or None,
+                         tip_link or values.get("model.tip_link") or None, origin)  # fmt: skip
+    if base_link or tip_link:
+        raise ValueError(
+            "--base and --tip choose a URDF's chain: give --urdf, or a parameter file with "
+            "model.source: robot_description"
+        )
+    defaults = dict(defaults or {})
+    names = values.get("joint_names", defaults.get("joint_names", []))
+    if list(names) != list(defaults.get("joint_names", [])):
+        defaults = {name: value for name, value in defaults.items() if name in ARM_PARAMETERS}
+    merged = {**defaults, **values}
+    try:
+        model = RobotModel.from_params(merged)
+    except ValueError as error:  # it names the parameter; the file, when there is one
+        raise ValueError(f"{origin}: {one_line(error)}" if origin else one_line(error)) from None
+    return Arm(model, str(merged.get("model.name") or DEFAULT_ROBOT_NAME), origin or "parameters")
+
+
+def urdf_values(values: Mapping[str, Any], loaded: LoadedUrdf) -> dict[str, Any]:
+    """Of the values, those the URDF chain's model takes, gravity turned into base_link's frame."""
+    own = {f"{param_prefix(name)}.{field}" for name in loaded.model.joint_names for field in JOINT_DRIVE_FIELDS}
+    taken = {k: v for k, v in values.items() if k in ARM_PARAMETERS or k in own}
+    if "gravity" in taken:
+        taken["gravity"] = loaded.in_base(finite_numbers("gravity", taken["gravity"], 3))
+    return taken
+
+
+def _urdf_arm(values, urdf, base_link, tip_link, origin) -> Arm:
+    """A chain read already (a node's) names no file in its errors: the parameter is named."""
+    text, where = None, origin or "robot_description"
+    if isinstance(urdf, UrdfText):
+        text, where = urdf.text, urdf.origin
+        try:
+            loaded = load_urdf(urdf.text, base_link, tip_link)
+        except ValueError as error:
+            raise ValueError(f"{where}: {one_line(error)}") from None
+    else:
+        loaded = urdf
+    try:
+        taken = urdf_values(values, loaded)
+        model = RobotModel.from_params({**loaded.model.to_params(), **taken}) if taken else loaded.model
+    except ValueError as error:
+        named = origin or (text is not None and where)
+        raise ValueError(f"{named}: {one_line(error)}" if named else one_line(error)) from None
+    name = loaded.robot_name or URDF_ROBOT_NAME
+    return Arm(model, name, f"{where} ({loaded.base_link} -> {loaded.tip_link})", loaded, text)
+
+
+def _described_urdf(values, origin, relative_to) -> UrdfText:
+    """The URDF of ``model.source: robot_description``: ``robot_description``, else ``model.urdf_file``."""
+    if values.get("robot_description"):
+        return UrdfText(str(values["robot_description"]), f"{origin or 'parameters'}: robot_description")
+    if values.get("model.urdf_file"):
+        return read_urdf_file(_beside(values["model.urdf_file"], relative_to), "model.urdf_file")
+    raise ValueError(
+        f"{origin or 'parameters'}: model.source is robot_description but neither "
+        "robot_description nor model.urdf_file is given (or give --urdf FILE)"
+    )
+
+
+def _beside(path, folder) -> Path:
+    """``path`` as given when it exists (relative to the working directory), else in ``folder``."""
+    path = Path(str(path))
+    if path.is_absolute() or path.exists() or folder is None:
+        return path
+    beside = Path(folder) / path
+    return beside if beside.exists() else path
