@@ -23,10 +23,10 @@ log trace((D F D)^-1), D = UNIT_SCALE (1 kg, 0.1 m out): the sum of the paramete
 variances in units of a 1 kg body 0.1 m out, so that no parameter is left to the noise
 (A-optimal design). Unless given, the held pose (the middle of the ranges or one of POSES
 random poses within them, preferring those where the arm's own torques take at most
-MAX_TORQUE_USE of any torque limit, leaving the rest to the payload) and the period (one of PERIODS: which band of frequencies uses
-the wrist's speed and acceleration limits best depends on their ratio) are chosen first, by
-the best of SCOUTS random motions at each; then the best of STARTS random motions is
-improved by SciPy's L-BFGS-B.
+MAX_TORQUE_USE of any torque limit, leaving the rest to the payload) and the period (one
+of PERIODS: which band of frequencies uses the wrist's speed and acceleration limits best
+depends on their ratio) are chosen first, by the best of SCOUTS random motions at each;
+then the best of STARTS random motions is improved by SciPy's L-BFGS-B.
 """
 
 from __future__ import annotations
@@ -157,6 +157,13 @@ def recorded(period: float, periods: int | None = None) -> float:
     return (max(int(MAX_PAYLOAD_DURATION / period + 1e-9), 1) if periods is None else periods) * period
 
 
+def period_choices(period: float | None = None, periods: int | None = None) -> list[float]:
+    """The periods [s] the design may use: ``period`` or PERIODS, those whose ``periods``
+    repetitions (default: as many as fit) last at most MAX_PAYLOAD_DURATION."""
+    given = [period] if period is not None else PERIODS
+    return [T for T in given if 0.0 < recorded(T, periods) <= MAX_PAYLOAD_DURATION * (1 + 1e-12)]
+
+
 def held_poses(model: RobotModel, margin: float, rng: np.random.Generator) -> list[np.ndarray]:
     """Poses the design may hold: the middle of the ranges, then POSES drawn uniformly within
     the ranges less ``margin`` (the wrist's values are the middle's: it moves over its range)."""
@@ -252,9 +259,10 @@ def optimise_payload_excitation(
         raise ValueError(f"period: must be within (0, {MAX_PAYLOAD_DURATION:g}] s, got {period}")
     if harmonics < 2:
         raise ValueError(f"harmonics: at least 2 are needed to start at rest, got {harmonics}")
-    for given in [period] if period is not None else PERIODS:
-        if not 0.0 < recorded(given, periods) <= MAX_PAYLOAD_DURATION * (1 + 1e-12):
-            raise ValueError(f"periods: {periods} x {given:g} s is not within (0, {MAX_PAYLOAD_DURATION:g}] s")
+    choices = period_choices(period, periods)
+    if not choices:
+        given = f"{period:g} s" if period is not None else f"{min(PERIODS):g} s at least"
+        raise ValueError(f"periods: {periods} x {given} is more than {MAX_PAYLOAD_DURATION:g} s")
     moving = wrist(model)
     rng = np.random.default_rng(seed)
     starts = [np.r_[rng.normal(size=2 * len(moving) * (harmonics - 1)), np.zeros(len(moving))] for _ in range(STARTS)]
@@ -273,7 +281,7 @@ def optimise_payload_excitation(
 
     # the held pose and the period too, unless given: those where a random motion tells the most
     poses = held_poses(model, margin, rng) if pose is None else [pose]
-    candidates = [(p, T) for p in poses for T in ([period] if period is not None else PERIODS)]
+    candidates = [(p, T) for p in poses for T in choices]
     scores = [min(cost(x, payload_limits(model, margin, p), T, True) for x in starts[:SCOUTS]) for p, T in candidates]
     pose, period = candidates[min(range(len(candidates)), key=scores.__getitem__)]
     limits = payload_limits(model, margin, pose)

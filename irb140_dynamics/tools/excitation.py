@@ -149,6 +149,7 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
         DEFAULT_PAYLOAD_HARMONICS,
         MAX_PAYLOAD_DURATION,
         PERIODS,
+        period_choices,
         recorded,
     )
 
@@ -158,12 +159,14 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
     if args.harmonics is None:
         args.harmonics = DEFAULT_PAYLOAD_HARMONICS if args.payload else DEFAULT_HARMONICS
     if args.payload:
-        longest = max(recorded(T, args.periods) for T in ([args.period] if args.period else PERIODS))
-        if longest > MAX_PAYLOAD_DURATION:
+        choices = period_choices(args.period, args.periods)
+        if not choices:
+            shortest = recorded(args.period or min(PERIODS), args.periods)
             raise ToolError(
-                f"--period x --periods: a payload motion lasts at most {MAX_PAYLOAD_DURATION:g} s, got {longest:g} s"
+                f"--period x --periods: a payload motion lasts at most {MAX_PAYLOAD_DURATION:g} s, got {shortest:g} s"
             )
-        period_bound = args.period or min(PERIODS)  # the fewest points per period: the check below
+        longest = max(recorded(T, args.periods) for T in choices)
+        period_bound = min(choices)  # the fewest points per period: the check below
         total = longest
     else:
         args.period = args.period or DEFAULT_PERIOD
