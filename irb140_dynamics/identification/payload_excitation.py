@@ -45,7 +45,13 @@ from irb140_dynamics.identification.excitation import (
     Limits,
     shaped,
 )
-from irb140_dynamics.identification.payload import PARAMETER_LABELS, UNIT_SCALE, excitation, payload_regressor
+from irb140_dynamics.identification.payload import (
+    MAX_RELATIVE_STD,
+    PARAMETER_LABELS,
+    UNIT_SCALE,
+    excitation,
+    payload_regressor,
+)
 
 WRIST_JOINTS = 3
 PERIODS = (2.0, 3.0, 5.0, 7.5, 10.0, 15.0)  # s the design chooses among (each divides 30 s)
@@ -124,7 +130,7 @@ class PayloadExcitation:
             f"recorded at {self.rate:g} Hz for {self.duration:g} s: one standard deviation of",
             f"  {values}",
             "  (flange frame, inertia about its origin; identify --payload-only refuses a parameter whose deviation "
-            "exceeds 5 % of the payload's scale)",
+            f"exceeds {100 * MAX_RELATIVE_STD:g} % of the payload's scale)",
         ]
 
 

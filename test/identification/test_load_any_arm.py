@@ -36,7 +36,6 @@ from irb140_dynamics.tools import identify as identify_tool
 from ..support.paths import ROOT, URDF_DATA
 from ..support.simulated_load import run, tool, with_drive_losses, write_csv
 
-pytestmark = pytest.mark.slow  # each arm: a design, 30 s of MuJoCo at 1 kHz and an identification
 NOISE = EffortNoise(0.01)
 TOOL = tool(3.1, (0.03, -0.05, 0.08), (0.01, 0.016, 0.02), (0.5, -0.4, 0.8))
 PANDA_ACCELERATIONS = (15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0)  # rad/s^2, Franka's documented limits
@@ -85,6 +84,7 @@ def identified(request, tmp_path_factory):
     return arm, design, recording, out
 
 
+@pytest.mark.slow  # each arm: a design, 30 s of MuJoCo at 1 kHz and an identification
 def test_the_tool_is_identified_within_the_issues_tolerances(identified):
     _, _, _, out = identified
     found = tool_model(out).model.payload
@@ -95,6 +95,7 @@ def test_the_tool_is_identified_within_the_issues_tolerances(identified):
     assert np.all(np.abs(moments / true_moments - 1.0) < 0.1), (moments, true_moments)
 
 
+@pytest.mark.slow
 def test_the_design_moves_the_wrist_within_the_limits_and_30_s_and_its_promise_holds(identified):
     arm, design, (t, Q, _, _), out = identified
     trajectory = design.trajectory
@@ -110,3 +111,23 @@ def test_the_design_moves_the_wrist_within_the_limits_and_30_s_and_its_promise_h
     if all(limit > 0 for limit in arm.torque_limits):
         assert printed == pytest.approx(design.std[0], rel=0.5)
     assert np.all(design.std > 0) and np.all(np.isfinite(design.std))
+
+
+@pytest.mark.parametrize("noise", [EffortNoise(0.01), EffortNoise(0.05, relative=False)], ids=["1 %", "0.05 N m"])
+def test_the_designs_deviations_are_those_identify_finds_at_that_noise(noise, tmp_path):
+    """The UR5's design's promise against the fit of a recording with exactly that noise (white,
+    per sample, at 500 Hz, for the design's duration; torques by our RNEA, so nothing else
+    is left unexplained): each of the ten deviations within 20 %."""
+    from irb140_dynamics.core import rnea_batch
+    from irb140_dynamics.identification.payload import fit_payload
+
+    from ..support.simulated_ur5 import true_ur5
+
+    arm = true_ur5()
+    design = optimise_payload_excitation(arm, iterations=0, noise=noise)
+    t = np.arange(int(design.duration * 500.0)) / 500.0
+    Q, QD, QDD = design.trajectory.evaluate(t)
+    tau = rnea_batch(arm.with_payload(TOOL), Q, QD, QDD)
+    tau += np.random.default_rng(2).normal(size=tau.shape) * design.sigma
+    fit = fit_payload(arm, write_csv(tmp_path / "run.csv", arm.joint_names, t, Q, QD, tau))
+    assert fit.estimate.std == pytest.approx(design.std, rel=0.2)
