@@ -13,8 +13,10 @@ from the flange frame to the last joint's frame (``flange_map``). Every fit poin
 are summed into normal equations (``least_squares``): a moving joint's row where it is fast
 enough for the Coulomb model (as ``identify`` uses rows), and every row of a joint held
 still throughout (it carries the payload's static load). Weighted least squares gives
-phi_hat and its covariance. The recording is refused, naming the parameters, when it does
-not excite one: its column (in units of a 1 kg body 0.1 m out) vanishes to rounding or
+phi_hat and its covariance, scaled by the measured correlation of its residuals as
+``identify`` scales it (``correlation``: torques the arm's own model leaves unexplained
+change slowly and tell less than as many independent samples). The recording is refused,
+naming the parameters, when it does not excite one: its column (in units of a 1 kg body 0.1 m out) vanishes to rounding or
 lies in the others' span (``excitation``), or its standard deviation exceeds
 MAX_RELATIVE_STD of the payload's own scale (m, m L, m L^2; see ``_check_excitation``);
 and when its mass comes out negative beyond the noise (``_check_mass``), or when the efforts
@@ -51,6 +53,7 @@ from irb140_dynamics.identification.consistent import (
     parameters_and_jacobian,
     pseudo_inertia,
 )
+from irb140_dynamics.identification.correlation import correlation_factor
 from irb140_dynamics.identification.least_squares import Estimate, NormalEquations, weighted_least_squares
 from irb140_dynamics.identification.pipeline import (
     FIT_BATCH,
@@ -177,7 +180,13 @@ def fit_payload(
             np.concatenate([Y, tau_arm[..., None]], axis=2), batch.tau - tau_arm, use[start : start + FIT_BATCH]
         )
     equations = _payload_columns(with_scale)
-    estimate = _estimate(tally.path, equations, tally.design.noise_correlation())
+    filter_correlation = tally.design.noise_correlation()
+    estimate = _estimate(tally.path, equations, filter_correlation)
+    first = points.take(slice(0, settings.correlation_points))  # consecutive fit points: their residuals
+    Y, tau_arm = payload_regressor(arm, first.q, first.qd, first.qdd)
+    residuals = Y @ estimate.beta - (first.tau - tau_arm)
+    correlation, _ = correlation_factor(np.where(use[: len(first)], residuals, np.nan), filter_correlation)
+    estimate = replace(estimate, covariance=estimate.covariance * (correlation / filter_correlation))
     _check_mass(tally.path, estimate)
     _check_excitation(tally.path, estimate)
     _check_effort_scale(tally.path, with_scale, tally.design.noise_correlation())
@@ -210,12 +219,12 @@ def _estimate(path, equations: NormalEquations, correlation: float) -> Estimate:
     parameters least told apart from the others when the regressor is singular."""
     scaled = _scaled(equations)
     seen = excitation(scaled.A.sum(axis=0))
-    _refuse(path, np.flatnonzero(seen < MIN_EXCITATION), None)
+    _refuse(path, np.flatnonzero(seen < MIN_EXCITATION))
     try:
         estimate = weighted_least_squares(scaled, _ALL_INDEPENDENT, correlation)
     except ValueError:
         weak = np.flatnonzero(seen <= max(WEAK_EXCITATION, float(seen.min())))
-        _refuse(path, weak, None)
+        _refuse(path, weak)
         raise
     covariance = estimate.covariance * np.outer(UNIT_SCALE, UNIT_SCALE)
     return replace(estimate, beta=estimate.beta * UNIT_SCALE, covariance=covariance)
@@ -272,7 +281,8 @@ def _check_excitation(path, estimate: Estimate) -> None:
     of the payload's own scale: m_ref = max(m, MIN_MASS) for the mass, m_ref L for the first
     moments and m_ref L^2 for the inertia, L = max(|c|, MIN_LENGTH). The deviations grow
     with the torques the arm's own model leaves unexplained (a params file without the
-    arm's friction) as well as with a weak motion: the line names both."""
+    arm's friction; their correlation shows them) as well as with a weak motion: the line
+    names both, first (the parameters' list may be cut at the line's end)."""
     phi = estimate.beta
     mass = max(abs(phi[0]), MIN_MASS)
     length = max(float(np.linalg.norm(phi[1:4])) / mass, MIN_LENGTH)
@@ -280,18 +290,24 @@ def _check_excitation(path, estimate: Estimate) -> None:
     std = estimate.std
     weak = np.flatnonzero(~(std <= MAX_RELATIVE_STD * scale))
     units = ["kg"] + ["kg m"] * 3 + ["kg m^2"] * 6
-    notes = [f" (+- {std[k]:.2g} {units[k]})" for k in range(10)]
-    _refuse(path, weak, notes, ", or check the arm's parameters")
-
-
-def _refuse(path, weak, notes: list[str] | None, also: str = "") -> None:
-    """RecordingError naming the ``weak`` parameters; ``also``: a cause besides the motion."""
     if len(weak):
-        names = ", ".join(f"{PARAMETER_LABELS[k]}{notes[k] if notes else ''}" for k in weak)
+        names = ", ".join(f"{PARAMETER_LABELS[k]} (+- {std[k]:.2g} {units[k]})" for k in weak)
+        raise RecordingError(
+            path,
+            "check the arm's parameters (torques its model leaves unexplained) or record `excitation --payload` "
+            f"(a weak motion): the payload's {names} deviate by more than {100 * MAX_RELATIVE_STD:g} % of its scale "
+            "(flange frame, inertia about its origin)",
+        )
+
+
+def _refuse(path, weak) -> None:
+    """RecordingError naming the ``weak`` parameters."""
+    if len(weak):
+        names = ", ".join(PARAMETER_LABELS[k] for k in weak)
         raise RecordingError(
             path,
             f"the motion does not excite the payload's {names} (flange frame, inertia about its origin): "
-            f"record `excitation --payload` (wrist motion){also}",
+            "record `excitation --payload` (wrist motion)",
         )
 
 

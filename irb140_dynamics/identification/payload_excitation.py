@@ -1,44 +1,139 @@
-"""Payload excitation: a wrist motion that makes a payload's ten inertial parameters observable.
+"""Payload excitation: a wrist motion designed for the ten inertial parameters of a payload
+on the arm at hand, with the standard deviations it promises them at a stated effort noise.
 
 The last three joints (the wrist; every joint of a shorter arm) follow the finite Fourier
-series of ``excitation``, the others hold a pose (by default the middle of their ranges):
-the held joints carry the payload's static load, which tells its mass from its first
-moments, and the wrist's turns and accelerations show its inertia. The wrist's motion is
-scaled to its limits like ``excitation``'s (position range less ``margin``, 98 % of the
-velocity and acceleration limits). The cost is log cond of the payload's regressor
-(``payload.payload_regressor``, ten columns) stacked over ``samples`` states of one
-period, each joint's rows divided by the arm's peak torque at that joint along the
-motion (torque sensors' noise grows with their range) and each column scaled to unit
-norm (so that kilograms and kg m^2 weigh alike), minimised by SciPy's L-BFGS-B from a
-seeded random start.
+series of ``excitation``, the others hold a pose: the held joints carry the payload's static
+load, which tells its mass from its first moments, and the wrist's turns, speeds and
+accelerations show its inertia. The wrist's motion is scaled to its limits like
+``excitation``'s (position range less ``margin``, 98 % of the velocity and acceleration
+limits); where a joint's speed or acceleration limit, not its range, bounds it, the centre
+of its motion (the wrist's pose) is a design variable too.
+
+What is optimised is what `identify --payload-only` will know. Its weighted least squares
+(``payload``) has the information matrix
+
+    F = sum over joints j of  (rate x duration / S) sum_k Y_kj^T Y_kj / sigma_j^2
+
+Y_kj joint j's row of the payload's regressor (``payload.payload_regressor``, flange frame)
+at S states of one period, sigma_j joint j's effort noise per recorded sample
+(``EffortNoise``, as the user states it), rate the recording's sample rate and duration
+what is recorded (the periods that fit in MAX_PAYLOAD_DURATION); F^-1 is the covariance of
+the ten parameters, and sqrt(diag F^-1) what the motion promises. The cost is
+log trace((D F D)^-1), D = UNIT_SCALE (1 kg, 0.1 m out): the sum of the parameters'
+variances in units of a 1 kg body 0.1 m out, so that no parameter is left to the noise
+(A-optimal design). Unless given, the held pose (the middle of the ranges or one of POSES
+random poses within them, preferring those where the arm's own torques take at most
+MAX_TORQUE_USE of any torque limit, leaving the rest to the payload) and the period (one
+of PERIODS: which band of frequencies uses the wrist's speed and acceleration limits best
+depends on their ratio) are chosen first, by the best of SCOUTS random motions at each;
+then the best of STARTS random motions is improved by SciPy's L-BFGS-B.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import minimize
 
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.identification.excitation import (
+    CHECK_POINTS_PER_HARMONIC,
     DEFAULT_MARGIN,
-    Excitation,
     FourierTrajectory,
     Limits,
     iterations_to,
     shaped,
 )
-from irb140_dynamics.identification.payload import PARAMETER_LABELS, excitation, payload_regressor
+from irb140_dynamics.identification.payload import (
+    MAX_RELATIVE_STD,
+    PARAMETER_LABELS,
+    UNIT_SCALE,
+    excitation,
+    payload_regressor,
+)
 
 WRIST_JOINTS = 3
-DEFAULT_PAYLOAD_PERIOD = 10.0  # s
+PERIODS = (2.0, 3.0, 5.0, 7.5, 10.0, 15.0)  # s the design chooses among (each divides 30 s)
+DEFAULT_PAYLOAD_HARMONICS = 3
 MAX_PAYLOAD_DURATION = 30.0  # s: a load identification is a short routine
+DEFAULT_RECORD_RATE = 500.0  # Hz: joint states as drivers commonly publish them
 MIN_WRIST_TRAVEL = 0.1  # rad: each wrist joint's motion at least this wide
-SAMPLES = 120
+POSES = 8  # random held poses tried besides the middle of the ranges (no --pose given)
+SCOUTS = 3  # of them scoring each held pose and period
+STARTS = 8  # random motions tried before the optimisation
+MAX_TORQUE_USE = 0.3  # of a torque limit the arm's own torques may take at a chosen pose: the rest is the payload's
+SAMPLES = 80  # states of one period the design sums over
 MAX_CONDITION = 1e3  # above: a parameter (nearly) in the others' span; a good pose gives 4 to 15
 WEAKLY_SEEN = 0.01  # sine of the angle between a parameter's column and the others': named when refused
+UNITS = ("kg", "kg m", "kg m", "kg m", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2")
+
+
+@dataclass(frozen=True)
+class EffortNoise:
+    """The recorded efforts' noise, one standard deviation per sample: ``value`` N m on
+    every joint, or (``relative``) that fraction of each joint's torque limit, of its peak
+    torque along the motion (the arm's own, without the payload) where the model gives none."""
+
+    value: float
+    relative: bool = True
+
+    def __post_init__(self):
+        if not (math.isfinite(self.value) and self.value > 0.0) or (self.relative and self.value >= 1.0):
+            raise ValueError(f"effort noise: must be > 0{' and below 100 %' if self.relative else ''}, got {self}")
+
+    @classmethod
+    def parse(cls, text: str) -> EffortNoise:
+        """'1%' (of each joint's torque limit) or '0.05' (N m); ValueError in one line."""
+        body = text.strip()
+        relative = body.endswith("%")
+        try:
+            value = float(body[:-1] if relative else body)
+        except ValueError:
+            raise ValueError(f"effort noise: expected N m (0.05) or a percentage (1%), got {text!r}") from None
+        return cls(value / 100.0 if relative else value, relative)
+
+    def sigma(self, model: RobotModel, peak: np.ndarray) -> np.ndarray:
+        """(n,) N m: each joint's noise; ``peak`` (n,) its peak torque along the motion."""
+        if not self.relative:
+            return np.full(model.n, self.value)
+        limits = np.array(model.torque_limits, dtype=float)
+        scale = np.where(limits > 0.0, limits, peak)
+        return self.value * np.maximum(scale, 1e-6 * max(float(scale.max()), 1e-9))
+
+    def __str__(self) -> str:
+        if self.relative:
+            return f"{100.0 * self.value:g} % of each joint's torque limit (peak torque where it has none)"
+        return f"{self.value:g} N m"
+
+
+DEFAULT_EFFORT_NOISE = EffortNoise(0.01)
+
+
+@dataclass(frozen=True, eq=False)
+class PayloadExcitation:
+    trajectory: FourierTrajectory
+    condition_number: float  # of the noise-weighted, column-scaled regressor (1 is ideal)
+    start_condition_number: float  # of the random start, before optimisation
+    evaluations: int
+    std: np.ndarray  # (10,) expected standard deviations of phi (flange frame, inertia about its origin)
+    sigma: np.ndarray  # (n,) N m: the effort noise per joint the design assumed
+    noise: EffortNoise
+    rate: float  # Hz
+    duration: float  # s
+
+    def expectation(self) -> list[str]:
+        """What the motion promises, as lines to print (or to write as comments)."""
+        values = ", ".join(f"{label} +- {s:.2g} {unit}" for label, s, unit in zip(PARAMETER_LABELS, self.std, UNITS))
+        return [
+            f"expected at an effort noise of {self.noise} ({', '.join(f'{s:.3g}' for s in self.sigma)} N m), "
+            f"recorded at {self.rate:g} Hz for {self.duration:g} s: one standard deviation of",
+            f"  {values}",
+            "  (flange frame, inertia about its origin; identify --payload-only refuses a parameter whose deviation "
+            f"exceeds {100 * MAX_RELATIVE_STD:g} % of the payload's scale)",
+        ]
 
 
 def wrist(model: RobotModel) -> np.ndarray:
@@ -65,89 +160,176 @@ def payload_limits(model: RobotModel, margin: float = DEFAULT_MARGIN, pose=None)
     return Limits(lower, upper, limits.speed, limits.acceleration)
 
 
+def recorded(period: float, periods: int | None = None) -> float:
+    """The seconds recorded: ``periods`` periods, by default as many as MAX_PAYLOAD_DURATION holds."""
+    return (max(int(MAX_PAYLOAD_DURATION / period + 1e-9), 1) if periods is None else periods) * period
+
+
+def period_choices(period: float | None = None, periods: int | None = None) -> list[float]:
+    """The periods [s] the design may use: ``period`` or PERIODS, those whose ``periods``
+    repetitions (default: as many as fit) last at most MAX_PAYLOAD_DURATION."""
+    given = [period] if period is not None else PERIODS
+    return [T for T in given if 0.0 < recorded(T, periods) <= MAX_PAYLOAD_DURATION * (1 + 1e-12)]
+
+
+def held_poses(model: RobotModel, margin: float, rng: np.random.Generator) -> list[np.ndarray]:
+    """Poses the design may hold: the middle of the ranges, then POSES drawn uniformly within
+    the ranges less ``margin`` (the wrist's values are the middle's: it moves over its range)."""
+    limits = Limits.of(model, margin)
+    middle = (limits.lower + limits.upper) / 2.0
+    held = np.setdiff1d(np.arange(model.n), wrist(model))
+    poses = [middle]
+    for _ in range(POSES if len(held) else 0):
+        pose = middle.copy()
+        pose[held] = rng.uniform(limits.lower[held], limits.upper[held])
+        poses.append(pose)
+    return poses
+
+
 def _trajectory(free, model: RobotModel, harmonics: int, period: float, limits: Limits) -> FourierTrajectory:
+    """The wrist's motion of ``free``: its Fourier coefficients, then one number per wrist
+    joint placing the motion's centre within the room its range leaves (tanh: -1 to 1)."""
     moving = wrist(model)
+    coefficients, placement = free[: -len(moving)], free[-len(moving) :]
     full = np.zeros((2, model.n, harmonics - 1))
-    full[:, moving, :] = free.reshape(2, len(moving), harmonics - 1)
+    full[:, moving, :] = coefficients.reshape(2, len(moving), harmonics - 1)
     with np.errstate(invalid="ignore", divide="ignore"):
-        return shaped(full.ravel(), model.n, harmonics, period, limits)
+        trajectory = shaped(full.ravel(), model.n, harmonics, period, limits)
+    Q = trajectory.evaluate(np.linspace(0.0, period, CHECK_POINTS_PER_HARMONIC * harmonics, endpoint=False))[0]
+    room = np.maximum(np.minimum(Q.min(axis=0) - limits.lower, limits.upper - Q.max(axis=0)), 0.0)
+    q0 = trajectory.q0.copy()
+    q0[moving] += np.tanh(placement) * room[moving] * (1.0 - 1e-9)
+    return FourierTrajectory(period, q0, trajectory.a, trajectory.b)
 
 
-def _weighted_regressor(model: RobotModel, trajectory: FourierTrajectory, samples: int = SAMPLES) -> np.ndarray:
-    """The payload's regressor over one period, each joint's rows divided by its peak torque."""
+def information(
+    model: RobotModel,
+    trajectory: FourierTrajectory,
+    noise: EffortNoise = DEFAULT_EFFORT_NOISE,
+    rate: float = DEFAULT_RECORD_RATE,
+    duration: float | None = None,
+    samples: int = SAMPLES,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(F (10, 10), sigma (n,), peak (n,)): the information matrix of the payload's ten
+    parameters that a recording of ``duration`` s (default one period) at ``rate`` Hz gives
+    at that noise, each joint's noise [N m] and the arm's own peak torque [N m] along the motion."""
+    duration = trajectory.period if duration is None else duration
     states = trajectory.evaluate(np.linspace(0.0, trajectory.period, samples, endpoint=False))
     Y, tau_arm = payload_regressor(model, *states)
     peak = np.abs(tau_arm).max(axis=0)
-    weights = 1.0 / np.maximum(peak, 1e-6 * max(float(peak.max()), 1e-300))
-    return (Y * weights[None, :, None]).reshape(-1, Y.shape[-1])
+    sigma = noise.sigma(model, peak)
+    weighted = (Y / sigma[None, :, None]).reshape(-1, Y.shape[-1])
+    return weighted.T @ weighted * (rate * duration / samples), sigma, peak
 
 
-def payload_condition_number(model: RobotModel, trajectory: FourierTrajectory, samples: int = SAMPLES) -> float:
-    """cond of the payload's weighted, column-scaled regressor over one period (see above)."""
-    stacked = _weighted_regressor(model, trajectory, samples)
-    norms = np.linalg.norm(stacked, axis=0)
-    if not np.all(norms > 0.0):
+def _torque_use(model: RobotModel, peak: np.ndarray) -> float:
+    """The largest fraction of a joint's torque limit the arm's own torques take (0: no limits)."""
+    limits = np.array(model.torque_limits, dtype=float)
+    limited = limits > 0.0
+    return float((peak[limited] / limits[limited]).max()) if limited.any() else 0.0
+
+
+def _a_optimal(F: np.ndarray) -> float:
+    """log of the sum of the parameters' variances in UNIT_SCALE units (inf when singular)."""
+    eigenvalues = np.linalg.eigvalsh(F * np.outer(UNIT_SCALE, UNIT_SCALE))
+    if not eigenvalues[0] > 1e-12 * max(eigenvalues[-1], 1e-300):
         return math.inf
-    singular = np.linalg.svd(stacked / norms, compute_uv=False)
-    return float(singular[0] / singular[-1]) if singular[-1] > 0 else math.inf
+    return math.log(float(np.sum(1.0 / eigenvalues)))
+
+
+def _condition(F: np.ndarray) -> float:
+    """cond of the weighted regressor, its columns scaled to unit norm: sqrt(cond(D F D))."""
+    diagonal = np.diag(F)
+    if not np.all(diagonal > 0.0):
+        return math.inf
+    scale = 1.0 / np.sqrt(diagonal)
+    eigenvalues = np.linalg.eigvalsh(F * np.outer(scale, scale))
+    return float(math.sqrt(eigenvalues[-1] / eigenvalues[0])) if eigenvalues[0] > 0 else math.inf
 
 
 def optimise_payload_excitation(
     model: RobotModel,
-    period: float = DEFAULT_PAYLOAD_PERIOD,
-    harmonics: int = 5,
+    period: float | None = None,
+    harmonics: int = DEFAULT_PAYLOAD_HARMONICS,
     seed: int = 0,
     iterations: int = 40,
     margin: float = DEFAULT_MARGIN,
     pose=None,
+    noise: EffortNoise = DEFAULT_EFFORT_NOISE,
+    rate: float = DEFAULT_RECORD_RATE,
+    periods: int | None = None,
     progress: Callable[[int, int], None] | None = None,
-) -> Excitation:
-    """A wrist motion within the model's limits minimising the payload regressor's condition
-    number; ValueError when the wrist's limits leave a joint less than MIN_WRIST_TRAVEL, or
-    when the pose leaves the condition number above MAX_CONDITION (naming the parameters).
+) -> PayloadExcitation:
+    """A wrist motion within the model's limits for the payload's ten parameters (see the
+    module's docstring), recorded for ``periods`` periods (default: as many as 30 s hold);
+    ValueError when the wrist's limits leave a joint less than MIN_WRIST_TRAVEL, or when
+    the pose leaves the condition number above MAX_CONDITION (naming the parameters).
     ``progress(done, iterations)`` after each of the optimiser's iterations."""
-    if not 0.0 < period <= MAX_PAYLOAD_DURATION:
+    if period is not None and not 0.0 < period <= MAX_PAYLOAD_DURATION:
         raise ValueError(f"period: must be within (0, {MAX_PAYLOAD_DURATION:g}] s, got {period}")
     if harmonics < 2:
         raise ValueError(f"harmonics: at least 2 are needed to start at rest, got {harmonics}")
-    limits = payload_limits(model, margin, pose)
+    choices = period_choices(period, periods)
+    if not choices:
+        given = f"{period:g} s" if period is not None else f"{min(PERIODS):g} s at least"
+        raise ValueError(f"periods: {periods} x {given} is more than {MAX_PAYLOAD_DURATION:g} s")
+    moving = wrist(model)
+    rng = np.random.default_rng(seed)
+    starts = [np.r_[rng.normal(size=2 * len(moving) * (harmonics - 1)), np.zeros(len(moving))] for _ in range(STARTS)]
     evaluations = 0
 
-    def cost(free):
+    def design(free, limits, period) -> tuple[FourierTrajectory, np.ndarray, np.ndarray, np.ndarray]:
+        trajectory = _trajectory(free, model, harmonics, period, limits)
+        return trajectory, *information(model, trajectory, noise, rate, recorded(period, periods))
+
+    def cost(free, limits, period, with_use=False):
         nonlocal evaluations
         evaluations += 1
-        value = payload_condition_number(model, _trajectory(free, model, harmonics, period, limits))
-        return math.log(min(value, 1e300))
+        _, F, _, peak = design(free, limits, period)
+        value = min(_a_optimal(F), 700.0)
+        return (_torque_use(model, peak) > MAX_TORQUE_USE, value) if with_use else value
 
-    start = np.random.default_rng(seed).normal(size=2 * len(wrist(model)) * (harmonics - 1))
-    start_cost = cost(start)
+    # the held pose and the period too, unless given: those where a random motion tells the most
+    poses = held_poses(model, margin, rng) if pose is None else [pose]
+    candidates = [(p, T) for p in poses for T in choices]
+    scores = [min(cost(x, payload_limits(model, margin, p), T, True) for x in starts[:SCOUTS]) for p, T in candidates]
+    pose, period = candidates[min(range(len(candidates)), key=scores.__getitem__)]
+    limits = payload_limits(model, margin, pose)
+    start_condition = _condition(design(starts[0], limits, period)[1])
+    costs = [cost(x, limits, period) for x in starts]
+    start, start_cost = starts[int(np.argmin(costs))], min(costs)
     best = start
     if iterations > 0:
+        budget = iterations * (len(start) + 1)
+        options = {"maxiter": iterations, "maxfun": budget, "eps": 1e-6}
         result = minimize(
             cost,
             start,
+            args=(limits, period),
             method="L-BFGS-B",
-            options={"maxiter": iterations, "eps": 1e-6},
+            options=options,
             callback=iterations_to(progress, iterations),
         )
         if progress is not None:
             progress(iterations, iterations)  # (the optimiser may stop before its last iteration)
         best = result.x if result.fun < start_cost else start
-    trajectory = _trajectory(best, model, harmonics, period, limits)
+    trajectory, F, sigma, _ = design(best, limits, period)
     travel = np.ptp(trajectory.evaluate(np.linspace(0.0, period, 100 * harmonics))[0], axis=0)
-    for j in wrist(model):
+    for j in moving:
         if travel[j] <= MIN_WRIST_TRAVEL:
             raise ValueError(
                 f"{model.joints[j].name}: its limits allow a motion of only {travel[j]:.3g} rad, "
                 f"{MIN_WRIST_TRAVEL:g} rad needed"
             )
-    condition = payload_condition_number(model, trajectory)
+    condition = _condition(F)
     if not condition <= MAX_CONDITION:
-        stacked = _weighted_regressor(model, trajectory)
-        seen = excitation(stacked.T @ stacked)
+        seen = excitation(F)
         names = ", ".join(PARAMETER_LABELS[k] for k in np.flatnonzero(seen <= max(WEAKLY_SEEN, seen.min())))
         raise ValueError(
             f"pose: at this pose the wrist's motion cannot tell the payload's {names} apart from the others "
             f"(condition number {condition:.3g}): hold another --pose"
         )
-    return Excitation(trajectory, condition, math.exp(start_cost), evaluations)
+    std = np.sqrt(np.diag(np.linalg.inv(F)))
+    return PayloadExcitation(
+        trajectory, condition, start_condition, evaluations, std, sigma, noise, rate, recorded(period, periods)
+    )

@@ -3,7 +3,7 @@
     irb140-excitation --out FILE [--params-file F | --urdf FILE [--base L] [--tip L]]
                       [-p NAME:=VALUE] [--rate HZ] [--period S]
                       [--harmonics K] [--periods P] [--seed N] [--iterations N]
-                      [--payload [--pose Q1,...,Qn]]
+                      [--payload [--pose Q1,...,Qn] [--effort-noise N|P%] [--record-rate HZ]]
     (or: ros2 run irb140_dynamics excitation ..., python -m irb140_dynamics.tools.excitation ...)
 
 Writes FILE, a trajectory_msgs/JointTrajectory in YAML (the form `ros2 topic pub` takes),
@@ -15,9 +15,11 @@ not at all. The optimisation's progress goes to stderr (a bar with the time left
 terminal, else a line per 10 %). Exit status 0; 1 with one line; 2 for a bad argument; 130 after Ctrl-C.
 
 With --payload, a load identification motion for `identify --payload-only`: the last three
-joints move (each over more than 0.1 rad), the others hold --pose (default: the middle of
-their ranges), at most 30 s in all; the condition number is the payload's ten-column
-regressor's (see docs/load.md).
+joints move (each over more than 0.1 rad), the others hold --pose (default: chosen with the
+motion), at most 30 s in all (default: as many periods as fit, the period chosen unless
+given); designed for the payload's ten parameters at the stated --effort-noise, it prints
+(and writes in FILE's header) each parameter's expected standard deviation, and the
+condition number of the payload's noise-weighted regressor (see docs/load.md).
 """
 
 from __future__ import annotations
@@ -40,7 +42,7 @@ from irb140_dynamics.tools.cli import (
     refuse_input_as_output,
     run,
 )
-from irb140_dynamics.tools.common import add_model_arguments, arm_of
+from irb140_dynamics.tools.common import add_model_arguments, arm_of, model_inputs
 
 MAX_POINTS = 1_000_000  # points written: 100 MB of YAML
 POINTS_PER_CYCLE = 4  # of the highest harmonic: fewer points do not show the motion
@@ -50,6 +52,12 @@ PUBLISH = "  ros2 topic pub --once /joint_trajectory_controller/joint_trajectory
 
 def parser() -> Parser:
     from irb140_dynamics.identification.excitation import DEFAULT_HARMONICS, DEFAULT_MARGIN, DEFAULT_PERIOD
+    from irb140_dynamics.identification.payload_excitation import (
+        DEFAULT_PAYLOAD_HARMONICS,
+        DEFAULT_RECORD_RATE,
+        MAX_PAYLOAD_DURATION,
+        PERIODS,
+    )
 
     p = Parser(prog="excitation", description=__doc__.split("\n\n")[0].split(": ", 1)[1])
     p.add_argument("--out", required=True, metavar="FILE", help="JointTrajectory YAML file to write")
@@ -59,19 +67,21 @@ def parser() -> Parser:
     p.add_argument(
         "--period",
         type=number(0.0, 1e4, above=True),
-        default=DEFAULT_PERIOD,
         metavar="S",
-        help=f"period [s] (default {DEFAULT_PERIOD:g})",
+        help=f"period [s] (default {DEFAULT_PERIOD:g}; with --payload chosen among "
+        f"{', '.join(f'{T:g}' for T in PERIODS)})",
     )
     p.add_argument(
         "--harmonics",
         type=number(1, 50, integer=True),
-        default=DEFAULT_HARMONICS,
         metavar="K",
-        help=f"Fourier harmonics per joint (default {DEFAULT_HARMONICS})",
+        help=f"Fourier harmonics per joint (default {DEFAULT_HARMONICS}; {DEFAULT_PAYLOAD_HARMONICS} with --payload)",
     )
     p.add_argument(
-        "--periods", type=number(1, 10_000, integer=True), default=1, metavar="P", help="periods written (default 1)"
+        "--periods",
+        type=number(1, 10_000, integer=True),
+        metavar="P",
+        help=f"periods written (default 1; with --payload as many as {MAX_PAYLOAD_DURATION:g} s hold)",
     )
     p.add_argument(
         "--margin",
@@ -100,6 +110,20 @@ def parser() -> Parser:
         help="with --payload: the pose [rad] the joints before the wrist hold, one value per joint within its "
         "range (the wrist's are not used; default: mid-range)",
     )
+    p.add_argument(
+        "--effort-noise",
+        type=_effort_noise,
+        metavar="N|P%",
+        help="with --payload: the recorded efforts' noise, one standard deviation per sample, in N m on every "
+        "joint (0.05) or a percentage of each joint's torque limit (1%%; of its peak torque where it has none); "
+        "default 1%%",
+    )
+    p.add_argument(
+        "--record-rate",
+        type=number(0.0, 1e5, above=True),
+        metavar="HZ",
+        help=f"with --payload: the rate the joint states will be recorded at (default {DEFAULT_RECORD_RATE:g})",
+    )
     add_model_arguments(p, "the model and its limits (default: the package's IRB-140)")
     return p
 
@@ -116,32 +140,58 @@ def _pose(text: str) -> list[float]:
     return values
 
 
+def _effort_noise(text: str):
+    from irb140_dynamics.identification.payload_excitation import EffortNoise
+
+    try:
+        return EffortNoise.parse(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error).removeprefix("effort noise: ")) from None
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     return run("excitation", lambda interrupts: _excitation(parser().parse_args(argv), interrupts))
 
 
 def _excitation(args: argparse.Namespace, interrupts) -> int:
-    points = args.rate * args.period * args.periods
+    from irb140_dynamics.identification.excitation import DEFAULT_HARMONICS, DEFAULT_PERIOD
+    from irb140_dynamics.identification.payload_excitation import (
+        DEFAULT_PAYLOAD_HARMONICS,
+        MAX_PAYLOAD_DURATION,
+        PERIODS,
+        period_choices,
+        recorded,
+    )
+
+    for option in ("pose", "effort_noise", "record_rate"):
+        if getattr(args, option) is not None and not args.payload:
+            raise ToolError(f"--{option.replace('_', '-')}: only with --payload")
+    if args.harmonics is None:
+        args.harmonics = DEFAULT_PAYLOAD_HARMONICS if args.payload else DEFAULT_HARMONICS
+    if args.payload:
+        choices = period_choices(args.period, args.periods)
+        if not choices:
+            shortest = recorded(args.period or min(PERIODS), args.periods)
+            raise ToolError(
+                f"--period x --periods: a payload motion lasts at most {MAX_PAYLOAD_DURATION:g} s, got {shortest:g} s"
+            )
+        longest = max(recorded(T, args.periods) for T in choices)
+        period_bound = min(choices)  # the fewest points per period: the check below
+        total = longest
+    else:
+        args.period = args.period or DEFAULT_PERIOD
+        args.periods = args.periods or 1
+        period_bound, total = args.period, args.period * args.periods
+    points = args.rate * total
     if points > MAX_POINTS:
         raise ToolError(f"--rate x --period x --periods gives {points:.3g} points, more than {MAX_POINTS:,}")
-    if args.rate * args.period < POINTS_PER_CYCLE * args.harmonics:
+    if args.rate * period_bound < POINTS_PER_CYCLE * args.harmonics:
         raise ToolError(
-            f"--rate x --period gives {args.rate * args.period:.3g} points per period, fewer than "
+            f"--rate x --period gives {args.rate * period_bound:.3g} points per period, fewer than "
             f"{POINTS_PER_CYCLE * args.harmonics} ({POINTS_PER_CYCLE} per cycle of harmonic {args.harmonics}): "
             "raise --rate"
         )
-    if args.pose is not None and not args.payload:
-        raise ToolError("--pose: only with --payload")
-    from irb140_dynamics.identification.payload_excitation import MAX_PAYLOAD_DURATION
-
-    if args.payload and args.period * args.periods > MAX_PAYLOAD_DURATION:
-        raise ToolError(
-            f"--period x --periods: a payload motion lasts at most {MAX_PAYLOAD_DURATION:g} s, "
-            f"got {args.period * args.periods:g} s"
-        )
-    from irb140_dynamics.tools.common import model_inputs
-
     check_model_paths(args)
     out = output_file(args.out)
     refuse_input_as_output(model_inputs(args), [(args.out, out)])
@@ -155,8 +205,13 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
 
     source = arm_of(args)
     model, path = source.model, source.origin
+    expectation = []
     if args.payload:
-        result, regressor = _payload_excitation(model, path, args), "the payload's regressor"
+        result, regressor = _payload_excitation(model, path, args), "the payload's noise-weighted regressor"
+        args.period = result.trajectory.period
+        args.periods = int(round(result.duration / args.period))
+        expectation = result.expectation()
+        print("\n".join(expectation), flush=True)
     else:
         base = find_base_parameters(model)
         print(
@@ -192,10 +247,13 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
         "Move the arm to the first point first. Publish it, e.g.:",
         PUBLISH.format(argument='"$(cat FILE)"   (or --yaml-file FILE)'),
         "and record: ros2 bag record /joint_states",
+        *expectation,
     ]
     text = joint_trajectory_text(model.joint_names, times, Q, QD, QDD, comments)
     if len(text) > SHELL_ARGUMENT_LIMIT:  # too long for "$(cat FILE)": the header says the way that works
-        comments[-2] = PUBLISH.format(argument="--yaml-file FILE   (too long for one shell argument)")
+        comments[comments.index("Move the arm to the first point first. Publish it, e.g.:") + 1] = PUBLISH.format(
+            argument="--yaml-file FILE   (too long for one shell argument)"
+        )
         text = joint_trajectory_text(model.joint_names, times, Q, QD, QDD, comments)
     with Outputs(interrupts) as outputs:
         outputs.text(out, args.out, text)
@@ -218,6 +276,8 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
 
 def _payload_excitation(model, path: str, args: argparse.Namespace):
     from irb140_dynamics.identification.payload_excitation import (
+        DEFAULT_EFFORT_NOISE,
+        DEFAULT_RECORD_RATE,
         optimise_payload_excitation,
         payload_limits,
         wrist,
@@ -230,13 +290,14 @@ def _payload_excitation(model, path: str, args: argparse.Namespace):
     except ValueError as error:
         message = str(error)
         raise ToolError(f"--{message}" if message.startswith("pose:") else message) from None
-    moving = ", ".join(model.joint_names[j] for j in wrist(model))
+    moving = wrist(model)
     print(
-        f"model: {path}; payload motion of {moving}; optimising ({counted(args.iterations, 'iteration')})...",
+        f"model: {path}; payload motion of {', '.join(model.joint_names[j] for j in moving)}; "
+        f"optimising ({counted(args.iterations, 'iteration')})...",
         flush=True,
     )
     try:
-        return optimise_payload_excitation(
+        result = optimise_payload_excitation(
             model,
             args.period,
             args.harmonics,
@@ -244,11 +305,23 @@ def _payload_excitation(model, path: str, args: argparse.Namespace):
             args.iterations,
             margin=args.margin,
             pose=args.pose,
+            noise=args.effort_noise or DEFAULT_EFFORT_NOISE,
+            rate=args.record_rate or DEFAULT_RECORD_RATE,
+            periods=args.periods,
             progress=_progress(),
         )
     except ValueError as error:
         message = str(error)
         raise ToolError(f"--{message}" if message.startswith("pose:") else message) from None
+    held = [j for j in range(model.n) if j not in moving]
+    trajectory = result.trajectory
+    print(
+        f"{len(moving)} joints moving {trajectory.period:g} s periods for {result.duration:g} s"
+        + (f", the others held at [{', '.join(f'{trajectory.q0[j]:.4f}' for j in held)}] rad" if held else "")
+        + ("" if args.pose is not None else " (chosen: --pose holds another)"),
+        flush=True,
+    )
+    return result
 
 
 def _progress():

@@ -168,5 +168,7 @@ def test_a_wrist_motion_too_small_for_the_noise_is_refused_with_the_deviations(t
         return write_csv(tmp_path / f"size_{size}.csv", arm.joint_names, t, Q, QD, tau)
 
     assert fit_payload(arm, recording(1.0)).payload.mass == pytest.approx(payload.mass, rel=0.02)
-    with pytest.raises(RecordingError, match=r"does not excite the payload's Ixx \(\+- [0-9.e-]+ kg m\^2\)"):
+    with pytest.raises(
+        RecordingError, match=r"excitation --payload` \(a weak motion\): the payload's Ixx \(\+- [0-9.e-]+ kg m\^2\)"
+    ):
         fit_payload(arm, recording(0.1))

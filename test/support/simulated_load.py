@@ -1,0 +1,78 @@
+"""A load identification run on a simulated arm, as a user makes it on a real one.
+
+The true arm (its model with friction and rotor inertia, the payload attached) is stepped in
+MuJoCo (``sim.engine.SimulatedArm``) at 1 kHz by a computed-torque controller: the feed-forward
+of the true arm along the reference, PD feedback scaled per joint by the mass matrix's
+diagonal at the start. What is recorded is what a driver publishes, at 500 Hz: the state at
+the step's start and the torque MuJoCo applied during it, with Gaussian noise of the stated
+``EffortNoise`` (1 % of each joint's torque limit, of its peak torque where it has none).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from irb140_dynamics.core import Friction, RigidBody, RobotModel, mass_matrix, rnea_batch
+from irb140_dynamics.identification.payload_excitation import EffortNoise
+
+CONTROL_RATE = 1000.0  # Hz
+RECORD_EVERY = 2  # control steps per recorded sample: 500 Hz
+KP, KD = 400.0, 40.0  # 1/s^2, 1/s: the feedback's bandwidth, through the mass matrix's diagonal
+
+
+def tool(mass, com, moments, angles) -> RigidBody:
+    """A payload of principal moments ``moments`` [kg m^2] turned by ``angles`` (xyz Euler, rad)."""
+    R = Rotation.from_euler("xyz", angles).as_matrix()
+    I = R @ np.diag(moments) @ R.T
+    return RigidBody(mass, com, (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]))
+
+
+def with_drive_losses(model: RobotModel) -> RobotModel:
+    """The model with viscous and Coulomb friction and rotor inertia on every joint, sized by
+    its torque limit (a URDF gives none): 0.5 % of the limit per rad/s, 1 % of it, and
+    0.1 % of it in kg m^2."""
+    limits = np.array(model.torque_limits, dtype=float)
+    joints = tuple(
+        replace(j, friction=Friction(0.005 * limit, 0.01 * limit), armature=0.001 * limit)
+        for j, limit in zip(model.joints, limits)
+    )
+    return replace(model, joints=joints)
+
+
+def run(arm: RobotModel, trajectory, duration: float, noise: EffortNoise, seed: int = 0):
+    """(t, Q, QD, TAU measured) at 500 Hz of the MuJoCo ``arm`` (payload included) following
+    ``trajectory`` for ``duration`` s under computed torque at 1 kHz."""
+    from irb140_dynamics.sim.engine import SimulatedArm
+
+    steps = int(round(duration * CONTROL_RATE))
+    t = np.arange(steps) / CONTROL_RATE
+    Q_ref, QD_ref, QDD_ref = trajectory.evaluate(t)
+    feed_forward = rnea_batch(arm, Q_ref, QD_ref, QDD_ref)
+    scale = np.diag(mass_matrix(arm, Q_ref[0])) + np.array([j.armature for j in arm.joints])
+    sim = SimulatedArm(arm, period=1.0 / CONTROL_RATE)
+    sim.reset(Q_ref[0], QD_ref[0])
+    kept = range(0, steps, RECORD_EVERY)
+    Q, QD, TAU = (np.empty((len(kept), arm.n)) for _ in range(3))
+    for k in range(steps):
+        q, qd = sim.q, sim.qd
+        sim.step(feed_forward[k] + scale * (KP * (Q_ref[k] - q) + KD * (QD_ref[k] - qd)))
+        if k % RECORD_EVERY == 0:
+            i = k // RECORD_EVERY
+            Q[i], QD[i], TAU[i] = q, qd, sim.applied
+    sigma = noise.sigma(arm, np.abs(TAU).max(axis=0))
+    measured = TAU + np.random.default_rng(seed).normal(size=TAU.shape) * sigma
+    return t[::RECORD_EVERY], Q, QD, measured
+
+
+def write_csv(path: Path, names, t, Q, QD, TAU) -> Path:
+    columns = (
+        ["time"] + [f"position_{n}" for n in names] + [f"velocity_{n}" for n in names] + [f"effort_{n}" for n in names]
+    )
+    np.savetxt(
+        path, np.column_stack([t, Q, QD, TAU]), delimiter=",", header=",".join(columns), comments="", fmt="%.12g"
+    )
+    return path
