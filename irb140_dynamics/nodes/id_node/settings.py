@@ -5,8 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from irb140_dynamics.core import RigidBody, RobotModel
-from irb140_dynamics.core.codegen import native
-from irb140_dynamics.core.codegen.kernels import WITH_FRICTION, Preparation, kernels_of, prepare
+from irb140_dynamics.core.codegen.kernels import Preparation, kernels_of, prepare
+from irb140_dynamics.core.codegen.recipes import WITH_FRICTION
 from irb140_dynamics.core.model.rigid_body import MAX_MASS
 from irb140_dynamics.core.payload.limits import RATED_PAYLOAD, derive_torque_limits
 from irb140_dynamics.core.payload.stop import stopping
@@ -147,13 +147,7 @@ def compiled(settings: IdNodeSettings, previous: IdNodeSettings | None) -> bool:
     """Whether finish_settings would be quick (the arm's code traced, and native already or
     never): then it may run on the executor. On the way, a kernel whose arm has compiled
     code already is bound to it (cheap; what prepare would do first)."""
-    kernels = kernels_of(settings.model)
-    if not kernels.compiled(*KERNELS):
-        return False
-    return not native.enabled() or all(
-        kernel.native is not None or native.COMPILER.bind_built(kernel)
-        for kernel in (kernels.kernel(name) for name in KERNELS)
-    )
+    return kernels_of(settings.model).ready(KERNELS)
 
 
 def kernels_text(kernels: Preparation | None) -> str:
@@ -167,5 +161,4 @@ def kernels_text(kernels: Preparation | None) -> str:
             f"kernels: Python form for now: compiling them as C took over {NATIVE_WAIT:g} s, "
             "native once the compile is done"
         )
-    why = "IRB140_NATIVE=0" if native.compiler() is not None else "no C compiler"
-    return f"kernels: Python form ({why}; traced in {kernels.seconds:.1f} s)"
+    return f"kernels: Python form ({kernels.reason}; traced in {kernels.seconds:.1f} s)"
