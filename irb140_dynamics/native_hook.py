@@ -50,6 +50,11 @@ def install(compiler: Compiler | None) -> None:
     _installed = compiler
 
 
+def installed() -> Compiler | None:
+    """The installed compiler, None when none is yet (nothing loaded)."""
+    return _installed
+
+
 def compiler() -> Compiler | None:
     """The installed compiler, the compile room imported on first need (see ``loader``)."""
     if _installed is None and loader is not None:

@@ -100,3 +100,28 @@ def test_with_no_compiler_installed_prepare_says_so_and_the_python_form_answers(
         np.testing.assert_array_equal(gravity(model, q), kernels_of(model).gravity_torques.scalar(q.tolist()))
     finally:
         native_hook.install(native.COMPILER)
+
+
+WARM_UP = """
+import sys
+import numpy as np
+from irb140_dynamics.core import gravity, irb140, kernels_of
+from irb140_dynamics.core.codegen.kernels import PROMOTE_AFTER
+model, q = irb140(), np.full(6, 0.3)
+for _ in range(PROMOTE_AFTER):
+    gravity(model, q)
+import threading
+for thread in threading.enumerate():  # the warm-up's: it loads the compile room, then asks it
+    if thread.name == "irb140-promote":
+        thread.join(timeout=120.0)
+import irb140_dynamics.native as native
+native.COMPILER.wait(timeout=120.0)
+print(kernels_of(model).is_native("gravity_torques"))
+"""
+
+
+@pytest.mark.skipif(not native.enabled(), reason="no C compiler (or IRB140_NATIVE=0)")
+def test_in_a_fresh_process_the_warm_up_loads_the_compile_room_and_goes_native():
+    done = subprocess.run([sys.executable, "-c", WARM_UP], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["True"]

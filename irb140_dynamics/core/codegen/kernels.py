@@ -73,9 +73,11 @@ class Kernel:
         (then asked for twice, harmless) but none is skipped, so it is asked for."""
         calls = self._calls = self._calls + 1
         if calls == PROMOTE_AFTER:
-            compiler = native_hook.compiler()
+            compiler = native_hook.installed()
             if compiler is not None:
                 compiler.promote(self)
+            else:  # the compile room loaded off the caller's thread: no call waits for it
+                threading.Thread(target=_promote, args=(self,), name="irb140-promote", daemon=True).start()
 
     @cached_property
     def _into(self):
@@ -92,6 +94,16 @@ class Kernel:
     def written(self) -> list[int]:
         """The indices of the outputs ``into`` writes: those not folded to constants."""
         return self.trace.writing[1]
+
+
+def _promote(kernel: Kernel) -> None:
+    """Ask the compiler (its room loaded here the first time) for ``kernel``'s native form."""
+    try:
+        compiler = native_hook.compiler()
+        if compiler is not None:
+            compiler.promote(kernel)
+    except Exception:  # the Python form stays in use
+        pass
 
 
 @dataclass(frozen=True)
