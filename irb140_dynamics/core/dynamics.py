@@ -9,13 +9,12 @@ Single-state functions take sequences of n numbers and return NumPy arrays; the
 All run the model's generated kernels (``codegen.kernels.kernels_of``), traced on first
 use; the single-state ``rnea``, ``gravity`` and ``mass_matrix`` run them as C once compiled
 (by the ``native`` room): in the background after PROMOTE_AFTER calls, or at once with
-``prepare(model, timeout)``. What a
-state is, and the checks of each argument, are in ``states``: anything else raises
-ValueError naming the argument (the kernels fold constants: a NaN times a zero constant
-would vanish). A result is never silently non-finite: where velocities, accelerations,
-torques or a wrench are so large that it overflows, ValueError says so, naming the inputs.
-g(q) and M(q) need no such check: q enters through cos and sin only, and the model's
-sanity caps keep them finite.
+``prepare(model, timeout)``. What a state is, and the checks of each argument, are in
+``states``: anything else raises ValueError naming the argument (the kernels fold
+constants: a NaN times a zero constant would vanish). A result is never silently
+non-finite: where velocities, accelerations, torques or a wrench are so large that it
+overflows, ValueError says so, naming the inputs. g(q) and M(q) need no such check: q
+enters through cos and sin only, and the model's sanity caps keep them finite.
 """
 
 from __future__ import annotations
