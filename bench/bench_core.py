@@ -6,7 +6,7 @@ Prints one table (ours, baseline, ratio ours/baseline, target) and writes the ra
 to bench/results/core.json. Sections:
 
 - single state: per-call cost of the public functions on NumPy (6,) arrays against
-  Pinocchio's, with their kernels compiled as C (core.codegen.native: what a program that
+  Pinocchio's, with their kernels compiled as C (irb140_dynamics.native: what a program that
   calls them often gets); the kernels' Python form on Python lists; a textbook NumPy RNEA,
   the approach the generated code avoids.
 - batch: states per second of the ``*_batch`` functions on N random states against a
@@ -120,7 +120,7 @@ class TextbookRnea:
 
 
 def with_native(model):
-    """``model`` with its single-state kernels compiled as C (core.codegen.native), as
+    """``model`` with its single-state kernels compiled as C (irb140_dynamics.native), as
     ``prepare`` makes them (a node at startup, or a program after PROMOTE_AFTER calls).
     Says so when there is no native code (no compiler)."""
     if not prepare(model, timeout=300.0).native:

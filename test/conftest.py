@@ -22,7 +22,7 @@ assert WORKER < WORKERS_AT_MOST, f"at most {WORKERS_AT_MOST} pytest-xdist worker
 os.environ["ROS_DOMAIN_ID"] = str(FIRST_DOMAIN + WORKER)
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ.pop("ROS_STATIC_PEERS", None)
-# Native kernels (core.codegen.native) compiled by this session into a folder of its own,
+# Native kernels (irb140_dynamics.native) compiled by this session into a folder of its own,
 # not into the user's cache: a test sees its own compiles, and leaves nothing behind.
 _CACHE = tempfile.TemporaryDirectory(prefix="irb140_kernels_")
 os.environ["IRB140_CACHE"] = _CACHE.name

@@ -5,6 +5,7 @@
 array([  0.   , 243.382,  79.156,  -0.   ,   2.43 ,   0.   ])
 """
 
+from irb140_dynamics.core.codegen.kernels import Kernels, kernels_of
 from irb140_dynamics.core.dynamics import (
     Preparation,
     coriolis,
@@ -43,6 +44,7 @@ __all__ = [
     "Preparation",
     "Friction",
     "Joint",
+    "Kernels",
     "MaxPayload",
     "ModelError",
     "PayloadCheck",
@@ -65,6 +67,7 @@ __all__ = [
     "gravity",
     "gravity_batch",
     "irb140",
+    "kernels_of",
     "link_frames",
     "load_model",
     "mass_matrix",

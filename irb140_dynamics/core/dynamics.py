@@ -6,15 +6,15 @@ M includes the joints' armature (rotor inertia); tau_f is joint friction (see ``
 
 Single-state functions take sequences of n numbers and return NumPy arrays; the
 ``*_batch`` forms take arrays shaped (N, n) and give the same numbers for N states at once.
-All run the model's generated kernels (see ``codegen``), traced on first use; the
-single-state ``rnea``, ``gravity`` and ``mass_matrix`` run them as C once compiled: in the
-background after PROMOTE_AFTER calls, or at once with ``prepare(model, timeout)``. What a
-state is, and the checks of each argument, are in ``states``: anything else raises
-ValueError naming the argument (the kernels fold constants: a NaN times a zero constant
-would vanish). A result is never silently non-finite: where velocities, accelerations,
-torques or a wrench are so large that it overflows, ValueError says so, naming the inputs.
-g(q) and M(q) need no such check: q enters through cos and sin only, and the model's
-sanity caps keep them finite.
+All run the model's generated kernels (``codegen.kernels.kernels_of``), traced on first
+use; the single-state ``rnea``, ``gravity`` and ``mass_matrix`` run them as C once compiled
+(by the ``native`` room): in the background after PROMOTE_AFTER calls, or at once with
+``prepare(model, timeout)``. What a state is, and the checks of each argument, are in
+``states``: anything else raises ValueError naming the argument (the kernels fold
+constants: a NaN times a zero constant would vanish). A result is never silently
+non-finite: where velocities, accelerations, torques or a wrench are so large that it
+overflows, ValueError says so, naming the inputs. g(q) and M(q) need no such check: q
+enters through cos and sin only, and the model's sanity caps keep them finite.
 """
 
 from __future__ import annotations
@@ -24,9 +24,9 @@ from math import isfinite
 
 import numpy as np
 
-from irb140_dynamics.core.codegen.kernels import Preparation, kernels_of, prepare
+from irb140_dynamics.core.codegen.kernels import VERBS_KERNELS, Preparation, kernels_of, prepare
 
-__all__ = [  # prepare, Preparation: compile a model's kernels now (see codegen.kernels)
+__all__ = [  # prepare, Preparation: make a model's kernels native now (see codegen.kernels)
     "Preparation",
     "coriolis",
     "coriolis_batch",
@@ -47,6 +47,7 @@ from irb140_dynamics.core.model.states import finite_result, finite_results, sta
 
 ArrayLike = Sequence[float] | np.ndarray
 _ARRAY, _FLOAT64 = np.ndarray, np.dtype(float)
+_KEPT = VERBS_KERNELS.kept  # id(model) -> its kernels: read inline on the hot paths, else kernels_of
 
 
 def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=None) -> np.ndarray:
@@ -57,7 +58,7 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
     origin) that the environment exerts on the flange, in the flange frame. tau balances
     it: tau = ID(q, qd, qdd) - J(q)^T f_ext, with J the flange Jacobian in the flange frame.
     """
-    kernels = kernels_of(model)
+    kernels = _KEPT.get(id(model)) or kernels_of(model)
     if f_ext is None:
         kernel = kernels.rnea_with_friction
         if kernel.native is not None:  # checks the arrays itself: None unless (n,) float64, finite
@@ -95,7 +96,7 @@ def rnea(model: RobotModel, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, f_ext=N
 
 def gravity(model: RobotModel, q: ArrayLike) -> np.ndarray:
     """Gravity torques g(q) [N m]: what holds the arm (and payload) still at q."""
-    kernels = kernels_of(model)
+    kernels = _KEPT.get(id(model)) or kernels_of(model)
     kernel = kernels.gravity_torques
     if kernel.native is not None:
         g = kernel.native(q)
@@ -126,7 +127,7 @@ def coriolis_matrix(model: RobotModel, q: ArrayLike, qd: ArrayLike) -> np.ndarra
 
 def mass_matrix(model: RobotModel, q: ArrayLike) -> np.ndarray:
     """The joint-space mass matrix M(q) [kg m^2], symmetric positive definite."""
-    kernel = kernels_of(model).mass_matrix
+    kernel = (_KEPT.get(id(model)) or kernels_of(model)).mass_matrix
     if kernel.native is not None:
         M = kernel.native(q)  # the whole matrix
         if M is not None:

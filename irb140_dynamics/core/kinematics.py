@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from irb140_dynamics.core.model.per_model import PerModel
 from irb140_dynamics.core.model.robot_model import DH, RobotModel
 from irb140_dynamics.core.model.states import state
 
@@ -60,34 +61,29 @@ def _slide(axis: np.ndarray, distance: float) -> np.ndarray:
     return move
 
 
-def _flange_matrix(model: RobotModel) -> np.ndarray:
-    """The flange's placement on the last link, 4x4, made on first use and kept with the
-    model (as ``_placements``)."""
-    try:
-        return model.__dict__["_flange_matrix"]
-    except KeyError:
-        matrix = model.__dict__["_flange_matrix"] = model.flange.matrix()
-        matrix.setflags(write=False)  # shared by every caller
-        return matrix
+def _flange(model: RobotModel) -> np.ndarray:
+    matrix = model.flange.matrix()
+    matrix.setflags(write=False)  # shared by every caller
+    return matrix
 
 
-def _placements(model: RobotModel) -> list[tuple]:
-    """Per joint (pre, post as 4x4, axis, offset, prismatic), made on first use and kept with
-    the model (models are immutable: see codegen.kernels_of)."""
-    try:
-        return model.__dict__["_placements"]
-    except KeyError:
-        placements = model.__dict__["_placements"] = [
-            (
-                joint.pre.matrix(),
-                joint.post.matrix(),
-                np.asarray(joint.axis if joint.prismatic else joint.turning_axis, dtype=float),
-                float(joint.offset),
-                joint.prismatic,
-            )
-            for joint in model.joints
-        ]
-        return placements
+def _joint_placements(model: RobotModel) -> list[tuple]:
+    return [
+        (
+            joint.pre.matrix(),
+            joint.post.matrix(),
+            np.asarray(joint.axis if joint.prismatic else joint.turning_axis, dtype=float),
+            float(joint.offset),
+            joint.prismatic,
+        )
+        for joint in model.joints
+    ]
+
+
+# The flange's placement on the last link (4x4), and per joint (pre, post as 4x4, axis,
+# offset, prismatic): made on first use and kept while the model lives (see per_model).
+_FLANGES, _PLACEMENTS = PerModel(_flange), PerModel(_joint_placements)
+_flange_matrix, _placements = _FLANGES.get, _PLACEMENTS.get
 
 
 def flange_pose(model: RobotModel, q) -> np.ndarray:

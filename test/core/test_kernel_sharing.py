@@ -24,7 +24,7 @@ def test_a_payload_mass_or_gravity_change_shares_the_code():
         irb140(payload=RigidBody(5.0, (0.0, 0.0, 0.1))),
         base.with_gravity((0.0, 0.0, -9.80665)),
     ):
-        assert kernels_of(other).compiled("rnea", "gravity_torques")  # by base, above
+        assert kernels_of(other).traced("rnea", "gravity_torques")  # by base, above
         assert code(other) is code(base) and code(other, "gravity_torques") is code(base, "gravity_torques")
 
 

@@ -7,8 +7,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from irb140_dynamics import native
 from irb140_dynamics.core import Friction, RigidBody, coriolis_matrix, gravity, irb140, mass_matrix, rnea
-from irb140_dynamics.core.codegen import native
 from irb140_dynamics.core.codegen.kernels import kernels_of, prepare
 from irb140_dynamics.core.monitoring.observer import MomentumObserver, monitor_terms
 

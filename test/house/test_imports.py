@@ -17,7 +17,7 @@ PACKAGE = "irb140_dynamics"
 # importlib used on purpose, and what it loads: never a module of this package.
 IMPORTLIB_ALLOWED = {
     "irb140_dynamics/ros/recorder.py": "message classes of a recorded topic's type (sensor_msgs.msg, ...)",
-    "irb140_dynamics/core/codegen/native.py": "a kernel's extension module, compiled from generated C into the cache",
+    "irb140_dynamics/native/compiler.py": "a kernel's extension module, compiled from generated C into the cache",
 }
 
 
@@ -92,6 +92,37 @@ def test_a_node_importing_another_node_breaks_the_rules(package_copy):
     result = lint_imports(package_copy)
     assert result.returncode != 0
     assert "No node imports another node" in result.stdout
+
+
+def test_a_process_started_from_the_core_breaks_the_rules(package_copy):
+    kernels = package_copy / PACKAGE / "core" / "codegen" / "kernels.py"
+    kernels.write_text(kernels.read_text() + "\n\ndef _compile():\n    import subprocess  # noqa\n")
+    result = lint_imports(package_copy)
+    assert result.returncode != 0
+    assert "irb140_dynamics.core is not allowed to import subprocess" in " ".join(result.stdout.split())
+
+
+PROCESS_CALLS = {"system", "popen", "fork", "forkpty", "posix_spawn", "posix_spawnp"}  # of os, and exec*, spawn*
+
+
+def process_calls(root: Path) -> list[str]:
+    """The calls in the core's source that start a process through ``os`` (imports of
+    subprocess and multiprocessing are the core-starts-no-process contract's)."""
+    found = []
+    for path in sorted((root / PACKAGE / "core").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            of_os = isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == "os"
+            if of_os and (node.attr in PROCESS_CALLS or node.attr.startswith(("exec", "spawn"))):
+                found.append(f"{path.relative_to(root)}:{node.lineno} os.{node.attr}")
+    return found
+
+
+def test_the_core_starts_no_process_through_os(package_copy):
+    assert process_calls(ROOT) == []
+    dynamics = package_copy / PACKAGE / "core" / "dynamics.py"
+    dynamics.write_text(dynamics.read_text() + "\n\ndef _cc():\n    import os\n\n    os.system('cc')\n")
+    (found,) = process_calls(package_copy)
+    assert found.startswith("irb140_dynamics/core/dynamics.py:") and found.endswith(" os.system")
 
 
 def test_a_cycle_inside_a_function_is_found(package_copy):

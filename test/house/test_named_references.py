@@ -6,7 +6,7 @@ benchmarks' Python files, the docs, the README and .importlinter):
 
 - a dotted name that starts with the package: the package, a module, or a name in one;
 - a dotted name that starts with one of the package's sub-packages and goes on at least one
-  name deeper (``core.codegen.native``, ``identification.base.BaseParameters``), unless a
+  name deeper (``core.codegen.kernels``, ``identification.base.BaseParameters``), unless a
   ``/`` or a file suffix follows it (``sim.md`` is a file);
 - the path of a Python file with at least one folder in it, ``nodes/id_node/node.py``,
   found from the repository's root, the package's folder or the citing file's folder

@@ -9,8 +9,8 @@ import pytest
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 
+from irb140_dynamics import native
 from irb140_dynamics.core import gravity
-from irb140_dynamics.core.codegen import native
 from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.nodes.id_node import settings as id_settings
 from irb140_dynamics.nodes.id_node.node import IdNode

@@ -25,7 +25,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from irb140_dynamics.core.codegen.program import ANGLES, Program
-from irb140_dynamics.core.codegen.python_code import constant, unpacked
+from irb140_dynamics.core.codegen.python_code import BOUND, bound, constant, parameters, unpacked
 
 _UFUNCS = {"*": "mul", "+": "add", "-": "sub", "/": "div", "neg": "neg", "tanh": "tanh"}
 _NAMESPACE = {
@@ -42,25 +42,27 @@ _NAMESPACE = {
 
 
 def compile_into(program: Program, scalars: Sequence[str] = ()) -> tuple[str, Callable, list[int]]:
-    """The writing array form of ``program``: (source, fn, written).
+    """The writing array form of ``program``: (source, bind, written).
 
-    ``fn(out, *groups)`` takes ``out``, a sequence with a writable (N,) array at each index
-    in ``written`` (the others, folded to constants, are not touched), and the argument
-    groups as arrays of shape (length, N) (the groups named in ``scalars`` as floats).
+    ``bind(constants)`` gives ``fn(out, *groups)`` with the last group (``k``) defaulting to
+    ``constants`` (see python_code.bound). ``fn`` takes ``out``, a sequence with a writable
+    (N,) array at each index in ``written`` (the others, folded to constants, are not
+    touched), and the argument groups as arrays of shape (length, N) (the groups named in
+    ``scalars`` as floats).
     """
-    source, written = into_source(program, scalars)
-    namespace = dict(_NAMESPACE)
-    exec(compile(source, f"<{program.name}_into>", "exec"), namespace)
-    return source, namespace[f"{program.name}_into"], written
+    source, written = into_source(program, scalars, default=BOUND)
+    (bind,) = bound(source, f"{program.name}_into", dict(_NAMESPACE))
+    return source, bind, written
 
 
-def into_source(program: Program, scalars: Sequence[str] = ()) -> tuple[str, list[int]]:
+def into_source(program: Program, scalars: Sequence[str] = (), default: str | None = None) -> tuple[str, list[int]]:
     """(the source of ``<name>_into``, see compile_into; the outputs it writes). Its names:
-    cos, sin, tanh, mul, add, sub, div, neg (NumPy's ufuncs) and empty (np.empty)."""
+    cos, sin, tanh, mul, add, sub, div, neg (NumPy's ufuncs) and empty (np.empty). With
+    ``default``, the last group defaults to the variable of that name."""
     scalar_vars = {f"{group}{i}" for group in scalars for i in range(program.group(group))}
     body, first_array, registers = _emit_into(program, scalar_vars)
     written = [j for j, out in enumerate(program.outputs) if isinstance(out, int)]
-    lines = [f"def {program.name}_into({', '.join(['out', *(group for group, _ in program.groups)])}):"]
+    lines = [f"def {program.name}_into(out, {parameters(program, default)}):"]
     lines += unpacked(program)
     lines += [f"    o{j} = out[{j}]" for j in written]
     if registers:

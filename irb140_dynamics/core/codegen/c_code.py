@@ -3,7 +3,7 @@
 The body is the infix text of ``python_code.statements``, the very operations of the
 Python form in the same order. Compiled without contraction or fast-math (no fused
 multiply-add) and with cos, sin and tanh left to libm, its results are the Python form's,
-bit for bit (``native`` checks that before use).
+bit for bit (the ``native`` room checks that before use).
 
 ``kernel_source`` is ``int kernel(const double *x, const double *k, double *out)``;
 ``extension_source`` adds a module ``<name>`` whose ``bind(k: bytes)`` returns the kernel

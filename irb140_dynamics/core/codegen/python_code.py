@@ -10,6 +10,7 @@ evaluate many states at once), ``c_code`` into a C function.
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Callable
 
 import numpy as np
@@ -74,24 +75,50 @@ def unpacked(program: Program) -> list[str]:
     return [f"    {_names(group, length)} = {group}" for group, length in program.groups if length]
 
 
-def python_source(program: Program) -> str:
-    """``def <name>(q, qd, ...): return (outputs,)``: the program on floats."""
+def python_source(program: Program, default: str | None = None) -> str:
+    """``def <name>(q, qd, ...): return (outputs,)``: the program on floats. With
+    ``default``, the last group (``k``) defaults to the variable of that name (see bound)."""
     lines, results = statements(program)
-    text = [f"def {program.name}({', '.join(group for group, _ in program.groups)}):", *unpacked(program)]
+    text = [f"def {program.name}({parameters(program, default)}):", *unpacked(program)]
     text += [f"    {var} = {expr}" for var, expr in lines]
     text.append(f"    return ({', '.join(results)},)")
     return "\n".join(text) + "\n"
 
 
+def parameters(program: Program, default: str | None = None) -> str:
+    """The groups as parameters; with ``default``, the last one defaults to that variable."""
+    names = [group for group, _ in program.groups]
+    if default is not None:
+        names[-1] += f"={default}"
+    return ", ".join(names)
+
+
+BOUND = "constants"  # the variable the last group defaults to in a bound function's source
+
+
+def bound(source: str, name: str, *namespaces: dict) -> list[Callable[[tuple], Callable]]:
+    """``bind(constants)`` in each namespace: the function ``name`` that ``source`` defines
+    (its last parameter defaulting to the variable BOUND, see python_source) with that
+    parameter defaulting to ``constants``: one model's payload and gravity (see kernels).
+    Each bound function is a plain function of its own, as fast to call as the code written
+    out for that model. The source is compiled once."""
+    wrapped = f"def bind({BOUND}):\n" + textwrap.indent(source, "    ") + f"    return {name}\n"
+    code = compile(wrapped, f"<{name}>", "exec")
+    binders = []
+    for namespace in namespaces:
+        exec(code, namespace)
+        binders.append(namespace.pop("bind"))
+    return binders
+
+
 def compile_python(program: Program) -> tuple[str, Callable, Callable]:
-    """(source, scalar_fn, array_fn): the same code on floats, and on NumPy arrays."""
-    source = python_source(program)
-    code = compile(source, f"<{program.name}>", "exec")
+    """(source, bind_scalar, bind_array): the code on floats and on NumPy arrays, each as
+    ``bind(constants)`` giving the function of the groups but ``k``, which defaults to the
+    constants given (see bound)."""
+    source = python_source(program, default=BOUND)
     scalar_ns = {"cos": math.cos, "sin": math.sin, "tanh": math.tanh}
     array_ns = {"cos": np.cos, "sin": np.sin, "tanh": np.tanh}
-    exec(code, scalar_ns)
-    exec(code, array_ns)
-    return source, scalar_ns[program.name], array_ns[program.name]
+    return source, *bound(source, program.name, scalar_ns, array_ns)
 
 
 def _names(group: str, length: int) -> str:

@@ -12,10 +12,11 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from ..codegen.array_code import into_source
-from ..codegen.kernels import WITH_FRICTION, kernels_of
+from ..codegen.kernels import kernels_of
 from ..codegen.layout import upper_to_full, whole_matrix
 from ..codegen.program import with_constants
 from ..codegen.python_code import statements
+from ..codegen.recipes import WITH_FRICTION
 
 KERNEL_OF = {"tau": WITH_FRICTION, "M": "mass_matrix", "Cqd": "coriolis", "g": "gravity_torques"}
 

@@ -24,10 +24,12 @@ import math
 import numpy as np
 
 from irb140_dynamics.core.algorithms.momentum import energy_gradient, kinetic_energy, momentum_terms  # noqa: F401 (part of this module's interface)
-from irb140_dynamics.core.codegen.kernels import kernels_of
+from irb140_dynamics.core.codegen.kernels import VERBS_KERNELS, kernels_of
 from irb140_dynamics.core.dynamics import gravity
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.model.states import finite_result, state
+
+_KEPT = VERBS_KERNELS.kept  # id(model) -> its kernels: read inline on the hot path, else kernels_of
 
 
 def monitor_terms(model: RobotModel, q, qd, qdd) -> tuple[list, list, list, list]:
@@ -37,7 +39,7 @@ def monitor_terms(model: RobotModel, q, qd, qdd) -> tuple[list, list, list, list
     What a node that monitors the arm needs per sample, at about the cost of one rnea: run
     as C once the kernel is native (see dynamics.rnea) and the states are float64 arrays."""
     n = model.n
-    kernel = kernels_of(model).monitor
+    kernel = (_KEPT.get(id(model)) or kernels_of(model)).monitor
     found = None if kernel.native is None else kernel.native(q, qd, qdd)  # None unless (n,) float64, finite
     if found is not None:
         terms, qd = found.tolist(), qd.tolist()

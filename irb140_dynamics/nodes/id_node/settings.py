@@ -5,8 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from irb140_dynamics.core import RigidBody, RobotModel
-from irb140_dynamics.core.codegen import native
-from irb140_dynamics.core.codegen.kernels import WITH_FRICTION, Preparation, prepare
+from irb140_dynamics.core.codegen.kernels import Preparation, prepare
+from irb140_dynamics.core.codegen.recipes import WITH_FRICTION
 from irb140_dynamics.core.model.rigid_body import MAX_MASS
 from irb140_dynamics.core.payload.limits import RATED_PAYLOAD, derive_torque_limits
 from irb140_dynamics.core.payload.stop import stopping
@@ -169,5 +169,4 @@ def kernels_text(kernels: Preparation | None) -> str:
             f"kernels: Python form for now: compiling them as C took over {NATIVE_WAIT:g} s, "
             "native once the compile is done"
         )
-    why = "IRB140_NATIVE=0" if native.compiler() is not None else "no C compiler"
-    return f"kernels: Python form ({why}; traced in {kernels.seconds:.1f} s)"
+    return f"kernels: Python form ({kernels.reason}; traced in {kernels.seconds:.1f} s)"

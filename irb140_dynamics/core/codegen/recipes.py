@@ -1,0 +1,84 @@
+"""Every kernel by name (``RECIPES``): how each is traced from the algorithms, on an arm
+whose last link's inertia and gravity come from the argument ``k`` (see kernels.ArmKernels)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from irb140_dynamics.core.algorithms import recursions as algorithms
+from irb140_dynamics.core.algorithms.momentum import momentum_terms
+from irb140_dynamics.core.algorithms.regressor import rigid_body_regressor
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """How a kernel is traced: ``algorithm(arm, cs, *groups, k)`` -> outputs, the argument
+    groups after q (each n long, ``wrench`` 6), and whether its outputs are M's upper
+    triangle (the C form then writes M whole)."""
+
+    algorithm: object
+    groups: tuple[str, ...] = ()
+    matrix: bool = False
+
+
+def _rnea(arm, cs, qd, qdd, k):
+    return algorithms.rnea(arm.links_with(k), cs, qd, qdd, arm.gravity_of(k))
+
+
+def _rnea_wrench(arm, cs, qd, qdd, wrench, k):
+    force, moment = algorithms.flange_wrench(arm.flange, wrench[:3], wrench[3:])
+    return algorithms.rnea(arm.links_with(k), cs, qd, qdd, arm.gravity_of(k), force, moment)
+
+
+def _gravity(arm, cs, k):
+    zeros = [0.0] * arm.n
+    return algorithms.rnea(arm.links_with(k), cs, zeros, zeros, arm.gravity_of(k))
+
+
+def _coriolis(arm, cs, qd, k):
+    return algorithms.rnea(arm.links_with(k), cs, qd, [0.0] * arm.n, (0.0, 0.0, 0.0))
+
+
+def _mass_matrix(arm, cs, k):
+    M = algorithms.crba(arm.links_with(k), cs)
+    return [M[i][j] for i in range(arm.n) for j in range(i, arm.n)]
+
+
+def _coriolis_matrix(arm, cs, qd, k):
+    return [x for row in algorithms.christoffel_coriolis(arm.links_with(k), cs, qd) for x in row]
+
+
+def _regressor(arm, cs, qd, qdd, k):
+    # column by column, as the algorithm computes them: then the array form (see
+    # array_code) keeps few intermediates alive (29 buffers for the IRB-140, not 138)
+    Y = rigid_body_regressor(arm.links_with(k), cs, qd, qdd, arm.gravity_of(k))
+    return [x for column in zip(*Y) for x in column]
+
+
+def _momentum(arm, cs, qd, k):
+    return momentum_terms(arm.links_with(k), cs, qd)
+
+
+def _monitor(arm, cs, qd, qdd, k):
+    links, gravity, zeros = arm.links_with(k), arm.gravity_of(k), [0.0] * arm.n
+    return [
+        *algorithms.rnea(links, cs, qd, qdd, gravity),
+        *algorithms.rnea(links, cs, zeros, zeros, gravity),
+        *momentum_terms(links, cs, qd),
+    ]
+
+
+RECIPES = {  # every kernel, by name; q comes first in each
+    "rnea": Recipe(_rnea, ("qd", "qdd")),  # (q, qd, qdd) -> tau
+    "rnea_wrench": Recipe(_rnea_wrench, ("qd", "qdd", "wrench")),  # + (f, n) on the flange
+    "gravity_torques": Recipe(_gravity),  # q -> g(q)
+    "coriolis": Recipe(_coriolis, ("qd",)),  # (q, qd) -> C(q, qd) qd
+    "mass_matrix": Recipe(_mass_matrix, matrix=True),  # q -> upper triangle of M, row by row
+    "coriolis_matrix": Recipe(_coriolis_matrix, ("qd",)),  # (q, qd) -> C, row by row
+    "regressor": Recipe(_regressor, ("qd", "qdd")),  # n x 10n, column by column
+    "momentum": Recipe(_momentum, ("qd",)),  # (q, qd) -> [M qd, C^T qd] (see observer)
+    "monitor": Recipe(_monitor, ("qd", "qdd")),  # [tau, g, M qd, C^T qd], one pass
+}
+# rnea with the model's joint friction inside (its coefficients appended to k); the model's
+# plain ``rnea`` when it has none
+WITH_FRICTION = "rnea_with_friction"
