@@ -188,8 +188,8 @@ def fit_payload(
     correlation, _ = correlation_factor(np.where(use[: len(first)], residuals, np.nan), filter_correlation)
     estimate = replace(estimate, covariance=estimate.covariance * (correlation / filter_correlation))
     _check_mass(tally.path, estimate)
+    _check_effort_scale(tally.path, with_scale, filter_correlation)  # the first cause: efforts not in N m
     _check_excitation(tally.path, estimate)
-    _check_effort_scale(tally.path, with_scale, tally.design.noise_correlation())
     phi, misfit = _nearest_physical(estimate)
     return PayloadFit(
         payload_of(phi),

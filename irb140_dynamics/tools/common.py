@@ -64,6 +64,7 @@ def arm_of(args: argparse.Namespace):
     from irb140_dynamics.core.io.params_file import read_parameter_file
 
     params_file = getattr(args, "params_file", None)
+    overrides: list[tuple[str, Any]] = []
     try:
         overrides = [parse_override(text) for text in getattr(args, "overrides", None) or []]
         values = given_values([params_file] if params_file else [], overrides)
@@ -83,6 +84,8 @@ def arm_of(args: argparse.Namespace):
     unknown = unknown_names(values, known, arm.model.joint_names)
     if unknown:
         raise BadArgument(_unknown_text(unknown, dict(overrides), params_file))
+    if arm.urdf is None and not params_file:  # the package's own arm: named by its file
+        arm = replace(arm, origin=str(default_config_path()))
     return replace(arm, given=values)
 
 

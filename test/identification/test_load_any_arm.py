@@ -21,7 +21,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from irb140_dynamics.core.io.model_source import tool_model
+from irb140_dynamics.core.io.arm_source import given_values, read_arm, read_urdf_file
 from irb140_dynamics.core.io.params_file import parameter_file_text
 from irb140_dynamics.core.model.rigid_body import inertia_matrix
 from irb140_dynamics.identification.excitation import check_limits
@@ -31,6 +31,7 @@ from irb140_dynamics.identification.payload_excitation import (
     optimise_payload_excitation,
     wrist,
 )
+from irb140_dynamics.package_files import default_config_path
 from irb140_dynamics.tools import identify as identify_tool
 
 from ..support.paths import ROOT, URDF_DATA
@@ -49,10 +50,19 @@ ARMS = {
 }
 
 
+def arm_model(params_file, urdf, tip):
+    """The model the tools read from these arguments (core.io.arm_source, as tools.common.arm_of)."""
+    from irb140_dynamics.core.io.params_file import read_parameter_file
+
+    values = given_values([params_file] if params_file else [])
+    text = read_urdf_file(urdf) if urdf else None
+    return read_arm(values, read_parameter_file(default_config_path()), text, None, tip).model
+
+
 def _arm(arguments, work, losses, accelerations):
     """(the true arm, the model arguments `identify` is given)."""
     values = dict(zip(arguments[::2], arguments[1::2]))
-    model = tool_model(values.get("--params-file"), values.get("--urdf"), None, values.get("--tip")).model
+    model = arm_model(values.get("--params-file"), values.get("--urdf"), values.get("--tip"))
     if not losses:
         return model, arguments
     model = with_drive_losses(model)
@@ -68,7 +78,7 @@ def _arm(arguments, work, losses, accelerations):
         model = replace(model, joints=joints)
     drives = work / "drives.yaml"
     drives.write_text(parameter_file_text(params, ["the arm's drive losses, identified first"]))
-    assert tool_model(drives, values["--urdf"], None, values.get("--tip")).model == model  # what identify reads
+    assert arm_model(drives, values["--urdf"], values.get("--tip")) == model  # what identify reads
     return model, [*arguments, "--params-file", str(drives)]
 
 
@@ -87,7 +97,7 @@ def identified(request, tmp_path_factory):
 @pytest.mark.slow  # each arm: a design, 30 s of MuJoCo at 1 kHz and an identification
 def test_the_tool_is_identified_within_the_issues_tolerances(identified):
     _, _, _, out = identified
-    found = tool_model(out).model.payload
+    found = arm_model(out, None, None).payload
     assert found.mass == pytest.approx(TOOL.mass, rel=0.02)
     assert np.linalg.norm(np.subtract(found.com, TOOL.com)) < 0.005
     moments = np.linalg.eigvalsh(inertia_matrix(found.inertia))

@@ -150,7 +150,10 @@ class Rebuild:
                 self._built.set()
             executor = self._executor(cancel)
             if executor is not None:
-                executor.create_task(self._hand_over, generation)
+                try:
+                    executor.create_task(self._hand_over, generation)
+                except Exception:  # noqa: BLE001  (the executor shut down meanwhile: nothing to hand over to)
+                    continue
 
     def _executor(self, cancel: threading.Event):
         """The node's executor; a build done while the node is being made waits for it
