@@ -154,3 +154,44 @@ def test_the_defaults_and_ranges_are_id_node_s():
         sensitivity.MAX_GAP,
     )
     assert gain.maximum == collision.MAX_GAIN
+
+
+def test_hostile_command_lines_fail_in_one_line_and_leave_nothing(tmp_path):
+    """Every bad value of the tools' fuzzing pools (test/support/tool_fuzz.py) in each of
+    the tool's arguments, one at a time, the others good."""
+    from ..support.tool_fuzz import (
+        INPUTS_BAD,
+        NUMBERS_BAD,
+        OUTPUTS_BAD,
+        PARAMS_BAD,
+        TOPICS_BAD,
+        Case,
+        check,
+        prepare,
+        run_case,
+        snapshot,
+    )
+
+    prepare(tmp_path)
+    good = {"recording": "rest.csv", "--out": "out.yaml", "--params-file": "params.yaml"}
+    bad = {
+        "recording": INPUTS_BAD,
+        "--out": OUTPUTS_BAD,
+        "--margin": [*NUMBERS_BAD, "1", "0.5"],
+        "--observer-gain": [*NUMBERS_BAD, "0", "1e5"],
+        "--topic": TOPICS_BAD,
+        "-p": PARAMS_BAD,
+        "--params-file": ["missing.yaml", "binary.csv", "/dev/zero", "folder", "absurd.csv"],
+    }
+    problems = []
+    for name, values in bad.items():
+        for value in values:
+            given = {**good, name: value}
+            argv = [given.pop("recording")] + [x for option, v in given.items() for x in (option, v)]
+            case = Case("calibrate_collision", [*argv, "--quiet"])
+            before = snapshot(tmp_path)
+            status, out, err = run_case(case, tmp_path)
+            problem = check(case, status, out, err, before, snapshot(tmp_path))
+            if problem or status == 0:  # rest.csv has no velocities: nothing succeeds
+                problems.append(f"{argv}: {problem or 'succeeded'}")
+    assert not problems, "\n".join(problems)
