@@ -92,8 +92,10 @@ def calibrated(request, tmp_path_factory):
     values = read_parameter_file(out)
     thresholds = np.array([values[f"{name}.collision_threshold"] for name in model.joint_names])
     assert values["collision.observer_gain"] == GAIN and np.all(thresholds > 0)
-    figures = {axis: float(re.search(rf"^{re.escape(axis)}: (\S+) N", printed, re.M).group(1)) for axis in AXES}
-    return model, thresholds, figures, printed
+    found = {axis: re.search(rf"^{re.escape(axis)}: (\S+) N \(worst pose at (\S+) s", printed, re.M) for axis in AXES}
+    figures = {axis: float(match.group(1)) for axis, match in found.items()}
+    worst = {axis: float(match.group(2)) for axis, match in found.items()}  # s from the recording's start
+    return model, thresholds, figures, worst
 
 
 def test_60_s_of_other_normal_motion_raise_no_alarm(calibrated):
@@ -110,15 +112,49 @@ def test_pushes_at_1_5_times_the_printed_figure_are_flagged_within_20_ms(calibra
     for k, axis in enumerate(AXES * 2):  # every direction at two poses
         start = 1.0 + k * PUSH_EVERY + 0.0137 * k  # between samples, at varied phases of the motion
         pushes.append(Push(start, start + PUSH_LENGTH, 1.5 * figures[axis] * np.array(UNIT[axis], dtype=float)))
-    t, Q, QD, TAU = recording = run(model, motion, pushes[-1].end + 0.5, seed=3, pushes=pushes)
+    delays = pushed(model, thresholds, figures, motion, pushes, AXES * 2, 1.0)
+    assert max(delays) <= WITHIN, delays
+
+
+def test_pushes_at_each_direction_s_worst_recorded_pose_are_flagged_within_20_ms(calibrated):
+    """The edge of the promise: each push where the printed figure comes from, the worst
+    recorded pose (the + directions in one run, the - in another; where two fall within
+    0.2 s of each other, the later a period of the motion away). There its pose needs the
+    printed figure itself (within 2 %: a period away, the pose is the recorded one to the
+    tracking error), so the push reaches 1.5 times the limiting joint's threshold, no more:
+    the observer's lag alone takes 7 samples (14 ms at 500 Hz, K dt = 0.2) to cross 1/1.5."""
+    model, thresholds, figures, worst = calibrated
+    delays = []
+    for sign in "+-":
+        axes = [axis for axis in AXES if axis[0] == sign]
+        starts = []
+        for axis in axes:
+            candidates = [worst[axis] + shift for shift in (0.0, 10.0, -10.0, 20.0, -20.0)]
+            starts.append(
+                next(c for c in candidates if 0.5 <= c <= 29.5 and all(abs(c - other) >= 0.2 for other in starts))
+            )
+        pushes = [
+            Push(start, start + 0.05, 1.5 * figures[axis] * np.array(UNIT[axis], dtype=float))
+            for start, axis in zip(starts, axes)
+        ]
+        delays += pushed(model, thresholds, figures, normal_motion(model, 1), pushes, axes, 1.02)
+    assert max(delays) <= WITHIN, delays
+
+
+def pushed(model, thresholds, figures, motion, pushes, axes, premise) -> list[float]:
+    """The delays [s] from each push's first joint state to the flag, the motion pushed as
+    ``pushes`` say (noise of another seed than the calibration's); checks that nothing is
+    flagged in the 0.1 s before a push, and that the pose of each needs no more than
+    ``premise`` times the printed figure."""
+    end = max(push.end for push in pushes) + 0.5
+    t, Q, QD, TAU = recording = run(model, motion, end, seed=3, pushes=pushes)
     flagged = flags(model, thresholds, recording)
     delays = []
-    for push, axis in zip(pushes, AXES * 2):
-        first = int(np.searchsorted(t, push.start))  # the push's first joint state
-        # the premise: at this pose the printed figure is detected (it is the worst recorded pose's)
-        assert detectable_force_at(model, Q[first], thresholds, UNIT[axis]) <= figures[axis]
+    for push, axis in zip(pushes, axes):
+        first = int(np.searchsorted(t, push.start - 1e-9))  # the push's first joint state
+        assert detectable_force_at(model, Q[first], thresholds, UNIT[axis]) <= premise * figures[axis]
         assert not flagged[first - 50 : first].any()  # nothing before it
         hit = np.flatnonzero(flagged[first:] & (t[first:] <= push.end))
         assert len(hit), (axis, push)
-        delays.append(t[first + hit[0]] - t[first])
-    assert max(delays) <= WITHIN, delays
+        delays.append(float(t[first + hit[0]] - t[first]))
+    return delays
