@@ -2,8 +2,8 @@
 recording, the thresholds from them, and the force at the flange they detect.
 
 The detectable force is checked against torques made another way: RNEA with the force as
-an external wrench on the flange (``rnea(..., f_ext)``, the flange's axes), on the IRB-140
-and the UR5 from its URDF; the peaks against a constant external torque the observer must
+an external wrench on the flange (``rnea(..., f_ext)``, the flange's axes), on the IRB-140,
+the UR5 from its URDF and an arm with a sliding joint; the peaks against a constant external torque the observer must
 settle on (dr/dt = K (tau_ext - r)). That the settings are id_node's:
 test/tools/test_calibrate_collision_tool.py.
 """
@@ -32,7 +32,12 @@ def ur5():
     return load_urdf((URDF_DATA / "ur5.urdf").read_text(), "base_link", "tool0").model
 
 
-ARMS = {"irb140": irb140, "ur5": ur5}
+def prismatic_arm():
+    """Turn, reach (a sliding joint: its threshold and load in N), wrist."""
+    return load_urdf((URDF_DATA / "prismatic_arm.urdf").read_text()).model
+
+
+ARMS = {"irb140": irb140, "ur5": ur5, "prismatic": prismatic_arm}
 
 
 def external_torques(model, q, force):
@@ -73,11 +78,16 @@ def test_the_figure_of_each_direction_is_the_worst_pose_s(name):
     for f in found:
         unit = np.zeros(3)
         unit["xyz".index(f.direction[1])] = 1.0 if f.direction[0] == "+" else -1.0
-        each = [detectable_force_at(model, q, thresholds, unit) for q in Q]
+        each = np.array([detectable_force_at(model, q, thresholds, unit) for q in Q])
+        if np.isinf(each).any():  # the sliding arm's z: no joint feels it
+            unfelt = np.flatnonzero(np.isinf(each))
+            assert f.force is None and f.undetected == len(unfelt) and f.time == t[unfelt[0]]
+            continue
         worst = int(np.argmax(each))
         assert f.force == pytest.approx(each[worst], rel=1e-12) and f.time == t[worst] and f.undetected == 0
         torques = np.abs(external_torques(model, Q[worst], f.force * unit)) / thresholds
         assert int(np.argmax(torques)) == f.joint
+    assert name != "prismatic" or [f.direction for f in found if f.force is None] == ["+z", "-z"]
 
 
 def test_a_pose_where_no_joint_feels_the_force_has_no_figure():

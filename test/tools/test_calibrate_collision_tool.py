@@ -195,3 +195,20 @@ def test_hostile_command_lines_fail_in_one_line_and_leave_nothing(tmp_path):
             if problem or status == 0:  # rest.csv has no velocities: nothing succeeds
                 problems.append(f"{argv}: {problem or 'succeeded'}")
     assert not problems, "\n".join(problems)
+
+
+def test_a_direction_no_joint_feels_is_named_not_given_a_figure(tmp_path, capsys):
+    """An arm that turns about z and slides and turns in the plane feels no force along z:
+    those lines say so, the others have figures; the sliding joint's unit is N."""
+    from irb140_dynamics.core.urdf import load_urdf
+
+    from ..support.paths import URDF_DATA
+
+    urdf = URDF_DATA / "prismatic_arm.urdf"
+    model = load_urdf(urdf.read_text()).model
+    s = drive(model, normal_motion(model, 2), 250.0, 4.0)
+    path = write_full_csv(tmp_path / "run.csv", model.joint_names, s.time, s.position, s.velocity, s.effort)
+    status, printed, err = calibrate(capsys, path, "--urdf", urdf, "--out", tmp_path / "c.yaml")
+    assert status == 0, err
+    assert re.search(r"^\+z: none: at 1000 recorded poses \(the first at 0\.000 s\) no joint feels", printed, re.M)
+    assert re.search(r"^-x: \d", printed, re.M) and re.search(r"^  reach: largest \|r\| \S+ N at ", printed, re.M)
