@@ -103,10 +103,10 @@ def _calibrate(argv: list[str], interrupts) -> int:
 
     source = arm_of(args)
     model = source.model
-    progress = None if args.quiet else reading_progress("calibrate_collision")
+    passes = [None, None] if args.quiet else [reading_progress("calibrate_collision"), _poses_progress()]
     try:
         peaks = ResidualPeaks(model, args.observer_gain)
-        for chunk in _chunks(Recording(args.recording, model.joint_names, args.topic), progress):
+        for chunk in _chunks(Recording(args.recording, model.joint_names, args.topic), passes[0]):
             peaks.add(chunk.time, chunk.position, chunk.velocity, chunk.effort)
         if peaks.observed == 0 and peaks.no_velocity:
             raise CalibrationError(
@@ -114,7 +114,7 @@ def _calibrate(argv: list[str], interrupts) -> int:
             )
         thresholds = collision_thresholds(peaks, args.margin)
         forces = DetectableForces(model, thresholds)
-        for chunk in _chunks(Recording(args.recording, model.joint_names, args.topic), progress):
+        for chunk in _chunks(Recording(args.recording, model.joint_names, args.topic), passes[1]):
             observed = usable(chunk.position, chunk.velocity, chunk.effort)[0]
             forces.add(chunk.time[observed], chunk.position[observed])
     except CalibrationError as error:
@@ -129,14 +129,32 @@ def _calibrate(argv: list[str], interrupts) -> int:
     return 0
 
 
+def _poses_progress():
+    """The second pass's bar: 'calibrate_collision: the poses of run.csv: [###   ] ...'."""
+    from pathlib import Path
+
+    from irb140_dynamics.tools.progress import Progress
+
+    bars: dict[str, Progress] = {}
+
+    def show(path: str, done: int, total: int) -> None:
+        if path not in bars:
+            bars[path] = Progress(f"calibrate_collision: the poses of {Path(path).name}", "samples")
+        bars[path](done, total)
+
+    return show
+
+
 def _chunks(recording, progress):
-    """The recording's chunks, the progress bar following them."""
+    """The recording's chunks, the progress bar following the work done on them."""
     read = 0
+    if progress:
+        progress(str(recording.path), 0, recording.total)
     for chunk in recording.chunks():
+        yield chunk
         read += len(chunk)
         if progress:
             progress(str(recording.path), read + sum(recording.skipped.values()), recording.total)
-        yield chunk
 
 
 def summary(model, peaks, thresholds, forces, margin: float, origin) -> list[str]:

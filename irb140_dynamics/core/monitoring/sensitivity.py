@@ -56,7 +56,11 @@ def usable(q: np.ndarray, qd: np.ndarray, effort: np.ndarray) -> tuple[np.ndarra
     has_velocity = np.isfinite(qd).all(axis=1)
     finite_effort = np.isfinite(effort).all(axis=1)
     no_effort = np.isnan(effort).all(axis=1)
-    return finite_state & has_velocity & finite_effort, finite_state & ~has_velocity, ~finite_effort & ~no_effort
+    return (
+        finite_state & has_velocity & finite_effort,
+        finite_state & ~has_velocity,
+        finite_state & ~finite_effort & ~no_effort,
+    )
 
 
 class ResidualPeaks:
