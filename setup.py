@@ -67,6 +67,7 @@ setup(
             "equations = irb140_dynamics.tools.programs:equations",
             "retime = irb140_dynamics.tools.programs:retime",
             "load_diagram = irb140_dynamics.tools.programs:load_diagram",
+            "calibrate_collision = irb140_dynamics.tools.programs:calibrate_collision",
             "trajectory_check_node = irb140_dynamics.nodes.trajectory_check_node:main",
             # the tools under names of their own, for an install without the ros2 CLI (pip)
             "irb140-export-urdf = irb140_dynamics.tools.programs:export_urdf",
@@ -76,6 +77,7 @@ setup(
             "irb140-equations = irb140_dynamics.tools.programs:equations",
             "irb140-retime = irb140_dynamics.tools.programs:retime",
             "irb140-load-diagram = irb140_dynamics.tools.programs:load_diagram",
+            "irb140-calibrate-collision = irb140_dynamics.tools.programs:calibrate_collision",
         ],
     },
 )

@@ -64,7 +64,7 @@ def arm_of(args: argparse.Namespace):
     from irb140_dynamics.core.io.params_file import read_parameter_file
 
     params_file = getattr(args, "params_file", None)
-    overrides: list[tuple[str, Any]] = []
+    overrides: list[tuple[str, Any]] = []  # (a -p that is no NAME:=VALUE: refused below, none named)
     try:
         overrides = [parse_override(text) for text in getattr(args, "overrides", None) or []]
         values = given_values([params_file] if params_file else [], overrides)

@@ -52,3 +52,10 @@ def retime() -> None:
     from irb140_dynamics.tools.retime import main
 
     finish(main)
+
+
+def calibrate_collision() -> None:
+    start("calibrate_collision", TOOL)
+    from irb140_dynamics.tools.calibrate_collision import main
+
+    finish(main)

@@ -14,7 +14,7 @@ from ..support.paths import CONFIG, ROOT
 
 EXECUTABLES = ["id_node", "payload_check_node"]
 IDENTIFICATION_TOOLS = ["identify", "excitation", "record"]
-TOOLS = ["export_urdf", *IDENTIFICATION_TOOLS]
+TOOLS = ["export_urdf", "calibrate_collision", *IDENTIFICATION_TOOLS]
 URDF = ROOT / "urdf" / "irb140.urdf"
 
 

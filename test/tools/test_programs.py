@@ -23,6 +23,7 @@ TOOLS = {
     "equations": "equations",
     "retime": "retime",
     "load_diagram": "load-diagram",
+    "calibrate_collision": "calibrate-collision",
 }
 NODES = ("id_node", "payload_check_node", "sim_node", "demo_node", "trajectory_check_node")
 FULL_ARGV = {"record", "export_urdf"}  # their main() takes argv with the program first (ROS arguments)

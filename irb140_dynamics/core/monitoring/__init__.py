@@ -1,7 +1,10 @@
 """What measured signals say beyond the model: joint accelerations estimated from velocities
 (``filters``), external joint torques from efforts (``observer``: the generalized momentum
 observer behind id_node's collision detection), the wrench on the flange they come from
-(``wrench``: a virtual force sensor) and the scales the markers draw loads with (``display``).
+(``wrench``: a virtual force sensor), collision thresholds set from a recording of normal
+work and the flange force they detect (``sensitivity``) and the scales the markers draw
+loads with (``display``).
 
-May import: ``core.model``, ``core.algorithms``, ``core.codegen``, ``core.dynamics``.
+May import: ``core.model``, ``core.algorithms``, ``core.codegen``, ``core.dynamics``,
+``core.kinematics``.
 """

@@ -1,0 +1,75 @@
+"""An arm at its normal work in MuJoCo, pushed now and then: recordings for the collision
+calibration tests.
+
+The arm (its model, friction and rotor inertia included) is stepped by
+``sim.engine.SimulatedArm`` at 1 kHz under computed torque (the model's feed-forward along
+the reference, PD feedback scaled per joint by the mass matrix's diagonal at the start),
+following a random Fourier motion within its limits (``identification.excitation.shaped``:
+"normal work", one seed one motion). What is recorded is what a driver publishes, at 500 Hz:
+the state at the step's start and the torque applied during it, with Gaussian noise of 1 %
+of each joint's torque limit (of its peak torque along the motion where it has none). A
+push is a force [N] on the flange origin, base axes, held over [start, end) s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from irb140_dynamics.core import RobotModel, mass_matrix, rnea_batch
+from irb140_dynamics.identification.excitation import Limits, shaped
+from irb140_dynamics.identification.payload_excitation import EffortNoise
+
+CONTROL_RATE = 1000.0  # Hz
+RECORD_EVERY = 2  # control steps per recorded sample: 500 Hz
+KP, KD = 400.0, 40.0  # 1/s^2, 1/s
+NOISE = EffortNoise(0.01)
+PERIOD, HARMONICS = 10.0, 5  # s: the motion's period, and its harmonics
+
+
+@dataclass(frozen=True)
+class Push:
+    start: float  # s
+    end: float  # s
+    force: np.ndarray  # (3,) N, base axes, on the flange origin
+
+
+def normal_motion(model: RobotModel, seed: int):
+    """A random Fourier motion of ``PERIOD`` s within the arm's limits (10 % of each range
+    kept free at both ends), at rest at t = 0."""
+    free = np.random.default_rng(seed).normal(size=2 * model.n * (HARMONICS - 1))
+    return shaped(free, model.n, HARMONICS, PERIOD, Limits.of(model, 0.1))
+
+
+def run(arm: RobotModel, trajectory, duration: float, seed: int = 0, pushes=()):
+    """(t, Q, QD, TAU measured) at 500 Hz of the MuJoCo ``arm`` following ``trajectory``
+    for ``duration`` s under computed torque at 1 kHz, pushed as ``pushes`` say."""
+    from irb140_dynamics.sim.engine import SimulatedArm
+
+    steps = int(round(duration * CONTROL_RATE))
+    t = np.arange(steps) / CONTROL_RATE
+    Q_ref, QD_ref, QDD_ref = trajectory.evaluate(t)
+    feed_forward = rnea_batch(arm, Q_ref, QD_ref, QDD_ref)
+    scale = np.diag(mass_matrix(arm, Q_ref[0])) + np.array([j.armature for j in arm.joints])
+    sim = SimulatedArm(arm, period=1.0 / CONTROL_RATE)
+    sim.reset(Q_ref[0], QD_ref[0])
+    kept = range(0, steps, RECORD_EVERY)
+    Q, QD, TAU = (np.empty((len(kept), arm.n)) for _ in range(3))
+    for k in range(steps):
+        q, qd = sim.q, sim.qd
+        force = next((p.force for p in pushes if p.start <= t[k] < p.end), None)
+        wrench = None if force is None else np.concatenate([force, np.zeros(3)])
+        sim.step(feed_forward[k] + scale * (KP * (Q_ref[k] - q) + KD * (QD_ref[k] - qd)), wrench)
+        if k % RECORD_EVERY == 0:
+            i = k // RECORD_EVERY
+            Q[i], QD[i], TAU[i] = q, qd, sim.applied
+    sigma = NOISE.sigma(arm, np.abs(TAU).max(axis=0))
+    measured = TAU + np.random.default_rng(seed).normal(size=TAU.shape) * sigma
+    return t[::RECORD_EVERY], Q, QD, measured
+
+
+def write_csv(path, names, t, Q, QD, TAU):
+    columns = [f"{field}_{name}" for field in ("position", "velocity", "effort") for name in names]
+    np.savetxt(path, np.column_stack([t, Q, QD, TAU]), delimiter=",", header=",".join(["time", *columns]), comments="")
+    return path
