@@ -10,20 +10,18 @@ Publishes    joint_states      sensor_msgs/JointState every step: position, velo
              /diagnostics      diagnostic_msgs/DiagnosticArray, 1 Hz: steps, late steps, commands
 Serves       ~/reset           std_srvs/Trigger: back to initial_positions, at rest, on brakes
 
-The true arm is the model of the parameters or of a URDF (``model.source``, as every node's)
-and may differ from the model a controller uses. It stays on its brakes from startup and each
-reset until its first command (and reset_hold); a command and a push are held until the next,
-or let go after command_timeout (sim.simulation). In real time (the default) the engine steps
-at ``rate`` in a thread of its own (sim.realtime: late steps caught up, far behind skipped,
-both counted); in ``lockstep`` once per command (sim.lockstep), stamped with simulated time,
-published on /clock. Bad messages are dropped, counted and warned about, never applied; no
-exception of ours leaves a callback (ros.runtime.guard). See docs/sim.md.
+The true arm is the model of the parameters or of a URDF (``model.source``, as every node's).
+It stays on its brakes from startup and each reset until its first command (and reset_hold);
+commands and pushes are held, and let go after command_timeout (sim.simulation). It steps at
+``rate`` in real time in a thread of its own (sim.realtime), or in ``lockstep`` once per
+command on simulated time, published on /clock (sim.lockstep). Bad messages are dropped,
+counted and warned about; no exception of ours leaves a callback (ros.runtime.guard).
+See docs/sim.md.
 """
 
 from __future__ import annotations
 
 import time
-from collections import Counter
 
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
@@ -64,7 +62,7 @@ class SimNode(Node):
         super().__init__("sim_node", **NODE_OPTIONS, **kwargs)
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
-        self._reported = Counter()  # the counts at the last diagnostics
+        self._reported = self.counts.copy()  # the counts at the last diagnostics
         self.simulation = Simulation(self.counts, lambda text: self.tally.warn("simulation", text))
         self.parameters = ArmParameters(self, NODE_PARAMETERS)
         self._reader = Rebuild(self, self.parameters.read_topic, self._take_urdf)
@@ -164,9 +162,10 @@ class SimNode(Node):
         if not response.success:
             response.message = "no model yet: waiting for robot_description"
             return response
-        response.message = f"reset to {self.simulation.setup.initial_positions.tolist()} rad"
-        if self.lockstep:  # when the first step is taken (the arm braked until then), exactly
-            response.message += f"; held until {self.simulation.held_until * 1e-9:.9f} s of simulated time"
+        setup, held = self.simulation.setup, self.simulation.held_until * 1e-9
+        response.message = f"reset to {setup.initial_positions.tolist()} rad; on brakes until the next command"
+        if self.lockstep:  # the first step taken, exactly: a reference stamped so starts with it
+            response.message += f"; held until {held:.9f} s of simulated time"
         return response
 
     @guarded("effort_commands")
