@@ -1,5 +1,5 @@
-"""trajectory_msgs/JointTrajectory to and from the core's Trajectory, and a trajectory
-report as one diagnostic_msgs/DiagnosticStatus (one KeyValue per joint and limit)."""
+"""trajectory_msgs/JointTrajectory to and from the core's Trajectory, and a report as one
+diagnostic_msgs/DiagnosticStatus (core.trajectories.checker gives its level and figures)."""
 
 from __future__ import annotations
 
@@ -7,10 +7,9 @@ from builtin_interfaces.msg import Duration
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from irb140_dynamics.core.io.stamps import sec_nanosec
-from irb140_dynamics.core.trajectories import Trajectory, TrajectoryReport
+from irb140_dynamics.core.trajectories import Trajectory
 
-OK, WARN, ERROR = DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR
+LEVELS = {"ok": DiagnosticStatus.OK, "warn": DiagnosticStatus.WARN, "error": DiagnosticStatus.ERROR}
 
 
 def trajectory_of(msg: JointTrajectory, joint_names) -> Trajectory:
@@ -29,32 +28,21 @@ def trajectory_of(msg: JointTrajectory, joint_names) -> Trajectory:
 
 def trajectory_message(tr: Trajectory, frame_id: str = "") -> JointTrajectory:
     """The trajectory as a message (velocities and accelerations where the points carry them)."""
-    msg = JointTrajectory(joint_names=list(tr.joint_names))
-    msg.header.frame_id = frame_id
-    for k in range(len(tr.t)):
-        sec, nanosec = sec_nanosec(tr.t[k])
-        msg.points.append(
-            JointTrajectoryPoint(
-                positions=tr.q[k].tolist(),
-                velocities=tr.qd[k].tolist() if tr.has_qd[k] else [],
-                accelerations=tr.qdd[k].tolist() if tr.has_qdd[k] else [],
-                time_from_start=Duration(sec=sec, nanosec=nanosec),
-            )
+    points = [
+        JointTrajectoryPoint(
+            positions=p["positions"],
+            velocities=p["velocities"],
+            accelerations=p["accelerations"],
+            time_from_start=Duration(**p["time_from_start"]),
         )
+        for p in tr.to_message()["points"]
+    ]
+    msg = JointTrajectory(joint_names=list(tr.joint_names), points=points)
+    msg.header.frame_id = frame_id
     return msg
 
 
-def report_status(report: TrajectoryReport, name: str, hardware_id: str, warn_use: float, notes=()) -> DiagnosticStatus:
-    """OK; WARN when a limit is used more than ``warn_use`` %; ERROR over a limit."""
-    worst = report.worst
-    level = ERROR if not report.ok else WARN if 100 * worst.ratio >= warn_use else OK
-    verdict = "within every limit" if report.ok else "OVER A LIMIT"
-    values = [KeyValue(key="duration [s]", value=f"{report.duration:.6f}")]
-    values += [KeyValue(key="note", value=note) for note in notes]
-    values += [KeyValue(key=f"{p.joint} {p.quantity}", value=p.line().split(": ", 1)[1]) for p in report.peaks]
-    message = f"{report.duration:.3f} s, {verdict}; worst: {worst.line()}"
-    return DiagnosticStatus(level=level, name=name, hardware_id=hardware_id, message=message, values=values)
-
-
-def error_status(reason: str, name: str, hardware_id: str) -> DiagnosticStatus:
-    return DiagnosticStatus(level=ERROR, name=name, hardware_id=hardware_id, message=reason)
+def status(level: str, name: str, hardware_id: str, message: str, figures=()) -> DiagnosticStatus:
+    """A DiagnosticStatus of ``level`` ('ok', 'warn', 'error') with (key, value) ``figures``."""
+    values = [KeyValue(key=key, value=value) for key, value in figures]
+    return DiagnosticStatus(level=LEVELS[level], name=name, hardware_id=hardware_id, message=message, values=values)
