@@ -1,7 +1,8 @@
 """What measured signals say beyond the model: joint accelerations estimated from velocities
 (``filters``), external joint torques from efforts (``observer``: the generalized momentum
 observer behind id_node's collision detection), the wrench on the flange they come from
-(``wrench``: a virtual force sensor) and the scales the markers draw loads with (``display``).
+(``wrench``: a virtual force sensor), the scales the markers draw loads with (``display``)
+and a controller's tracking error over time (``tracking``).
 
 May import: ``core.model``, ``core.algorithms``, ``core.codegen``, ``core.dynamics``.
 """

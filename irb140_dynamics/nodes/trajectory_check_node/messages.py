@@ -1,11 +1,10 @@
-"""trajectory_msgs/JointTrajectory to and from the core's Trajectory, and a report as one
-diagnostic_msgs/DiagnosticStatus (core.trajectories.checker gives its level and figures)."""
+"""trajectory_msgs/JointTrajectory to the core's Trajectory (and back: ros.messages), and a
+report as one diagnostic_msgs/DiagnosticStatus (core.trajectories.checker: its level, figures)."""
 
 from __future__ import annotations
 
-from builtin_interfaces.msg import Duration
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
-from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+from trajectory_msgs.msg import JointTrajectory
 
 from irb140_dynamics.core.trajectories import Trajectory
 
@@ -24,22 +23,6 @@ def trajectory_of(msg: JointTrajectory, joint_names) -> Trajectory:
         for p in msg.points
     ]
     return Trajectory.from_message({"joint_names": list(msg.joint_names), "points": points}, joint_names)
-
-
-def trajectory_message(tr: Trajectory, frame_id: str = "") -> JointTrajectory:
-    """The trajectory as a message (velocities and accelerations where the points carry them)."""
-    points = [
-        JointTrajectoryPoint(
-            positions=p["positions"],
-            velocities=p["velocities"],
-            accelerations=p["accelerations"],
-            time_from_start=Duration(**p["time_from_start"]),
-        )
-        for p in tr.to_message()["points"]
-    ]
-    msg = JointTrajectory(joint_names=list(tr.joint_names), points=points)
-    msg.header.frame_id = frame_id
-    return msg
 
 
 def status(level: str, name: str, hardware_id: str, message: str, figures=()) -> DiagnosticStatus:

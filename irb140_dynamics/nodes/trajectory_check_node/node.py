@@ -30,7 +30,8 @@ from trajectory_msgs.msg import JointTrajectory
 from irb140_dynamics.core import RobotModel
 from irb140_dynamics.core.errors import one_line
 from irb140_dynamics.core.trajectories import TrajectoryChecker, TrajectoryError
-from irb140_dynamics.nodes.trajectory_check_node.messages import status, trajectory_message, trajectory_of
+from irb140_dynamics.nodes.trajectory_check_node.messages import status, trajectory_of
+from irb140_dynamics.ros.messages.joint_messages import trajectory_message
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import Spec
