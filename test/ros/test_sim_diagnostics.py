@@ -80,7 +80,7 @@ def test_real_time_counts_go_on_after_a_push_timed_out_and_late_steps_still_warn
     after = next_counts(sim, diagnostics)
     assert after["external_wrench.timeouts"] == 1
     assert after["steps"] > before["steps"] > 0  # still counting after the timeout
-    assert abs(after["steps"] - sim.node.schedule.steps) < 2000  # the schedule's own count (1 kHz, within 2 s)
+    assert abs(after["steps"] - sim.node.loop.schedule.steps) < 2000  # the schedule's own count (1 kHz, within 2 s)
     with sim.node.simulation.lock:  # the stepping thread waits: its steps fall behind
         time.sleep(0.2)
     assert sim.spin_until(
@@ -91,5 +91,5 @@ def test_real_time_counts_go_on_after_a_push_timed_out_and_late_steps_still_warn
         ),
     )
     counts = next_counts(sim, diagnostics)
-    assert counts["skipped_steps"] == sim.node.schedule.skipped > 0
-    assert counts["late_steps"] <= sim.node.schedule.late
+    assert counts["skipped_steps"] == sim.node.loop.schedule.skipped > 0
+    assert counts["late_steps"] <= sim.node.loop.schedule.late

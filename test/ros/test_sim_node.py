@@ -173,7 +173,7 @@ def test_diagnostics_warn_when_real_time_is_lost(sim):
             for s in msg.status
         ),
     )
-    assert sim.node.schedule.skipped > 0
+    assert sim.node.loop.schedule.skipped > 0
 
 
 def test_a_blow_up_resets_the_arm_and_the_node_goes_on(sim):

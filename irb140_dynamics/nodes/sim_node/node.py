@@ -88,7 +88,6 @@ class SimNode(Node):
             steady = Clock(clock_type=ClockType.STEADY_TIME)
             self.create_timer(self.get_parameter("lockstep_timeout").value / TICKS, self._republish, clock=steady)
         self.loop = RealTimeLoop(period, self._step, self._on_step_error)
-        self.schedule = self.loop.schedule
         first = self.parameters.draft(build_setup, self.parameters.values())
         if first is not None:
             self._use(first)
@@ -142,7 +141,7 @@ class SimNode(Node):
                 self.get_logger().warning(f"thread_priority refused ({refused}): ordinary scheduling")
         mode = "lockstep: one step per command" if self.lockstep else "real time"
         self.get_logger().info(
-            f"ready: {len(setup.joint_names)} joints {list(setup.joint_names)}, {1.0 / self.schedule.period:g} Hz "
+            f"ready: {len(setup.joint_names)} joints {list(setup.joint_names)}, {1.0 / self.loop.schedule.period:g} Hz "
             f"({mode}), payload {setup.engine.model.payload.mass} kg; on brakes until the first command"
         )
 
@@ -246,7 +245,7 @@ class SimNode(Node):
     def _publish_diagnostics(self) -> None:
         """The counts since startup; WARN with every problem of the last period (sim.simulation.problems)."""
         counts, simulation = self.counts, self.simulation
-        for key, value in (self.lockstep or self.schedule).counts().items():  # set, not added
+        for key, value in (self.lockstep or self.loop.schedule).counts().items():  # set, not added
             counts[key] = value
         recent, self._reported = counts - self._reported, counts.copy()
         found = problems(recent) if simulation.arm is not None else ["waiting for the model (robot_description)"]
