@@ -1,5 +1,5 @@
 """trajectory_check_node: JointTrajectories checked against the arm's limits and re-timed
-(``node``); ``messages``: JointTrajectory <-> the core's Trajectory, a report's status."""
+(``node``; the checks are core.trajectories', the messages ros.messages')."""
 
 from irb140_dynamics.entry import NODE, finish, start
 

@@ -21,7 +21,7 @@ model's payload (payload.*), friction and armature count.
 
 from __future__ import annotations
 
-from diagnostic_msgs.msg import DiagnosticStatus
+from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from std_msgs.msg import String
@@ -30,8 +30,7 @@ from trajectory_msgs.msg import JointTrajectory
 from irb140_dynamics.core import RobotModel
 from irb140_dynamics.core.errors import one_line
 from irb140_dynamics.core.trajectories import TrajectoryChecker, TrajectoryError
-from irb140_dynamics.nodes.trajectory_check_node.messages import status, trajectory_of
-from irb140_dynamics.ros.messages.joint_messages import trajectory_message
+from irb140_dynamics.ros.messages.joint_messages import trajectory_message, trajectory_of
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import Spec
@@ -48,6 +47,7 @@ NODE_PARAMETERS = [
 ]
 STARTUP_WAIT = 2.0  # s: at most this long for the torque limits before the node comes up
 WAITING = "no model yet: waiting for a URDF on the robot_description topic"
+LEVELS = {"ok": DiagnosticStatus.OK, "warn": DiagnosticStatus.WARN, "error": DiagnosticStatus.ERROR}
 
 
 def draft(values: dict) -> tuple[RobotModel, int, float]:
@@ -133,10 +133,17 @@ class TrajectoryCheckNode(Node):
         except TrajectoryError as error:
             self.tally.add(topic, "refused")
             self.tally.warn(topic, f"refused a {topic} message: {one_line(error)}")
-            self._report_pub.publish(status("error", name, self.get_name(), one_line(error)))
+            self._report(name, "error", one_line(error))
             return
-        figures = checker.figures(report, notes)
-        self._report_pub.publish(status(checker.level(report), name, self.get_name(), report.headline(), figures))
+        self._report(name, checker.level(report), report.headline(), checker.figures(report, notes))
+
+    def _report(self, name: str, level: str, message: str, figures=()) -> None:
+        """A DiagnosticStatus of ``level`` ('ok', 'warn', 'error') with (key, value) ``figures``."""
+        values = [KeyValue(key=key, value=value) for key, value in figures]
+        hardware_id = self.get_name()
+        self._report_pub.publish(
+            DiagnosticStatus(level=LEVELS[level], name=name, hardware_id=hardware_id, message=message, values=values)
+        )
 
     @guarded("check_trajectory")
     def _on_check(self, msg: JointTrajectory) -> None:

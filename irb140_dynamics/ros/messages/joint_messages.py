@@ -23,6 +23,7 @@ __all__ = [
     "read_joint_state",
     "read_trajectory",
     "trajectory_message",
+    "trajectory_of",
 ]
 
 
@@ -107,9 +108,27 @@ def read_trajectory(msg: JointTrajectory, order: JointOrder):
         raise BadMessage("bad_trajectory", str(error)) from None
 
 
+def trajectory_of(msg: JointTrajectory, joint_names):
+    """The message as a core.trajectories.Trajectory (checked, per point, as the controller
+    takes it: core.trajectories.message), in the model's joint order; TrajectoryError
+    naming the point."""
+    from irb140_dynamics.core.trajectories.message import Trajectory
+
+    points = [
+        {
+            "positions": list(p.positions),
+            "velocities": list(p.velocities),
+            "accelerations": list(p.accelerations),
+            "time_from_start": {"sec": p.time_from_start.sec, "nanosec": p.time_from_start.nanosec},
+        }
+        for p in msg.points
+    ]
+    return Trajectory.from_message({"joint_names": list(msg.joint_names), "points": points}, joint_names)
+
+
 def trajectory_message(tr, frame_id: str = "") -> JointTrajectory:
     """A core.trajectories.Trajectory as a message (velocities and accelerations on the
-    points that carry them)."""
+    points that carry them): trajectory_of, the other way."""
     msg = JointTrajectory(joint_names=list(tr.joint_names))
     msg.header.frame_id = frame_id
     for k in range(len(tr.t)):
