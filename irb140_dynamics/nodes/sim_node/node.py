@@ -15,8 +15,7 @@ It stays on its brakes from startup and each reset until its first command (and 
 commands and pushes are held, and let go after command_timeout (sim.simulation). It steps at
 ``rate`` in real time in a thread of its own (sim.realtime), or in ``lockstep`` once per
 command on simulated time, published on /clock (sim.lockstep). Bad messages are dropped,
-counted and warned about; no exception of ours leaves a callback (ros.runtime.guard).
-See docs/sim.md.
+counted and warned about; no exception of ours leaves a callback (ros.runtime.guard); docs/sim.md.
 """
 
 from __future__ import annotations
@@ -200,8 +199,7 @@ class SimNode(Node):
             self.tally.drop("external_wrench", error)
 
     def _step(self, k: int, t: float) -> None:
-        """Step k of the stepping thread (real time), due at t (monotonic): one period
-        under the command held, then the state published, stamped t on the node's clock."""
+        """Step k of the stepping thread (real time), due at t (monotonic): stepped, published."""
         if not self.context.ok():
             return
         stamp = self._stamp_offset + round(t * 1e9)

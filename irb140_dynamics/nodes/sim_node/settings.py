@@ -11,7 +11,6 @@ from irb140_dynamics.sim.engine import DEFAULT_INTEGRATOR, SimulatedArm
 from irb140_dynamics.sim.mjcf import INTEGRATORS
 from irb140_dynamics.sim.simulation import Setup, initial_positions
 
-MAX_TIME = 3600.0  # s: command_timeout, reset_hold
 NODE_PARAMETERS = [
     Spec("rate", 1000.0, "steps (and joint_states) per second of simulated time", "Hz", True, 1.0, 100000.0),
     Spec("substeps", 1, "MuJoCo steps per step (integration step 1 / (rate * substeps))", "", True, 1, 1000),
@@ -40,7 +39,7 @@ NODE_PARAMETERS = [
         "(in real time; in lockstep each step applies the command it answers)",
         "s",
         minimum=0.0,
-        maximum=MAX_TIME,
+        maximum=3600.0,
     ),
     Spec(
         "initial_positions",
@@ -55,7 +54,7 @@ NODE_PARAMETERS = [
         "least this long (simulated time)",
         "s",
         minimum=0.0,
-        maximum=MAX_TIME,
+        maximum=3600.0,
     ),
     Spec("noise.position", 0.0, "std dev of the noise on the published positions", "rad", minimum=0.0, maximum=10.0),
     Spec("noise.effort", 0.0, "std dev of the noise on the published efforts", "N m", minimum=0.0, maximum=1e4),
