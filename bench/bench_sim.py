@@ -5,7 +5,8 @@
 Prints one table and writes the raw figures to bench/results/sim.json. Two runs, each in
 fresh processes with a namespace of their own, as bench_nodes.py starts its nodes:
 
-- baseline: sim_node alone (no controller: zero torque; the arm rests on its stops);
+- baseline: sim_node alone (no controller: one zero-torque command from here, held, so
+  that the arm leaves its brakes and MuJoCo steps; the arm rests on its stops);
 - ours: sim_node beside id_node closing the loop (effort_commands = g(q), the gravity
   compensation test's setup): two Python processes on the same cores.
 
@@ -52,9 +53,9 @@ SKIPPED_TARGET = Target(0, absolute=True)
 QOS_DEPTH = 1000  # this process's joint_states subscription
 
 
-def counts_of(msg, hardware_id: str) -> dict | None:
+def counts_of(msg) -> dict | None:
     for status in msg.status:
-        if status.name == "sim_node: simulation" and status.hardware_id == hardware_id:
+        if status.name == "sim_node: simulation":  # the only sim_node of its isolated domain
             return {kv.key: int(kv.value) for kv in status.values if kv.value.isdigit()}
     return None
 
@@ -81,6 +82,7 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
             f"initial_positions:={POSE}",
             "-p",
             f"thread_priority:={priority}",
+            *([] if loop else ["-p", "command_timeout:=0.0"]),
         ],
         env,
     )
@@ -103,7 +105,6 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
     executor = SingleThreadedExecutor()
     executor.add_node(listener)
     diagnostics, receiver = [], None
-    hardware_id = f"{namespace}/sim_node"
     try:
         listener.create_subscription(
             DiagnosticArray, "/diagnostics", lambda msg: diagnostics.append((time.monotonic(), msg)), 100
@@ -127,6 +128,13 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
                 controller,
                 "id_node's effort_commands",
             )
+        if controller is None:  # zero torque, held: else the arm stays on its brakes, unstepped
+            from std_msgs.msg import Float64MultiArray
+
+            zero = listener.create_publisher(Float64MultiArray, f"{namespace}/effort_commands", 10)
+            wait_for(lambda: zero.get_subscription_count() > 0, STARTUP_TIMEOUT, sim, "sim_node's effort_commands")
+            for _ in range(10):  # sim_node takes commands best effort
+                zero.publish(Float64MultiArray(data=[0.0] * 6))
         receiver = Receiver(states, taker.context)
         receiver.start()
 
@@ -138,23 +146,23 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
         spin(warmup)
         first = len(diagnostics)
         wait_for(
-            lambda: spin(0.05) or any(counts_of(m, hardware_id) for _, m in diagnostics[first:]),
+            lambda: spin(0.05) or any(counts_of(m) for _, m in diagnostics[first:]),
             5.0,
             sim,
             "sim_node's /diagnostics",
         )
-        start_at, start_msg = next((t, m) for t, m in diagnostics[first:] if counts_of(m, hardware_id))
+        start_at, start_msg = next((t, m) for t, m in diagnostics[first:] if counts_of(m))
         cpu0 = sim.cpu_seconds(), controller.cpu_seconds() if controller else 0.0
         load0 = snapshot()
         spin(duration - 0.5)
         later = len(diagnostics)
         wait_for(
-            lambda: spin(0.05) or any(counts_of(m, hardware_id) for _, m in diagnostics[later:]),
+            lambda: spin(0.05) or any(counts_of(m) for _, m in diagnostics[later:]),
             5.0,
             sim,
             "sim_node's /diagnostics",
         )
-        end_at, end_msg = next((t, m) for t, m in diagnostics[later:] if counts_of(m, hardware_id))
+        end_at, end_msg = next((t, m) for t, m in diagnostics[later:] if counts_of(m))
         cpu1 = sim.cpu_seconds(), controller.cpu_seconds() if controller else 0.0
         load1 = snapshot()
         for process in (sim, controller):
@@ -169,7 +177,7 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
         for process in (sim, controller):
             if process is not None:
                 process.stop()
-    c0, c1 = counts_of(start_msg, hardware_id), counts_of(end_msg, hardware_id)
+    c0, c1 = counts_of(start_msg), counts_of(end_msg)
     steps = c1["steps"] - c0["steps"]
     window = (_ns(start_msg.header.stamp), _ns(end_msg.header.stamp))
     records = np.array(receiver.records, dtype=np.int64).reshape(-1, 5)

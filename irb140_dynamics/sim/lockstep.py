@@ -55,6 +55,10 @@ class LockstepClock:
         """Simulated time of state k [ns]: exactly k periods, whatever k."""
         return round(self.steps * self.period * 1e9)
 
+    def counts(self) -> dict[str, int]:
+        """The counts /diagnostics reports, by name."""
+        return {"steps": self.steps, "republished": self.republished, "duplicates_dropped": self.duplicates}
+
     def accept(self, command: np.ndarray) -> bool:
         """Step on ``command``? False (counted) for the duplicate answer to a state published again."""
         self._dropped = False

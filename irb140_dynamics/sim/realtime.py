@@ -53,6 +53,10 @@ class StepSchedule:
         self.steps += count
         return count
 
+    def counts(self) -> dict[str, int]:
+        """The counts /diagnostics reports, by name."""
+        return {"steps": self.steps, "late_steps": self.late, "skipped_steps": self.skipped}
+
     def due_time(self, k: int) -> float:
         """When step k is due, on the clock of ``now``."""
         return self.start + k * self.period

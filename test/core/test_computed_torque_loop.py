@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import irb140, load_model
-from irb140_dynamics.core.trajectories.reference import computed_torque
-from irb140_dynamics.nodes.demo_node.node import CENTRE, motion
+from irb140_dynamics.core.trajectories.reference import DEMO_CENTRE, computed_torque, swing
 from irb140_dynamics.sim.engine import SimulatedArm
 
 from ..support.paths import ROOT
@@ -23,9 +22,9 @@ KP, KD = np.full(6, 400.0), np.full(6, 40.0)  # id_node's defaults
 def tracking_rms(model, duration=PERIOD) -> np.ndarray:
     """RMS of q_ref - q per joint [rad] with ``model`` in the controller, the true arm simulated."""
     arm = SimulatedArm(TRUE_ARM, period=1.0 / RATE)
-    arm.reset(CENTRE)
+    arm.reset(DEMO_CENTRE)
     t = np.arange(int(duration * RATE)) / RATE
-    Q, QD, QDD = motion(t, PERIOD)
+    Q, QD, QDD = swing(t, PERIOD)
     command, errors = np.zeros(6), []
     for q_ref, qd_ref, qdd_ref in zip(Q, QD, QDD):
         q, qd = arm.q.copy(), arm.qd.copy()

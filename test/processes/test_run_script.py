@@ -114,7 +114,8 @@ def test_the_demo_stops_on_ctrl_c_and_writes_its_plot_where_it_says(tmp_path):
 
 @pytest.mark.slow
 def test_the_demo_with_a_duration_ends_by_itself_with_its_plot(tmp_path):
-    """--duration S: S seconds of tracking figures, then the plot, every node stopped, exit 0."""
+    """--duration S: S seconds of tracking figures, the first from a held arm, then the plot,
+    every node stopped, exit 0."""
     seconds = 3
     process = run_script("--demo", "--duration", str(seconds), cwd=tmp_path)
     try:
@@ -128,6 +129,9 @@ def test_the_demo_with_a_duration_ends_by_itself_with_its_plot(tmp_path):
     assert f"run.sh: the demo's {seconds} s are over; stopping the nodes" in output, output
     figures = [line for line in output.splitlines() if line.startswith("t=") and "mrad" in line]
     assert figures, output  # the loop ran: its figures came before the end
+    first = figures[0].split()
+    joint_2 = float(first[first.index("joint_2") + 1])
+    assert joint_2 < 200.0, figures[0]  # from a held arm: sim_node waited on its brakes (a fall: some 850 mrad)
     assert "stopped by itself" not in output and leftovers == [], output
 
 

@@ -7,7 +7,7 @@ from diagnostic_msgs.msg import DiagnosticStatus
 from trajectory_msgs.msg import JointTrajectory
 
 from irb140_dynamics.core import irb140
-from irb140_dynamics.nodes.trajectory_check_node.messages import trajectory_message
+from irb140_dynamics.ros.messages.joint_messages import trajectory_message
 
 from ..support.trajectories import smooth_trajectory
 

@@ -24,10 +24,10 @@ def test_the_plot_uses_the_latest_joint_state_when_the_error_s_own_was_dropped(t
         errors = harness.publisher(JointState, "/id_node/tracking_error")
         q = np.linspace(-0.5, 0.5, 6)
         states.publish(joint_state(q, 1_000))
-        assert harness.spin_until(lambda: harness.node._latest is not None)
+        assert harness.spin_until(lambda: harness.node.log.latest is not None)
         errors.publish(joint_state(np.full(6, 1e-3), 2_000))  # its joint state (stamp 2000) never came
-        assert harness.spin_until(lambda: len(harness.node._history) == 1)
-        t, reference, actual = harness.node._history[0]
+        assert harness.spin_until(lambda: len(harness.node.log.history) == 1)
+        t, reference, actual = harness.node.log.history[0]
         np.testing.assert_array_equal(actual, q)
         np.testing.assert_allclose(reference - actual, 1e-3, rtol=1e-12)
         assert harness.node.write_plot() == str(plot)
@@ -50,7 +50,7 @@ def test_tracking_errors_without_joint_states_print_no_figures_and_say_what_is_m
     with running(DemoNode, parameter_overrides=[Parameter("plot_file", value=str(plot))]) as harness:
         errors = harness.publisher(JointState, "/id_node/tracking_error")
         errors.publish(joint_state(np.full(6, 1e-3), 2_000))
-        assert harness.spin_until(lambda: len(harness.node._recent) == 1)
+        assert harness.spin_until(lambda: len(harness.node.log.recent) == 1)
         harness.node._print()
         assert harness.node.write_plot() is None
     out = capsys.readouterr().out

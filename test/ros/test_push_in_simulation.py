@@ -42,7 +42,7 @@ def received(sim, count: int) -> None:
 
 
 def test_bad_wrenches_are_dropped_and_counted_never_applied(sim):
-    assert sim.spin_until(lambda: sim.node.arm is not None)
+    assert sim.spin_until(lambda: sim.node.simulation.arm is not None)
     bad = [
         wrench("flange", [np.nan, 0.0, 0.0]),
         wrench("base_link", [0.0, np.inf, 0.0]),
@@ -58,21 +58,19 @@ def test_bad_wrenches_are_dropped_and_counted_never_applied(sim):
     assert counts["external_wrench.dropped"] == len(bad)
     assert counts["external_wrench.dropped_not_finite"] == 2 and counts["external_wrench.dropped_absurd_wrench"] == 2
     assert counts["external_wrench.dropped_unknown_frame"] == 2
-    assert sim.node.push.current(sim.node._now(), 0.0) == (None, "base")  # nothing held
+    assert sim.node.simulation.held_push(sim.node._now()) == (None, "base")  # nothing held
 
 
 def test_a_push_is_held_in_the_frame_it_names(sim):
-    assert sim.spin_until(lambda: sim.node.arm is not None)
+    assert sim.spin_until(lambda: sim.node.simulation.arm is not None)
     sim.pushes.publish(wrench("flange", [1.0, 2.0, 3.0], [0.1, 0.2, 0.3]))
     received(sim, 1)
-    values, frame = sim.node.push.current(sim.node._now(), 0.0)
+    values, frame = sim.node.simulation.held_push(sim.node._now())
     assert frame == "tip" and values.tolist() == [1.0, 2.0, 3.0, 0.1, 0.2, 0.3]
     sim.pushes.publish(wrench("base_link", [0.0, 0.0, 5.0]))
     received(sim, 2)
-    values, frame = sim.node.push.current(sim.node._now(), 0.0)
+    values, frame = sim.node.simulation.held_push(sim.node._now())
     assert frame == "base" and values.tolist() == [0.0, 0.0, 5.0, 0.0, 0.0, 0.0]
-    # let go after command_timeout (here 1 s of simulated time) without a new one
-    assert sim.node.push.current(sim.node._now() + 2_000_000_000, 1.0) == (None, "base")
 
 
 def test_a_20_newton_push_shows_on_external_wrench_in_lockstep():
@@ -107,7 +105,7 @@ def test_a_20_newton_push_shows_on_external_wrench_in_lockstep():
             force_error = np.linalg.norm(np.array([f.x, f.y, f.z]) - PUSH)
             torque_error = np.linalg.norm([m.x, m.y, m.z])  # N m: none pushed
             assert force_error <= 0.05 * 20.0 and torque_error <= 0.05 * 20.0 * 0.1, (stamp(msg), f, m)
-        moved = np.abs(sim.arm.q - POSE).max()
+        moved = np.abs(sim.simulation.arm.q - POSE).max()
         assert 1e-3 < moved < 0.3, moved  # the arm gave way, far from its limits
     finally:
         if id_node is not None:

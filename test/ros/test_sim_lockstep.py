@@ -141,7 +141,7 @@ def test_without_commands_the_last_state_is_republished_and_the_arm_stays(lockst
     assert all(stamp(msg) == 0 and msg.position.tolist() == POSE for msg in sim.states)
     assert all(clock_ns(msg) == 0 for msg in sim.clock)
     assert sim.node.lockstep.steps == 0 and sim.node.lockstep.republished >= 2
-    assert sim.node.arm.q.tolist() == POSE  # without torque it would fall: it never stepped
+    assert sim.node.simulation.arm.q.tolist() == POSE  # without torque it would fall: it never stepped
     first_step(sim)  # and it goes on at the next command
     assert stamp(sim.states[-1]) == PERIOD_NS
     republished = sim.node.lockstep.republished

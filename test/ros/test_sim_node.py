@@ -1,7 +1,6 @@
 """sim_node in-process with real rclpy and DDS: commands in, states out, hold and timeout,
 reset, noise, bad commands, parameters."""
 
-import itertools
 import time
 
 import numpy as np
@@ -58,10 +57,23 @@ def stamp(msg) -> int:
     return msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
 
 
-def states_after_reset(sim, count: int):
-    """Reset the arm, and the first ``count`` joint states after it."""
+def states_after_reset(sim, count: int, tau=None):
+    """Reset the arm (on brakes until a command comes), command ``tau`` (None: zero torque)
+    and the first ``count`` joint states stepped after the reset, from the first that
+    carries ``tau`` as its effort (while braked the effort is zero)."""
+    first = len(sim.states)
     sim.node.reset()
-    return states_stepped_after(sim, sim.node.reset_stamp, count)[-count:]
+    reset_at = sim.node.reset_stamp
+    tau = np.zeros(6) if tau is None else np.asarray(tau, dtype=float)
+    command(sim, tau)
+
+    def under_tau():
+        after = [msg for msg in sim.states[first:] if stamp(msg) > reset_at]
+        start = next((i for i, msg in enumerate(after) if np.array_equal(msg.effort, tau)), len(after))
+        return after[start:]
+
+    assert sim.spin_until(lambda: len(under_tau()) >= count), "joint_states stopped"
+    return under_tau()[:count]
 
 
 def states_stepped_after(sim, reset_at: int, count: int):
@@ -83,9 +95,7 @@ def test_states_are_named_stamped_every_period_and_the_arm_falls_without_torque(
 
 def test_a_gravity_command_is_applied_and_held(sim):
     g = gravity(irb140(), POSE)
-    command(sim, g)
-    wait_for_effort(sim, g)
-    states = states_after_reset(sim, 500)
+    states = states_after_reset(sim, 500, g)
     position = np.array([msg.position for msg in states])
     assert np.abs(position - POSE).max() < 1e-6  # held exactly: the engine's gravity is ours
     assert all(np.array_equal(msg.effort, g) for msg in states)  # one command, held
@@ -130,7 +140,7 @@ def test_no_exception_leaves_a_callback(sim, monkeypatch):
     def broken(msg, n):
         raise RuntimeError("a defect")
 
-    monkeypatch.setattr(sim_node, "read_command", broken)
+    monkeypatch.setattr(sim_node, "command_torques", broken)
     command(sim, COMMAND)
     assert sim.spin_until(lambda: sim.node.counts["effort_commands.errors"] >= 1)
     monkeypatch.undo()
@@ -154,7 +164,7 @@ def test_no_exception_leaves_a_callback(sim, monkeypatch):
 
 def test_diagnostics_warn_when_real_time_is_lost(sim):
     diagnostics = sim.listen(DiagnosticArray, "/diagnostics")
-    with sim.node._lock:  # the stepping thread waits: its steps fall behind
+    with sim.node.simulation.lock:  # the stepping thread waits: its steps fall behind
         time.sleep(0.2)
     assert sim.spin_until(
         lambda: any(
@@ -163,7 +173,7 @@ def test_diagnostics_warn_when_real_time_is_lost(sim):
             for s in msg.status
         ),
     )
-    assert sim.node.schedule.skipped > 0
+    assert sim.node.loop.schedule.skipped > 0
 
 
 def test_a_blow_up_resets_the_arm_and_the_node_goes_on(sim):
@@ -174,18 +184,34 @@ def test_a_blow_up_resets_the_arm_and_the_node_goes_on(sim):
     assert np.isfinite(sim.states[-1].position).all()
 
 
-@pytest.mark.parametrize("sim", [{"reset_hold": 1.0}], indirect=True)
-def test_reset_puts_the_arm_back_and_holds_it(sim):
+def moved(msg) -> bool:
+    return msg.position.tolist() != POSE or np.any(msg.velocity) or np.any(msg.effort)
+
+
+def test_the_arm_is_on_brakes_until_its_first_command(sim):
+    """Started before its controller, the arm holds still (reset_hold 0), then falls under zero torque."""
+    assert sim.spin_until(lambda: len(sim.states) >= 500)
+    assert not any(moved(msg) for msg in sim.states)
+    command(sim, np.zeros(6))
+    assert sim.spin_until(lambda: sim.states and abs(sim.states[-1].position[1] - POSE[1]) > 1e-3)  # released: it falls
+
+
+@pytest.mark.parametrize("sim", [{"reset_hold": 0.3}], indirect=True)
+def test_reset_puts_the_arm_back_on_brakes_until_a_command_and_reset_hold(sim):
+    command(sim, np.zeros(6))
     assert sim.spin_until(lambda: sim.states and abs(sim.states[-1].position[1] - POSE[1]) > 1e-3)  # fallen
     client = sim.probe.create_client(Trigger, "/sim_node/reset")
     assert client.wait_for_service(timeout_sec=10.0)
     reply = sim.call(lambda: client.call_async(Trigger.Request()))
     assert reply.success and "reset" in reply.message
-    after = states_stepped_after(sim, sim.node.reset_stamp, 150)
-    held = list(itertools.takewhile(lambda msg: msg.position.tolist() == POSE, after))
-    assert len(held) > 50, [msg.position.tolist() for msg in after[:3]]
-    assert all(not np.any(msg.velocity) and not np.any(msg.effort) for msg in held)
+    after = states_stepped_after(sim, sim.node.reset_stamp, 600)  # twice reset_hold, no command since: braked
+    assert len(after) >= 600 and not any(moved(msg) for msg in after)
+    sim.node.reset()
+    reset_at = sim.node.reset_stamp
+    command(sim, np.zeros(6))  # at once: braked for reset_hold all the same
     assert sim.spin_until(lambda: sim.states[-1].position[1] < POSE[1] - 1e-3)  # released
+    released = next(msg for msg in sim.states if stamp(msg) > reset_at and moved(msg))
+    assert stamp(released) - reset_at >= 0.3e9
 
 
 @pytest.mark.parametrize("sim", [{"reset_hold": 100.0, "noise.position": 0.01, "noise.effort": 2.0}], indirect=True)
@@ -195,7 +221,7 @@ def test_noise_on_positions_and_efforts(sim):
     effort = np.array([msg.effort for msg in states])
     assert 0.008 < position.std() < 0.012 and abs(position.mean()) < 0.002
     assert 1.6 < effort.std() < 2.4
-    assert sim.node.arm.q.tolist() == POSE  # the noise is on the messages, not the arm
+    assert sim.node.simulation.arm.q.tolist() == POSE  # the noise is on the messages, not the arm
     assert not np.any(np.array([msg.velocity for msg in states]))
 
 
@@ -203,10 +229,8 @@ def test_runtime_changes_apply_and_bad_ones_are_refused(sim):
     g = gravity(irb140(payload=RigidBody(5.0)), POSE)
     results = sim.set_parameters([Parameter("payload.mass", value=5.0)])
     assert [r.successful for r in results] == [True]
-    assert sim.node.arm.model.payload.mass == 5.0
-    command(sim, g)
-    wait_for_effort(sim, g)
-    position = np.array([msg.position for msg in states_after_reset(sim, 200)])
+    assert sim.node.simulation.arm.model.payload.mass == 5.0
+    position = np.array([msg.position for msg in states_after_reset(sim, 200, g)])
     assert np.abs(position - POSE).max() < 1e-6  # the new payload is simulated
     for name, value, reason in [
         ("initial_positions", [0.0] * 5, "expected 6 values"),
@@ -216,7 +240,7 @@ def test_runtime_changes_apply_and_bad_ones_are_refused(sim):
     ]:
         result = sim.set_parameters([Parameter(name, value=value)])[0]
         assert not result.successful and reason in result.reason, (name, result.reason)
-    assert sim.node.arm.model.payload.mass == 5.0
+    assert sim.node.simulation.arm.model.payload.mass == 5.0
 
 
 @pytest.mark.parametrize(

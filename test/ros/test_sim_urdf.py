@@ -25,11 +25,8 @@ def test_a_urdf_arm_is_simulated_and_held_by_its_own_gravity():
     )
     with running(SimNode, parameter_overrides=overrides) as sim:
         sim.states = sim.listen(JointState, "joint_states", 1000)
-        commands = sim.publisher(Float64MultiArray, "effort_commands")
-        g = gravity(model, POSE)
-        commands.publish(Float64MultiArray(data=g.tolist()))
-        assert sim.spin_until(lambda: sim.states and np.array_equal(sim.states[-1].effort, g))
-        states = states_after_reset(sim, 300)
+        sim.commands = sim.publisher(Float64MultiArray, "effort_commands")
+        states = states_after_reset(sim, 300, gravity(model, POSE))
         assert list(states[0].name) == list(model.joint_names)
         assert np.abs(np.array([msg.position for msg in states]) - POSE).max() < 1e-6
 

@@ -10,8 +10,8 @@ from trajectory_msgs.msg import JointTrajectory
 
 from irb140_dynamics.core import RigidBody, irb140
 from irb140_dynamics.core.trajectories import check_trajectory, trajectory_limits
-from irb140_dynamics.nodes.trajectory_check_node.messages import trajectory_message, trajectory_of
 from irb140_dynamics.nodes.trajectory_check_node.node import TrajectoryCheckNode
+from irb140_dynamics.ros.messages.joint_messages import trajectory_message, trajectory_of
 
 from ..support.ros_harness import running
 from ..support.trajectories import limit_use, smooth_trajectory

@@ -17,6 +17,7 @@ from matplotlib.figure import Figure  # noqa: E402
 
 from irb140_dynamics.core import RigidBody, irb140  # noqa: E402
 from irb140_dynamics.core.io.trajectory_file import read_joint_trajectory  # noqa: E402
+from irb140_dynamics.core.monitoring.tracking import TrackingLog  # noqa: E402
 from irb140_dynamics.core.payload.diagram import DiagramPoint, LoadDiagram  # noqa: E402
 from irb140_dynamics.core.regressor import inertial_parameters  # noqa: E402
 from irb140_dynamics.core.trajectories.limits import trajectory_limits  # noqa: E402
@@ -97,8 +98,11 @@ def test_the_check_fails_on_a_title_wider_than_its_figure():
 
 def test_the_demo_plot(saved, tmp_path):
     t = np.linspace(0.0, 8.0, 200)
-    history = [(x, np.full(6, np.sin(x)), np.full(6, np.sin(x) + 0.01)) for x in t]
-    demo = SimpleNamespace(_history=history, _recent=[1], label=LABEL, plot_file=str(tmp_path / "demo.png"))
+    log = TrackingLog()
+    for k, x in enumerate(t):
+        log.state(k, np.full(6, np.sin(x) + 0.01))
+        log.error(x, k, np.full(6, -0.01))
+    demo = SimpleNamespace(log=log, label=LABEL, plot_file=str(tmp_path / "demo.png"))
     assert DemoNode.write_plot(demo) == demo.plot_file
     assert saved.problems == [[]]
     figure = saved.figures[0]

@@ -2,8 +2,8 @@
 (``filters``), external joint torques from efforts (``observer``: the generalized momentum
 observer behind id_node's collision detection), the wrench on the flange they come from
 (``wrench``: a virtual force sensor), collision thresholds set from a recording of normal
-work and the flange force they detect (``sensitivity``) and the scales the markers draw
-loads with (``display``).
+work and the flange force they detect (``sensitivity``), the scales the markers draw
+loads with (``display``) and a controller's tracking error over time (``tracking``).
 
 May import: ``core.model``, ``core.algorithms``, ``core.codegen``, ``core.dynamics``,
 ``core.kinematics``.

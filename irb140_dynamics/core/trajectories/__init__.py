@@ -8,12 +8,14 @@ interpolates it. ``limits``: the torque, velocity and acceleration limits (torqu
 params file leaves at 0 derived as the payload check does). ``check``: per joint the peak
 torque (RNEA with friction, armature and payload), velocity and acceleration against the
 limits. ``retiming``: the time-optimal timing of the same path (``path``: the grid over it;
-``topp``: reachability analysis).
+``topp``: reachability analysis). ``checker``: a model and its limits, built once, checking
+and re-timing every trajectory a service is sent; a report's level, headline and figures.
 
 May import: ``core.model``, the verbs in ``core.dynamics``, ``core.payload`` (limits). No ROS.
 """
 
 from .check import JointPeak, TrajectoryReport, check_trajectory
+from .checker import TrajectoryChecker
 from .limits import Limits, torque_limit_notes, trajectory_limits
 from .message import Trajectory, TrajectoryError
 from .retiming import Retimed, retime
@@ -24,6 +26,7 @@ __all__ = [
     "Limits",
     "Retimed",
     "Trajectory",
+    "TrajectoryChecker",
     "TrajectoryError",
     "TrajectoryReport",
     "check_trajectory",

@@ -79,6 +79,11 @@ class TrajectoryReport:
     def lines(self) -> list[str]:
         return [p.line() for p in self.peaks]
 
+    def headline(self) -> str:
+        """The report in one line: its duration, the verdict and the worst use of a limit."""
+        verdict = "within every limit" if self.ok else "OVER A LIMIT"
+        return f"{self.duration:.3f} s, {verdict}; worst: {self.worst.line()}"
+
 
 def profiles(model: RobotModel, sp: Spline, t, seg) -> dict[str, np.ndarray]:
     """Torque, velocity and acceleration (each (len(t), n)) of the interpolation at t."""

@@ -9,16 +9,30 @@ and the measured state into torques:
         = rnea(q, qd, v) - tau_f(qd) + tau_f(qd_ref)   with v the bracket
 
 so that with an exact model the error e = q_ref - q obeys e'' + Kd e' + Kp e = 0.
+
+``swing`` is the demo's reference motion: every joint out and back, from rest to rest.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from irb140_dynamics.core.dynamics import rnea, rnea_batch
 from irb140_dynamics.core.model.robot_model import RobotModel
+
+DEMO_CENTRE = (0.0, -0.6, 1.0, 0.0, 0.5, 0.0)  # rad, the IRB-140's: where the demo's motion starts and ends
+DEMO_AMPLITUDE = (0.8, 0.5, 0.5, 1.0, 0.6, 1.5)  # rad
+
+
+def swing(t, period: float, centre=DEMO_CENTRE, amplitude=DEMO_AMPLITUDE):
+    """q, qd, qdd (each (len(t), n)) at times ``t`` [s] of c + a (1 - cos(w t)) / 2 with
+    w = 2 pi / period: from rest at ``centre`` out to centre + amplitude and back, in one period."""
+    w = 2 * math.pi / period
+    c, a, t = np.array(centre), np.array(amplitude), np.asarray(t, dtype=float)[:, None]
+    return c + a * (1 - np.cos(w * t)) / 2, a * w * np.sin(w * t) / 2, a * w**2 * np.cos(w * t) / 2
 
 
 @dataclass(frozen=True, eq=False)

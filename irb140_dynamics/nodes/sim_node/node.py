@@ -2,30 +2,25 @@
 
 Subscribes   effort_commands   std_msgs/Float64MultiArray: joint torques [N m], model joint
                                order (as ros2_control's JointGroupEffortController ~/commands)
-             ~/external_wrench geometry_msgs/WrenchStamped: a push on the flange, held (see
-                               sim_node.push)
+             ~/external_wrench geometry_msgs/WrenchStamped: a push on the flange, in the axes of
+                               the tip link (flange) or the base link its frame_id names
 Publishes    joint_states      sensor_msgs/JointState every step: position, velocity, effort =
                                the torque applied, named, stamped
              /clock            rosgraph_msgs/Clock, in lockstep only: the simulated time, every step
              /diagnostics      diagnostic_msgs/DiagnosticArray, 1 Hz: steps, late steps, commands
-Serves       ~/reset           std_srvs/Trigger: back to initial_positions, at rest
+Serves       ~/reset           std_srvs/Trigger: back to initial_positions, at rest, on brakes
 
-The true arm is the model of the parameters or of a URDF (``model.source``, as every node's)
-and may differ from the model a controller uses. In real time (the default) a command is
-held (zero-order hold) until the next; once it is older than command_timeout, zero torque
-is applied. The engine steps at ``rate`` in real time (sub-steps allowed) in a thread of
-its own, catching up late steps (counted) and skipping when far behind (counted). In
-``lockstep`` it steps once per command instead (sim.lockstep), stamps with simulated time
-and publishes it on /clock. Bad commands (wrong length, NaN or infinite) are dropped,
-counted and warned about, never applied; no exception of ours leaves a callback
-(ros.runtime.guard). See docs/sim.md.
+The true arm is the model of the parameters or of a URDF (``model.source``, as every node's).
+It stays on its brakes from startup and each reset until its first command (and reset_hold);
+commands and pushes are held, and let go after command_timeout (sim.simulation). It steps at
+``rate`` in real time in a thread of its own (sim.realtime), or in ``lockstep`` once per
+command on simulated time, published on /clock (sim.lockstep). Bad messages are dropped,
+counted and warned about; no exception of ours leaves a callback (ros.runtime.guard); docs/sim.md.
 """
 
 from __future__ import annotations
 
-import threading
 import time
-from collections import Counter
 
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
@@ -39,10 +34,9 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, String
 from std_srvs.srv import Trigger
 
-from irb140_dynamics.nodes.sim_node.push import HeldWrench
-from irb140_dynamics.nodes.sim_node.settings import NODE_PARAMETERS, SimNodeSettings, build_settings, read_command
+from irb140_dynamics.nodes.sim_node.settings import NODE_PARAMETERS, build_setup
 from irb140_dynamics.ros.messages.joint_messages import BadMessage
-from irb140_dynamics.ros.messages.wrench import chain_links
+from irb140_dynamics.ros.messages.wrench import chain_links, read_wrench
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.usage import model_sections
@@ -50,11 +44,9 @@ from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
 from irb140_dynamics.ros.runtime.rebuild import Rebuild
 from irb140_dynamics.ros.runtime.spin import run
-from irb140_dynamics.sim.engine import SimulatedArm, SimulationError
 from irb140_dynamics.sim.lockstep import TICKS, LockstepClock
 from irb140_dynamics.sim.realtime import RealTimeLoop
-
-WARN_LATE_SHARE = 0.01  # /diagnostics WARN when more of the last period's steps were late
+from irb140_dynamics.sim.simulation import Measured, Setup, Simulation, command_torques, problems
 
 
 def _reset_failed(request, response, error):
@@ -67,29 +59,23 @@ class SimNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__("sim_node", **NODE_OPTIONS, **kwargs)
-        self.settings: SimNodeSettings | None = None  # None: waiting for the model (robot_description topic)
-        self.arm: SimulatedArm | None = None  # the engine, stepped under self._lock
-        self._lock = threading.Lock()  # the arm and settings: the stepping thread against callbacks
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
+        self._reported = self.counts.copy()  # the counts at the last diagnostics
+        self.simulation = Simulation(self.counts, lambda text: self.tally.warn("simulation", text))
         self.parameters = ArmParameters(self, NODE_PARAMETERS)
         self._reader = Rebuild(self, self.parameters.read_topic, self._take_urdf)
-        self._draft = None  # the settings of a change accepted by _on_set, for _on_set_done
-        self._reported = Counter()  # the counts at the last diagnostics
-        self._command = None  # (time received [s, monotonic], torques)
-        self._command_stale = True
-        self._rng = np.random.default_rng()
+        self._draft = None  # the setup of a change accepted by _on_set, for _on_set_done
         self._stamp_offset = self.get_clock().now().nanoseconds - time.monotonic_ns()  # node clock - monotonic
         self.last_stamp = 0  # ns, node clock (lockstep: simulated time): of the last state published
         self.reset_stamp = 0  # ns, as last_stamp: states stamped later were stepped after the last reset
-        self._held_until = 0  # ns, on self._now(): the arm is held still until then
+        self._names, self._state_msg = (), JointState()
 
         depth = self.get_parameter("qos.depth").value
         period = 1.0 / self.get_parameter("rate").value
         self._state_pub = self.create_publisher(JointState, "joint_states", depth)
         commands_qos = QoSProfile(depth=depth, reliability=ReliabilityPolicy.BEST_EFFORT)
         self.create_subscription(Float64MultiArray, "effort_commands", self._on_command, commands_qos)
-        self.push = HeldWrench()
         self.create_subscription(WrenchStamped, "~/external_wrench", self._on_wrench, depth)
         self.create_service(Trigger, "~/reset", self._on_reset)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
@@ -98,15 +84,10 @@ class SimNode(Node):
         if self.get_parameter("lockstep").value:
             self.lockstep = LockstepClock(period)
             self._clock_pub = self.create_publisher(ClockMessage, "/clock", QoSProfile(depth=1))
-            self._clock_msg = ClockMessage()
-            self.create_timer(
-                self.get_parameter("lockstep_timeout").value / TICKS,
-                self._republish,
-                clock=Clock(clock_type=ClockType.STEADY_TIME),
-            )
+            steady = Clock(clock_type=ClockType.STEADY_TIME)
+            self.create_timer(self.get_parameter("lockstep_timeout").value / TICKS, self._republish, clock=steady)
         self.loop = RealTimeLoop(period, self._step, self._on_step_error)
-        self.schedule = self.loop.schedule
-        first = self.parameters.draft(build_settings, self.parameters.values())
+        first = self.parameters.draft(build_setup, self.parameters.values())
         if first is not None:
             self._use(first)
         self.add_on_set_parameters_callback(self._on_set)
@@ -117,11 +98,11 @@ class SimNode(Node):
     @property
     def model(self):
         """The model in force (None while waiting for a URDF)."""
-        return None if self.settings is None else self.settings.model
+        return None if self.simulation.arm is None else self.simulation.arm.model
 
     def _on_set(self, parameters) -> SetParametersResult:
         """A change is accepted only if the whole new configuration checks (the engine built)."""
-        result, self._draft = self.parameters.check_change(parameters, build_settings)
+        result, self._draft = self.parameters.check_change(parameters, build_setup)
         return result
 
     def _on_set_done(self, parameters) -> None:
@@ -135,7 +116,7 @@ class SimNode(Node):
 
     def _take_urdf(self, urdf) -> None:
         """The URDF read: checked whole (its engine built), swapped in, or refused."""
-        draft = self.parameters.take_urdf(urdf, build_settings)
+        draft = self.parameters.take_urdf(urdf, build_setup)
         if draft is not None:
             self._use(draft)
 
@@ -143,55 +124,35 @@ class SimNode(Node):
         self.loop.stop()
         return super().destroy_node()
 
-    def _use(self, settings: SimNodeSettings) -> None:
-        """Switch to new settings: a new model of the same joints continues from the current
-        state; other joints (a new URDF) start at initial_positions. The first starts the
-        loop (lockstep: publishes the first state)."""
-        names = list(settings.model.joint_names)
-        with self._lock:
-            first = self.arm is None
-            new_joints = first or names != list(self.arm.model.joint_names)
-            if new_joints or settings.model != self.arm.model:
-                if not new_joints:
-                    settings.engine.take_state_of(self.arm)
-                self.arm = settings.engine
-            self.settings = settings
-            if new_joints:
-                self._state_msg = JointState(name=names)
-                self._command = None
-                self.push.clear()
-                self._reset()
+    def _use(self, setup: Setup) -> None:
+        """Run on ``setup``; the first starts stepping (lockstep: publishes the first state)."""
+        first = self.simulation.setup is None
+        with self.simulation.lock:
+            if self.simulation.use(setup, self._now()):
+                self.reset_stamp = self.last_stamp
         if not first:
             return
-        mode = "lockstep: one step per command" if self.lockstep else "real time"
         if self.lockstep:
-            self._publish_lockstep()
+            self._publish_lockstep(self.simulation.measure())
         else:
             refused = self.loop.start(self.get_parameter("thread_priority").value)
             if refused:
                 self.get_logger().warning(f"thread_priority refused ({refused}): ordinary scheduling")
+        mode = "lockstep: one step per command" if self.lockstep else "real time"
         self.get_logger().info(
-            f"ready: {len(names)} joints {names}, {1.0 / self.schedule.period:g} Hz ({mode}), "
-            f"payload {settings.model.payload.mass} kg"
+            f"ready: {len(setup.joint_names)} joints {list(setup.joint_names)}, {1.0 / self.loop.schedule.period:g} Hz "
+            f"({mode}), payload {setup.engine.model.payload.mass} kg; on brakes until the first command"
         )
 
     def _now(self) -> int:
-        """ns: simulated time (of the state published last) in lockstep, else monotonic."""
-        return self.lockstep.stamp if self.lockstep else time.monotonic_ns()
+        """ns: simulated time (of the state published last) in lockstep, else the node's clock."""
+        return self.lockstep.stamp if self.lockstep else self._stamp_offset + time.monotonic_ns()
 
     def reset(self) -> bool:
-        """The arm back at initial_positions, at rest, held for reset_hold; False without a model."""
-        with self._lock:
-            if self.arm is None:
-                return False
-            self._reset()
-        return True
-
-    def _reset(self) -> None:
-        self.arm.reset(self.settings.initial_positions)
-        self.reset_stamp = self.last_stamp
-        self._held_until = self._now() + round(self.settings.reset_hold * 1e9)
-        self.counts["resets"] += 1
+        """The arm back at initial_positions, at rest, on brakes (see sim.simulation); False without a model."""
+        with self.simulation.lock:
+            self.reset_stamp = self.last_stamp
+            return self.simulation.reset(self._now())
 
     @guarded("reset", fallback=_reset_failed)
     def _on_reset(self, request, response):
@@ -199,118 +160,80 @@ class SimNode(Node):
         if not response.success:
             response.message = "no model yet: waiting for robot_description"
             return response
-        response.message = f"reset to {self.settings.initial_positions.tolist()} rad"
-        if self.lockstep:  # when the first step is taken (the arm held still until then), exactly
-            response.message += f"; held until {self._held_until * 1e-9:.9f} s of simulated time"
+        setup, held = self.simulation.setup, self.simulation.held_until * 1e-9
+        response.message = f"reset to {setup.initial_positions.tolist()} rad; on brakes until the next command"
+        if self.lockstep:  # the first step taken, exactly: a reference stamped so starts with it
+            response.message += f"; held until {held:.9f} s of simulated time"
         return response
 
     @guarded("effort_commands")
     def _on_command(self, msg: Float64MultiArray) -> None:
         """Real time: hold the command. Lockstep: apply it for one step, publish the state."""
         self.tally.add("effort_commands", "received")
-        arm = self.arm
+        arm = self.simulation.arm
         if arm is None:
             self.tally.add("effort_commands", "no_model_yet")
             return
         try:
-            tau = read_command(msg, arm.n)
+            tau = command_torques(msg.data, arm.n)
         except BadMessage as error:
             self.tally.drop("effort_commands", error)
             return
         if self.lockstep is None:
-            self._command = (time.monotonic(), tau)
-            self._command_stale = False
-            return
-        if not self.lockstep.accept(tau):
-            return
-        with self._lock:
-            self._advance(tau)
+            self.simulation.command(tau, self._now())
+        elif self.lockstep.accept(tau):
+            state = self.simulation.step(self.lockstep.stamp, tau)
             self.lockstep.step(tau)
-        self._publish_lockstep()
+            self._publish_lockstep(state)
 
     @guarded("external_wrench")
     def _on_wrench(self, msg: WrenchStamped) -> None:
-        """Hold the push from the next step on (see sim_node.push)."""
+        """Hold the push from the next step on (ros.messages.wrench reads it)."""
         self.tally.add("external_wrench", "received")
-        if self.arm is None:
+        if self.simulation.arm is None:
             self.tally.add("external_wrench", "no_model_yet")
             return
         try:
-            with self._lock:
-                self.push.receive(msg, chain_links(self.parameters), self._now())
+            self.simulation.push(*read_wrench(msg, chain_links(self.parameters)), self._now())
         except BadMessage as error:
             self.tally.drop("external_wrench", error)
 
-    def _held_command(self, now: float) -> np.ndarray:
-        """The last command while it is fresh, else zero torque."""
-        if self._command is None:
-            return np.zeros(self.arm.n)
-        received, tau = self._command
-        timeout = self.settings.command_timeout
-        if timeout > 0.0 and now - received > timeout:
-            if not self._command_stale:
-                self._command_stale = True
-                self.counts["command_timeouts"] += 1
-            return np.zeros(self.arm.n)
-        return tau
-
-    def _advance(self, tau: np.ndarray) -> None:
-        """One step under tau (under the lock), or none while held after a reset; a blow-up
-        (the engine resets the arm) is counted."""
-        arm = self.arm
-        if self._now() < self._held_until:
-            arm.applied = np.zeros(arm.n)
-            return
-        try:
-            arm.step(tau, *self.push.current(self._now(), self.settings.command_timeout))
-        except SimulationError as error:
-            self.counts["diverged"] += 1
-            self.tally.warn("simulation", str(error))
-
     def _step(self, k: int, t: float) -> None:
-        """Step k of the stepping thread (real time), due at t (monotonic): apply the held
-        command for one period, then publish the state."""
+        """Step k of the stepping thread (real time), due at t (monotonic): stepped, published."""
         if not self.context.ok():
             return
-        with self._lock:
-            self._advance(self._held_command(time.monotonic()))
-            self.last_stamp = self._stamp_offset + round(t * 1e9)  # node clock, ns
-            state = self._state()
-        self._publish_state(*state)
+        stamp = self._stamp_offset + round(t * 1e9)
+        with self.simulation.lock:
+            state = self.simulation.step(stamp)
+            self.last_stamp = stamp
+        self._publish_state(state, stamp)
 
-    def _state(self):
-        arm = self.arm
-        return arm.q, arm.qd, arm.applied, self._state_msg, self.settings, self.last_stamp
-
-    def _publish_state(self, q, qd, effort, msg, settings, stamp) -> None:
-        if settings.position_noise > 0.0:
-            q += self._rng.normal(0.0, settings.position_noise, len(q))
-        if settings.effort_noise > 0.0:
-            effort = effort + self._rng.normal(0.0, settings.effort_noise, len(q))
-        if not (np.isfinite(q).all() and np.isfinite(qd).all() and np.isfinite(effort).all()):
+    def _publish_state(self, state: Measured, stamp: int) -> None:
+        if not (np.isfinite(state.q).all() and np.isfinite(state.qd).all() and np.isfinite(state.effort).all()):
             self.tally.drop("joint_states", BadMessage("not_finite", "a state that is not finite was not published"))
             return
+        if state.joint_names is not self._names:
+            self._names, self._state_msg = state.joint_names, JointState(name=list(state.joint_names))
+        msg = self._state_msg
         msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp, 1_000_000_000)
-        msg.position, msg.velocity, msg.effort = q.tolist(), qd.tolist(), effort.tolist()
+        msg.position, msg.velocity, msg.effort = state.q.tolist(), state.qd.tolist(), state.effort.tolist()
         self._state_pub.publish(msg)
 
-    def _publish_lockstep(self) -> None:
+    def _publish_lockstep(self, state: Measured) -> None:
         """Lockstep: /clock, then the state, both at the current simulated time."""
         if not self.context.ok():  # shutting down (Ctrl-C): a command still came in
             return
-        with self._lock:
-            self.last_stamp = self.lockstep.stamp
-            state = self._state()
-        clock = self._clock_msg.clock
-        clock.sec, clock.nanosec = divmod(self.last_stamp, 1_000_000_000)
-        self._clock_pub.publish(self._clock_msg)
-        self._publish_state(*state)
+        self.last_stamp = stamp = self.lockstep.stamp
+        clock = ClockMessage()
+        clock.clock.sec, clock.clock.nanosec = divmod(stamp, 1_000_000_000)
+        self._clock_pub.publish(clock)
+        self._publish_state(state, stamp)
 
     @guarded("joint_states")
     def _republish(self) -> None:
         """Lockstep, no command for lockstep_timeout: the last state (and /clock) again."""
-        if self.arm is not None and self.lockstep.tick():
-            self._publish_lockstep()
+        if self.simulation.arm is not None and self.lockstep.tick():
+            self._publish_lockstep(self.simulation.measure())
 
     def _on_step_error(self, error: Exception) -> None:
         if self.context.ok():
@@ -318,38 +241,22 @@ class SimNode(Node):
 
     @guarded("diagnostics")
     def _publish_diagnostics(self) -> None:
-        """Step counts; WARN when steps ran late or were skipped, or commands were dropped."""
+        """The counts since startup; WARN with every problem of the last period (sim.simulation.problems)."""
+        counts, simulation = self.counts, self.simulation
+        for key, value in (self.lockstep or self.loop.schedule).counts().items():  # set, not added
+            counts[key] = value
+        recent, self._reported = counts - self._reported, counts.copy()
+        found = problems(recent) if simulation.arm is not None else ["waiting for the model (robot_description)"]
+        state = "no model" if simulation.arm is None else simulation.status(self._now())
         if self.lockstep:
-            self.counts["steps"], self.counts["republished"] = self.lockstep.steps, self.lockstep.republished
-            self.counts["duplicates_dropped"] = self.lockstep.duplicates
-        else:
-            self.counts["steps"], self.counts["late_steps"] = self.schedule.steps, self.schedule.late
-            self.counts["skipped_steps"] = self.schedule.skipped
-        if self.push.timed_out:
-            self.counts["external_wrench.timeouts"] = self.push.timed_out
-        recent = self.counts - self._reported
-        self._reported = self.counts.copy()
-        hardware_id = self.parameters.robot_name or self.get_fully_qualified_name()
-        status = DiagnosticStatus(name=f"{self.get_name()}: simulation", hardware_id=hardware_id)
-        steps = recent["steps"]
-        problems = [] if self.settings is not None else ["waiting for the model (robot_description)"]
-        if recent["late_steps"] > WARN_LATE_SHARE * steps or recent["skipped_steps"]:
-            problems.append(
-                f"cannot keep real time: {recent['late_steps']} of {steps} steps late, "
-                f"{recent['skipped_steps']} skipped in the last period"
-            )
-        dropped = sum(n for key, n in recent.items() if key.endswith((".dropped", ".errors")))
-        if dropped:
-            problems.append(f"{dropped} messages dropped or callbacks failed in the last period")
-        if recent["diverged"]:
-            problems.append("the simulation diverged and was reset")
-        if self.lockstep:
-            state = f"lockstep, {recent['republished']} states republished (no command)"
-        else:
-            state = "no command: zero torque" if self._command_stale else "command held"
-        status.level = DiagnosticStatus.WARN if problems else DiagnosticStatus.OK
-        status.message = "; ".join(problems) or f"{steps} steps in the last period; {state}"
-        status.values = [KeyValue(key=key, value=str(value)) for key, value in sorted(self.counts.items())]
+            state = f"lockstep, {recent['republished']} states republished (no command); {state}"
+        status = DiagnosticStatus(
+            name=f"{self.get_name()}: simulation",
+            hardware_id=self.parameters.robot_name or self.get_fully_qualified_name(),
+            level=DiagnosticStatus.WARN if found else DiagnosticStatus.OK,
+            message="; ".join(found) or f"{recent['steps']} steps in the last period; {state}",
+            values=[KeyValue(key=key, value=str(value)) for key, value in sorted(counts.items())],
+        )
         msg = DiagnosticArray(status=[status])
         msg.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(msg)

@@ -1,14 +1,12 @@
 """trajectory_check_node: will a JointTrajectory keep the arm's limits, and how fast could
 the same path go.
 
-Subscribes   ~/check_trajectory   trajectory_msgs/JointTrajectory: checked as
-                                  joint_trajectory_controller plays it (see
-                                  core.trajectories.check), reported on ~/trajectory_report
+Subscribes   ~/check_trajectory   trajectory_msgs/JointTrajectory: checked as ros2_control's
+                                  joint_trajectory_controller plays it, reported
              ~/retime             trajectory_msgs/JointTrajectory: re-timed time-optimally,
-                                  published on ~/retimed, its check on ~/trajectory_report
-             <watch_topic>        (parameter; e.g. /joint_trajectory_controller/joint_trajectory)
-                                  checked like ~/check_trajectory: a watch on what the
-                                  controller is sent
+                                  published on ~/retimed, its check reported
+             <watch_topic>        (e.g. /joint_trajectory_controller/joint_trajectory) checked
+                                  like ~/check_trajectory: a watch on what the controller is sent
              robot_description    std_msgs/String: the model, as in the other nodes
 Publishes    ~/trajectory_report  diagnostic_msgs/DiagnosticStatus: the duration, a KeyValue per
                                   joint and limit (peak, limit, use, when, which segment); OK,
@@ -23,9 +21,7 @@ model's payload (payload.*), friction and armature count.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
-from diagnostic_msgs.msg import DiagnosticStatus
+from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from std_msgs.msg import String
@@ -33,20 +29,8 @@ from trajectory_msgs.msg import JointTrajectory
 
 from irb140_dynamics.core import RobotModel
 from irb140_dynamics.core.errors import one_line
-from irb140_dynamics.core.trajectories import (
-    Limits,
-    TrajectoryError,
-    check_trajectory,
-    retime,
-    torque_limit_notes,
-    trajectory_limits,
-)
-from irb140_dynamics.nodes.trajectory_check_node.messages import (
-    error_status,
-    report_status,
-    trajectory_message,
-    trajectory_of,
-)
+from irb140_dynamics.core.trajectories import TrajectoryChecker, TrajectoryError
+from irb140_dynamics.ros.messages.joint_messages import trajectory_message, trajectory_of
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import Spec
@@ -56,79 +40,34 @@ from irb140_dynamics.ros.runtime.guard import Tally, guarded
 from irb140_dynamics.ros.runtime.rebuild import Rebuild
 from irb140_dynamics.ros.runtime.spin import run
 
-MAX_WARN_USE = 1e6  # %
-MIN_GRID, MAX_GRID = 10, 100_000
 NODE_PARAMETERS = [
-    Spec(
-        "watch_topic",
-        "",
-        "also check every JointTrajectory on this topic (e.g. /joint_trajectory_controller/joint_trajectory); "
-        "empty: none",
-        read_only=True,
-    ),
-    Spec("retime.grid", 1000, "grid steps over the path when re-timing, about", minimum=MIN_GRID, maximum=MAX_GRID),
-    Spec(
-        "diagnostics.warn_use",
-        90.0,
-        "a trajectory using more of a limit than this is a WARN",
-        "%",
-        minimum=0.0,
-        maximum=MAX_WARN_USE,
-    ),
+    Spec("watch_topic", "", "also check every JointTrajectory on this topic (the controller's); empty: none", "", True),
+    Spec("retime.grid", 1000, "grid steps over the path when re-timing, about", minimum=10, maximum=100_000),
+    Spec("diagnostics.warn_use", 90.0, "a trajectory using more of a limit than this is a WARN", "%", False, 0.0, 1e6),
 ]
 STARTUP_WAIT = 2.0  # s: at most this long for the torque limits before the node comes up
+WAITING = "no model yet: waiting for a URDF on the robot_description topic"
+LEVELS = {"ok": DiagnosticStatus.OK, "warn": DiagnosticStatus.WARN, "error": DiagnosticStatus.ERROR}
 
 
-@dataclass(frozen=True)
-class Draft:
-    model: RobotModel
-    grid: int
-    warn_use: float
-
-
-@dataclass(frozen=True)
-class TrajectoryCheckSettings:
-    model: RobotModel
-    grid: int
-    warn_use: float
-    limits: Limits
-    notes: tuple[str, ...]  # where the torque limits come from
-
-
-def check_settings(values: dict) -> Draft:
-    return Draft(RobotModel.from_params(values), values["retime.grid"], values["diagnostics.warn_use"])
-
-
-def finish_settings(draft: Draft, previous: TrajectoryCheckSettings | None) -> TrajectoryCheckSettings:
-    """The torque limits (derived off the executor when the params leave them at 0)."""
-    same = previous is not None and (previous.model.joints, previous.model.gravity) == (
-        draft.model.joints,
-        draft.model.gravity,
-    )
-    limits = previous.limits if same else trajectory_limits(draft.model)
-    return TrajectoryCheckSettings(
-        draft.model, draft.grid, draft.warn_use, limits, torque_limit_notes(draft.model, limits)
-    )
-
-
-def quick(draft: Draft, previous: TrajectoryCheckSettings | None) -> bool:
-    return previous is not None and (previous.model.joints, previous.model.gravity) == (
-        draft.model.joints,
-        draft.model.gravity,
-    )
+def draft(values: dict) -> tuple[RobotModel, int, float]:
+    """What a checker is built from (the model checked whole), its limits not derived yet."""
+    return RobotModel.from_params(values), values["retime.grid"], values["diagnostics.warn_use"]
 
 
 class TrajectoryCheckNode(Node):
+    """Trajectories in; a report each, and the re-timed ones, out."""
+
     def __init__(self, **kwargs):
         super().__init__("trajectory_check_node", **NODE_OPTIONS, **kwargs)
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
-        self.settings: TrajectoryCheckSettings | None = None  # None: not built yet, or waiting for a URDF
+        self.checker: TrajectoryChecker | None = None  # None: not built yet, or waiting for a URDF
         self.parameters = ArmParameters(self, NODE_PARAMETERS)
-        self.rebuild = Rebuild(self, finish_settings, self._use)
+        self.rebuild = Rebuild(self, lambda job, previous: TrajectoryChecker.of(*job, previous), self._use)
         self._reader = Rebuild(self, self.parameters.read_topic, self._take_urdf)
         self._draft = None  # the draft of a change accepted by _on_set, for _on_set_done
-        first = self.parameters.draft(check_settings, self.parameters.values())
+        first = self.parameters.draft(draft, self.parameters.values())
         if first is not None:
             self.rebuild.submit(first)
             self.rebuild.wait(STARTUP_WAIT)  # the torque limits, if quick; else they follow
@@ -148,103 +87,81 @@ class TrajectoryCheckNode(Node):
     @property
     def model(self) -> RobotModel | None:
         """The model in force (None while waiting for a URDF)."""
-        return None if self.settings is None else self.settings.model
+        return None if self.checker is None else self.checker.model
 
-    def _use(self, settings: TrajectoryCheckSettings) -> None:
-        self.settings = settings
+    def _use(self, checker: TrajectoryChecker) -> None:
+        self.checker = checker
 
     def _on_set(self, parameters) -> SetParametersResult:
         """A change is accepted only if the whole new configuration checks."""
-        result, self._draft = self.parameters.check_change(parameters, check_settings)
+        result, self._draft = self.parameters.check_change(parameters, draft)
         return result
 
     def _on_set_done(self, parameters) -> None:
         """The change accepted: in force at once when the torque limits stay, else derived
         off the executor meanwhile."""
-        draft, self._draft = self._draft, None
-        if draft is None:
-            return
-        if quick(draft, self.rebuild.previous):
-            self.rebuild.build_here(draft)
-        else:
-            self.rebuild.submit(draft)
+        job, previous, self._draft = self._draft, self.rebuild.previous, None
+        if job is not None and previous is not None and previous.keeps_limits(job[0]):
+            self.rebuild.build_here(job)
+        elif job is not None:
+            self.rebuild.submit(job)
 
     def _on_description(self, msg: String) -> None:
         """A new URDF: read off the executor, then checked (``_take_urdf``)."""
         self._reader.submit(msg.data)
 
     def _take_urdf(self, urdf) -> None:
-        draft = self.parameters.take_urdf(urdf, check_settings)
-        if draft is not None:
-            self.rebuild.submit(draft)
+        job = self.parameters.take_urdf(urdf, draft)
+        if job is not None:
+            self.rebuild.submit(job)
 
-    def _not_ready(self) -> str:
-        if self.rebuild.failure is not None:
-            return f"cannot check: {self.rebuild.status()}"
-        if self.rebuild.pending_since is not None:
-            return "not checked: the torque limits are being derived; send it again shortly"
-        return "no model yet: waiting for a URDF on the robot_description topic"
-
-    def _name(self, what: str) -> str:
-        return f"{self.get_name()}: {what}"
-
-    def _refuse(self, topic: str, what: str, reason: str) -> None:
-        """An ERROR report for a message that cannot be checked; counted, warned (throttled)."""
-        self.tally.add(topic, "refused")
-        self.tally.warn(topic, f"refused a {topic} message: {reason}")
-        self._report_pub.publish(error_status(reason, self._name(what), self.get_name()))
-
-    def _trajectory(self, topic: str, what: str, msg: JointTrajectory):
+    def _answer(self, topic: str, what: str, msg: JointTrajectory) -> None:
+        """Check (``what`` 'trajectory') or re-time ('retimed') the message and report it:
+        an ERROR report, counted and warned about, when it cannot be."""
         self.counts[f"{topic}.received"] += 1
-        settings = self.settings
-        if settings is None:
-            self._refuse(topic, what, self._not_ready())
-            return None, None
+        checker, name, notes = self.checker, f"{self.get_name()}: {what}", ()
         try:
-            return settings, trajectory_of(msg, settings.model.joint_names)
+            if checker is None:
+                raise TrajectoryError(f"not checked: {self.rebuild.status() or WAITING}")
+            tr = trajectory_of(msg, checker.model.joint_names)
+            if what == "retimed":
+                retimed, report = checker.retime(tr)
+                self._retimed_pub.publish(out := trajectory_message(retimed, msg.header.frame_id))
+                notes = (f"re-timed from {tr.duration:.6f} s, {len(out.points)} points",)
+            else:
+                report = checker.check(tr)
         except TrajectoryError as error:
-            self._refuse(topic, what, one_line(error))
-            return None, None
-
-    def _check(self, topic: str, msg: JointTrajectory) -> None:
-        settings, tr = self._trajectory(topic, "trajectory", msg)
-        if tr is None:
+            self.tally.add(topic, "refused")
+            self.tally.warn(topic, f"refused a {topic} message: {one_line(error)}")
+            self._report(name, "error", one_line(error))
             return
-        report = check_trajectory(settings.model, tr, settings.limits)
-        status = report_status(report, self._name("trajectory"), self.get_name(), settings.warn_use, settings.notes)
-        self._report_pub.publish(status)
+        self._report(name, checker.level(report), report.headline(), checker.figures(report, notes))
+
+    def _report(self, name: str, level: str, message: str, figures=()) -> None:
+        """A DiagnosticStatus of ``level`` ('ok', 'warn', 'error') with (key, value) ``figures``."""
+        values = [KeyValue(key=key, value=value) for key, value in figures]
+        hardware_id = self.get_name()
+        self._report_pub.publish(
+            DiagnosticStatus(level=LEVELS[level], name=name, hardware_id=hardware_id, message=message, values=values)
+        )
 
     @guarded("check_trajectory")
     def _on_check(self, msg: JointTrajectory) -> None:
-        self._check("check_trajectory", msg)
+        self._answer("check_trajectory", "trajectory", msg)
 
     @guarded("watch")
     def _on_watch(self, msg: JointTrajectory) -> None:
-        self._check("watch", msg)
+        self._answer("watch", "trajectory", msg)
 
     @guarded("retime")
     def _on_retime(self, msg: JointTrajectory) -> None:
-        settings, tr = self._trajectory("retime", "retimed", msg)
-        if tr is None:
-            return
-        try:
-            result = retime(settings.model, tr, settings.limits, grid=settings.grid)
-        except TrajectoryError as error:
-            self._refuse("retime", "retimed", one_line(error))
-            return
-        out = trajectory_message(result.trajectory, msg.header.frame_id)
-        self._retimed_pub.publish(out)
-        report = check_trajectory(settings.model, result.trajectory, settings.limits)
-        notes = (*settings.notes, f"re-timed from {tr.duration:.6f} s, {len(out.points)} points")
-        status = report_status(report, self._name("retimed"), self.get_name(), settings.warn_use, notes)
-        self._report_pub.publish(status)
+        self._answer("retime", "retimed", msg)
 
 
 def usage() -> Usage:
     """What ``trajectory_check_node --help`` prints: this module's docstring and every parameter."""
-    return Usage(
-        "trajectory_check_node", __doc__, [*model_sections(), ("trajectory_check_node's own", NODE_PARAMETERS)]
-    )
+    own = ("trajectory_check_node's own", NODE_PARAMETERS)
+    return Usage("trajectory_check_node", __doc__, [*model_sections(), own])
 
 
 def main(args=None):

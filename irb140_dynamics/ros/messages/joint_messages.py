@@ -5,10 +5,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from builtin_interfaces.msg import Duration
 from sensor_msgs.msg import JointState
-from trajectory_msgs.msg import JointTrajectory
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from irb140_dynamics.core.io.stamps import seconds
+from irb140_dynamics.core.io.stamps import sec_nanosec, seconds
 from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder, NotForThisModel
 
 __all__ = [
@@ -21,6 +22,8 @@ __all__ = [
     "read_effort",
     "read_joint_state",
     "read_trajectory",
+    "trajectory_message",
+    "trajectory_of",
 ]
 
 
@@ -103,6 +106,42 @@ def read_trajectory(msg: JointTrajectory, order: JointOrder):
         return Trajectory(np.array(times), np.array(Q), np.array(QD), np.array(QDD) if QDD else None)
     except ValueError as error:
         raise BadMessage("bad_trajectory", str(error)) from None
+
+
+def trajectory_of(msg: JointTrajectory, joint_names):
+    """The message as a core.trajectories.Trajectory (checked, per point, as the controller
+    takes it: core.trajectories.message), in the model's joint order; TrajectoryError
+    naming the point."""
+    from irb140_dynamics.core.trajectories.message import Trajectory
+
+    points = [
+        {
+            "positions": list(p.positions),
+            "velocities": list(p.velocities),
+            "accelerations": list(p.accelerations),
+            "time_from_start": {"sec": p.time_from_start.sec, "nanosec": p.time_from_start.nanosec},
+        }
+        for p in msg.points
+    ]
+    return Trajectory.from_message({"joint_names": list(msg.joint_names), "points": points}, joint_names)
+
+
+def trajectory_message(tr, frame_id: str = "") -> JointTrajectory:
+    """A core.trajectories.Trajectory as a message (velocities and accelerations on the
+    points that carry them): trajectory_of, the other way."""
+    msg = JointTrajectory(joint_names=list(tr.joint_names))
+    msg.header.frame_id = frame_id
+    for k in range(len(tr.t)):
+        sec, nanosec = sec_nanosec(tr.t[k])
+        msg.points.append(
+            JointTrajectoryPoint(
+                positions=tr.q[k].tolist(),
+                velocities=tr.qd[k].tolist() if tr.has_qd[k] else [],
+                accelerations=tr.qdd[k].tolist() if tr.has_qdd[k] else [],
+                time_from_start=Duration(sec=sec, nanosec=nanosec),
+            )
+        )
+    return msg
 
 
 def _index(names, n_positions: int, order: JointOrder) -> tuple[list[int], int]:
