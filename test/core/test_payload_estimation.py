@@ -12,11 +12,11 @@ from irb140_dynamics.core import Friction, RigidBody, gravity, irb140, rnea
 from irb140_dynamics.core.kinematics import flange_pose
 from irb140_dynamics.core.payload.mass_com_estimation import (
     EstimationError,
-    RestDetector,
     RestSample,
     estimate_payload,
     payload_columns,
 )
+from irb140_dynamics.core.payload.rest_samples import RestDetector
 
 from ..support.common import random_urdf_model
 
