@@ -22,6 +22,12 @@ MAX_HELD = 1000
 STEADY = Clock(clock_type=ClockType.STEADY_TIME)
 
 
+def reply(response, success: bool, message: str):
+    """A std_srvs/Trigger response, filled."""
+    response.success, response.message = success, message
+    return response
+
+
 class CheckService:
     """~/check of ``node``: ``answer(request, response)`` answers for the parameters in force;
     while ``pending()``, a request waits for ``settled()``."""
@@ -47,20 +53,18 @@ class CheckService:
     async def _on_request(self, request, response):
         try:
             if self._pending() and not await self._settled_in_time():
-                response.success, response.message = (
+                waited = f"waited {self._wait():.1f} s, check.wait_timeout"
+                return reply(
+                    response,
                     False,
-                    (
-                        f"UNPROVEN: the analysis of the new parameters is still running (waited {self._wait():.1f} s, "
-                        "check.wait_timeout): ask again later"
-                    ),
+                    f"UNPROVEN: the analysis of the new parameters is still running ({waited}): ask again later",
                 )
-                return response
             return self._answer(request, response)
         except Exception as error:  # noqa: BLE001  (the point: nothing escapes to the executor)
             self._node.tally.error("check", error)
-            response.success = False
-            response.message = f"UNPROVEN: not checked: internal error {type(error).__name__}: {one_line(error)}"
-            return response
+            return reply(
+                response, False, f"UNPROVEN: not checked: internal error {type(error).__name__}: {one_line(error)}"
+            )
 
     def _wait(self) -> float:
         return float(self._node.get_parameter("check.wait_timeout").value)

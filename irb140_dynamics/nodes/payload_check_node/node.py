@@ -16,14 +16,12 @@ Publishes    /diagnostics   diagnostic_msgs/DiagnosticArray: one status per join
                             payload and one for its estimate, after each check and every
                             diagnostics.period
 
-Torque limits: <joint>.torque_limit when > 0, else derived as in the report: the worst
-static torque of the rated payload over the joint ranges; none for a joint it cannot load.
-A joint state older than STALE_AFTER (node clock) is still used, and the check says so.
-The limits and the workspace analysis are computed off the executor after each accepted
-change (and at startup, up to STARTUP_WAIT before the node comes up), within
-check.analysis_timeout (what is not proven by then is UNPROVEN); a newer change cancels
-the analysis under way. Until they are done, ~/check waits for them, up to
-check.wait_timeout (see check_service).
+Torque limits: <joint>.torque_limit when > 0, else as in the report the rated payload's
+worst static torque over the joint ranges; none for a joint it cannot load. A joint state
+older than STALE_AFTER (node clock) is still used, and the check says so. Each accepted
+change (and the start, up to STARTUP_WAIT) is analysed off the executor, limits and
+workspace, within check.analysis_timeout (what is not proven by then is UNPROVEN); a newer
+change cancels it. ~/check waits for it, up to check.wait_timeout (see check_service).
 """
 
 from __future__ import annotations
@@ -36,18 +34,12 @@ from std_msgs.msg import String
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import gravity, rnea
+from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder, NotForThisModel
 from irb140_dynamics.core.payload import check_payload
-from irb140_dynamics.core.payload.mass_com_estimation import EstimationError
-from irb140_dynamics.core.payload.rest_samples import PayloadEstimator
-from irb140_dynamics.nodes.payload_check_node.check_service import CheckService
+from irb140_dynamics.core.payload.rest_samples import EstimationError, PayloadEstimator
+from irb140_dynamics.nodes.payload_check_node.check_service import CheckService, reply
 from irb140_dynamics.nodes.payload_check_node.settings import NODE_PARAMETERS, Settings, check_settings, finish_settings
-from irb140_dynamics.ros.messages.joint_messages import (
-    BadMessage,
-    JointOrder,
-    NotForThisModel,
-    finite_torques,
-    joint_state_of,
-)
+from irb140_dynamics.ros.messages.joint_messages import finite_torques, joint_state_of
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import joint_states_qos
@@ -63,14 +55,9 @@ STARTUP_WAIT = 2.0  # s: at most this long for the first analysis before the nod
 NO_MODEL = "no model yet: waiting for a URDF on the robot_description topic"
 
 
-def _answer(response, success: bool, message: str):
-    response.success, response.message = success, message
-    return response
-
-
 def _failed(what: str):
     """A guarded service's answer to an exception of ours."""
-    return lambda request, response, error: _answer(
+    return lambda request, response, error: reply(
         response, False, f"{what}: internal error {type(error).__name__}: {error}"
     )
 
@@ -227,10 +214,10 @@ class PayloadCheckNode(Node):
         """~/check's answer now (see check_service: it waits for the analysis first)."""
         why = self._not_ready()
         if why is not None:
-            return _answer(response, False, f"UNPROVEN: {why}")
+            return reply(response, False, f"UNPROVEN: {why}")
         result, stale = self.check()
         note = "\n(no joint_states received yet: checked over the workspace only)" if result.torque is None else ""
-        return _answer(response, result.ok, result.report() + note + ("" if stale is None else f"\nnote: {stale}"))
+        return reply(response, result.ok, result.report() + note + ("" if stale is None else f"\nnote: {stale}"))
 
     @guarded("estimate_payload", fallback=_failed("cannot estimate"))
     def _on_estimate(self, request, response):
@@ -240,21 +227,21 @@ class PayloadCheckNode(Node):
                 raise EstimationError(NO_MODEL)
             estimate, note = self.estimator.estimate(self.settings.model)
         except EstimationError as error:
-            return _answer(response, False, f"cannot estimate: {error}")
+            return reply(response, False, f"cannot estimate: {error}")
         message = estimate.summary() + ("" if note is None else f"\nnote: {note}")
         if not self.get_parameter("estimation.apply").value:
-            return _answer(response, True, message)
+            return reply(response, True, message)
         mass, com = float(estimate.mass), [float(x) for x in estimate.com]  # set as any change: checked whole
         applied = self.set_parameters_atomically(
             [Parameter("payload.mass", value=mass), Parameter("payload.com", value=com)]
         )
         if applied.successful:
-            return _answer(response, True, f"{message}\napplied: payload.mass and payload.com set")
-        return _answer(response, False, f"{message}\nnot applied: {applied.reason}")
+            return reply(response, True, f"{message}\napplied: payload.mass and payload.com set")
+        return reply(response, False, f"{message}\nnot applied: {applied.reason}")
 
     @guarded("clear_samples", fallback=_failed("not cleared"))
     def _on_clear(self, request, response):
-        return _answer(response, True, self.estimator.clear())
+        return reply(response, True, self.estimator.clear())
 
     def _estimate_status(self) -> DiagnosticStatus:
         message, figures = self.estimator.summary()

@@ -10,7 +10,6 @@ from irb140_dynamics.core.payload.analysis import PayloadAnalysis, analyse
 from irb140_dynamics.ros.parameters.specs import MAX_MASS, QOS_PARAMETERS, RELIABILITIES, Spec, check_choice
 
 MIN_PERIOD, MAX_PERIOD = 0.1, 3600.0  # s: diagnostics.period
-MIN_ANALYSIS, MAX_ANALYSIS = 0.1, 3600.0  # s: check.analysis_timeout
 NODE_PARAMETERS = [
     Spec(
         "rated_payload.mass", 6.0, "the rated payload the limits are derived from", "kg", minimum=0.0, maximum=MAX_MASS
@@ -29,17 +28,17 @@ NODE_PARAMETERS = [
     Spec(
         "check.analysis_timeout",
         20.0,
-        f"the analysis of new parameters (limits, workspace) stops after this long, {MIN_ANALYSIS:g} to "
-        f"{MAX_ANALYSIS:g}; what it has not proven by then ~/check answers UNPROVEN",
+        "the analysis of new parameters (limits, workspace) stops after this long; what it has not proven "
+        "by then ~/check answers UNPROVEN",
         "s",
         read_only=True,
-        minimum=MIN_ANALYSIS,
-        maximum=MAX_ANALYSIS,
+        minimum=0.1,
+        maximum=3600.0,
     ),
     Spec(
         "check.wait_timeout",
         30.0,
-        "~/check waits this long for the analysis of new parameters, 0 to 600; then it answers UNPROVEN (running)",
+        "~/check waits this long for the analysis of new parameters; then it answers UNPROVEN (still running)",
         "s",
         minimum=0.0,
         maximum=600.0,
