@@ -12,11 +12,11 @@ from irb140_dynamics.core import Friction, RigidBody, gravity, irb140, rnea
 from irb140_dynamics.core.kinematics import flange_pose
 from irb140_dynamics.core.payload.mass_com_estimation import (
     EstimationError,
-    RestDetector,
     RestSample,
     estimate_payload,
     payload_columns,
 )
+from irb140_dynamics.core.payload.rest_samples import NO_EFFORT_ADVICE, PayloadEstimator, RestDetector
 
 from ..support.common import random_urdf_model
 
@@ -203,3 +203,33 @@ def test_rest_detector_counts_the_poses_of_rests_without_effort():
     assert poses_without_effort() == [0.3, 0.4, 0.5]
     detector.clear()
     assert detector.samples == [] and detector.without_effort == []
+
+
+def test_estimator_takes_a_non_finite_effort_as_none_and_leaves_out_one_too_large():
+    estimator = PayloadEstimator(REST_VELOCITY, 0.1)
+    q, still = np.zeros(6), np.zeros(6)
+    for k in range(200):  # a rest whose efforts are not finite: a rest without effort
+        assert "not finite, taken as none" in estimator.take(k * 0.001, q, still, [np.nan] + [0.0] * 5)
+    assert "left out" in estimator.take(0.2, q, still, np.full(6, 1e200))  # nothing taken: the rest goes on
+    assert estimator.take(0.3, q, np.ones(6), None) is None  # moves on
+    assert len(estimator.detector.without_effort) == 1 and estimator.detector.samples == []
+    with pytest.raises(EstimationError) as refusal:
+        estimator.estimate(arm())
+    assert str(refusal.value) == "1 rest pose had no effort in joint_states: " + NO_EFFORT_ADVICE
+    assert estimator.summary() == ("0 rest samples", {"rest samples": "0"})
+
+
+def test_estimator_names_missing_efforts_first_then_estimates_and_forgets():
+    true, rng = arm().with_payload(PAYLOAD), np.random.default_rng(7)
+    estimator = PayloadEstimator(REST_VELOCITY, 0.1, friction=arm().friction)
+    clock = iter(np.arange(0.0, 100.0, 0.001))
+    for q in WRIST_POSES:
+        for qd in rest_velocities(rng, 200):
+            estimator.take(next(clock), q, qd, None if q is WRIST_POSES[0] else rnea(true, q, qd, np.zeros(6)))
+        estimator.take(next(clock), q, np.ones(6), None)  # moves on
+    estimate, note = estimator.estimate(arm())
+    assert estimate.mass == pytest.approx(PAYLOAD.mass, rel=1e-4) and note.startswith("1 rest pose had no effort")
+    message, figures = estimator.summary()
+    assert message == f"3 rest samples; last estimate: {estimate.summary()}"
+    assert figures["estimated mass [kg]"] == f"{estimate.mass:.3f}"
+    assert estimator.clear() == "forgot 3 rest samples and the last estimate" and estimator.last is None

@@ -152,13 +152,13 @@ def test_payload_check_drops_a_joint_state_without_finite_torques(payload_node):
     """Velocities 1e200: dropped as id_node drops it; the check keeps the state before."""
     node = payload_node
     node.joint_states.publish(joint_state(Q))
-    assert node.spin_until(lambda: node.node._state is not None)
+    assert node.spin_until(lambda: node.node.state is not None)
     node.joint_states.publish(joint_state(Q, [1e200] * 6))
     assert node.spin_until(lambda: node.node.counts["joint_states.dropped_non_finite_torques"] == 1)
     reply = check(node)
     assert reply.success, reply.message
     assert "nan" not in reply.message and reply.message.startswith("OK: ")
-    assert node.node._state[0] == Q
+    assert node.node.state.q == Q
 
 
 def test_payload_check_answers_an_internal_error_and_goes_on(payload_node, monkeypatch):

@@ -196,15 +196,20 @@ def test_fuzz_payload_check_node():
                 and core_torques(gravity, model, item.state[0]) is not None
             ):
                 state = item.state
-            assert (node._state is None) == (state is None)
+            assert (node.state is None) == (state is None)
             if state is not None:
-                assert (node._state[0], node._state[1]) == state
+                assert (node.state.q, node.state.qd) == state
             if k % 10 == 0:
                 result, _ = node.check()
                 settings = node.settings
                 q, qd = state if state is not None else (None, None)
                 expected = check_payload(
-                    settings.model, settings.model.payload, settings.limits, q, qd, workspace=settings.workspace
+                    settings.model,
+                    settings.model.payload,
+                    settings.analysis.limits,
+                    q,
+                    qd,
+                    workspace=settings.analysis.workspace,
                 )
                 assert result.report() == expected.report()
                 assert "nan" not in result.report()

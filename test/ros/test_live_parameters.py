@@ -13,11 +13,11 @@ from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import RigidBody, gravity, irb140
+from irb140_dynamics.core.payload import analysis as payload_analysis
 from irb140_dynamics.nodes.id_node import node as id_module
 from irb140_dynamics.nodes.id_node import settings as id_settings
 from irb140_dynamics.nodes.id_node.node import IdNode
 from irb140_dynamics.nodes.payload_check_node import node as payload_module
-from irb140_dynamics.nodes.payload_check_node import settings as payload_settings
 from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
 
 from ..support.ros_harness import TIMEOUT, running
@@ -119,8 +119,8 @@ def test_a_payload_or_gravity_change_compiles_nothing_and_keeps_or_derives_the_l
 
 @pytest.fixture
 def gated_payload_node(monkeypatch):
-    gate = Gate(payload_settings.workspace_load)
-    monkeypatch.setattr(payload_settings, "workspace_load", gate)
+    gate = Gate(payload_analysis.workspace_load)
+    monkeypatch.setattr(payload_analysis, "workspace_load", gate)
     overrides = [Parameter("diagnostics.period", value=0.0)]
     with running(PayloadCheckNode, parameter_overrides=overrides) as harness:
         harness.gate = gate
@@ -145,7 +145,7 @@ def test_check_right_after_a_change_waits_and_answers_for_the_new_parameters(gat
     client = node.parameter_client()  # meanwhile: the parameter services answer, joint states are taken
     assert node.call(lambda: client.get_parameters(["payload.mass"])).values[0].double_value == 7.0
     node.publisher(JointState, "joint_states").publish(JointState(name=NAMES, position=Q))
-    assert node.spin_until(lambda: node.node._state is not None)
+    assert node.spin_until(lambda: node.node.state is not None)
     assert not future.done(), future.result()
     node.gate.open()
     assert node.spin_until(future.done)
@@ -178,22 +178,22 @@ def test_check_wait_timeout_is_refused_outside_its_range(gated_payload_node, val
 
 def test_a_payload_change_reuses_the_limits_and_a_warn_use_change_the_analysis(gated_payload_node, monkeypatch):
     node = gated_payload_node
-    derived = Gate(payload_settings.derive_torque_limits)
-    monkeypatch.setattr(payload_settings, "derive_torque_limits", derived)
-    limits = node.node.settings.limits
+    derived = Gate(payload_analysis.derive_torque_limits)
+    monkeypatch.setattr(payload_analysis, "derive_torque_limits", derived)
+    limits = node.node.settings.analysis.limits
     assert [r.successful for r in node.set_parameters([Parameter("payload.mass", value=2.0)])] == [True]
-    assert derived.calls == 0 and node.node.settings.limits is limits
-    sweeps, workspace = node.gate.calls, node.node.settings.workspace
+    assert derived.calls == 0 and node.node.settings.analysis.limits is limits
+    sweeps, workspace = node.gate.calls, node.node.settings.analysis.workspace
     assert node.node.set_parameters([Parameter("diagnostics.warn_use", value=50.0)])[0].successful
     assert node.node.rebuild.pending_since is None  # in force at once: nothing to analyse
-    assert node.node.settings.warn_use == 50.0 and node.node.settings.workspace is workspace
+    assert node.node.settings.warn_use == 50.0 and node.node.settings.analysis.workspace is workspace
     assert node.gate.calls == sweeps
 
 
 def test_a_slow_first_analysis_does_not_hold_up_startup(monkeypatch):
-    gate = Gate(payload_settings.workspace_load)
+    gate = Gate(payload_analysis.workspace_load)
     gate.close()
-    monkeypatch.setattr(payload_settings, "workspace_load", gate)
+    monkeypatch.setattr(payload_analysis, "workspace_load", gate)
     monkeypatch.setattr(payload_module, "STARTUP_WAIT", 0.2)
     overrides = [Parameter("diagnostics.period", value=0.0)]
     with running(PayloadCheckNode, parameter_overrides=overrides) as harness:

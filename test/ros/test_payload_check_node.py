@@ -13,8 +13,8 @@ from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import RigidBody, irb140, rnea, workspace_load
+from irb140_dynamics.core.payload import analysis as analysis_module
 from irb140_dynamics.nodes.payload_check_node import node as module
-from irb140_dynamics.nodes.payload_check_node import settings as settings_module
 from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
 
 from ..support.ros_harness import running
@@ -58,9 +58,9 @@ def node(monkeypatch):
 
 
 def at_pose(harness, q, qd=()):
-    harness.node._state = None
+    harness.node.state = None
     harness.joint_states.publish(JointState(name=NAMES, position=list(q), velocity=list(qd)))
-    assert harness.spin_until(lambda: harness.node._state is not None)
+    assert harness.spin_until(lambda: harness.node.state is not None)
 
 
 def check(harness):
@@ -103,7 +103,7 @@ def test_max_payload_here_puts_the_limiting_joint_at_its_limit(node, com, q):
     rows = parse_report(check(node).message)
     mass, joint = rows["here"]
     j = NAMES.index(joint)
-    limit = node.node.settings.limits.values[j]
+    limit = node.node.settings.analysis.limits.values[j]
     tau = rnea(irb140(payload=RigidBody(mass, tuple(com))), q, np.zeros(6), np.zeros(6))
     assert abs(tau[j]) == pytest.approx(limit, rel=2e-3 / mass)  # the reply prints mass to 1 g
     exact = node.node.check()[0].max_payload_here.mass
@@ -225,7 +225,7 @@ def test_a_failure_of_the_analysis_is_reported_and_the_next_change_recovers(node
     def failing(*args, **kwargs):
         raise ValueError("payload.com: the sweep failed")
 
-    monkeypatch.setattr(settings_module, "workspace_load", failing)
+    monkeypatch.setattr(analysis_module, "workspace_load", failing)
     assert [r.successful for r in node.set_parameters([Parameter("payload.mass", value=2.0)])] == [True]
     assert node.node.settings is settings
     reply = check(node)
@@ -238,9 +238,9 @@ def test_a_failure_of_the_analysis_is_reported_and_the_next_change_recovers(node
         built.append(workspace_load(*args))
         return built[-1]
 
-    monkeypatch.setattr(settings_module, "workspace_load", sweep)
+    monkeypatch.setattr(analysis_module, "workspace_load", sweep)
     assert [r.successful for r in node.set_parameters([Parameter("payload.mass", value=3.0)])] == [True]
-    assert len(built) == 1 and node.node.settings.workspace is built[0]  # built once
+    assert len(built) == 1 and node.node.settings.analysis.workspace is built[0]  # built once
     assert node.node.settings.model.payload.mass == 3.0
     reply = check(node)
     assert reply.success and reply.message.startswith("OK: 3.000 kg fits, worst joint_"), reply.message

@@ -64,7 +64,7 @@ def test_an_analysis_out_of_time_answers_unproven():
     overrides = from_urdf(robot_description=chain_urdf(30), check__analysis_timeout=0.5, payload__mass=3.0)
     with running(PayloadCheckNode, parameter_overrides=overrides) as harness:
         reply = check(harness)
-        assert harness.node.settings.workspace.out_of_time
+        assert harness.node.settings.analysis.workspace.out_of_time
     first = reply.message.splitlines()[0]
     assert not reply.success and first.startswith("UNPROVEN: 3.000 kg not proven to fit: ")
     assert "the analysis ran out of time" in first

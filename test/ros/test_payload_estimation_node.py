@@ -9,7 +9,7 @@ from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import rnea
-from irb140_dynamics.nodes.payload_check_node import payload_estimator as estimation
+from irb140_dynamics.core.payload import rest_samples as estimation
 from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
 
 from ..core.test_payload_estimation import PAYLOAD, WRIST_POSES, arm, peak_torque, rest_velocities
@@ -66,13 +66,13 @@ def send(harness, q, qd, effort=None, through_topic=True):
     if effort is not None:
         msg.effort = list(map(float, effort))
     msg.header.stamp.sec, msg.header.stamp.nanosec = int(harness.t), int(round((harness.t % 1) * 1e9))
-    before = harness.node._state
+    before = harness.node.state
     if through_topic:
         harness.joint_states.publish(msg)
-        assert harness.spin_until(lambda: harness.node._state is not before)
+        assert harness.spin_until(lambda: harness.node.state is not before)
     else:
         harness.node._on_joint_state(msg)
-        assert harness.node._state is not before
+        assert harness.node.state is not before
 
 
 def rest_in(harness, poses, rng, with_effort=True, per_pose=FEW):

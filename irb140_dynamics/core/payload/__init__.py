@@ -5,7 +5,10 @@
 - ``check``: a payload against those limits, now and in its proven worst pose;
 - ``family``: a payload's torques as affine in its mass, and their proven extremes;
 - ``workspace``: the joint ranges and the sampled search for the worst pose;
+- ``analysis``: what a check runs on (the limits and the workspace's worst loads), reused
+  where a new arm or payload leaves them as they were;
 - ``mass_com_estimation``: the payload's mass and centre of mass from efforts at rest;
+- ``rest_samples``: the rests of a stream of joint states, and the estimate they give;
 - ``stop``: when a long analysis stops early (cancelled, or out of time);
 - ``proof/``: the rigorous bounds (harmonic sums, interval boxes, branch and bound).
 

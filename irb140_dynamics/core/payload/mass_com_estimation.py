@@ -7,20 +7,17 @@ part is linear in phi = [m, m c_x, m c_y, m c_z] (c in the flange frame):
 
 with J_v, J_w the flange Jacobian's rows, R the flange orientation and g the gravity
 vector, all in the base frame (g_arm: the model's own gravity torques, payload removed).
-"At rest" is slower than a rest velocity, where the model's tanh-smoothed Coulomb friction
-is far from zero: RestDetector takes the model's friction at each joint state's measured
-velocity off its efforts (nothing at qd = 0). Weighted least squares over the rest poses
-(each torque weighted by the inverse of its average's standard error, when the rest had
-several joint states) gives phi, its standard deviations from the residual, and the
-condition number of the (column-scaled) weighted Y.
+Weighted least squares over the rest poses (``rest_samples`` keeps them from a stream of
+joint states; each torque weighted by the inverse of its average's standard error, when
+the rest had several joint states) gives phi, its standard deviations from the residual,
+and the condition number of the (column-scaled) weighted Y.
 
 The payload's inertia does not show at rest: it is not estimated.
 
 Refusals (EstimationError, saying what to do): fewer than MIN_POSES poses; poses too
 similar to determine phi (condition number above MAX_CONDITION: the message says which
 line of the CoM is undetermined and which wrist motion would help); an implausible result
-(mass <= 0, or the CoM more than MAX_COM_DISTANCE from the flange). A rest without efforts
-is no sample: RestDetector counts its pose in ``without_effort``.
+(mass <= 0, or the CoM more than MAX_COM_DISTANCE from the flange).
 """
 
 from __future__ import annotations
@@ -32,7 +29,6 @@ import numpy as np
 
 from irb140_dynamics.core.dynamics import gravity
 from irb140_dynamics.core.kinematics import flange_jacobian, flange_pose
-from irb140_dynamics.core.model.friction import JointFriction
 from irb140_dynamics.core.model.rigid_body import RigidBody
 from irb140_dynamics.core.model.robot_model import RobotModel
 
@@ -158,98 +154,3 @@ def _advice(weak: np.ndarray, scale: np.ndarray) -> str:
     if abs(line[2]) > 0.9:
         return what + "tilt the wrist (joint 5) so that the flange z axis points in different directions"
     return what + "turn the flange about its axis (joint 6) and tilt the wrist (joint 5) between poses"
-
-
-class RestDetector:
-    """Averages joint states while every joint is slower than ``rest_velocity`` [rad/s]; a rest
-    of at least ``rest_time`` [s] becomes a sample, one per distinct pose (a pose within
-    ``same_pose`` [rad] of an earlier one replaces it).
-
-    ``friction`` (the model's JointFriction, or None): its torque at each joint state's
-    measured velocity is taken off that state's efforts before averaging. Inside the rest band
-    the tanh-smoothed Coulomb friction is not small (with the default smoothing velocity, 76 %
-    of its level at 0.01 rad/s, 96 % at 0.02); at qd = 0 it is exactly 0. A rest whose joint states carry no effort
-    is no sample; its pose is counted in ``without_effort`` (until a sample of it comes)."""
-
-    def __init__(
-        self,
-        rest_velocity: float,
-        rest_time: float,
-        same_pose: float = 1e-3,
-        max_samples: int = 100,
-        friction: JointFriction | None = None,
-    ):
-        self.rest_velocity, self.rest_time = rest_velocity, rest_time
-        self.same_pose, self.max_samples = same_pose, max_samples
-        self.friction = friction
-        self.samples: list[RestSample] = []
-        self.without_effort: list[np.ndarray] = []  # poses of rests without effort
-        self._restart()
-
-    def clear(self) -> None:
-        self.samples, self.without_effort = [], []
-        self._restart()
-
-    def _restart(self) -> None:
-        self._start = self._last = None  # times of the current rest's first and last joint states
-        self._sum_q = self._sum_effort = self._sum_squares = None
-        self._count = 0
-        self._has_effort = True  # of the current rest's joint states (a change ends the rest)
-
-    def update(self, t: float, q, qd, effort) -> bool:
-        """Take one joint state (effort may be None); True when a rest sample was added.
-        ValueError, nothing taken, for an effort too large to average (its square overflows)."""
-        q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
-        if effort is not None:
-            effort = np.asarray(effort, dtype=float)
-            with np.errstate(over="ignore", invalid="ignore"):
-                if not np.isfinite(effort * effort).all():
-                    raise ValueError(f"effort {effort.tolist()} N m: too large to average")
-        moving = np.max(np.abs(qd)) >= self.rest_velocity
-        added = False
-        if moving or (self._start is not None and self._has_effort != (effort is not None)):
-            added = self._close()
-            self._restart()
-        if moving:
-            return added
-        if self._start is None:
-            self._start, self._has_effort = t, effort is not None
-            self._sum_q, self._sum_effort, self._sum_squares = (np.zeros_like(q) for _ in range(3))
-        self._sum_q += q
-        if effort is not None:
-            if self.friction is not None:
-                effort = effort - self.friction.torques(qd)
-            self._sum_effort += effort
-            self._sum_squares += effort**2
-        self._count += 1
-        self._last = t
-        return added
-
-    def _close(self) -> bool:
-        if self._start is None or self._last - self._start < self.rest_time:
-            return False
-        n = self._count
-        q = self._sum_q / n
-        if not self._has_effort:
-            self.without_effort = self._others(self.without_effort, q, lambda p: p) + [q]
-            return False
-        mean = self._sum_effort / n
-        error = None
-        if n > 1:
-            variance = np.maximum(self._sum_squares / n - mean**2, 0.0) * n / (n - 1)
-            error = np.sqrt(variance / n)
-        self.samples = self._others(self.samples, q, lambda s: s.q) + [RestSample(q, mean, n, error)]
-        self.without_effort = self._others(self.without_effort, q, lambda p: p)
-        return True
-
-    def _others(self, kept: list, q: np.ndarray, pose_of) -> list:
-        """``kept`` without the entries of pose q, leaving room for one more (at most max_samples)."""
-        others = [x for x in kept if np.max(np.abs(pose_of(x) - q)) > self.same_pose]
-        return others[len(others) - self.max_samples + 1 :] if len(others) >= self.max_samples else others
-
-    def flush(self) -> bool:
-        """Close a rest still going on (e.g. before an estimate): True if it became a sample."""
-        added = self._close()
-        if added:
-            self._restart()
-        return added

@@ -1,5 +1,4 @@
-"""payload_check_node: can the arm hold this payload (``node``; ~/check waiting for the
-analysis of new parameters: ``check_service``); what is on the flange (``payload_estimator``)."""
+"""payload_check_node: can the arm hold this payload, and what is on the flange (``node``)."""
 
 from irb140_dynamics.entry import NODE, finish, start
 

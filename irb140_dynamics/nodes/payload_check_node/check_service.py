@@ -1,13 +1,10 @@
-"""~/check (std_srvs/Trigger): answered for the parameters in force, waiting for their analysis.
+"""~/check (std_srvs/Trigger), answered for the parameters in force once they are analysed.
 
-Right after an accepted change the limits and the workspace analysis of the new parameters
-run off the executor (see ros.runtime.rebuild). A request that comes meanwhile waits (its
-callback is a coroutine: the executor goes on serving joint_states, the parameter services
-and the timers) and is answered as soon as the analysis is in force or has failed, for the
-parameters then in force; or, after ``check.wait_timeout`` seconds (a one-shot timer on the
-steady clock), with ``UNPROVEN: the analysis of the new parameters is still running ...``.
-At most MAX_HELD requests wait at once. Coroutine callbacks need one of rclpy's own
-executors: the node spins on the SingleThreadedExecutor.
+An accepted change is analysed off the executor (ros.runtime.rebuild). A request that comes
+meanwhile waits, as a coroutine: the node's SingleThreadedExecutor goes on serving its other
+callbacks. It is answered once the analysis is in force or has failed, or after
+check.wait_timeout seconds (a one-shot timer on the steady clock) UNPROVEN, still running.
+At most MAX_HELD requests wait at once; more are answered as after the wait.
 """
 
 from __future__ import annotations
@@ -21,22 +18,25 @@ from std_srvs.srv import Trigger
 
 from irb140_dynamics.core.errors import one_line
 
-MAX_HELD = 1000  # requests waiting at once; more are answered at once, as after the wait
-WAIT_PARAMETER = "check.wait_timeout"
+MAX_HELD = 1000
 STEADY = Clock(clock_type=ClockType.STEADY_TIME)
 
 
-class CheckService:
-    """~/check of a node: ``answer(request, response)`` answers now (the parameters in force
-    analysed); ``pending()`` tells that an accepted change is still being analysed;
-    ``settled()`` (the node calls it) lets the waiting requests go."""
+def reply(response, success: bool, message: str):
+    """A std_srvs/Trigger response, filled."""
+    response.success, response.message = success, message
+    return response
 
-    def __init__(self, node, answer: Callable, pending: Callable[[], bool], name: str = "~/check"):
+
+class CheckService:
+    """~/check of ``node``: ``answer(request, response)`` answers for the parameters in force;
+    while ``pending()``, a request waits for ``settled()``."""
+
+    def __init__(self, node, answer: Callable, pending: Callable[[], bool]):
         self._node, self._answer, self._pending = node, answer, pending
         self._waiting: list[Future] = []
-        # reentrant: while a request waits, the node's other callbacks (in its default,
-        # mutually exclusive group) run, and so do other requests
-        node.create_service(Trigger, name, self._on_request, callback_group=ReentrantCallbackGroup())
+        # reentrant: while a request waits, the node's other callbacks and requests run
+        node.create_service(Trigger, "~/check", self._on_request, callback_group=ReentrantCallbackGroup())
 
     @property
     def held(self) -> int:
@@ -44,7 +44,7 @@ class CheckService:
         return len(self._waiting)
 
     def settled(self) -> None:
-        """The analysis in force (or failed): every waiting request is answered."""
+        """The analysis in force, or failed: every waiting request is answered."""
         waiting, self._waiting = self._waiting, []
         for done in waiting:
             if not done.done():
@@ -53,16 +53,21 @@ class CheckService:
     async def _on_request(self, request, response):
         try:
             if self._pending() and not await self._settled_in_time():
-                return _still_running(response, self._wait())
+                waited = f"waited {self._wait():.1f} s, check.wait_timeout"
+                return reply(
+                    response,
+                    False,
+                    f"UNPROVEN: the analysis of the new parameters is still running ({waited}): ask again later",
+                )
             return self._answer(request, response)
         except Exception as error:  # noqa: BLE001  (the point: nothing escapes to the executor)
             self._node.tally.error("check", error)
-            response.success = False
-            response.message = f"UNPROVEN: not checked: internal error {type(error).__name__}: {one_line(error)}"
-            return response
+            return reply(
+                response, False, f"UNPROVEN: not checked: internal error {type(error).__name__}: {one_line(error)}"
+            )
 
     def _wait(self) -> float:
-        return float(self._node.get_parameter(WAIT_PARAMETER).value)
+        return float(self._node.get_parameter("check.wait_timeout").value)
 
     async def _settled_in_time(self) -> bool:
         """Wait for the analysis, at most check.wait_timeout: True if it settled."""
@@ -78,12 +83,3 @@ class CheckService:
             self._node.destroy_timer(timer)
             if done in self._waiting:
                 self._waiting.remove(done)
-
-
-def _still_running(response, waited: float):
-    response.success = False
-    response.message = (
-        f"UNPROVEN: the analysis of the new parameters is still running (waited {waited:.1f} s, "
-        f"{WAIT_PARAMETER}): ask again later"
-    )
-    return response

@@ -6,63 +6,43 @@ Serves       ~/check        std_srvs/Trigger: the configured payload (payload.* 
                             over the joint ranges; success: it fits (proven); the reply's
                             message: a one-line verdict (OK, OVER-LIMIT or UNPROVEN), then
                             the report
-             ~/estimate_payload, ~/clear_samples   std_srvs/Trigger: payload estimation from the
-                            efforts at rest (see nodes/payload_check_node/payload_estimator.py)
+             ~/estimate_payload   std_srvs/Trigger: the payload's mass and centre of mass from
+                            the efforts at rest (see core.payload.rest_samples); with
+                            estimation.apply, set as payload.mass and payload.com
+             ~/clear_samples      std_srvs/Trigger: forget the rest samples and the last estimate
 Subscribes   joint_states   sensor_msgs/JointState (matched by joint name, as in id_node)
              robot_description  std_msgs/String: the model, as in id_node (see ros.parameters.arm)
-Publishes    /diagnostics   diagnostic_msgs/DiagnosticArray: one status per joint and one for
-                            the payload, after each check and every diagnostics.period
+Publishes    /diagnostics   diagnostic_msgs/DiagnosticArray: one status per joint, one for the
+                            payload and one for its estimate, after each check and every
+                            diagnostics.period
 
-Torque limits: <joint>.torque_limit when > 0, else derived as in the report: the worst
-static torque of the rated payload over the joint ranges; none for a joint it cannot load.
-A joint state older than STALE_AFTER (node clock) is still used, and the check says so.
-The limits and the workspace analysis are computed off the executor after each accepted
-change (and at startup, up to STARTUP_WAIT before the node comes up), within
-check.analysis_timeout (what is not proven by then is UNPROVEN); a newer change cancels
-the analysis under way. Until they are done, ~/check waits for them, up to
-check.wait_timeout (see check_service).
+Torque limits: <joint>.torque_limit when > 0, else as in the report the rated payload's
+worst static torque over the joint ranges; none for a joint it cannot load. A joint state
+older than STALE_AFTER (node clock) is still used, and the check says so. Each accepted
+change (and the start, up to STARTUP_WAIT) is analysed off the executor, limits and
+workspace, within check.analysis_timeout (what is not proven by then is UNPROVEN); a newer
+change cancels it. ~/check waits for it, up to check.wait_timeout (see check_service).
 """
 
 from __future__ import annotations
 
-import time
-
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from rcl_interfaces.msg import SetParametersResult
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
+from std_srvs.srv import Trigger
 
-from irb140_dynamics.core import RobotModel, gravity, rnea
-from irb140_dynamics.core.io.stamps import seconds
-from irb140_dynamics.core.payload import (
-    check_payload,
-)
-from irb140_dynamics.core.payload.mass_com_estimation import EstimationError
-from irb140_dynamics.nodes.payload_check_node.check_service import CheckService
-from irb140_dynamics.nodes.payload_check_node.payload_estimator import (
-    PayloadEstimator,
-)
-from irb140_dynamics.nodes.payload_check_node.settings import (
-    NODE_PARAMETERS,
-    PayloadCheckSettings,
-    analysed,
-    check_settings,
-    finish_settings,
-)
-from irb140_dynamics.ros.messages.joint_messages import (
-    BadMessage,
-    JointOrder,
-    NotForThisModel,
-    finite_torques,
-    read_effort,
-    read_joint_state,
-)
+from irb140_dynamics.core import gravity, rnea
+from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder, NotForThisModel
+from irb140_dynamics.core.payload import check_payload
+from irb140_dynamics.core.payload.rest_samples import EstimationError, PayloadEstimator
+from irb140_dynamics.nodes.payload_check_node.check_service import CheckService, reply
+from irb140_dynamics.nodes.payload_check_node.settings import NODE_PARAMETERS, Settings, check_settings, finish_settings
+from irb140_dynamics.ros.messages.joint_messages import finite_torques, joint_state_of
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
-from irb140_dynamics.ros.parameters.specs import (
-    joint_states_qos,
-)
+from irb140_dynamics.ros.parameters.specs import joint_states_qos
 from irb140_dynamics.ros.parameters.usage import model_sections
 from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.diagnostics import payload_statuses
@@ -72,23 +52,34 @@ from irb140_dynamics.ros.runtime.spin import run
 
 STALE_AFTER = 1.0  # s: a joint state older than this is reported as stale
 STARTUP_WAIT = 2.0  # s: at most this long for the first analysis before the node is ready
+NO_MODEL = "no model yet: waiting for a URDF on the robot_description topic"
+
+
+def _failed(what: str):
+    """A guarded service's answer to an exception of ours."""
+    return lambda request, response, error: reply(
+        response, False, f"{what}: internal error {type(error).__name__}: {error}"
+    )
 
 
 class PayloadCheckNode(Node):
+    """Joint states and parameters in; ~/check, the payload estimate and /diagnostics out."""
+
     def __init__(self, **kwargs):
         super().__init__("payload_check_node", **NODE_OPTIONS, **kwargs)
-        self.settings: PayloadCheckSettings | None = None  # None: waiting for the model (robot_description topic)
+        self.settings: Settings | None = None  # analysed; None: waiting for the model (robot_description topic)
+        self.state = self.received = None  # the latest good joint state (JointStateValue), when received
+        self._early = None  # (the latest joint state, received) before the first model
         self._started = False
-        self._state = None  # (q, qd, time received [node clock]) of the latest good joint state
-        self._early = None  # (the latest joint state, time received) before the first model
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
         self.parameters = ArmParameters(self, NODE_PARAMETERS)
-        self.estimator = PayloadEstimator(self, self._model)
+        get = self.get_parameter
+        self.estimator = PayloadEstimator(get("estimation.rest_velocity").value, get("estimation.rest_time").value)
         self.check_service = CheckService(self, self._on_check, lambda: self.rebuild.pending_since is not None)
         self.rebuild = Rebuild(self, finish_settings, self._use, settled=self.check_service.settled)
         self._reader = Rebuild(self, self.parameters.read_topic, self._take_urdf)
-        self._draft = None  # the draft of a change accepted by _on_set, for _on_set_done
+        self._draft = None  # the settings of a change accepted by _on_set, for _on_set_done
         first = self.parameters.draft(check_settings, self.parameters.values())
         if first is not None:
             self.rebuild.submit(first)
@@ -97,28 +88,26 @@ class PayloadCheckNode(Node):
         self.add_post_set_parameters_callback(self._on_set_done)
         if self.parameters.from_topic:
             self.create_subscription(String, "robot_description", self._on_description, DESCRIPTION_QOS)
-
         self.create_subscription(JointState, "joint_states", self._on_joint_state, joint_states_qos(self))
+        self.create_service(Trigger, "~/estimate_payload", self._on_estimate)
+        self.create_service(Trigger, "~/clear_samples", self._on_clear)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
-        period = self.get_parameter("diagnostics.period").value
-        if period > 0.0:
-            self.create_timer(period, self._on_timer)
+        if get("diagnostics.period").value > 0.0:
+            self.create_timer(get("diagnostics.period").value, self._on_timer)
         self._started = True
-        if self.settings is not None:
-            self._log_ready()
-        elif self.rebuild.pending_since is not None:
-            mass, com = self.get_parameter("payload.mass").value, list(self.get_parameter("payload.com").value)
-            self.get_logger().info(
-                f"ready: ~/check for a {mass} kg payload at {com} m "
-                "(its workspace analysis still running: ~/check waits for it)"
-            )
+        if self.settings is not None or self.rebuild.pending_since is not None:
+            self._log_ready(first.model.payload)
+
+    def _log_ready(self, payload) -> None:
+        running = "" if self.settings is not None else " (its workspace analysis still running: ~/check waits for it)"
+        self.get_logger().info(f"ready: ~/check for a {payload.mass} kg payload at {list(payload.com)} m{running}")
 
     @property
-    def model(self) -> RobotModel | None:
+    def model(self):
         """The model in force (None while waiting for a URDF)."""
         return None if self.settings is None else self.settings.model
 
-    def _on_set(self, parameters) -> SetParametersResult:
+    def _on_set(self, parameters):
         """A change is accepted only if the whole new configuration checks."""
         result, self._draft = self.parameters.check_change(parameters, check_settings)
         return result
@@ -127,62 +116,47 @@ class PayloadCheckNode(Node):
         """The change accepted: in force at once when nothing is to be analysed, else
         analysed off the executor (~/check waits for it)."""
         draft, self._draft = self._draft, None
-        if draft is None:
-            return
-        if analysed(draft, self.rebuild.previous):
+        if draft is not None and draft.same_analysis(self.rebuild.previous):
             self.rebuild.build_here(draft)
-        else:
+        elif draft is not None:
             self.rebuild.submit(draft)
 
     def _on_description(self, msg: String) -> None:
-        """A new URDF: read off the executor, then checked (``_take_urdf``)."""
+        """A new URDF: read off the executor, then checked whole (``_take_urdf``)."""
         self._reader.submit(msg.data)
 
     def _take_urdf(self, urdf) -> None:
-        """The URDF read: checked whole with the parameters in force, analysed off the
-        executor and swapped in, or refused keeping the model in use."""
+        """The URDF read: with the parameters in force analysed and swapped in, or refused."""
         draft = self.parameters.take_urdf(urdf, check_settings)
         if draft is not None:
             self.rebuild.submit(draft)
 
-    def _use(self, settings: PayloadCheckSettings) -> None:
-        """Switch to new settings (built, limits and workspace sweep included, when checked)."""
+    def _use(self, settings: Settings) -> None:
+        """Switch to new analysed settings; other joints forget the joint state and rest samples."""
         first, names = self.settings is None, settings.model.joint_names
         if first or names != self.settings.model.joint_names:
             self._order = JointOrder(names)
-            self._state = None
-            self.estimator.detector.clear()  # rest samples of other joints
+            self.state = None
+            self.estimator.detector.clear()
         self.settings = settings
-        problem = None if self._state is None else self._finite_problem(*self._state[:2])
-        if problem is not None:  # a held state the new model gives no finite torques for
-            self.tally.drop("joint_states", problem)
-            self._state = None
-        self.estimator.use(settings.rest_velocity, settings.rest_time, settings.model.friction)
+        self.estimator.configure(settings.rest_velocity, settings.rest_time, settings.model.friction)
+        if self.state is not None:  # held: the new model must give finite torques for it too
+            try:
+                self._check_finite(self.state)
+            except BadMessage as problem:
+                self.tally.drop("joint_states", problem)
+                self.state = None
         if first and self._early is not None:  # the latest joint state before the first model
             early, self._early = self._early, None
             self._take(*early)
         if first and self._started:  # the model came after startup
-            self._log_ready()
+            self._log_ready(settings.model.payload)
 
-    def _log_ready(self) -> None:
-        payload = self.settings.model.payload
-        self.get_logger().info(f"ready: ~/check for a {payload.mass} kg payload at {list(payload.com)} m")
-
-    def _model(self) -> RobotModel:
-        """The model in force, for the payload estimate."""
-        if self.settings is None:
-            raise EstimationError("no model yet: waiting for a URDF on the robot_description topic")
-        return self.settings.model
-
-    def _finite_problem(self, q, qd) -> BadMessage | None:
-        """Why the model in force gives no finite torques at (q, qd), qdd = 0 (as id_node), or None."""
+    def _check_finite(self, state) -> None:
+        """BadMessage unless the model gives finite torques at the state, qdd = 0 (as id_node)."""
         model = self.settings.model
-        try:
-            finite_torques(rnea, model, q, qd, [0.0] * model.n)
-            finite_torques(gravity, model, q)
-        except BadMessage as error:
-            return error
-        return None
+        finite_torques(rnea, model, state.q, state.qd, [0.0] * model.n)
+        finite_torques(gravity, model, state.q)
 
     @guarded("joint_states")
     def _on_joint_state(self, msg: JointState) -> None:
@@ -193,78 +167,87 @@ class PayloadCheckNode(Node):
             return
         self._take(msg, self.get_clock().now())
 
-    def _take(self, msg: JointState, now) -> None:
-        """A joint state received at ``now`` (node clock): the state checks use, and the
+    def _take(self, msg: JointState, received) -> None:
+        """A joint state received at ``received`` (node clock): the state checks use, and the
         payload estimate's sample; a bad one dropped, counted and warned about."""
         try:
-            q, qd = read_joint_state(msg, self._order)
+            state = joint_state_of(msg, self._order)
+            self._check_finite(state)
         except NotForThisModel:
             self.counts["joint_states.ignored"] += 1
             return
         except BadMessage as error:
             self.tally.drop("joint_states", error)
             return
-        problem = self._finite_problem(q, qd)
-        if problem is not None:
-            self.tally.drop("joint_states", problem)
-            return
-        self._state = (q, qd, now)
-        try:
-            effort = read_effort(msg, self._order)
-        except BadMessage as error:
-            self.counts[f"estimation.{error.kind}"] += 1
-            self.tally.warn("estimation", f"no effort of a joint state for the payload estimate ({error})")
-            effort = None
-        stamp = msg.header.stamp
-        t = seconds(stamp.sec, stamp.nanosec)
-        try:
-            self.estimator.update(t if t != 0.0 else now.nanoseconds * 1e-9, q, qd, effort)
-        except ValueError as error:  # an absurd effort: not averaged
-            self.counts["estimation.effort_too_large"] += 1
-            self.tally.warn("estimation", f"a joint state left out of the payload estimate ({error})")
+        self.state, self.received = state, received
+        left_out = self.estimator.take(state.stamp or received.nanoseconds * 1e-9, state.q, state.qd, state.effort)
+        if left_out is not None:
+            self.tally.add("estimation", "effort_left_out")
+            self.tally.warn("estimation", f"payload estimate: {left_out}")
 
     def check(self):
-        """Check the payload (at the latest state, if any) and publish /diagnostics:
-        (the PayloadCheck, how old the state is in words if older than STALE_AFTER, else None);
-        (None, None) while there is no model."""
-        settings, state = self.settings, self._state
+        """The check at the latest joint state, if any, published on /diagnostics: (the
+        PayloadCheck, the state's age in words if older than STALE_AFTER, else None); (None,
+        None) without a model."""
+        settings, state = self.settings, self.state
         if settings is None:
             return None, None
-        q, qd, received = state if state is not None else (None, None, None)
+        q, qd = (None, None) if state is None else (state.q, state.qd)
+        analysis = settings.analysis
         result = check_payload(
-            settings.model, settings.model.payload, settings.limits, q, qd, workspace=settings.workspace
+            settings.model, settings.model.payload, analysis.limits, q, qd, workspace=analysis.workspace
         )
-        stale = None if received is None else self._stale(received)
-        statuses = payload_statuses(result, self.get_name(), settings.warn_use, stale)
-        self._publish(statuses + [self.estimator.status(self.get_name())])
+        age = None if state is None else (self.get_clock().now() - self.received).nanoseconds * 1e-9
+        stale = f"joint_states received {age:.1f} s ago" if age is not None and age > STALE_AFTER else None
+        self._publish(payload_statuses(result, self.get_name(), settings.warn_use, stale) + [self._estimate_status()])
         return result, stale
 
     def _not_ready(self) -> str | None:
-        """None when the parameters in force have been analysed; else why not (yet), for
-        /diagnostics and ~/check (which first waits while an analysis is pending)."""
-        status = self.rebuild.status()
-        if status is None and self.settings is not None:
-            return None
+        """None when the parameters in force are analysed; else why not (yet)."""
         if self.rebuild.failure is not None:
-            return f"cannot check: {status}"
-        since = self.rebuild.pending_since
-        if since is None:
-            return "no model yet: waiting for a URDF on the robot_description topic"
-        return (
-            f"pending: the limits and workspace analysis of the new parameters are running "
-            f"(for {time.monotonic() - since:.1f} s); ~/check waits for them"
+            return f"cannot check: {self.rebuild.status()}"
+        if self.rebuild.pending_since is not None:
+            return f"pending: {self.rebuild.status()} (the limits and workspace analysis); ~/check waits for it"
+        return NO_MODEL if self.settings is None else None
+
+    def _on_check(self, request, response):
+        """~/check's answer now (see check_service: it waits for the analysis first)."""
+        why = self._not_ready()
+        if why is not None:
+            return reply(response, False, f"UNPROVEN: {why}")
+        result, stale = self.check()
+        note = "\n(no joint_states received yet: checked over the workspace only)" if result.torque is None else ""
+        return reply(response, result.ok, result.report() + note + ("" if stale is None else f"\nnote: {stale}"))
+
+    @guarded("estimate_payload", fallback=_failed("cannot estimate"))
+    def _on_estimate(self, request, response):
+        """The payload from the rests so far; with estimation.apply, set as the parameters."""
+        try:
+            if self.settings is None:
+                raise EstimationError(NO_MODEL)
+            estimate, note = self.estimator.estimate(self.settings.model)
+        except EstimationError as error:
+            return reply(response, False, f"cannot estimate: {error}")
+        message = estimate.summary() + ("" if note is None else f"\nnote: {note}")
+        if not self.get_parameter("estimation.apply").value:
+            return reply(response, True, message)
+        mass, com = float(estimate.mass), [float(x) for x in estimate.com]  # set as any change: checked whole
+        applied = self.set_parameters_atomically(
+            [Parameter("payload.mass", value=mass), Parameter("payload.com", value=com)]
         )
+        if applied.successful:
+            return reply(response, True, f"{message}\napplied: payload.mass and payload.com set")
+        return reply(response, False, f"{message}\nnot applied: {applied.reason}")
 
-    def _publish(self, statuses) -> None:
-        for status in statuses:  # the robot's name (model.name, or the URDF's), as rqt_robot_monitor groups them
-            status.hardware_id = self.parameters.robot_name or status.hardware_id
-        diagnostics = DiagnosticArray(status=statuses)
-        diagnostics.header.stamp = self.get_clock().now().to_msg()
-        self._diagnostics_pub.publish(diagnostics)
+    @guarded("clear_samples", fallback=_failed("not cleared"))
+    def _on_clear(self, request, response):
+        return reply(response, True, self.estimator.clear())
 
-    def _stale(self, received) -> str | None:
-        age = (self.get_clock().now() - received).nanoseconds * 1e-9
-        return f"joint_states received {age:.1f} s ago" if age > STALE_AFTER else None
+    def _estimate_status(self) -> DiagnosticStatus:
+        message, figures = self.estimator.summary()
+        values = [KeyValue(key=key, value=value) for key, value in figures.items()]
+        name = self.get_name()
+        return DiagnosticStatus(name=f"{name}: payload estimation", hardware_id=name, message=message, values=values)
 
     @guarded("diagnostics")
     def _on_timer(self) -> None:
@@ -276,20 +259,12 @@ class PayloadCheckNode(Node):
         name = self.get_name()
         self._publish([DiagnosticStatus(level=level, name=f"{name}: payload", hardware_id=name, message=why)])
 
-    def _on_check(self, request, response):
-        """~/check's answer now (see check_service: it waits for the analysis first)."""
-        why = self._not_ready()
-        if why is not None:
-            response.success, response.message = False, f"UNPROVEN: {why}"
-            return response
-        result, stale = self.check()
-        response.success = result.ok
-        response.message = result.report()
-        if result.torque is None:
-            response.message += "\n(no joint_states received yet: checked over the workspace only)"
-        elif stale is not None:
-            response.message += f"\nnote: {stale}"
-        return response
+    def _publish(self, statuses) -> None:
+        for status in statuses:  # the robot's name (model.name, or the URDF's), as rqt_robot_monitor groups them
+            status.hardware_id = self.parameters.robot_name or status.hardware_id
+        diagnostics = DiagnosticArray(status=statuses)
+        diagnostics.header.stamp = self.get_clock().now().to_msg()
+        self._diagnostics_pub.publish(diagnostics)
 
 
 def usage() -> Usage:

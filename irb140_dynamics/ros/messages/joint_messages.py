@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from builtin_interfaces.msg import Duration
@@ -15,9 +16,11 @@ from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder, NotFo
 __all__ = [
     "BadMessage",
     "JointOrder",
+    "JointStateValue",
     "NotForThisModel",
     "core_result",
     "finite_torques",
+    "joint_state_of",
     "publish_efforts",
     "read_effort",
     "read_joint_state",
@@ -72,6 +75,27 @@ def read_joint_state(msg: JointState, order: JointOrder) -> tuple[list[float], l
     if len(msg.effort) not in (0, length):
         raise BadMessage("length_mismatch", f"effort has {len(msg.effort)} values for {length} joints")
     return q, qd
+
+
+class JointStateValue(NamedTuple):
+    """A joint state in the model's joint order: ``stamp`` [s] (0.0: unstamped), q [rad], qd
+    [rad/s] (zeros when the message has none), effort [N m] (None when it has none; as given,
+    finite or not: what uses it judges)."""
+
+    stamp: float
+    q: list[float]
+    qd: list[float]
+    effort: list[float] | None
+
+
+def joint_state_of(msg: JointState, order: JointOrder) -> JointStateValue:
+    """The message read once (see read_joint_state: BadMessage, NotForThisModel)."""
+    q, qd = read_joint_state(msg, order)
+    effort = None
+    if len(msg.effort):
+        index, _ = _index(msg.name, len(msg.position), order)
+        effort = [float(msg.effort[i]) for i in index]
+    return JointStateValue(seconds(msg.header.stamp.sec, msg.header.stamp.nanosec), q, qd, effort)
 
 
 def read_effort(msg: JointState, order: JointOrder) -> list[float] | None:
