@@ -44,6 +44,14 @@ def moments(seed: int, longest: float, count: int = 12) -> list:
     return spread(cases, 3, key=lambda case: case.values[0])
 
 
+def stop_codes(signals) -> set[int]:
+    """The exit statuses a run stopped by ``signals`` may end with: 128 + the first signal
+    taken. Signals sent 10 ms apart to a process that was not scheduled meanwhile are
+    pending together, and Python takes pending signals in the order of their numbers, not
+    of their sending: any of them may be the first taken."""
+    return {128 + s for s in signals}
+
+
 def interrupted(command, folder, delay, signals):
     environment = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONUNBUFFERED": "1"}
     process = subprocess.Popen(
@@ -94,7 +102,7 @@ def test_identify_interrupted_at_any_moment(recording, tmp_path, delay, signals)
             "run.csv",
         ], left
         return
-    assert code == 128 + signals[0], output
+    assert code in stop_codes(signals), output
     assert output.count("identify: interrupted") == 1 and "error" not in output, output
     assert left == ["out", "run.csv"], left
 
@@ -119,7 +127,7 @@ def test_excitation_interrupted_at_any_moment(tmp_path, delay, signals):
     if code == 0:
         assert left == ["excitation.yaml"] and "wrote excitation.yaml" in output, output
         return
-    assert code == 128 + signals[0] and output.count("excitation: interrupted") == 1, output
+    assert code in stop_codes(signals) and output.count("excitation: interrupted") == 1, output
     assert left == [], left
 
 
@@ -133,5 +141,5 @@ def test_export_urdf_interrupted_at_any_moment(tmp_path, delay, signals):
     if code == 0:
         assert left == ["arm.urdf"] and "wrote arm.urdf" in output, output
         return
-    assert code == 128 + signals[0] and output.count("export_urdf: interrupted") == 1, output
+    assert code in stop_codes(signals) and output.count("export_urdf: interrupted") == 1, output
     assert left == [], left

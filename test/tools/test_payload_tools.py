@@ -90,7 +90,7 @@ def test_retime_and_the_trajectory_check_use_the_identified_inertia(workflow, id
     """`retime --check-only --params-file LOAD.yaml` prints the torques of the identified
     payload, inertia included (not those of the same mass and CoM without it), and the
     trajectory check node's settings take the file's payload whole."""
-    from irb140_dynamics.nodes.trajectory_check_node.node import check_settings
+    from irb140_dynamics.nodes.trajectory_check_node.node import draft
 
     _, motion, _, _, load = workflow
     trajectory = Trajectory.from_message(yaml.safe_load(motion.read_text()), identified.joint_names)
@@ -104,7 +104,7 @@ def test_retime_and_the_trajectory_check_use_the_identified_inertia(workflow, id
     assert all(peak.line() in printed for peak in torques), printed
     assert not all(peak.line() in printed for peak in without)
     values = {**read_parameter_file(load), "retime.grid": 1000, "diagnostics.warn_use": 80.0}
-    assert check_settings(values).model.payload == identified.payload  # the node reads payload.inertia
+    assert draft(values)[0].payload == identified.payload  # the node reads payload.inertia
 
 
 def test_a_bag_gives_the_same_payload_and_a_previous_payload_in_the_arm_file_is_replaced(
