@@ -1,4 +1,5 @@
-"""Joint trajectories: reference motions and computed-torque control (``reference``); a
+"""Joint trajectories: reference motions and computed-torque control (``reference``), the
+torques of a stream of measured states following one in time (``tracking``); a
 JointTrajectory checked against the model's limits and re-timed time-optimally.
 
 ``message``: a JointTrajectory as the core sees it (times, positions and, per point, optional
@@ -10,7 +11,8 @@ torque (RNEA with friction, armature and payload), velocity and acceleration aga
 limits. ``retiming``: the time-optimal timing of the same path (``path``: the grid over it;
 ``topp``: reachability analysis).
 
-May import: ``core.model``, the verbs in ``core.dynamics``, ``core.payload`` (limits). No ROS.
+May import: ``core.model``, the verbs in ``core.dynamics``, ``core.payload`` (limits), ``core.monitoring``
+(the observer's terms, the velocity filter). No ROS.
 """
 
 from .check import JointPeak, TrajectoryReport, check_trajectory
