@@ -29,7 +29,7 @@ from typing import NamedTuple
 import numpy as np
 
 from irb140_dynamics.core.dynamics import gravity, rnea
-from irb140_dynamics.core.model.joint_order import BadMessage
+from irb140_dynamics.core.model.joint_order import BadMessage, core_result, finite_torques
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.monitoring.filters import VelocityDifferentiator
 from irb140_dynamics.core.monitoring.observer import monitor_terms
@@ -37,25 +37,6 @@ from irb140_dynamics.core.trajectories.reference import Trajectory, computed_tor
 
 ACCELERATION_MODES = ("zero", "differentiate")
 EFFORT_SOURCES = ("feedforward", "gravity", "computed_torque")
-
-
-def core_result(function, model, *state):
-    """``function(model, *state)``; the core's refusal (ValueError: a state too large for
-    the model, the torques not finite) as BadMessage non_finite_torques."""
-    try:
-        return function(model, *state)
-    except ValueError as error:
-        raise BadMessage("non_finite_torques", str(error)) from None
-
-
-def finite_torques(function, model, *state):
-    """``function(model, *state)`` (rnea, gravity) when all its torques are finite, else
-    BadMessage non_finite_torques (an absurd but finite state can overflow the model's sums)."""
-    tau = core_result(function, model, *state)
-    values = tau.tolist() if type(tau) is np.ndarray else tau  # a sum of floats: a fraction of NumPy's
-    if not (math.isfinite(sum(values)) or all(map(math.isfinite, values))):
-        raise BadMessage("non_finite_torques", f"the model gives {[float(x) for x in tau]}")
-    return tau
 
 
 @dataclass(frozen=True, eq=False)

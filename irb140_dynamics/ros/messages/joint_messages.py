@@ -11,8 +11,7 @@ from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
 
 from irb140_dynamics.core.io.stamps import seconds
-from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder, NotForThisModel
-from irb140_dynamics.core.trajectories.tracking import core_result, finite_torques
+from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder, NotForThisModel, core_result, finite_torques
 from irb140_dynamics.ros.messages.joint_state_cdr import read_joint_state_cdr
 
 __all__ = [
