@@ -40,7 +40,7 @@ from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 from irb140_dynamics.core import irb140, load_model
 from irb140_dynamics.core.trajectories.reference import computed_torque
 from irb140_dynamics.nodes.demo_node.node import reference_message
-from irb140_dynamics.nodes.id_node.tracking import DEFAULT_KD, DEFAULT_KP
+from irb140_dynamics.nodes.id_node.settings import DEFAULT_KD, DEFAULT_KP
 from irb140_dynamics.ros.messages.joint_messages import JointOrder, read_trajectory
 
 from ..support.node_process import TIMEOUT, interrupt, module_command, run_to_exit, start, wait_for_line

@@ -74,7 +74,7 @@ def test_a_huge_finite_acceleration_still_gives_the_core_torques(differentiating
     publish_and_count(node, joint_state(Q, [0.0] * 6, sec=1, nanosec=0), "torques.published")
     publish_and_count(node, joint_state(Q, [1e10] * 6, sec=1, nanosec=1), "torques.published", 2)
     assert node.spin_until(lambda: len(node.feedforward) == 2)
-    qdd = node.node._differentiator.qdd
+    qdd = node.node.stream.differentiator.qdd
     assert all(map(math.isfinite, qdd)) and max(qdd) > 1e10
     np.testing.assert_allclose(node.feedforward[-1].effort, rnea(irb140(), Q, [1e10] * 6, qdd), rtol=1e-12)
 
@@ -93,7 +93,7 @@ def test_an_absurd_reference_is_refused_on_arrival_and_counted_as_a_reference(id
     node = id_node
     node.reference.publish(reference(Q, [1e200] * 6))
     assert node.spin_until(lambda: node.node.counts["reference.dropped_non_finite_torques"] == 1)
-    assert node.node.tracker.trajectory is None
+    assert node.node.stream.tracker.trajectory is None
     # the joint states are unaffected: gravity and feed-forward torques at the measured state
     publish_and_count(node, joint_state(Q), "torques.published")
     assert node.spin_until(lambda: node.feedforward and node.gravity)
@@ -107,7 +107,7 @@ def test_a_held_reference_the_new_model_cannot_take_is_let_go(id_node):
     qd = [0.0, 0.0, 0.0, 0.0, 0.0, 3e153]
     assert math.isfinite(max(abs(rnea(irb140(), Q, qd, np.zeros(6)))))
     node.reference.publish(reference(Q, qd))
-    assert node.spin_until(lambda: node.node.tracker.trajectory is not None)
+    assert node.spin_until(lambda: node.node.stream.tracker.trajectory is not None)
     heavy = RigidBody(1e6, (0.5, 0.5, 0.5), (1e6, 1e6, 1e6, 0.0, 0.0, 0.0))
     with pytest.raises(ValueError, match="not finite"):  # the core refuses such torques
         rnea(irb140(payload=heavy), Q, qd, np.zeros(6))
@@ -117,7 +117,7 @@ def test_a_held_reference_the_new_model_cannot_take_is_let_go(id_node):
         Parameter("payload.inertia", value=list(heavy.inertia)),
     ]
     assert node.set_parameters_atomically(changes).successful
-    assert node.node.tracker.trajectory is None
+    assert node.node.stream.tracker.trajectory is None
     assert node.node.counts["reference.dropped_non_finite_torques"] == 1
 
 
@@ -127,7 +127,7 @@ def test_an_exception_of_ours_in_a_callback_is_counted_and_the_node_goes_on(id_n
     def broken(*args):
         raise RuntimeError("a defect")
 
-    monkeypatch.setattr(id_module, "read_joint_state", broken)
+    monkeypatch.setattr(id_module, "read_joint_sample", broken)
     node.joint_states.publish(joint_state(Q))
     assert node.spin_until(lambda: node.node.counts["joint_states.errors"] == 1)
     monkeypatch.undo()

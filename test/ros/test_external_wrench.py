@@ -88,7 +88,7 @@ def started(harness):
     harness.diagnostics = harness.listen(DiagnosticArray, "/diagnostics")
     harness.joint_states = harness.publisher(JointState, "joint_states")
     assert harness.spin_until(lambda: harness.node.settings is not None), "no model"
-    assert harness.spin_until(lambda: harness.node.wrench._publisher.subscribers > 0)
+    assert harness.spin_until(lambda: harness.node._wrench_pub.subscribers > 0)
     return harness
 
 

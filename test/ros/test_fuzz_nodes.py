@@ -51,7 +51,7 @@ class Recorder:
 
 def held_point(node):
     """The first point of the trajectory id_node follows, as (q, qd, qdd or None) lists."""
-    trajectory = node.tracker.trajectory
+    trajectory = node.stream.tracker.trajectory
     qdd = None if trajectory.qdd is None else trajectory.qdd[0].tolist()
     return trajectory.q[0].tolist(), trajectory.qd[0].tolist(), qdd
 
@@ -110,7 +110,7 @@ def test_fuzz_id_node(mode):
                 model = node.settings.model
                 if held is not None and core_torques(rnea, model, held[0], held[1], held[2] or [0.0] * 6) is None:
                     held = None  # let go: the new model gives no finite torques there
-                assert (node.tracker.trajectory is None) == (held is None)
+                assert (node.stream.tracker.trajectory is None) == (held is None)
             if fuzz.rng.random() < 0.1:
                 ref = fuzz.reference()
                 node._on_reference(ref.msg)
@@ -120,7 +120,7 @@ def test_fuzz_id_node(mode):
                     q, qd, qdd = ref.state
                     if core_torques(rnea, node.settings.model, q, qd, qdd or [0.0] * 6) is not None:
                         held = ref.state
-                assert (node.tracker.trajectory is None) == (held is None)
+                assert (node.stream.tracker.trajectory is None) == (held is None)
                 if held is not None:
                     assert held_point(node) == (held[0], held[1], held[2])
             item = fuzz.joint_state()
@@ -149,7 +149,7 @@ def test_fuzz_id_node(mode):
                 counts["dropped"] += 1
                 continue
             q, qd = item.state
-            qdd = node._differentiator.qdd if mode == "differentiate" else [0.0] * 6
+            qdd = node.stream.differentiator.qdd if mode == "differentiate" else [0.0] * 6
             q_ff, qd_ff, qdd_ff = (held[0], held[1], held[2] or qdd) if held is not None else (q, qd, qdd)
             tau, g = core_torques(rnea, model, q_ff, qd_ff, qdd_ff), core_torques(gravity, model, q)
             if tau is None or g is None or not all(map(math.isfinite, qdd)):

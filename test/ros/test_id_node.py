@@ -105,7 +105,7 @@ def test_reference_gives_exact_feedforward(node):
         accelerations=[qdd_ref[i] for i in order],
     )
     reference.publish(JointTrajectory(joint_names=[NAMES[i] for i in order], points=[point]))
-    assert node.spin_until(lambda: node.node.tracker.trajectory is not None)
+    assert node.spin_until(lambda: node.node.stream.tracker.trajectory is not None)
     q_measured = [0.0, -0.5, 0.5, 0.0, 0.0, 0.0]
     ff, g = send(node, joint_state(q_measured))
     np.testing.assert_allclose(ff.effort, rnea(irb140(), q_ref, qd_ref, qdd_ref), rtol=1e-12, atol=1e-12)
@@ -267,18 +267,18 @@ def test_reference_expires_and_an_empty_one_lets_it_go():
         model, zeros = irb140(), np.zeros(6)
         q_ref, q = [0.3, -0.9, 1.1, 0.0, 0.4, 0.0], [0.0, -0.5, 0.5, 0.0, 0.0, 0.0]
         for clear in (False, True):
-            harness.node.tracker.clear()
+            harness.node.stream.tracker.clear()
             reference.publish(reference_point(q_ref))  # no accelerations given: qdd = 0 (mode zero)
-            assert harness.spin_until(lambda: harness.node.tracker.trajectory is not None)
+            assert harness.spin_until(lambda: harness.node.stream.tracker.trajectory is not None)
             ff, _ = send(harness, joint_state(q))
             np.testing.assert_allclose(ff.effort, rnea(model, q_ref, zeros, zeros), rtol=1e-12, atol=1e-12)
             if clear:
                 reference.publish(JointTrajectory())
-                assert harness.spin_until(lambda: harness.node.tracker.trajectory is None)
+                assert harness.spin_until(lambda: harness.node.stream.tracker.trajectory is None)
             else:  # until the node's clock is past the timeout (its reference let go)
                 node = harness.node
                 assert harness.spin_until(
-                    lambda: node.tracker.sample(node.get_clock().now().nanoseconds * 1e-9, 1.0) is None
+                    lambda: node.stream.tracker.sample(node.get_clock().now().nanoseconds * 1e-9, 1.0) is None
                 )
             ff, _ = send(harness, joint_state(q))
             np.testing.assert_allclose(ff.effort, rnea(model, q, zeros, zeros), rtol=1e-12, atol=1e-12)
@@ -288,7 +288,7 @@ def test_a_bad_reference_is_dropped_and_the_held_one_kept(node):
     reference = node.publisher(JointTrajectory, "/id_node/reference")
     q_ref = [0.3, -0.9, 1.1, 0.0, 0.4, 0.0]
     reference.publish(reference_point(q_ref))
-    assert node.spin_until(lambda: node.node.tracker.trajectory is not None)
+    assert node.spin_until(lambda: node.node.stream.tracker.trajectory is not None)
     reference.publish(JointTrajectory(joint_names=NAMES[:5], points=[JointTrajectoryPoint(positions=[0.0] * 5)]))
     assert node.spin_until(lambda: node.node.counts["reference.dropped_missing_joints"] == 1)
     ff, _ = send(node, joint_state(STRETCHED))

@@ -1,4 +1,5 @@
-"""id_node's own JointState (de)serialization against rclpy's, message for message."""
+"""id_node's own JointState (de)serialization against rclpy's, message for message, and the
+one reading of a joint state into a sample."""
 
 import math
 import random
@@ -8,7 +9,8 @@ import pytest
 from rclpy.serialization import deserialize_message, serialize_message
 from sensor_msgs.msg import JointState
 
-from irb140_dynamics.core.model.joint_order import BadMessage
+from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder, NotForThisModel
+from irb140_dynamics.ros.messages.joint_messages import read_joint_sample
 from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage, read_joint_state_cdr
 
 CHARACTERS = "abz_09é€😀"  # names of 1- to 4-byte UTF-8 characters shift every alignment
@@ -142,3 +144,29 @@ def test_effort_message_is_rclpy_serialization(count):
             expected.header.stamp.sec,
             expected.header.stamp.nanosec,
         )
+
+
+def test_a_joint_sample_is_the_same_from_the_bytes_or_the_message():
+    """read_joint_sample: one value of stamp, time, q, qd and effort in the model's order,
+    whatever form the joint state comes in; the clock read only for an unstamped one."""
+    order = JointOrder(["a", "b", "c"])
+    msg = JointState(name=["c", "x", "a", "b"], position=[3.0, 9.0, 1.0, 2.0], effort=[30.0, 0.0, 10.0, 20.0])
+    msg.header.stamp.sec, msg.header.stamp.nanosec = 4, 500_000_000
+    for form in (msg, serialize_message(msg)):
+        sample = read_joint_sample(form, order, never)
+        assert (sample.stamp.sec, sample.stamp.nanosec, sample.t) == (4, 500_000_000, 4.5)
+        assert sample.q.tolist() == [1.0, 2.0, 3.0] and sample.qd.tolist() == [0.0, 0.0, 0.0]
+        assert sample.effort == [10.0, 20.0, 30.0] and sample.bad_effort is None
+    msg.header.stamp.sec, msg.header.stamp.nanosec = 0, 0
+    msg.effort = [math.nan, 0.0, 1.0, 2.0]
+    sample = read_joint_sample(serialize_message(msg), order, lambda: 7.25)
+    assert sample.t == 7.25 and sample.effort is None and sample.bad_effort.kind == "effort_not_finite"
+    msg.effort = [1.0]
+    with pytest.raises(BadMessage, match="length_mismatch"):
+        read_joint_sample(msg, order, never)
+    with pytest.raises(NotForThisModel):
+        read_joint_sample(JointState(name=["x"], position=[0.0]), order, never)
+
+
+def never():
+    raise AssertionError("a stamped joint state's time is its stamp")

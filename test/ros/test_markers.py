@@ -7,7 +7,6 @@ import pinocchio as pin
 import pytest
 from builtin_interfaces.msg import Time
 from rclpy.parameter import Parameter
-from rclpy.serialization import deserialize_message, serialize_message
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import Marker, MarkerArray
 
@@ -16,7 +15,6 @@ from irb140_dynamics.core.io.urdf import export_urdf, load_urdf
 from irb140_dynamics.core.kinematics import flange_pose
 from irb140_dynamics.core.monitoring import display
 from irb140_dynamics.core.monitoring.wrench import flange_jacobian_in
-from irb140_dynamics.nodes.id_node.marker_bytes import packed
 from irb140_dynamics.nodes.id_node.markers import MarkerScene, build_markers, lifetime
 from irb140_dynamics.nodes.id_node.node import IdNode
 
@@ -119,22 +117,6 @@ def test_a_scene_kept_between_states_publishes_what_a_fresh_build_does(limits):
     with pytest.raises(ValueError):  # refused; the next state is drawn whole again
         kept.update(limits, Time(), [np.nan] * 6, np.zeros(6))
     assert kept.update(shown, stamp, q, tau, external, colliding) == fresh
-
-
-@pytest.mark.parametrize("frame_id", ["base_link", "base", "world_frame"])  # strings shift the alignment
-def test_packed_markers_are_what_rclpy_serialises(limits, frame_id):
-    rng = np.random.default_rng(6)
-    for model in (MODEL, irb140()):  # with and without the payload sphere
-        kept = MarkerScene(model, frame_id, 0.3)
-        for i in range(9):
-            q, tau = rng.uniform(-2.0, 2.0, 6), rng.uniform(-200.0, 200.0, 6)
-            external = rng.uniform(-30.0, 30.0, 6) if i % 3 else None
-            markers = kept.update(limits, Time(sec=i, nanosec=7 * i), q, tau, external, ("joint_2", "joint_ä")[: i % 3])
-            ours, theirs = packed(markers), serialize_message(markers)
-            assert len(ours) == len(theirs), f"state {i}"  # padding bytes aside (not initialised by rclpy)
-            assert deserialize_message(ours, MarkerArray) == deserialize_message(theirs, MarkerArray), f"state {i}"
-    with pytest.raises(ValueError, match="meshes"):
-        packed(MarkerArray(markers=[Marker(mesh_resource="package://arm/link.dae")]))
 
 
 def test_lifetime_spans_three_periods():

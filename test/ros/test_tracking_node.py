@@ -73,12 +73,12 @@ def trajectory(points):
 
 def follow(harness, msg):
     harness.reference.publish(msg)
-    assert harness.spin_until(lambda: harness.node.tracker.trajectory is not None)
+    assert harness.spin_until(lambda: harness.node.stream.tracker.trajectory is not None)
 
 
 def elapsed(harness) -> float:
     """s on the node's clock since the reference in force started."""
-    return harness.node.get_clock().now().nanoseconds * 1e-9 - harness.node.tracker._start
+    return harness.node.get_clock().now().nanoseconds * 1e-9 - harness.node.stream.tracker.start
 
 
 def test_a_trajectory_is_followed_in_time_held_at_its_end_then_let_go():
@@ -140,4 +140,4 @@ def test_gains_are_live_parameters(node):
 def test_a_trajectory_going_back_in_time_is_refused(node, times):
     node.reference.publish(trajectory([(times[0], A), (times[1], B)]))
     assert node.spin_until(lambda: node.node.counts["reference.dropped"] >= 1)
-    assert node.node.tracker.trajectory is None
+    assert node.node.stream.tracker.trajectory is None

@@ -1,10 +1,16 @@
 """Joints matched by name: where each of a model's joints sits in a list of joint names.
 
 Used for every stream of joint values (JointState messages, recordings), whatever carries
-them: a name list may hold the model's joints in any order and other joints besides.
+them: a name list may hold the model's joints in any order and other joints besides. A
+message refused is a BadMessage, e.g. one the model gives no finite torques for
+(``finite_torques``).
 """
 
 from __future__ import annotations
+
+import math
+
+import numpy as np
 
 
 class BadMessage(ValueError):
@@ -60,3 +66,22 @@ class JointOrder:
         if missing:
             raise BadMessage("missing_joints", f"no {', '.join(missing)} in {list(names)}")
         return [where[name] for name in self.joint_names]
+
+
+def core_result(function, model, *state):
+    """``function(model, *state)``; the core's refusal (ValueError: a state too large for
+    the model, the torques not finite) as BadMessage non_finite_torques."""
+    try:
+        return function(model, *state)
+    except ValueError as error:
+        raise BadMessage("non_finite_torques", str(error)) from None
+
+
+def finite_torques(function, model, *state):
+    """``function(model, *state)`` (rnea, gravity) when all its torques are finite, else
+    BadMessage non_finite_torques (an absurd but finite state can overflow the model's sums)."""
+    tau = core_result(function, model, *state)
+    values = tau.tolist() if type(tau) is np.ndarray else tau  # a sum of floats: a fraction of NumPy's
+    if not (math.isfinite(sum(values)) or all(map(math.isfinite, values))):
+        raise BadMessage("non_finite_torques", f"the model gives {[float(x) for x in tau]}")
+    return tau

@@ -8,6 +8,8 @@
   gives 0.162 m across; never less than MIN_PAYLOAD_DIAMETER, so that a light payload shows.
 - A force is an arrow of ARROW_PER_NEWTON (0.01 m/N: 20 N draws 0.2 m), at most
   MAX_ARROW long (the length saturates; the label keeps the number).
+- A joint is a sphere of JOINT_DIAMETER at its origin; one at the place of earlier joints
+  (within SAME_PLACE, e.g. a wrist's) nests inside them, NESTED times as large each.
 
 Units: N m, kg, m, N. Colours are (red, green, blue) in 0..1.
 """
@@ -15,8 +17,12 @@ Units: N m, kg, m, N. Colours are (red, green, blue) in 0..1.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
+
+from irb140_dynamics.core.kinematics import joint_origins_and_flange
+from irb140_dynamics.core.monitoring.wrench import wrench_of
 
 YELLOW_AT = 0.7  # load where the colour is yellow
 GREEN, YELLOW, RED, GREY = (0.0, 1.0, 0.0), (1.0, 1.0, 0.0), (1.0, 0.0, 0.0), (0.5, 0.5, 0.5)
@@ -24,6 +30,9 @@ PAYLOAD_DENSITY = 2700.0  # kg/m^3
 MIN_PAYLOAD_DIAMETER = 0.02  # m
 ARROW_PER_NEWTON = 0.01  # m/N
 MAX_ARROW = 2.0  # m
+JOINT_DIAMETER = 0.06  # m
+NESTED = 0.7
+SAME_PLACE = 0.01  # m
 
 
 def joint_loads(tau, limits) -> list[float | None]:
@@ -98,3 +107,39 @@ def arrow_end(start, force) -> np.ndarray:
 
 def _mix(a, b, share: float) -> tuple[float, float, float]:
     return tuple(x + share * (y - x) for x, y in zip(a, b))
+
+
+class ArmPicture(NamedTuple):
+    """Where the arm's markers go at one state, in the base frame [m], all finite."""
+
+    origins: list  # (x, y, z) of each joint's origin
+    earlier: list[int]  # per joint, how many earlier joints share its place
+    diameters: list[float]  # of the joints' spheres
+    payload: list  # (x, y, z) of the payload's centre of mass
+    flange: list  # (x, y, z) of the flange origin
+    force: np.ndarray | None  # N, base axes: the external force on the flange (None: not measured)
+    arrow_end: list | None  # (x, y, z) where its arrow ends
+    loads: list  # |tau_j| / limit_j (see joint_loads)
+
+
+def arm_picture(model, q, tau, limits=None, external=None) -> ArmPicture:
+    """The picture of the state q with joint torques ``tau`` [N m] against ``limits`` (None:
+    none known) and, if measured, the ``external`` joint torques; ValueError if a number
+    is not finite. One pass of forward kinematics gives the places and the wrench."""
+    origins, pose, J = joint_origins_and_flange(model, q)
+    flange = pose[:3, 3]
+    near = np.linalg.norm(origins[:, None, :] - origins[None, :, :], axis=2) < SAME_PLACE
+    earlier = np.tril(near, -1).sum(axis=1).tolist()
+    payload = pose[:3, :3] @ np.asarray(model.payload.com, dtype=float) + flange
+    force = end = None
+    numbers = [origins, payload, flange]
+    if external is not None:
+        force = wrench_of(pose, J, external, "base").force
+        end = arrow_end(flange, force)
+        numbers.append(end)
+    if not all(np.isfinite(x).all() for x in numbers):
+        raise ValueError("markers not finite")
+    loads = joint_loads(tau, np.full(model.n, np.inf) if limits is None else limits)
+    diameters = [JOINT_DIAMETER * NESTED**k for k in earlier]
+    end = None if end is None else end.tolist()
+    return ArmPicture(origins.tolist(), earlier, diameters, payload.tolist(), flange.tolist(), force, end, loads)

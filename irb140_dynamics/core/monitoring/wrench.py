@@ -106,3 +106,51 @@ def _turned(R: np.ndarray, J: np.ndarray) -> np.ndarray:
 def _check_frame(frame: str) -> None:
     if frame not in FRAMES:
         raise ValueError(f"frame: must be 'tip' or 'base', got {frame!r}")
+
+
+class WrenchStream:
+    """The flange wrenches of a stream of observed samples (q, external torques), and how
+    near a singularity they came since the last report."""
+
+    def __init__(self):
+        self.forget()
+
+    def forget(self) -> None:
+        """A new model: the last sample belongs to the old one."""
+        self._sample, self._smallest = None, None  # (model, q, r); the smallest sigma_min since the last report
+
+    def note(self, model: RobotModel, q, tau_ext) -> None:
+        """An observed sample, reported on even when no wrench is asked of it."""
+        self._sample = (model, q, tau_ext)
+
+    def estimate(self, frame: str) -> FlangeWrench:
+        """The wrench of the last sample noted, in the axes of ``frame`` (ValueError if not finite)."""
+        wrench = flange_wrench(*self._sample, frame)
+        sigma = wrench.smallest_singular_value
+        self._smallest = sigma if self._smallest is None else min(self._smallest, sigma)
+        return wrench
+
+    def report(self) -> tuple[bool, str, dict[str, str]]:
+        """(near a singularity now or at a wrench since the last report, the message, the
+        smallest singular values of J); starts a new period."""
+        if self._sample is None:
+            return False, "no efforts received: no wrench estimated", {}
+        try:
+            now = flange_wrench(*self._sample, "tip")
+        except ValueError as error:
+            return True, f"no wrench at the last joint state ({error})", {}
+        sigma = now.smallest_singular_value
+        smallest = sigma if self._smallest is None else min(self._smallest, sigma)
+        self._smallest = None
+        values = {
+            "smallest singular value of J, now": f"{sigma:.4f}",
+            "smallest singular value of J since last report": f"{smallest:.4f}",
+        }
+        if smallest >= SINGULAR_THRESHOLD:
+            return False, f"smallest singular value of J {smallest:.4f}", values
+        where = "now" if now.near_singularity else "since the last report"
+        message = (
+            f"near a singularity {where}: smallest singular value of J {smallest:.4f} < {SINGULAR_THRESHOLD:g}; "
+            "the wrench estimate is damped and poor along the direction the arm cannot push"
+        )
+        return True, message, values

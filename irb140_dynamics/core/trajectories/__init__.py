@@ -1,4 +1,5 @@
-"""Joint trajectories: reference motions and computed-torque control (``reference``); a
+"""Joint trajectories: reference motions and computed-torque control (``reference``), the
+torques of a stream of measured states following one in time (``tracking``); a
 JointTrajectory checked against the model's limits and re-timed time-optimally.
 
 ``message``: a JointTrajectory as the core sees it (times, positions and, per point, optional
@@ -11,7 +12,8 @@ limits. ``retiming``: the time-optimal timing of the same path (``path``: the gr
 ``topp``: reachability analysis). ``checker``: a model and its limits, built once, checking
 and re-timing every trajectory a service is sent; a report's level, headline and figures.
 
-May import: ``core.model``, the verbs in ``core.dynamics``, ``core.payload`` (limits). No ROS.
+May import: ``core.model``, the verbs in ``core.dynamics``, ``core.payload`` (limits), ``core.monitoring``
+(the observer's terms, the velocity filter). No ROS.
 """
 
 from .check import JointPeak, TrajectoryReport, check_trajectory

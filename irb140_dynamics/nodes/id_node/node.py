@@ -2,7 +2,9 @@
 
 Subscribes   joint_states          sensor_msgs/JointState (matched by joint name)
              ~/reference           trajectory_msgs/JointTrajectory: followed in time from its
-                                   header.stamp, or on arrival (see nodes.id_node.tracking)
+                                   header.stamp (zero: on arrival; node clock) until
+                                   reference_timeout after its last point; empty: let go
+                                   (see core.trajectories.tracking)
              robot_description     std_msgs/String (transient local): the model, with model.source
                                    robot_description and no URDF parameter or file
                                    (see ros.parameters.arm)
@@ -10,17 +12,22 @@ Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, q
              gravity_torques       sensor_msgs/JointState, effort = g(q)
              effort_commands       std_msgs/Float64MultiArray (when enabled), model joint order:
                                    feed-forward, gravity or computed-torque commands
-             ~/tracking_error      sensor_msgs/JointState, position = q_ref - q, velocity = qd_ref - qd
-             external_torques      sensor_msgs/JointState, effort = external torques by the momentum
-                                   observer (for joint states that carry efforts;
-                                   see nodes.id_node.collision)
-             collision             std_msgs/Bool (transient local), any over its collision_threshold
-             external_wrench       geometry_msgs/WrenchStamped: the wrench on the flange the external
-                                   torques come from (see id_node.wrench)
+             ~/tracking_error      sensor_msgs/JointState while a reference is in force:
+                                   position = q_ref - q, velocity = qd_ref - qd
+             external_torques      sensor_msgs/JointState, effort = the external torques r of the
+                                   momentum observer, for joint states that carry efforts
+                                   (core.monitoring.observer)
+             collision             std_msgs/Bool (reliable, transient local): true while any |r_j|
+                                   exceeds joint j's collision_threshold (core.monitoring.collision)
+             external_wrench       geometry_msgs/WrenchStamped (while anything subscribes): the
+                                   wrench on the flange r comes from (core.monitoring.wrench), in
+                                   the tip link's axes or, with external_wrench.frame base, the
+                                   base link's (the torque about the flange origin in both)
              ~/markers             visualization_msgs/MarkerArray at markers.rate: loads, payload,
                                    external force, collision (see id_node.markers)
-             /diagnostics          diagnostic_msgs/DiagnosticArray, message counts and collision, 1 Hz
-             (an empty ~/reference trajectory lets the held reference go)
+             /diagnostics          diagnostic_msgs/DiagnosticArray, 1 Hz: message counts; a
+                                   collision now or since the last report (ERROR); the wrench's
+                                   nearness to a singularity (WARN)
 
 Torques are in N m, named and ordered as the model's joints, stamped with the input stamp.
 A message that cannot give finite torques is dropped and counted (per topic), never
@@ -30,22 +37,22 @@ serialized bytes (ros.messages.joint_state_cdr: a third of rclpy's cost per mess
 
 from __future__ import annotations
 
-import math
 from array import array
 
 import numpy as np
-from diagnostic_msgs.msg import DiagnosticArray
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import WrenchStamped
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray, String
+from std_msgs.msg import Bool, Float64MultiArray, String
 from trajectory_msgs.msg import JointTrajectory
 
-from irb140_dynamics.core import gravity, rnea
 from irb140_dynamics.core.io.stamps import seconds
-from irb140_dynamics.core.monitoring.filters import VelocityDifferentiator
-from irb140_dynamics.core.monitoring.observer import monitor_terms
-from irb140_dynamics.nodes.id_node.collision import RESTARTS, CollisionMonitor
+from irb140_dynamics.core.monitoring.collision import RESTARTS, CollisionMonitor
+from irb140_dynamics.core.monitoring.wrench import WrenchStream
+from irb140_dynamics.core.trajectories.tracking import TorqueStream
 from irb140_dynamics.nodes.id_node.markers import MarkerPublisher
 from irb140_dynamics.nodes.id_node.settings import (
     NODE_PARAMETERS,
@@ -55,21 +62,16 @@ from irb140_dynamics.nodes.id_node.settings import (
     finish_settings,
     kernels_text,
 )
-from irb140_dynamics.nodes.id_node.tracking import ReferenceTracker
-from irb140_dynamics.nodes.id_node.wrench import WrenchSensor
 from irb140_dynamics.ros.messages.joint_messages import (
     BadMessage,
     JointOrder,
+    JointSample,
     NotForThisModel,
-    core_result,
-    finite_torques,
-    publish_efforts,
-    read_effort,
-    read_joint_state,
+    read_joint_sample,
     read_trajectory,
 )
-from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage, read_joint_state_cdr
-from irb140_dynamics.ros.messages.wrench import chain_links
+from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage
+from irb140_dynamics.ros.messages.wrench import fill_wrench
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import joint_states_qos
@@ -81,9 +83,11 @@ from irb140_dynamics.ros.runtime.listened import ListenedPublisher
 from irb140_dynamics.ros.runtime.rebuild import Rebuild
 from irb140_dynamics.ros.runtime.spin import run
 
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
 
 class IdNode(Node):
-    """Joint states in; feed-forward and gravity torques out."""
+    """Joint states in; feed-forward and gravity torques, commands and what efforts say out."""
 
     def __init__(self, **kwargs):
         super().__init__("id_node", **NODE_OPTIONS, **kwargs)
@@ -92,36 +96,36 @@ class IdNode(Node):
         self.tally = Tally(self.get_logger())
         self.counts = self.tally.counts
         self._reported = self.counts.copy()  # the counts at the last diagnostics
-        self.tracker = ReferenceTracker()
-        self._differentiator = None
+        self.stream, self.collision, self.wrench = TorqueStream(), CollisionMonitor(), WrenchStream()
         self.parameters = ArmParameters(self, NODE_PARAMETERS, PER_JOINT_PARAMETERS)
         self.rebuild = Rebuild(self, finish_settings, self._use)
         self._reader = Rebuild(self, self.parameters.read_topic, self._take_urdf)
         depth = self.get_parameter("qos.depth").value
-        self.collision = CollisionMonitor(self, [], depth)  # joints: by _use
-        self.wrench = WrenchSensor(self, depth)
+        self._feedforward_pub = ListenedPublisher(self, JointState, "feedforward_torques", depth)
+        self._gravity_pub = ListenedPublisher(self, JointState, "gravity_torques", depth)
+        self._tracking_pub = ListenedPublisher(self, JointState, "~/tracking_error", depth)
+        self._external_pub = ListenedPublisher(self, JointState, "external_torques", depth)
+        self._wrench_pub = ListenedPublisher(self, WrenchStamped, "external_wrench", depth)
+        self._collision_pub = self.create_publisher(Bool, "collision", LATCHED)
+        self._collision_pub.publish(Bool(data=False))
+        self._command_pub = None
+        if self.get_parameter("effort_commands.enabled").value:
+            self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands", depth)
+        self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
+        self._command_msg, self._wrench_msg = Float64MultiArray(), WrenchStamped()
         self.markers = MarkerPublisher(self, self.get_parameter("markers.rate").value)
-        self._command_msg = Float64MultiArray()
         first = self.parameters.draft(check_settings, self.parameters.values())
-        if first is not None:
+        if first is not None:  # built here: a model that cannot be built stops the start (one line)
             self._use(finish_settings(first, None))
             self.rebuild.previous = self.settings
         self._draft = None  # the settings of a change accepted by _on_set, for _on_set_done
         self.add_on_set_parameters_callback(self._on_set)
         self.add_post_set_parameters_callback(self._on_set_done)
-
         self.create_subscription(JointState, "joint_states", self._on_joint_state, joint_states_qos(self), raw=True)
         self.create_subscription(JointTrajectory, "~/reference", self._on_reference, depth)
-        self._feedforward_pub = ListenedPublisher(self, JointState, "feedforward_torques", depth)
-        self._gravity_pub = ListenedPublisher(self, JointState, "gravity_torques", depth)
-        self._tracking_pub = ListenedPublisher(self, JointState, "~/tracking_error", depth)
-        self._command_pub = None
-        if self.get_parameter("effort_commands.enabled").value:
-            self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands", depth)
-        self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
-        self.create_timer(1.0, self._publish_diagnostics)
         if self.parameters.from_topic:
             self.create_subscription(String, "robot_description", self._on_description, DESCRIPTION_QOS)
+        self.create_timer(1.0, self._publish_diagnostics)
         self._started = True
         if self.settings is not None:
             self._log_ready()
@@ -137,8 +141,8 @@ class IdNode(Node):
         return result
 
     def _on_set_done(self, parameters) -> None:
-        """The change accepted: its settings built off the executor (kernels bound or
-        compiled, limits derived), the model before answering meanwhile."""
+        """The change accepted: its settings built off the executor (kernels, limits), the
+        settings before answering meanwhile."""
         draft, self._draft = self._draft, None
         if draft is not None:
             self.rebuild.submit(draft)
@@ -148,171 +152,116 @@ class IdNode(Node):
         self._reader.submit(msg.data)
 
     def _take_urdf(self, urdf) -> None:
-        """The URDF read: checked whole with the parameters in force, built off the
-        executor and swapped in, or refused keeping the model in use."""
+        """The URDF read: checked whole with the parameters in force and built off the
+        executor, or refused keeping the model in use."""
         draft = self.parameters.take_urdf(urdf, check_settings)
         if draft is not None:
             self.rebuild.submit(draft)
 
     def _use(self, settings: IdNodeSettings) -> None:
-        """Switch to new (validated, compiled) settings; new joints come with a new model. A
-        held reference the new model gives no finite torques for is let go."""
-        first, names = self.settings is None, list(settings.model.joint_names)
-        if not first and self._started and settings.model.joints != self.settings.model.joints:
+        """New settings, built; a model of other joints starts its streams afresh."""
+        old, model, names = self.settings, settings.model, list(settings.model.joint_names)
+        if old is not None and self._started and model.joints != old.model.joints:
             self.get_logger().info(f"new model in force; {kernels_text(settings.kernels)}")
-        if first or names != list(self.settings.model.joint_names):
+        if old is None or names != list(old.model.joint_names):
             self._order = JointOrder(names)
-            self._zeros = np.zeros(len(names))
-            self._feedforward_msg = EffortMessage(names)
-            self._gravity_msg = EffortMessage(names)
-            self._tracking_msg = JointState(name=names)
-            self.tracker.clear()
-            self._differentiator = None
+            self._feedforward_msg, self._gravity_msg = EffortMessage(names), EffortMessage(names)
+            self._external_msg, self._tracking_msg = EffortMessage(names), JointState(name=names)
             self.wrench.forget()
             self.markers.forget()
-        if self._differentiator is None or settings.cutoff_frequency != self.settings.cutoff_frequency:
-            self._differentiator = VelocityDifferentiator(settings.model.n, settings.cutoff_frequency)
-        self.collision.use(settings.model, settings.collision)
-        self.settings = settings
-        held = self.tracker.trajectory
-        if held is not None and not held.torques_finite(settings.model):
-            self.tracker.clear()
+        source = settings.effort_source if self._command_pub is not None else None
+        mode, cutoff, timeout = settings.acceleration_mode, settings.cutoff_frequency, settings.reference_timeout
+        if not self.stream.use(model, mode, cutoff, timeout, source, settings.gains):
             self.tally.drop("reference", BadMessage("non_finite_torques", "the new model gives none at the reference"))
-        if first and self._started:  # the model came after startup
+        self.collision.use(model, settings.collision.gain, settings.collision.thresholds)
+        self.settings = settings
+        if old is None and self._started:  # the model came after startup
             self._log_ready()
 
     def _log_ready(self) -> None:
-        names = list(self.settings.model.joint_names)
+        model = self.settings.model
         self.get_logger().info(
-            f"ready: {len(names)} joints {names}, payload {self.settings.model.payload.mass} kg; "
+            f"ready: {model.n} joints {list(model.joint_names)}, payload {model.payload.mass} kg; "
             f"{kernels_text(self.settings.kernels)}"
         )
+
+    def _now(self) -> float:
+        return self.get_clock().now().nanoseconds * 1e-9
 
     @guarded("joint_states")
     def _on_joint_state(self, msg: bytes | JointState) -> None:
         """A joint state as DDS carries it (see ros.messages.joint_state_cdr), or as a JointState."""
         self.counts["joint_states.received"] += 1
-        settings = self.settings
-        if settings is None:
+        if self.settings is None:
             self.counts["joint_states.no_model_yet"] += 1
             return
         try:
-            if isinstance(msg, bytes):
-                msg = read_joint_state_cdr(msg)
-            q, qd = read_joint_state(msg, self._order)
-            q, qd = np.array(q), np.array(qd)  # float64 arrays: what the native kernels take
-            t = self._time_of(msg)
-            tau, g, command, reference, terms = self._torques(msg, t, q, qd, settings)
+            sample = read_joint_sample(msg, self._order, self._now)
+            tau, g, command, reference, terms = self.stream.torques(
+                sample.t, sample.q, sample.qd, sample.effort is not None, self._now
+            )
         except NotForThisModel:
             self.counts["joint_states.ignored"] += 1
             return
         except BadMessage as error:
             self.tally.drop("joint_states", error)
             return
-        stamp = msg.header.stamp
-        publish_efforts(self._feedforward_pub, self._feedforward_msg, stamp, tau)
-        publish_efforts(self._gravity_pub, self._gravity_msg, stamp, g)
+        stamp = sample.stamp
+        if self._feedforward_pub.subscribers:  # serialized for nobody would cost the stream for nothing
+            self._feedforward_pub.publish(self._feedforward_msg.serialize(stamp, tau))
+        if self._gravity_pub.subscribers:
+            self._gravity_pub.publish(self._gravity_msg.serialize(stamp, g))
         if command is not None:
             self._command_msg.data = array("d", command)
             self._command_pub.publish(self._command_msg)
         self.counts["torques.published"] += 1
         if reference is not None and self._tracking_pub.subscribers:
-            self._publish_tracking_error(stamp, q, qd, reference)
-        self.markers.note(stamp, q, tau)
-        self._observe(msg, t, q, qd, g, terms)
-
-    def _publish_tracking_error(self, stamp, q, qd, reference) -> None:
-        q_ref, qd_ref, _ = reference
-        msg = self._tracking_msg
-        msg.header.stamp.sec, msg.header.stamp.nanosec = stamp.sec, stamp.nanosec
-        msg.position = (np.asarray(q_ref) - q).tolist()
-        msg.velocity = (np.asarray(qd_ref) - qd).tolist()
-        self._tracking_pub.publish(msg)
-
-    def _torques(self, msg, t: float, q, qd, settings: IdNodeSettings):
-        """(feed-forward, gravity, command torques or None, the reference in force or None,
-        the observer's terms or None), the torques all finite, or BadMessage. With efforts
-        and no reference, one pass gives the torques and the observer's terms."""
-        model = settings.model
-        estimate = self._estimated_acceleration(t, qd, settings)
-        tracker = self.tracker
-        reference = (
-            tracker.sample(self.get_clock().now().nanoseconds * 1e-9, settings.reference_timeout)
-            if tracker.trajectory is not None
-            else None
-        )  # no clock read without one
-        q_ff, qd_ff, qdd_ref = reference or (q, qd, None)
-        try:
-            terms = None
-            if reference is None and len(msg.effort):
-                tau, g, *terms = core_result(monitor_terms, model, q, qd, estimate)  # refuses non-finite tau, g
-            else:
-                tau = finite_torques(rnea, model, q_ff, qd_ff, estimate if qdd_ref is None else qdd_ref)
-                g = finite_torques(gravity, model, q)
-            command = None
-            if self._command_pub is not None:
-                if settings.effort_source == "gravity":
-                    command = g
-                elif settings.effort_source == "computed_torque":
-                    command = finite_torques(self.tracker.command, model, q, qd, reference, settings.gains)
-                elif qdd_ref is None and settings.acceleration_mode == "differentiate":
-                    command = finite_torques(rnea, model, q_ff, qd_ff, self._zeros)  # never a measured qdd
-                else:
-                    command = tau
-        except BadMessage:
-            if settings.acceleration_mode == "differentiate":
-                self._differentiator.reset()  # the estimate may be what overflowed: start afresh
-            raise
-        return tau, g, command, reference, terms
-
-    def _observe(self, msg, t: float, q, qd, g, terms) -> None:
-        """Efforts in the message: run the momentum observer (external torques, collision),
-        counting its restarts (collision.restart_gap, _repeated_stamp, _older_stamp)."""
-        try:
-            effort = read_effort(msg, self._order)
-        except BadMessage as error:
+            msg = self._tracking_msg
+            msg.header.stamp.sec, msg.header.stamp.nanosec = stamp.sec, stamp.nanosec
+            msg.position = (np.asarray(reference[0]) - sample.q).tolist()
+            msg.velocity = (np.asarray(reference[1]) - sample.qd).tolist()
+            self._tracking_pub.publish(msg)
+        self.markers.note(stamp, sample.q, tau)
+        if sample.bad_effort is not None:
             self.collision.reset()
-            self.counts[f"collision.{error.kind}"] += 1
-            self.tally.warn("collision", f"observer skipped a joint state ({error})")
-            return
-        if effort is None:
-            return
+            self.counts["collision.effort_not_finite"] += 1
+            self.tally.warn("collision", f"observer skipped a joint state ({sample.bad_effort})")
+        elif sample.effort is not None:
+            self._observe(sample, g, terms)
+
+    def _observe(self, sample: JointSample, g, terms) -> None:
+        """Efforts measured: the external torques (external_torques), a collision, the flange
+        wrench (external_wrench) and the markers of the measured efforts."""
+        colliding_before = bool(self.collision.colliding)
         try:
-            restarted = self.collision.update(t, q, qd, effort, g, msg.header.stamp, terms)
+            r = self.collision.update(sample.t, sample.q, sample.qd, sample.effort, g, terms)
         except ValueError as error:
             self.counts["collision.observer_reset"] += 1
             self.tally.warn("collision", f"observer reset ({error})")
             return
+        restarted = self.collision.restarted
         if restarted is not None:
             self.counts[f"collision.restart_{restarted}"] += 1
             self.tally.warn("collision", f"observer restarted at r = 0 ({RESTARTS[restarted]})")
-        self._estimate_wrench(msg.header.stamp, q, effort)
-
-    def _estimate_wrench(self, stamp, q, effort) -> None:
-        """The observer's external torques as the flange wrench (external_wrench) and markers."""
-        settings, r = self.settings, self.collision.residual
-        colliding = [settings.model.joint_names[j] for j in self.collision.colliding]
-        self.markers.observed(effort, r, colliding)
+        if self._external_pub.subscribers:
+            self._external_pub.publish(self._external_msg.serialize(sample.stamp, r))
+        colliding = self.collision.colliding
+        if bool(colliding) != colliding_before:
+            self._collision_pub.publish(Bool(data=bool(colliding)))
+        model, frame = self.settings.model, self.settings.wrench_frame
+        self.markers.note(sample.stamp, sample.q, sample.effort, r, [model.joint_names[j] for j in colliding])
+        self.wrench.note(model, sample.q, r)
+        if not self._wrench_pub.subscribers:
+            return
         try:
-            self.wrench.update(settings.model, settings.wrench_frame, chain_links(self.parameters), stamp, q, r)
+            wrench = self.wrench.estimate(frame)
         except ValueError as error:
             self.counts["external_wrench.not_finite"] += 1
             self.tally.warn("external_wrench", f"no wrench for a joint state ({error})")
-
-    def _estimated_acceleration(self, t: float, qd, settings: IdNodeSettings):
-        if settings.acceleration_mode == "zero":
-            return self._zeros
-        qdd = self._differentiator.update(t, qd.tolist())  # Python floats: an overflow is inf, no warning
-        if not all(map(math.isfinite, qdd)):  # an absurd velocity jump overflowed the difference
-            self._differentiator.reset()
-            raise BadMessage("not_finite_acceleration", f"the differentiated velocities give {qdd}")
-        return np.array(qdd)
-
-    def _time_of(self, msg) -> float:
-        """The message's stamp [s]; for an unstamped stream, the time of arrival."""
-        stamp = msg.header.stamp
-        t = seconds(stamp.sec, stamp.nanosec)
-        return t if t != 0.0 else self.get_clock().now().nanoseconds * 1e-9
+            return
+        base, tip = self.parameters.chain_links
+        msg = fill_wrench(self._wrench_msg, sample.stamp, tip if frame == "tip" else base, wrench.force, wrench.torque)
+        self._wrench_pub.publish(msg)
 
     @guarded("reference")
     def _on_reference(self, msg: JointTrajectory) -> None:
@@ -320,29 +269,36 @@ class IdNode(Node):
         torques at every point; an empty trajectory lets the reference go."""
         self.counts["reference.received"] += 1
         if not msg.points or self.settings is None:
-            self.tracker.clear()
+            self.stream.tracker.clear()
             return
         try:
-            trajectory = read_trajectory(msg, self._order)
-            if not trajectory.torques_finite(self.settings.model):
-                raise BadMessage("non_finite_torques", "the model gives no finite torques at some point")
+            start = seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
+            self.stream.follow(read_trajectory(msg, self._order), start or self._now())
         except BadMessage as error:
             self.tally.drop("reference", error)
-            return
-        start = seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
-        self.tracker.follow(trajectory, start or self.get_clock().now().nanoseconds * 1e-9)
 
     @guarded("diagnostics")
     def _publish_diagnostics(self) -> None:
-        """Message counts (see message_status) and the collision status."""
+        """Message counts (see message_status), the collision and the wrench's statuses."""
         recent = self.counts - self._reported
         self._reported = self.counts.copy()
         name, hardware_id = self.get_name(), self.parameters.robot_name or self.get_fully_qualified_name()
-        status = message_status(name, hardware_id, self.counts, recent, self.rebuild, self.settings is None)
-        statuses = [status, self.collision.status(name, hardware_id), self.wrench.status(name, hardware_id)]
+        statuses = [
+            message_status(name, hardware_id, self.counts, recent, self.rebuild, self.settings is None),
+            _status(f"{name}: collision", hardware_id, self.collision.report(), DiagnosticStatus.ERROR),
+            _status(f"{name}: external wrench", hardware_id, self.wrench.report(), DiagnosticStatus.WARN),
+        ]
         msg = DiagnosticArray(status=statuses)
         msg.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics_pub.publish(msg)
+
+
+def _status(name: str, hardware_id: str, report, flagged_level: bytes) -> DiagnosticStatus:
+    """A status of a core report (flagged, message, values): ``flagged_level`` when flagged, else OK."""
+    flagged, message, values = report
+    key_values = [KeyValue(key=key, value=value) for key, value in values.items()]
+    level = flagged_level if flagged else DiagnosticStatus.OK
+    return DiagnosticStatus(level=level, name=name, hardware_id=hardware_id, message=message, values=key_values)
 
 
 def usage() -> Usage:

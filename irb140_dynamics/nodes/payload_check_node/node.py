@@ -39,7 +39,7 @@ from irb140_dynamics.core.payload import check_payload
 from irb140_dynamics.core.payload.rest_samples import EstimationError, PayloadEstimator
 from irb140_dynamics.nodes.payload_check_node.check_service import CheckService, reply
 from irb140_dynamics.nodes.payload_check_node.settings import NODE_PARAMETERS, Settings, check_settings, finish_settings
-from irb140_dynamics.ros.messages.joint_messages import finite_torques, joint_state_of
+from irb140_dynamics.ros.messages.joint_messages import finite_torques, read_joint_sample
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import joint_states_qos
@@ -68,7 +68,7 @@ class PayloadCheckNode(Node):
     def __init__(self, **kwargs):
         super().__init__("payload_check_node", **NODE_OPTIONS, **kwargs)
         self.settings: Settings | None = None  # analysed; None: waiting for the model (robot_description topic)
-        self.state = self.received = None  # the latest good joint state (JointStateValue), when received
+        self.state = self.received = None  # the latest good joint state (JointSample), when received
         self._early = None  # (the latest joint state, received) before the first model
         self._started = False
         self.tally = Tally(self.get_logger())
@@ -171,7 +171,7 @@ class PayloadCheckNode(Node):
         """A joint state received at ``received`` (node clock): the state checks use, and the
         payload estimate's sample; a bad one dropped, counted and warned about."""
         try:
-            state = joint_state_of(msg, self._order)
+            state = read_joint_sample(msg, self._order, lambda: received.nanoseconds * 1e-9)
             self._check_finite(state)
         except NotForThisModel:
             self.counts["joint_states.ignored"] += 1
@@ -180,7 +180,9 @@ class PayloadCheckNode(Node):
             self.tally.drop("joint_states", error)
             return
         self.state, self.received = state, received
-        left_out = self.estimator.take(state.stamp or received.nanoseconds * 1e-9, state.q, state.qd, state.effort)
+        left_out = self.estimator.take(state.t, state.q, state.qd, state.effort)
+        if state.bad_effort is not None:
+            left_out = f"an effort not finite, taken as none ({state.bad_effort})"
         if left_out is not None:
             self.tally.add("estimation", "effort_left_out")
             self.tally.warn("estimation", f"payload estimate: {left_out}")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
@@ -11,43 +12,23 @@ from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from irb140_dynamics.core.io.stamps import sec_nanosec, seconds
-from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder, NotForThisModel
+from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder, NotForThisModel, core_result, finite_torques
+from irb140_dynamics.ros.messages.joint_state_cdr import read_joint_state_cdr
 
 __all__ = [
     "BadMessage",
     "JointOrder",
-    "JointStateValue",
     "NotForThisModel",
+    "JointSample",
     "core_result",
     "finite_torques",
-    "joint_state_of",
-    "publish_efforts",
     "read_effort",
+    "read_joint_sample",
     "read_joint_state",
     "read_trajectory",
     "trajectory_message",
     "trajectory_of",
 ]
-
-
-def core_result(function, model, *state):
-    """``function(model, *state)``; the core's refusal (ValueError: a state too large for
-    the model, the torques not finite) as BadMessage non_finite_torques."""
-    try:
-        return function(model, *state)
-    except ValueError as error:
-        raise BadMessage("non_finite_torques", str(error)) from None
-
-
-def finite_torques(function, model, *state):
-    """``function(model, *state)`` (rnea, gravity) when all its torques are finite, else
-    BadMessage non_finite_torques (an absurd but finite state can overflow the model's
-    sums; the core may return the non-finite torques or refuse them with ValueError)."""
-    tau = core_result(function, model, *state)
-    values = tau.tolist() if type(tau) is np.ndarray else tau  # a sum of floats: a fraction of NumPy's
-    if not (math.isfinite(sum(values)) or all(map(math.isfinite, values))):
-        raise BadMessage("non_finite_torques", f"the model gives {[float(x) for x in tau]}")
-    return tau
 
 
 def _pick(values, index: list[int], field: str, length: int, required: bool) -> list[float]:
@@ -60,6 +41,41 @@ def _pick(values, index: list[int], field: str, length: int, required: bool) -> 
     if not all(map(math.isfinite, picked)):
         raise BadMessage("not_finite", f"{field} is not finite: {picked}")
     return picked
+
+
+class JointSample(NamedTuple):
+    """One joint state of the model's joints, read once."""
+
+    stamp: object  # the header's stamp (sec, nanosec), as the answers carry it
+    t: float  # s: the stamp; for an unstamped message, the time of arrival
+    q: np.ndarray  # rad, float64 (what the native kernels take)
+    qd: np.ndarray  # rad/s; zeros when the message has none
+    effort: list[float] | None  # N m; None when the message has none, or bad_effort
+    bad_effort: BadMessage | None  # efforts given but not finite (effort_not_finite): q and qd still hold
+
+
+def read_joint_sample(msg: bytes | JointState, order: JointOrder, now: Callable[[], float]) -> JointSample:
+    """The sample of a JointState or of its serialized bytes (read by joint_state_cdr), its
+    joints matched by name (see read_joint_state); ``now()`` [s] is read only for an
+    unstamped message. BadMessage (NotForThisModel for other joints only) if unusable."""
+    if type(msg) is bytes:
+        msg = read_joint_state_cdr(msg)
+    index, length = _index(msg.name, len(msg.position), order)
+    q = _pick(msg.position, index, "position", length, required=True)
+    qd = _pick(msg.velocity, index, "velocity", length, required=False)
+    effort, bad_effort = msg.effort, None
+    if len(effort) == 0:
+        effort = None
+    elif len(effort) != length:
+        raise BadMessage("length_mismatch", f"effort has {len(effort)} values for {length} joints")
+    else:
+        try:
+            effort = _pick(effort, index, "effort", length, required=True)
+        except BadMessage as error:
+            effort, bad_effort = None, BadMessage("effort_not_finite", str(error))
+    stamp = msg.header.stamp
+    t = seconds(stamp.sec, stamp.nanosec) or now()
+    return JointSample(stamp, t, np.array(q), np.array(qd), effort, bad_effort)
 
 
 def read_joint_state(msg: JointState, order: JointOrder) -> tuple[list[float], list[float]]:
@@ -75,27 +91,6 @@ def read_joint_state(msg: JointState, order: JointOrder) -> tuple[list[float], l
     if len(msg.effort) not in (0, length):
         raise BadMessage("length_mismatch", f"effort has {len(msg.effort)} values for {length} joints")
     return q, qd
-
-
-class JointStateValue(NamedTuple):
-    """A joint state in the model's joint order: ``stamp`` [s] (0.0: unstamped), q [rad], qd
-    [rad/s] (zeros when the message has none), effort [N m] (None when it has none; as given,
-    finite or not: what uses it judges)."""
-
-    stamp: float
-    q: list[float]
-    qd: list[float]
-    effort: list[float] | None
-
-
-def joint_state_of(msg: JointState, order: JointOrder) -> JointStateValue:
-    """The message read once (see read_joint_state: BadMessage, NotForThisModel)."""
-    q, qd = read_joint_state(msg, order)
-    effort = None
-    if len(msg.effort):
-        index, _ = _index(msg.name, len(msg.position), order)
-        effort = [float(msg.effort[i]) for i in index]
-    return JointStateValue(seconds(msg.header.stamp.sec, msg.header.stamp.nanosec), q, qd, effort)
 
 
 def read_effort(msg: JointState, order: JointOrder) -> list[float] | None:
@@ -170,11 +165,3 @@ def trajectory_message(tr, frame_id: str = "") -> JointTrajectory:
 
 def _index(names, n_positions: int, order: JointOrder) -> tuple[list[int], int]:
     return order.for_values(names, n_positions)
-
-
-def publish_efforts(publisher, message, stamp, effort) -> None:
-    """Publish ``message`` (a ros.messages.joint_state_cdr.EffortMessage: fixed names) with ``stamp``
-    and ``effort`` on a ListenedPublisher, if anything subscribes: a message nobody has
-    subscribed to would cost its serialization for nothing."""
-    if publisher.subscribers:
-        publisher.publish(message.serialize(stamp, effort))
