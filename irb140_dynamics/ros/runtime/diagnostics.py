@@ -1,9 +1,5 @@
-"""Statuses for /diagnostics (rqt_robot_monitor, aggregators): a payload check, and the
-message counts of id_node.
-
-The key-values of a payload check are its own figures (PayloadCheck.joint_figures,
-payload_figures): the same strings as in the ~/check report.
-"""
+"""Statuses for /diagnostics: a payload check (its key-values the figures of the ~/check
+report), and the message counts of id_node."""
 
 from __future__ import annotations
 
@@ -36,7 +32,7 @@ def payload_statuses(
         name=f"{node_name}: payload",
         hardware_id=node_name,
         message=message,
-        values=_key_values(figures),
+        values=[KeyValue(key=key, value=value) for key, value in figures.items()],
     )
     return statuses + [summary]
 
@@ -69,12 +65,8 @@ def _joint_status(check: PayloadCheck, j: int, node_name: str, warn_use: float) 
         name=f"{node_name}: {check.joint_names[j]}",
         hardware_id=node_name,
         message=message,
-        values=_key_values(figures),
+        values=[KeyValue(key=key, value=value) for key, value in figures.items()],
     )
-
-
-def _key_values(figures: dict[str, str]) -> list[KeyValue]:
-    return [KeyValue(key=key, value=value) for key, value in figures.items()]
 
 
 def message_status(node_name: str, hardware_id: str, counts, recent, parameters, waiting: bool) -> DiagnosticStatus:
