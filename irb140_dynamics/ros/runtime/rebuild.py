@@ -1,13 +1,11 @@
 """Slow work off the executor: the newest job built in a worker thread, its result handed back.
 
-Building a configuration (compiling kernels, sweeping the workspace) on the executor thread
-would stall its messages. ``Rebuild.submit(job)`` builds ``build(job, previous)`` in a worker
-thread and gives the result to ``use`` on the executor thread through
-``executor.create_task`` (which every rclpy executor, the EventsExecutor included, runs at
-once from another thread). Only the newest job counts: a newer one cancels the build under
-way (``core.payload.stop``: it stops at its next ``out_of_time`` check), so a burst of
-changes ends with the newest. While a build runs, ``submit`` has lowered the interpreter's
-switch interval (process-wide) so that the executor thread gets the interpreter lock quickly.
+``Rebuild.submit(job)`` builds ``build(job, previous)`` (compiling kernels, sweeping the
+workspace: what would stall the messages) in a worker thread and gives the result to ``use``
+on the executor thread through ``executor.create_task`` (run at once by every rclpy executor,
+the EventsExecutor included). A newer job cancels the build under way (``core.payload.stop``),
+so a burst of changes ends with the newest. ``submit`` lowers the interpreter's switch
+interval (process-wide) so that the executor thread gets the lock quickly meanwhile.
 """
 
 from __future__ import annotations

@@ -18,12 +18,8 @@ import rclpy.logging
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
-from rclpy.signals import (
-    SignalHandlerOptions,
-    get_current_signal_handlers_options,
-    install_signal_handlers,
-    uninstall_signal_handlers,
-)
+from rclpy.signals import SignalHandlerOptions as Options
+from rclpy.signals import get_current_signal_handlers_options, install_signal_handlers, uninstall_signal_handlers
 from rclpy.utilities import remove_ros_args
 
 from irb140_dynamics.core.errors import one_line
@@ -174,8 +170,8 @@ def ctrl_c_as_a_flag() -> Iterator[list]:
     options = get_current_signal_handlers_options()
     uninstall_signal_handlers()  # rclpy chains to the handler before it: unchain it first
     previous = signal.signal(signal.SIGINT, on_sigint)
-    if options in (SignalHandlerOptions.SIGTERM, SignalHandlerOptions.ALL):
-        install_signal_handlers(SignalHandlerOptions.SIGTERM)
+    if options in (Options.SIGTERM, Options.ALL):
+        install_signal_handlers(Options.SIGTERM)
     try:
         yield interrupted
     finally:
