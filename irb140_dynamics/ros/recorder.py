@@ -117,8 +117,6 @@ class Recorder(Node):
         super().__init__("record")
         self.topic, self.out, self.options = self.resolve_topic_name(options.topic), Path(out), options
         self.duration, self.tail = options.duration, options.tail
-        if not self.duration >= 0.0 or not self.tail >= 0.0:
-            raise ValueError(f"--duration and --tail: must be >= 0, got {self.duration}, {self.tail}")
         self.finished: str | None = None  # why the recording is complete
         self.failure: str | None = None  # why it cannot go on (one line)
         self.reference_end: int | None = None  # ns, node clock: where the last motion ends

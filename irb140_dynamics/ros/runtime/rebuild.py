@@ -127,7 +127,7 @@ class Rebuild:
         except Cancelled:
             raise
         except Exception as error:  # noqa: BLE001  (handed to the node, not raised in a thread)
-            return Failed((error,))
+            return Failed(error)
         return result
 
     def _run(self) -> None:
