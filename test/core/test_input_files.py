@@ -2,7 +2,7 @@
 
 import pytest
 
-from irb140_dynamics.core.io.params_file import read_parameter_file
+from irb140_dynamics.core.io.params_file import rcl_refusal, read_parameter_file
 from irb140_dynamics.core.io.text_files import ENVIRONMENT_LIMIT, read_text_file
 
 from ..support.paths import CONFIG
@@ -49,3 +49,24 @@ def test_the_size_limit_is_checked_before_reading_and_can_be_changed(tmp_path, m
 def _write(path, data: bytes):
     path.write_bytes(data)
     return path
+
+
+RCL_AT = ", at /project/src/parse.c:391, at /project/src/rcl/arguments.c:415"  # rcl's source lines, as it appends them
+
+
+def test_rcl_refusing_a_params_file_is_one_line_quoting_the_line(tmp_path):
+    """rcl's text (as rclpy.init raises it, Jazzy) read back: the file, the line number, the
+    line itself, and the hint for a list of mixed integers and doubles."""
+    path = tmp_path / "mixed.yaml"
+    path.write_text("/**:\n  ros__parameters:\n    gravity: [0, 0.0, -9.81]\n")
+    text = (
+        f"failed to initialize rcl: Couldn't parse params file: '--params-file {path}'. Error: Sequence should be "
+        f"of same type. Value type 'double' do not belong at line_num 3{RCL_AT}"
+    )
+    assert rcl_refusal(text) == (
+        f"{path}:3: Sequence should be of same type. Value type 'double' do not belong in "
+        "`gravity: [0, 0.0, -9.81]`; write every number of a list as a double, e.g. 0.0 not 0"
+    )
+    near = f"failed to initialize rcl: Couldn't parse params file: '--params-file {path}'. Error: Error parsing a event near line 0{RCL_AT}"
+    assert rcl_refusal(near) == f"{path}: Error parsing a event"  # line 0: no line to quote
+    assert rcl_refusal(f"failed to initialize rcl: no such thing{RCL_AT}") == "failed to initialize rcl: no such thing"

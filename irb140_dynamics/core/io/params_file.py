@@ -6,6 +6,7 @@ the parameters, doubles written as doubles (see ``yaml_numbers``).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Mapping
 from functools import lru_cache
 from typing import Any
@@ -108,3 +109,27 @@ def parameter_file_text(params: Mapping[str, Any], comments: Iterable[str] = ())
 
     emit(nested(params), 4)
     return "\n".join(lines) + "\n"
+
+
+_RCL_PARAMS_FILE_ERROR = re.compile(
+    r"params file: '--params-file (?P<path>.+?)'\. Error: (?P<reason>.+?)"
+    r"(?:(?: at line_num| near line|\. Error at line) (?P<line>\d+))?\s*(?:, at /|$)"
+)
+
+
+def rcl_refusal(text: str) -> str:
+    """rcl's refusal of a command line (the text of its error) in one line; for a params
+    file, ``path:line: reason in `the line```, with a hint for its commonest mistake."""
+    found = _RCL_PARAMS_FILE_ERROR.search(text)
+    if not found:
+        return text.split(", at /")[0]
+    path, reason, line = found["path"], found["reason"].rstrip(". "), found["line"]
+    if line is None or int(line) < 1:  # rcl gives line 0 for some errors (a binary file)
+        return f"{path}: {reason}"
+    try:  # the line as it is, undecodable bytes (a binary file) escaped
+        with open(path, encoding="utf-8", errors="backslashreplace") as stream:
+            source = stream.read().splitlines()[int(line) - 1].strip()
+    except (OSError, IndexError):
+        source = "?"
+    hint = "; write every number of a list as a double, e.g. 0.0 not 0" if "same type" in reason else ""
+    return f"{path}:{line}: {reason} in `{source}`{hint}"

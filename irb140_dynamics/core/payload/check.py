@@ -214,6 +214,24 @@ class PayloadCheck:
             "worst static gap [N m]": f"{load.gap[j]:.2g}",
         }
 
+    def joint_status(self, j: int, warn_use: float) -> tuple[str, str]:
+        """Joint j's level ('OK'; 'WARN' from ``warn_use`` %, when the payload loads it
+        without a limit, or when the proof cannot tell whether it is within its limit;
+        'ERROR' proven over it) and its message in one line."""
+        figures, finite = self.joint_figures(j), math.isfinite(self.limit[j])
+        uses = {"worst use": self.worst_use[j], **({} if self.use is None else {"use now": self.use[j]})}
+        most = max(uses, key=uses.get)
+        of_limit = f"{figures[most]} of its {figures['limit [N m]']} N m limit"
+        if self.beyond[j]:
+            return "ERROR", of_limit if finite else figures["limit source"]
+        if not self.within[j]:
+            return "WARN", f"unproven: {of_limit} by its bound: {self.unfinished}"
+        if finite:
+            return ("WARN" if uses[most] >= warn_use else "OK"), of_limit
+        if j in self.loaded_without_limit:
+            return "WARN", self.no_limit_note(j)
+        return "OK", figures["limit source"]
+
     def payload_figures(self) -> dict[str, str]:
         """The payload and its largest masses by label ("here" only with a state)."""
         figures = {"payload mass [kg]": f"{self.payload.mass:.3f}", "payload com [m]": _vector(self.payload.com)}

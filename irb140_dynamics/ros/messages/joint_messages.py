@@ -85,7 +85,7 @@ def read_joint_state(msg: JointState, order: JointOrder) -> tuple[list[float], l
     taken positionally only if its length matches the model. ``effort`` is not used, but
     its length must fit too. Raises NotForThisModel for a message about other joints only.
     """
-    index, length = _index(msg.name, len(msg.position), order)
+    index, length = order.for_values(msg.name, len(msg.position))
     q = _pick(msg.position, index, "position", length, required=True)
     qd = _pick(msg.velocity, index, "velocity", length, required=False)
     if len(msg.effort) not in (0, length):
@@ -98,7 +98,7 @@ def read_effort(msg: JointState, order: JointOrder) -> list[float] | None:
     ``effort_not_finite`` for a NaN or infinite one). Call after read_joint_state."""
     if len(msg.effort) == 0:
         return None
-    index, length = _index(msg.name, len(msg.position), order)
+    index, length = order.for_values(msg.name, len(msg.position))
     try:
         return _pick(msg.effort, index, "effort", length, required=True)
     except BadMessage as error:
@@ -113,7 +113,7 @@ def read_trajectory(msg: JointTrajectory, order: JointOrder):
 
     times, Q, QD, QDD = [], [], [], []
     for k, point in enumerate(msg.points):
-        index, length = _index(msg.joint_names, len(point.positions), order)
+        index, length = order.for_values(msg.joint_names, len(point.positions))
         Q.append(_pick(point.positions, index, f"points[{k}].positions", length, required=True))
         QD.append(_pick(point.velocities, index, f"points[{k}].velocities", length, required=False))
         if len(point.accelerations):

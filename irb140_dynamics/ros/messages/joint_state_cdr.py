@@ -1,16 +1,13 @@
 """sensor_msgs/JointState as the bytes DDS carries (CDR), for id_node's path per message.
 
-rclpy turns every message taken into a Python object field by field, and every message
-published back into C. id_node reads its joint states from the serialized bytes with
-``struct`` instead (strings read as rclpy reads them), and publishes its torque messages as
-bytes: the message written once, then only the stamp and the efforts written into a copy.
-bench/bench_nodes.py measures what that saves (docs/benchmarks.md).
-
-The layout is XCDR1 (what rmw_fastrtps and rmw_cyclonedds send for ROS 2 types): a
-4-byte encapsulation header, then the fields in order, each primitive aligned to its size
-counted from the end of the header; a string is a uint32 length (NUL included) and its
-bytes, a sequence a uint32 count and its elements. Anything but little-endian plain CDR
-(encapsulation 0x0001) goes to rclpy's deserializer, so every valid message is read.
+rclpy converts every message taken into Python field by field, and every one published back;
+id_node reads its joint states from the bytes with ``struct`` (strings as rclpy reads them)
+and publishes its torques as bytes written once, only the stamp and efforts rewritten
+(bench/bench_nodes.py measures the saving). The layout is XCDR1, as rmw_fastrtps and
+rmw_cyclonedds send it: a 4-byte encapsulation header, then the fields in order, each
+primitive aligned to its size from the end of the header; a string is a uint32 length (NUL
+included) and its bytes, a sequence a uint32 count and its elements. Anything but
+little-endian plain CDR (encapsulation 0x0001) goes to rclpy's deserializer.
 """
 
 from __future__ import annotations
@@ -76,7 +73,10 @@ def _read_plain_le(raw: bytes) -> JointStateView:
         at = _FRAME_ID + len(block)
     else:
         frame_id, at = _string(raw, _FRAME_ID)
-        count, at = _count(raw, at, end, 5)  # a name takes 5 bytes at least (length, NUL)
+        at = _aligned(at, 4) + 4
+        (count,) = _UINT32.unpack_from(raw, at - 4)
+        if count * 5 > end - at:  # a name takes 5 bytes at least (length, NUL)
+            raise ValueError(f"a sequence of {count} does not fit in {end} bytes")
         listed = []
         for _ in range(count):
             name, at = _string(raw, at)
@@ -112,8 +112,7 @@ def _sequences(raw: bytes, at: int, end: int) -> list[tuple]:
             continue
         pad = -(at - HEADER) % 8
         at += pad
-        layout = _DOUBLES.get(count) or _doubles_layout(count)
-        fields.append(layout.unpack_from(raw, at))
+        fields.append(struct.unpack_from(f"<{count}d", raw, at))
         form += f"{pad}x{count}d"
         at += 8 * count
     _tail_seen = (start, end, struct.Struct(form), tuple(counts), tuple(where[1:]))
@@ -122,15 +121,6 @@ def _sequences(raw: bytes, at: int, end: int) -> list[tuple]:
 
 def _aligned(at: int, size: int) -> int:
     return at + (-(at - HEADER) % size)
-
-
-def _count(raw: bytes, at: int, end: int, element_size: int) -> tuple[int, int]:
-    """A sequence's count and where its elements start; ValueError if they cannot fit."""
-    at = _aligned(at, 4)
-    (count,) = _UINT32.unpack_from(raw, at)
-    if count * element_size > end - at - 4:
-        raise ValueError(f"a sequence of {count} does not fit in {end} bytes")
-    return count, at + 4
 
 
 def _string(raw: bytes, at: int) -> tuple[str, int]:
@@ -143,16 +133,6 @@ def _string(raw: bytes, at: int) -> tuple[str, int]:
     text = raw[start:stop]
     nul = text.find(0)
     return (text if nul < 0 else text[:nul]).decode("utf-8", "replace"), stop
-
-
-_DOUBLES: dict[int, struct.Struct] = {}
-
-
-def _doubles_layout(count: int) -> struct.Struct:
-    layout = struct.Struct(f"<{count}d")
-    if len(_DOUBLES) < 64:  # counts seen: a few joint counts, bounded against odd senders
-        _DOUBLES[count] = layout
-    return layout
 
 
 class EffortMessage:

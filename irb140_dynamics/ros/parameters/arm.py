@@ -1,25 +1,14 @@
-"""A node's parameters: where its arm comes from, the arm's own, and the node's, each declared
-with its descriptor and the value given at startup (see ``overrides``).
+"""A node's parameters: where its arm comes from, the arm's own and the node's, each declared
+with its descriptor and the value given at startup (``overrides``).
 
-``model.source`` (read-only):
-
-- ``parameters`` (default): the model's parameters (``joint_names``, ``<joint>.*``), over
-  the built-in IRB-140 model (config/irb140.yaml); a params file naming other joints gives
-  every per-joint value.
-- ``robot_description``: the chain from ``model.base_link`` to ``model.tip_link`` of a URDF
-  (see ``core.urdf``), from the string parameter ``robot_description`` when it is set, else
-  from the file ``model.urdf_file``, else from the topic ``robot_description``
-  (std_msgs/String, reliable, transient local, as robot_state_publisher publishes it: the
-  node subscribes with ``DESCRIPTION_QOS`` and hands each text to ``read``). The per-joint
-  model parameters are not declared then: the URDF gives the joints, their inertials,
-  limits and friction; ``gravity`` (in the URDF's root frame, turned into base_link's),
-  ``friction.smoothing_velocity`` and ``payload.*`` (on the tip link) work as with
-  parameters, and the node's own per-joint parameters are declared as each URDF comes.
-
-``values()`` gives every parameter by name; ``model_values(values)`` what the node's check
-builds its model from: the values as they are, or a URDF's model under them. The node
-itself declares nothing else, checks every change whole in its own on-set callback and
-builds what it runs on.
+``model.source`` (read-only): ``parameters`` (default), the model's parameters
+(``joint_names``, ``<joint>.*``) over the built-in IRB-140 model (config/irb140.yaml); or
+``robot_description``, the chain from ``model.base_link`` to ``model.tip_link`` of a URDF:
+the parameter ``robot_description``, else the file ``model.urdf_file``, else each text on
+the topic ``robot_description`` (``DESCRIPTION_QOS``, as robot_state_publisher publishes
+it; the node's own per-joint parameters are declared as each URDF comes). Either way the
+model is read as every tool reads it (``core.io.arm_source.read_arm``). The node checks each
+change whole in its own on-set callback (``check_change``) and builds what it runs on.
 """
 
 from __future__ import annotations
@@ -34,71 +23,47 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from irb140_dynamics.core import Joint, RigidBody, RobotModel
 from irb140_dynamics.core.errors import one_line
-from irb140_dynamics.core.io.arm_source import read_arm
+from irb140_dynamics.core.io.arm_source import SOURCES, read_arm, read_urdf_file
 from irb140_dynamics.core.io.params_file import read_parameter_file
-from irb140_dynamics.core.io.text_files import size_limit
-from irb140_dynamics.core.io.urdf import MAX_URDF_CHARS, LoadedUrdf, UrdfError, load_urdf, read_urdf
+from irb140_dynamics.core.io.urdf import LoadedUrdf, load_urdf
 from irb140_dynamics.core.io.urdf.writer import BASE, FLANGE
 from irb140_dynamics.core.model.robot_model import check_joint_names
 from irb140_dynamics.package_files import default_config_path
 from irb140_dynamics.ros.parameters.overrides import Overrides
 from irb140_dynamics.ros.parameters.services import ParameterServices
 from irb140_dynamics.ros.parameters.spec import Spec, as_type
-from irb140_dynamics.ros.parameters.specs import MODEL_NAME, check_choice, joint_names_spec, model_specs
+from irb140_dynamics.ros.parameters.specs import (
+    DESCRIPTION_PARAMETERS,
+    MODEL_NAME,
+    SOURCE,
+    check_choice,
+    joint_names_spec,
+    model_specs,
+)
 from irb140_dynamics.ros.runtime.command_line import params_files_given
 
-SOURCES = ("parameters", "robot_description")
 DESCRIPTION_QOS = QoSProfile(
     depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
 )
-SOURCE = Spec(
-    "model.source",
-    "parameters",
-    "where the model comes from: 'parameters' (joint_names and <joint>.*) or 'robot_description' (URDF)",
-    read_only=True,
-)
-DESCRIPTION_PARAMETERS = [
-    Spec(
-        "robot_description",
-        "",
-        "the URDF text (model.source robot_description); empty: model.urdf_file, else the robot_description topic",
-        read_only=True,
-    ),
-    Spec(
-        "model.urdf_file",
-        "",
-        "a URDF file, when robot_description is empty; empty: the robot_description topic",
-        read_only=True,
-    ),
-    Spec("model.base_link", "", "the URDF link the chain starts from (fixed); empty: the root link", read_only=True),
-    Spec(
-        "model.tip_link",
-        "",
-        "the URDF link where the chain ends, the payload's frame; empty: the only leaf",
-        read_only=True,
-    ),
-]
 STAND_IN = RobotModel((Joint("stand_in", link=RigidBody(1.0)),))  # checks the parameters before a URDF comes
-PerJoint = Callable[[Sequence[str]], list[Spec]]
-
-
-def no_joint_parameters(joint_names) -> list[Spec]:
-    return []
 
 
 class ArmParameters:
-    """The parameters of ``node``: the arm's and ``specs`` (the node's own; ``per_joint``:
-    its own of each joint). ``urdf``: the URDF chain in use (None: a model of parameters,
-    or none yet from the topic); ``from_topic``: the URDF comes on the topic."""
+    """The parameters of ``node``: the arm's and ``specs`` (the node's own; ``per_joint``: its
+    own of each joint). ``urdf``: the URDF chain in use (None: a model of parameters, or none
+    yet from the topic); ``from_topic``: the URDF comes on the topic; ``robot_name``: the
+    hardware_id of /diagnostics."""
 
-    def __init__(self, node: Node, specs: Sequence[Spec], per_joint: PerJoint = no_joint_parameters):
-        self._node, self._per_joint = node, per_joint
+    def __init__(
+        self, node: Node, specs: Sequence[Spec], per_joint: Callable[[Sequence[str]], list[Spec]] | None = None
+    ):
+        self._node, self._per_joint = node, per_joint or (lambda joint_names: [])
         self._overrides = overrides = Overrides(node)
-        self.declaring = False  # declarations are no changes: a node's on-set callback lets them through
+        self.declaring = False  # declarations are no changes: check_change lets them through
         self.urdf: LoadedUrdf | None = None
         self.from_topic = False
         self.refused, self.last_refusal = 0, ""  # URDFs refused on the topic, and why the last one was
-        self.robot_name = ""  # the hardware_id of /diagnostics: model.name, or the URDF's <robot name>
+        self.robot_name = ""
         source = overrides.declare(SOURCE)
         check_choice("model.source", source, SOURCES)
         if source == "robot_description":
@@ -106,13 +71,21 @@ class ArmParameters:
             self._chain_ends = (base or None, tip or None)
             origin = "robot_description parameter" if text else f"model.urdf_file {path}"
             if text or path:
-                self.urdf = self.read(text or _read_file(path), origin)
+                self.urdf = self.read(text or read_urdf_file(path, "model.urdf_file").text, origin)
             self.from_topic = self.urdf is None
             joint_names = None if self.urdf is None else self.urdf.model.joint_names
             arm = model_specs([], {})
         else:
-            joint_names, arm = self._parameters_form()
-        self.declare([*arm, *specs, *([] if joint_names is None else per_joint(joint_names))])
+            path = default_config_path()
+            if not path.is_file():
+                raise ValueError(f"default model: no {path}; is the package installed? (or give --params-file)")
+            defaults, given = read_parameter_file(path), params_files_given()
+            over = f"params file {', '.join(given)} (over the built-in IRB-140 model, {path})"
+            node.get_logger().info(f"model: {over if given else f'the built-in IRB-140 model ({path})'}")
+            joint_names = check_joint_names(overrides.declare(joint_names_spec(defaults["joint_names"])))
+            self.robot_name = overrides.declare(MODEL_NAME)
+            arm = model_specs(joint_names, defaults)
+        self.declare([*arm, *specs, *([] if joint_names is None else self._per_joint(joint_names))])
         overrides.warn_unknown(joint_names)
         if self.urdf is not None:
             self._announce(origin)
@@ -124,20 +97,8 @@ class ArmParameters:
         node.add_pre_set_parameters_callback(self._as_declared_types)
         ParameterServices(node)
 
-    def _parameters_form(self) -> tuple[list[str], list[Spec]]:
-        path = default_config_path()
-        if not path.is_file():
-            raise ValueError(f"default model: no {path}; is the package installed? (or give --params-file)")
-        defaults = read_parameter_file(path)
-        given = params_files_given()
-        over = f"params file {', '.join(given)} (over the built-in IRB-140 model, {path})"
-        self._node.get_logger().info(f"model: {over if given else f'the built-in IRB-140 model ({path})'}")
-        names = check_joint_names(self._overrides.declare(joint_names_spec(defaults["joint_names"])))
-        self.robot_name = self._overrides.declare(MODEL_NAME)
-        return names, model_specs(names, defaults)
-
     def declare(self, specs: Sequence[Spec]) -> None:
-        """Declare parameters not declared yet, with the values given at startup."""
+        """Declare the parameters not declared yet, with the values given at startup."""
         self.declaring = True
         try:
             for spec in specs:
@@ -152,10 +113,9 @@ class ArmParameters:
         return values | {p.name: p.value for p in changes}
 
     def model_values(self, values: dict[str, Any], urdf: LoadedUrdf | None = None) -> dict[str, Any] | None:
-        """What the model is built from: ``values`` with the model's own parameters those of
-        the arm they give (``core.io.arm_source.read_arm``, as every tool reads it: a URDF's
-        chain, ``urdf`` or else the one in use, under the values it takes, ``gravity`` turned
-        from the URDF's root frame into base_link's); None while no URDF has come."""
+        """``values`` with the model's own parameters those of the arm they give (a URDF's
+        chain, ``urdf`` or else the one in use, under the values it takes); None while no
+        URDF has come."""
         urdf = urdf or self.urdf
         if urdf is None and self.from_topic:
             return None
@@ -163,41 +123,34 @@ class ArmParameters:
 
     def read(self, text: str, origin: str = "robot_description topic") -> LoadedUrdf:
         """The URDF's chain (thread-safe: parsing only), or ValueError naming ``origin``."""
-        limit = size_limit(MAX_URDF_CHARS)
-        if len(text) > limit:
-            raise ValueError(f"{origin}: {UrdfError('document', f'{len(text)} characters, more than {limit}')}")
         try:
             return load_urdf(text, *self._chain_ends)
         except ValueError as error:
             raise ValueError(f"{origin}: {error}") from None
 
     def read_topic(self, text: str, previous=None) -> LoadedUrdf | Exception:
-        """A URDF of the topic read (in a worker thread), or the error that refuses it."""
+        """A URDF of the topic read (a Rebuild's build, in its worker thread), or the error
+        that refuses it (on the executor thread, in ``take_urdf``)."""
         try:
             return self.read(text)
-        except Exception as error:  # noqa: BLE001  (refused on the executor thread, see refuse)
+        except Exception as error:  # noqa: BLE001
             return error
 
-    def refuse(self, error: BaseException) -> None:
-        """A URDF of the topic refused: counted and logged; the model in use stays."""
-        self.refused += 1
-        kind = "" if isinstance(error, ValueError) else f"{type(error).__name__}: "
-        self.last_refusal = f"{kind}{one_line(error)}"
-        keeping = "still waiting" if self.urdf is None else f"keeping the model of {self.urdf.model.n} joints"
-        self._node.get_logger().error(f"refused a robot_description ({keeping}): {self.last_refusal}")
-
     def take_urdf(self, urdf: LoadedUrdf | Exception, check: Callable[[dict], Any]) -> Any:
-        """On the executor thread, a URDF of the topic read (see read_topic): the node's
-        per-joint parameters of its joints declared, then checked whole with the values in
-        force (``check``, as in draft); its draft, the URDF in use from now on; or None,
-        refused (see refuse), the model in use staying."""
+        """On the executor thread, a URDF of the topic read: the node's per-joint parameters
+        of its joints declared, then everything checked (``draft``); the draft, the URDF in
+        use from now on. Or None: refused (counted, logged), the model in use staying."""
         try:
             if isinstance(urdf, Exception):
                 raise urdf
             self.declare(self._per_joint(urdf.model.joint_names))
             draft = self.draft(check, self.values(), urdf)
         except Exception as error:  # noqa: BLE001 (nothing of ours may leave a callback)
-            self.refuse(error)
+            self.refused += 1
+            kind = "" if isinstance(error, ValueError) else f"{type(error).__name__}: "
+            self.last_refusal = f"{kind}{one_line(error)}"
+            keeping = "still waiting" if self.urdf is None else f"keeping the model of {self.urdf.model.n} joints"
+            self._node.get_logger().error(f"refused a robot_description ({keeping}): {self.last_refusal}")
             return None
         self.urdf = urdf
         self._announce("robot_description topic")
@@ -205,30 +158,28 @@ class ArmParameters:
 
     def draft(self, check: Callable[[dict], Any], values: dict[str, Any], urdf: LoadedUrdf | None = None) -> Any:
         """``check`` (a node's: its settings, not built yet, or ValueError naming the
-        parameter) of the model's values (see model_values); None while no URDF has come,
-        the node's own values checked on a stand-in arm meanwhile."""
+        parameter) of the model's values; None while no URDF has come, the node's own values
+        checked meanwhile on a one-joint stand-in arm."""
         model_values = self.model_values(values, urdf)
-        if model_values is None:
-            check(self.stand_in(values))
-            return None
-        return check(model_values)
+        if model_values is not None:
+            return check(model_values)
+        defaults = {spec.name: spec.default for spec in self._per_joint(STAND_IN.joint_names)}
+        check({**STAND_IN.to_params(), **defaults, **values})
+        return None
 
     def check_change(self, parameters: Sequence[Parameter], check: Callable[[dict], Any]):
-        """(rclpy's answer, the draft) for a change: ``check`` of every value with the change
-        applied (see draft); a ValueError refuses it, naming the parameter. Declarations pass
-        unchecked (draft None)."""
+        """(rclpy's answer, the draft) for a change: ``draft`` of every value with the change
+        applied; a ValueError refuses it, naming the parameter. Declarations pass (draft None)."""
         if self.declaring:
             return SetParametersResult(successful=True), None
         try:
-            draft = self.draft(check, self.values(parameters))
+            return SetParametersResult(successful=True), self.draft(check, self.values(parameters))
         except ValueError as error:
             return SetParametersResult(successful=False, reason=one_line(error)), None
         except Exception as error:  # noqa: BLE001  (a defect of ours must not end the node)
-            self._node.get_logger().error(f"validating {[p.name for p in parameters]}: {type(error).__name__}: {error}")
-            return SetParametersResult(
-                successful=False, reason=f"internal error: {type(error).__name__}: {error}"
-            ), None
-        return SetParametersResult(successful=True), draft
+            why = f"{type(error).__name__}: {error}"
+            self._node.get_logger().error(f"validating {[p.name for p in parameters]}: {why}")
+            return SetParametersResult(successful=False, reason=f"internal error: {why}"), None
 
     def _as_declared_types(self, parameters: list[Parameter]) -> list[Parameter]:
         """`ros2 param set ... payload.mass 3` means 3.0 for a double parameter (``spec.as_type``)."""
@@ -240,41 +191,26 @@ class ArmParameters:
             for p in parameters
         ]
 
-    def stand_in(self, values: dict[str, Any]) -> dict[str, Any]:
-        """``values`` on a one-joint stand-in arm: what a node checks its own parameters on
-        while no URDF has come."""
-        defaults = {spec.name: spec.default for spec in self._per_joint(STAND_IN.joint_names)}
-        return {**STAND_IN.to_params(), **defaults, **values}
-
     @property
     def chain_links(self) -> tuple[str, str]:
         """(base link, tip link): the frames of markers and wrenches."""
         return (self.urdf.base_link, self.urdf.tip_link) if self.urdf is not None else (BASE, FLANGE)
 
     def _announce(self, origin: str) -> None:
-        self.robot_name = self.urdf.robot_name or "robot"
-        names, held = list(self.urdf.model.joint_names), self.urdf.held_joints
+        urdf, logger = self.urdf, self._node.get_logger()
+        self.robot_name = urdf.robot_name or "robot"
+        names, held = list(urdf.model.joint_names), urdf.held_joints
         held = f"; held at zero: {', '.join(held)}" if held else ""
-        logger = self._node.get_logger()
-        chain = f"{self.urdf.base_link} -> {self.urdf.tip_link}"
-        logger.info(f"model from the {origin}: {chain}, {len(names)} joints {names}{held}")
-        for warning in self.urdf.warnings:
+        logger.info(f"model from the {origin}: {urdf.base_link} -> {urdf.tip_link}, {len(names)} joints {names}{held}")
+        for warning in urdf.warnings:
             logger.warning(warning)
-        for note in self.urdf.notes:
+        for note in urdf.notes:
             logger.info(f"note: {note}")
 
 
-def _read_file(path: str) -> str:
-    """The file's text, bounded (``read_urdf``: a regular file, of at most MAX_URDF_CHARS)."""
-    try:
-        return read_urdf(path)
-    except UrdfError as error:
-        raise ValueError(f"model.urdf_file: {error.reason}") from None
-
-
 def declare_fixed(node: Node, specs: Sequence[Spec]) -> list[Any]:
-    """Declare the parameters of a node without an arm, read only at startup (read-only
-    ones), with the values given, and serve the parameter services; their values, in order."""
+    """Declare the parameters of a node without an arm (read-only, read at startup) with the
+    values given, and serve the parameter services; their values, in order."""
     overrides = Overrides(node)
     values = [overrides.declare(spec) for spec in specs]
     overrides.warn_unknown(None)

@@ -1,16 +1,12 @@
-"""The parameter values given to a node at startup (params files, ``-p``), read through rclpy's
-public API, and the warning about those no node of the package has.
+"""The values given to a node at startup (params files, ``-p``), read through rclpy's public
+API, and a warning for each that no node of the package has.
 
-A node is made with ``NODE_OPTIONS``: rclpy then declares every value given as a parameter
-of its own (``automatically_declare_parameters_from_overrides``), which is how its name,
-type and value can be read. ``Overrides`` takes them over: it undeclares them at once and
-keeps them, and each of the node's parameters is then declared with its descriptor and the
-value given (see ``spec.declare``: an integer for a double taken as that double). What is
-left when the node has declared everything is warned about by name, with the nearest known
-name: a typo in a params file (``payload.mas``), or a list written as a mapping (``dh: {a:
-...}``, which rcl flattens to ``dh.a``, ...), would otherwise leave the default in force
-without a word. A parameter of a sibling node (one ``/**`` section serves them all) is not
-warned about.
+Made with ``NODE_OPTIONS``, rclpy declares every value given as a parameter of the node;
+``Overrides`` undeclares them at once and keeps them, for the node's own declarations (with
+descriptors) to take. What is left is warned about by name, with the nearest known name: a
+typo (``payload.mas``) or a list written as a mapping (``dh: {a: ...}``, flattened by rcl to
+``dh.a``) would otherwise leave the default in force without a word. A sibling node's
+parameter (one ``/**`` section serves them all) is no typo.
 """
 
 from __future__ import annotations
@@ -28,8 +24,8 @@ from irb140_dynamics.core.io.parameter_names import (
 )
 from irb140_dynamics.ros.parameters.spec import Spec, declare
 
-# how every node of the package is made: the values given read as parameters (see above);
-# the parameter services are the package's own (``services``)
+# how every node of the package is made: the values given read as parameters (see above),
+# the parameter services the package's own (``services``)
 NODE_OPTIONS = {"automatically_declare_parameters_from_overrides": True, "start_parameter_services": False}
 RCLPY_PARAMETERS = ("use_sim_time", "start_type_description_service")  # declared by rclpy itself: left to it
 MAX_UNKNOWN_WARNINGS = 10

@@ -1,13 +1,11 @@
-"""A node's parameter services (the six of rcl_interfaces, as ``ros2 param`` calls them),
-answered through the node's public parameter API, and safe against any request.
+"""A node's six parameter services (as ``ros2 param`` calls them), answered through the node's
+public parameter API and safe against any request.
 
 rclpy's own set services raise inside the callback on a parameter type they do not know (a
 ParameterValue.type of 99, from a hand-made client), which ends the node's spin, and let
-''  through to its internals. Here a set request refuses such a parameter by name, and an
-unknown name naming the nearest known one; the rest is set as rclpy does, one by one
-(SetParameters) or all or none (SetParametersAtomically), each change checked whole by the
-node's own on-set callback. Any other failure is answered with an empty response and
-warned about (throttled): the node goes on.
+'' through to its internals. Here such a parameter, or a name not declared, is refused by
+name (with the nearest known one); the rest is set as rclpy sets it, each change checked
+whole by the node's on-set callback. Any other failure is an empty response and a warning.
 """
 
 from __future__ import annotations
@@ -34,7 +32,7 @@ PARAMETER_TYPES = {kind.value for kind in Parameter.Type}
 
 
 class ParameterServices:
-    """The six parameter services of ``node`` (``~/set_parameters``, ...)."""
+    """The parameter services of ``node`` (``~/set_parameters``, ...)."""
 
     def __init__(self, node: Node):
         self._node = node
@@ -56,27 +54,26 @@ class ParameterServices:
     def _answered(self, srv_type, answer):
         def callback(request, response):
             try:
-                return answer(request, response) or response
+                answer(request, response)
+                return response
             except Exception as error:  # noqa: BLE001  (no request may end the node)
-                self._node.get_logger().warning(
-                    f"{srv_type.__name__} request failed: {type(error).__name__}: {error}", throttle_duration_sec=2.0
-                )
+                why = f"{srv_type.__name__} request failed: {type(error).__name__}: {error}"
+                self._node.get_logger().warning(why, throttle_duration_sec=2.0)
                 return srv_type.Response()
 
         return callback
 
-    def _declared(self, names) -> bool:
+    def _declared(self, names) -> bool:  # as rclpy: one name not declared, none answered
         return all(self._node.has_parameter(name) for name in names)
 
     def _describe(self, request, response) -> None:
-        if self._declared(request.names):  # as rclpy: one name not declared, none answered
+        if self._declared(request.names):
             response.descriptors = self._node.describe_parameters(list(request.names))
 
     def _get(self, request, response) -> None:
         if self._declared(request.names):
             with contextlib.suppress(ParameterUninitializedException):  # as rclpy: one without a value, none
-                parameters = self._node.get_parameters(list(request.names))
-                response.values = [p.get_parameter_value() for p in parameters]
+                response.values = [p.get_parameter_value() for p in self._node.get_parameters(list(request.names))]
 
     def _get_types(self, request, response) -> None:
         if self._declared(request.names):
@@ -86,23 +83,20 @@ class ParameterServices:
         with contextlib.suppress(TypeError, ValueError):  # as rclpy: a bad request, an empty list
             response.result = self._node.list_parameters(list(request.prefixes), request.depth)
 
-    def _set(self, request, response) -> None:
-        """Each parameter set on its own, in order."""
+    def _set(self, request, response) -> None:  # each parameter on its own, in order
         response.results = [self._set_all([message]) for message in request.parameters]
 
     def _set_atomically(self, request, response) -> None:
         response.result = self._set_all(request.parameters)
 
     def _set_all(self, messages) -> SetParametersResult:
-        refusal = self._refusal(messages)
-        return refusal or self._node.set_parameters_atomically(_parameters(messages))
-
-    def _refusal(self, messages) -> SetParametersResult | None:
-        """A parameter of no known type, or a name not declared, refused by name; else None."""
         for message in messages:
             if message.value.type not in PARAMETER_TYPES:
-                return _refused(f"{message.name!r}: {message.value.type} is not a parameter type")
-        return undeclared(self._node, [m.name for m in messages])
+                return SetParametersResult(
+                    successful=False, reason=f"{message.name!r}: {message.value.type} is not a parameter type"
+                )
+        refused = undeclared(self._node, [message.name for message in messages])
+        return refused or self._node.set_parameters_atomically([Parameter.from_parameter_msg(m) for m in messages])
 
 
 def undeclared(node: Node, names) -> SetParametersResult | None:
@@ -111,14 +105,7 @@ def undeclared(node: Node, names) -> SetParametersResult | None:
     if not unknown:
         return None
     hint = nearest_hint(unknown[0], node.list_parameters([], 0).names) if unknown[0] else ""
-    return _refused(
-        f"undeclared parameter{'s' if len(unknown) > 1 else ''} {unknown}: not a parameter of this node{hint}"
+    plural = "s" if len(unknown) > 1 else ""
+    return SetParametersResult(
+        successful=False, reason=f"undeclared parameter{plural} {unknown}: not a parameter of this node{hint}"
     )
-
-
-def _parameters(messages) -> list[Parameter]:
-    return [Parameter.from_parameter_msg(message) for message in messages]
-
-
-def _refused(reason: str) -> SetParametersResult:
-    return SetParametersResult(successful=False, reason=reason)

@@ -1,7 +1,6 @@
-"""One parameter of a node (``Spec``): its name, default, and the ``ParameterDescriptor`` that
-states its type, range, read-only flag and description once, for rclpy to enforce, for
-``ros2 param describe`` and for ``--help``; and its declaration with a value given at startup.
-"""
+"""One parameter of a node (``Spec``): its name, default, type, range, unit, read-only flag
+and description, stated once: for rclpy to enforce (its ``ParameterDescriptor``), for
+``ros2 param describe`` and for ``--help``; and its declaration with the value given."""
 
 from __future__ import annotations
 
@@ -31,9 +30,7 @@ class Spec:
 
     @property
     def type(self) -> Parameter.Type:
-        if isinstance(self.default, Parameter.Type):
-            return self.default
-        return Parameter.Type.from_parameter_value(self.default)
+        return self.default if not self.has_default else Parameter.Type.from_parameter_value(self.default)
 
     @property
     def has_default(self) -> bool:
@@ -46,15 +43,16 @@ class Spec:
         descriptor = ParameterDescriptor(
             name=self.name, type=self.type.value, description=self.description + unit, read_only=self.read_only
         )
-        if self.type not in (Parameter.Type.INTEGER, Parameter.Type.DOUBLE):
-            return descriptor
-        if self.minimum is None or self.maximum is None or not math.isfinite(self.maximum - self.minimum):
+        low, high = self.minimum, self.maximum
+        if self.type in (Parameter.Type.INTEGER, Parameter.Type.DOUBLE) and not (
+            low is not None and high is not None and math.isfinite(high - low)
+        ):
             raise ValueError(f"{self.name}: a numeric parameter needs a finite range (minimum and maximum)")
         if self.type == Parameter.Type.INTEGER:
-            descriptor.integer_range = [IntegerRange(from_value=int(self.minimum), to_value=int(self.maximum), step=1)]
-        else:
+            descriptor.integer_range = [IntegerRange(from_value=int(low), to_value=int(high), step=1)]
+        elif self.type == Parameter.Type.DOUBLE:
             descriptor.floating_point_range = [
-                FloatingPointRange(from_value=float(self.minimum), to_value=float(self.maximum), step=0.0)
+                FloatingPointRange(from_value=float(low), to_value=float(high), step=0.0)
             ]
         return descriptor
 

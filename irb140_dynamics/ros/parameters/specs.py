@@ -1,5 +1,5 @@
-"""The parameters every node shares: the robot model's (``model_specs``, with the finite
-ranges of its numbers) and the joint_states QoS; and ``check_choice``, the one rule a
+"""The parameters every node shares: where the arm comes from, the model's own (with the
+finite ranges of its numbers), the joint_states QoS; and ``check_choice``, the one rule a
 descriptor cannot state for a string (its choices)."""
 
 from __future__ import annotations
@@ -11,22 +11,14 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
+from irb140_dynamics.core.io.arm_source import DEFAULT_ROBOT_NAME
 from irb140_dynamics.core.model.joints import MAX_FRICTION, MAX_TORQUE_LIMIT, param_prefix
-from irb140_dynamics.core.model.rigid_body import MAX_MASS as CORE_MAX_MASS
+from irb140_dynamics.core.model.rigid_body import MAX_MASS
 from irb140_dynamics.ros.parameters.spec import Spec
 
-# The finite ranges of the model's numbers (ParameterDescriptor ranges, `ros2 param describe`):
-# wide, to keep inf, nan and 1e308 out, not to judge the robot.
-# Masses, torque limits and friction: the core's own caps (core.model), so that the
-# descriptor and the model (a URDF's effort included) refuse the same values.
-MAX_MASS = CORE_MAX_MASS  # kg
+# The finite ranges of the model's numbers: wide, to keep inf, nan and 1e308 out, not to
+# judge the robot; masses (kg), torque limits and friction the core's own caps (a URDF's too).
 MAX_TORQUE = MAX_TORQUE_LIMIT  # N m (torque limits, collision thresholds)
-MAX_VELOCITY = 1e4  # rad/s
-MAX_ACCELERATION = 1e7  # rad/s^2
-MAX_VISCOUS = MAX_FRICTION  # N m s/rad
-MAX_COULOMB = MAX_FRICTION  # N m
-MAX_ARMATURE = MAX_FRICTION  # kg m^2
-MAX_SMOOTHING_VELOCITY = 1e3  # rad/s
 MAX_QOS_DEPTH = 10_000  # messages: 10 s at 1 kHz; DDS may reserve memory for the whole depth
 RELIABILITIES = {"best_effort": ReliabilityPolicy.BEST_EFFORT, "reliable": ReliabilityPolicy.RELIABLE}
 QOS_PARAMETERS = [
@@ -46,6 +38,38 @@ QOS_PARAMETERS = [
         maximum=MAX_QOS_DEPTH,
     ),
 ]
+JOINT_NUMBERS = (  # each joint's numbers of 0 and up: (name suffix, description, unit, maximum)
+    ("torque_limit", "joint torque limit, 0 = none given", "N m", MAX_TORQUE),
+    ("velocity_limit", "joint speed limit, 0 = none given", "rad/s", 1e4),
+    ("acceleration_limit", "joint acceleration limit, 0 = none given", "rad/s^2", 1e7),
+    ("friction.viscous", "viscous friction coefficient", "N m s/rad", MAX_FRICTION),
+    ("friction.coulomb", "Coulomb friction level (smoothed, see friction.smoothing_velocity)", "N m", MAX_FRICTION),
+    ("armature", "rotor inertia reflected through the gear, added to M's diagonal", "kg m^2", MAX_FRICTION),
+)
+MODEL_NAME = Spec(
+    "model.name",
+    DEFAULT_ROBOT_NAME,
+    "the robot's name, the hardware_id of the nodes' /diagnostics (a URDF model: its <robot name>)",
+    read_only=True,
+)
+SOURCE = Spec(
+    "model.source",
+    "parameters",
+    "where the model comes from: 'parameters' (joint_names and <joint>.*) or 'robot_description' (URDF)",
+    read_only=True,
+)
+DESCRIPTION_PARAMETERS = [  # model.source robot_description
+    Spec(name, "", description, read_only=True)
+    for name, description in (
+        (
+            "robot_description",
+            "the URDF text (model.source robot_description); empty: model.urdf_file, else the robot_description topic",
+        ),
+        ("model.urdf_file", "a URDF file, when robot_description is empty; empty: the robot_description topic"),
+        ("model.base_link", "the URDF link the chain starts from (fixed); empty: the root link"),
+        ("model.tip_link", "the URDF link where the chain ends, the payload's frame; empty: the only leaf"),
+    )
+]
 
 
 def check_choice(name: str, value, choices) -> None:
@@ -59,22 +83,15 @@ def joint_states_qos(node: Node) -> QoSProfile:
     return QoSProfile(depth=node.get_parameter("qos.depth").value, reliability=reliability)
 
 
-JOINT_NUMBERS = (  # each joint's numbers of 0 and up: (name suffix, description, unit, maximum)
-    ("torque_limit", "joint torque limit, 0 = none given", "N m", MAX_TORQUE),
-    ("velocity_limit", "joint speed limit, 0 = none given", "rad/s", MAX_VELOCITY),
-    ("acceleration_limit", "joint acceleration limit, 0 = none given", "rad/s^2", MAX_ACCELERATION),
-    ("friction.viscous", "viscous friction coefficient", "N m s/rad", MAX_VISCOUS),
-    ("friction.coulomb", "Coulomb friction level (smoothed, see friction.smoothing_velocity)", "N m", MAX_COULOMB),
-    ("armature", "rotor inertia reflected through the gear, added to M's diagonal", "kg m^2", MAX_ARMATURE),
-)
+def joint_names_spec(names: list[str]) -> Spec:
+    """``joint_names``, with these names as its default."""
+    return Spec("joint_names", list(names), "the model's joints, base to flange", read_only=True)
 
 
 def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
-    """The model's parameters for these joints; defaults from the default model's file.
-
-    The per-joint defaults apply only when the joints are the default model's own: a
-    params file naming other joints must give every value (nothing is silently borrowed).
-    """
+    """The model's parameters for these joints, the defaults those of the default model's
+    file; its per-joint defaults only when the joints are its own (a params file naming
+    other joints gives every value: nothing is silently borrowed)."""
     own = list(defaults.get("joint_names", [])) == list(joint_names)
 
     def default(name, kind):
@@ -88,7 +105,7 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
             "Coulomb friction is coulomb * tanh(qd / this)",
             "rad/s",
             minimum=1e-9,
-            maximum=MAX_SMOOTHING_VELOCITY,
+            maximum=1e3,
         ),
         *_body_specs(
             "payload", "the payload on the flange", "flange frame", lambda name, kind: defaults.get(name, kind)
@@ -96,20 +113,16 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
     ]
     for name in joint_names:
         joint = param_prefix(name)  # the joint's parameter prefix (its name, if a parameter name)
+        dh, limits = f"{joint}.dh", f"{joint}.position_limits"
         specs += [
             Spec(
-                f"{joint}.dh",
-                default(f"{joint}.dh", Parameter.Type.DOUBLE_ARRAY),
+                dh,
+                default(dh, Parameter.Type.DOUBLE_ARRAY),
                 "standard DH row [a, alpha, d, theta_offset]",
                 "m, rad, m, rad",
             ),
             *_body_specs(f"{joint}.link", f"the link {joint} moves", "its DH frame", default),
-            Spec(
-                f"{joint}.position_limits",
-                default(f"{joint}.position_limits", [-math.pi, math.pi]),
-                "[lower, upper] joint position",
-                "rad",
-            ),
+            Spec(limits, default(limits, [-math.pi, math.pi]), "[lower, upper] joint position", "rad"),
             *(
                 Spec(f"{joint}.{suffix}", default(f"{joint}.{suffix}", 0.0), text, unit, minimum=0.0, maximum=maximum)
                 for suffix, text, unit, maximum in JOINT_NUMBERS
@@ -119,40 +132,13 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
 
 
 def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
-    zeros3, zeros6 = [0.0] * 3, [0.0] * 6
-    optional = prefix == "payload"
+    """mass, com and inertia of a body: a payload's are none by default, a link's are to be given."""
+    payload = prefix == "payload"
+    mass, com, inertia = f"{prefix}.mass", f"{prefix}.com", f"{prefix}.inertia"
+    double, array = Parameter.Type.DOUBLE, Parameter.Type.DOUBLE_ARRAY
+    inertia_text = f"inertia of {what} about its centre of mass, [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]"
     return [
-        Spec(
-            f"{prefix}.mass",
-            default(f"{prefix}.mass", 0.0 if optional else Parameter.Type.DOUBLE),
-            f"mass of {what}",
-            "kg",
-            minimum=0.0,
-            maximum=MAX_MASS,
-        ),
-        Spec(
-            f"{prefix}.com",
-            default(f"{prefix}.com", zeros3 if optional else Parameter.Type.DOUBLE_ARRAY),
-            f"centre of mass of {what}, in {frame}",
-            "m",
-        ),
-        Spec(
-            f"{prefix}.inertia",
-            default(f"{prefix}.inertia", zeros6 if optional else Parameter.Type.DOUBLE_ARRAY),
-            f"inertia of {what} about its centre of mass, [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]",
-            "kg m^2",
-        ),
+        Spec(mass, default(mass, 0.0 if payload else double), f"mass of {what}", "kg", minimum=0.0, maximum=MAX_MASS),
+        Spec(com, default(com, [0.0] * 3 if payload else array), f"centre of mass of {what}, in {frame}", "m"),
+        Spec(inertia, default(inertia, [0.0] * 6 if payload else array), inertia_text, "kg m^2"),
     ]
-
-
-def joint_names_spec(names: list[str]) -> Spec:
-    """``joint_names``, with these names as its default."""
-    return Spec("joint_names", list(names), "the model's joints, base to flange", read_only=True)
-
-
-MODEL_NAME = Spec(
-    "model.name",
-    "irb140",
-    "the robot's name, the hardware_id of the nodes' /diagnostics (a URDF model: its <robot name>)",
-    read_only=True,
-)

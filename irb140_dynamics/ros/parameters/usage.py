@@ -6,9 +6,14 @@ from dataclasses import replace
 
 from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.package_files import default_config_path
-from irb140_dynamics.ros.parameters.arm import DESCRIPTION_PARAMETERS, SOURCE
 from irb140_dynamics.ros.parameters.spec import Spec
-from irb140_dynamics.ros.parameters.specs import MODEL_NAME, joint_names_spec, model_specs
+from irb140_dynamics.ros.parameters.specs import (
+    DESCRIPTION_PARAMETERS,
+    MODEL_NAME,
+    SOURCE,
+    joint_names_spec,
+    model_specs,
+)
 
 JOINT = "NAME"  # stands for each joint of joint_names in the per-joint parameters
 
@@ -20,18 +25,14 @@ def model_sections() -> list[tuple[str, list[Spec]]]:
         defaults = read_parameter_file(default_config_path())
     except (OSError, ValueError):  # help without the file: the types, no defaults
         defaults = {}
-    names = list(defaults.get("joint_names", []))
     specs = model_specs([JOINT], {})
-    whole = [
-        replace(spec, default=defaults[spec.name]) if spec.name in defaults else spec
-        for spec in specs
-        if not spec.name.startswith(f"{JOINT}.")
-    ]
     per_joint = [spec for spec in specs if spec.name.startswith(f"{JOINT}.")]
+    whole = [replace(spec, default=defaults.get(spec.name, spec.default)) for spec in specs if spec not in per_joint]
+    names = list(defaults.get("joint_names", [])) or [JOINT]
     return [
         (
             "The model (defaults: the built-in IRB-140 model, config/irb140.yaml)",
-            [SOURCE, MODEL_NAME, joint_names_spec(names or [JOINT]), *whole],
+            [SOURCE, MODEL_NAME, joint_names_spec(names), *whole],
         ),
         (f"Per joint, {JOINT} = each of joint_names (the built-in model gives every one for its joints)", per_joint),
         ("The model from a URDF (model.source: robot_description)", list(DESCRIPTION_PARAMETERS)),

@@ -1,3 +1,3 @@
-"""What every node needs to run: main() and spinning (``spin``), callbacks that never
-raise (``guard``), slow work off the executor (``rebuild``), /diagnostics statuses
+"""What every node needs to run: main() and spinning (``spin``, ``command_line``), callbacks
+that never raise (``guard``), slow work off the executor (``rebuild``), /diagnostics
 (``diagnostics``), publishers that know their subscribers (``listened``)."""

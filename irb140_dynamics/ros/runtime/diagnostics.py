@@ -1,29 +1,22 @@
-"""Statuses for /diagnostics (rqt_robot_monitor, aggregators): a payload check, and the
-message counts of id_node.
-
-The key-values of a payload check are its own figures (PayloadCheck.joint_figures,
-payload_figures): the same strings as in the ~/check report.
-"""
+"""Statuses for /diagnostics: a payload check (its key-values the figures of the ~/check
+report), and the message counts of id_node."""
 
 from __future__ import annotations
-
-import math
 
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
 
 from irb140_dynamics.core.payload import PayloadCheck
 
 OK, WARN, ERROR = DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR
+LEVELS = {"OK": OK, "WARN": WARN, "ERROR": ERROR}
 
 
 def payload_statuses(
     check: PayloadCheck, node_name: str, warn_use: float, stale: str | None = None
 ) -> list[DiagnosticStatus]:
-    """One status per joint (OK; WARN from ``warn_use`` %, when the payload loads a joint
-    without a limit, or when its proof cannot tell whether it is within its limit; ERROR
-    proven over its limit), then one for the payload with the largest payloads and the
-    verdict (``PayloadCheck.headline``), WARN at least when ``stale`` (how old the joint
-    state is) is given."""
+    """One status per joint (``PayloadCheck.joint_status``), then one for the payload: its
+    largest payloads and the verdict (``PayloadCheck.headline``), WARN at least when
+    ``stale`` (how old the joint state is) is given."""
     statuses = [_joint_status(check, j, node_name, warn_use) for j in range(len(check.joint_names))]
     figures = check.payload_figures()
     message = check.headline()
@@ -36,45 +29,20 @@ def payload_statuses(
         name=f"{node_name}: payload",
         hardware_id=node_name,
         message=message,
-        values=_key_values(figures),
+        values=[KeyValue(key=key, value=value) for key, value in figures.items()],
     )
     return statuses + [summary]
 
 
 def _joint_status(check: PayloadCheck, j: int, node_name: str, warn_use: float) -> DiagnosticStatus:
-    figures = check.joint_figures(j)
-    limit = check.limit[j]
-    uses = {"worst use": check.worst_use[j], **({} if check.use is None else {"use now": check.use[j]})}
-    most = max(uses, key=uses.get)
-    if check.beyond[j]:
-        level = ERROR
-    elif not check.within[j]:
-        level = WARN
-    elif math.isfinite(limit):
-        level = WARN if uses[most] >= warn_use else OK
-    else:
-        level = WARN if j in check.loaded_without_limit else OK
-    if not check.beyond[j] and not check.within[j]:
-        message = (
-            f"unproven: {figures[most]} of its {figures['limit [N m]']} N m limit by its bound: {check.unfinished}"
-        )
-    elif math.isfinite(limit):
-        message = f"{figures[most]} of its {figures['limit [N m]']} N m limit"
-    elif level == WARN:
-        message = check.no_limit_note(j)
-    else:
-        message = figures["limit source"]
+    level, message = check.joint_status(j, warn_use)
     return DiagnosticStatus(
-        level=level,
+        level=LEVELS[level],
         name=f"{node_name}: {check.joint_names[j]}",
         hardware_id=node_name,
         message=message,
-        values=_key_values(figures),
+        values=[KeyValue(key=key, value=value) for key, value in check.joint_figures(j).items()],
     )
-
-
-def _key_values(figures: dict[str, str]) -> list[KeyValue]:
-    return [KeyValue(key=key, value=value) for key, value in figures.items()]
 
 
 def message_status(node_name: str, hardware_id: str, counts, recent, parameters, waiting: bool) -> DiagnosticStatus:

@@ -1,13 +1,10 @@
 """No exception of ours leaves a ROS callback: what fails is dropped, counted and warned about.
 
-``Tally`` keeps a node's message counts per topic (``joint_states.received``,
-``joint_states.dropped_not_finite``, ``reference.dropped_non_finite_torques``, ...) and
-warns about drops and errors, at most once every ``WARN_PERIOD`` seconds per topic. The
-keys come from fixed sets (topics, the kinds of BadMessage), so the counts stay bounded.
-
-``guarded(topic)`` wraps a node's callback method (subscription, timer, service): an
-exception escaping it is counted as ``<topic>.errors`` and warned about, and the node
-goes on (a service then answers ``fallback(request, response, error)``).
+``Tally`` keeps a node's message counts by ``<topic>.<what>`` (``joint_states.received``,
+``joint_states.dropped_not_finite``, ...: fixed sets of keys, so the counts stay bounded)
+and warns at most once every ``WARN_PERIOD`` seconds per topic. ``guarded(topic)`` wraps a
+callback method: an exception escaping it is counted as ``<topic>.errors``, warned about,
+and the node goes on (a service then answers ``fallback(request, response, error)``).
 """
 
 from __future__ import annotations
@@ -21,8 +18,6 @@ WARN_PERIOD = 2.0  # s between two warnings about the same topic
 
 
 class Tally:
-    """Message counts by ``<topic>.<what>``, and warnings throttled per topic."""
-
     def __init__(self, logger, warn_period: float = WARN_PERIOD):
         self.counts: Counter[str] = Counter()
         self._logger = logger

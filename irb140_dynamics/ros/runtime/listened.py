@@ -1,10 +1,6 @@
-"""Publishers that know whether anything subscribes, at no cost per message.
-
-``Publisher.get_subscription_count`` is an rcl call; asked for every
-message of three topics, it cost more than the torques it saved. A ``ListenedPublisher``
-keeps the count from DDS's matched events instead, served by the node's executor: a new
-subscriber is counted once DDS has matched it and the executor has taken the event.
-"""
+"""Publishers that know whether anything subscribes, at no cost per message: the count comes
+from DDS's matched events (served by the node's executor), not from an rcl call per message
+(``get_subscription_count``: it cost more than the torques it saved)."""
 
 from __future__ import annotations
 

@@ -1,17 +1,11 @@
 """Slow work off the executor: the newest job built in a worker thread, its result handed back.
 
-A node's executor thread serves its messages; building a new configuration there
-(compiling kernels, sweeping the workspace) would stall them. ``Rebuild.submit(job)``
-builds ``build(job, previous)`` in a worker thread and gives the result (or a ``Failed``)
-to ``use`` on the node's executor thread, through ``executor.create_task``: rclpy's
-executors, the EventsExecutor included, run a task made from another thread at once,
-waking from their wait. Only the newest job counts: one submitted while another is built
-cancels it (a build that checks ``core.payload.stop.out_of_time`` stops at its next
-check and is dropped), so changes faster than builds end with the newest.
-
-While a build runs, the executor thread must still get the interpreter lock quickly:
-``submit`` lowers the interpreter's switch interval to SWITCH_INTERVAL (process-wide; it
-only matters while two threads want to run Python, i.e. during builds).
+``Rebuild.submit(job)`` builds ``build(job, previous)`` (compiling kernels, sweeping the
+workspace: what would stall the messages) in a worker thread and gives the result to ``use``
+on the executor thread through ``executor.create_task`` (run at once by every rclpy executor,
+the EventsExecutor included). A newer job cancels the build under way (``core.payload.stop``),
+so a burst of changes ends with the newest. ``submit`` lowers the interpreter's switch
+interval (process-wide) so that the executor thread gets the lock quickly meanwhile.
 """
 
 from __future__ import annotations
@@ -38,51 +32,48 @@ class Failed:
 
 
 class Rebuild:
-    """``build(job, previous)`` off the executor, the newest only; ``use(result)`` on it.
-    ``previous`` is the last result built (None at first)."""
+    """``build(job, previous)`` off the executor, the newest only; ``use(result)`` on it, then
+    ``settled()`` if given (also after a failure, which keeps what is in force). ``previous``:
+    the last result built (None at first); ``pending_since``: time.monotonic() of the newest
+    job not yet in force; ``failure``: why the newest build failed."""
 
     def __init__(self, node, build: Callable[[Any, Any], Any], use: Callable[[Any], None], settled=None):
-        """``settled()``, if given, is called after each result is used or has failed."""
         self._node, self._build, self._use, self._settled = node, build, use, settled
         self._lock = threading.Lock()
         self._generation = 0  # of the newest job
-        self._cancel = threading.Event()
-        self._job: tuple[int, Any, threading.Event] | None = None  # the newest job not yet started
+        self._cancel = threading.Event()  # of the newest job
+        self._job: tuple[int, Any, threading.Event] | None = None  # the newest job, not yet started
         self._worker = False  # a worker thread is under way
         self._ready: tuple[int, Any] | None = None  # the newest result, not yet used
         self._built = threading.Event()  # set with _ready
         self.previous = None
-        self.pending_since: float | None = None  # time.monotonic() of the newest job not yet in force
-        self.failure: str | None = None  # why the newest build failed (what was in force stays)
+        self.pending_since: float | None = None
+        self.failure: str | None = None
 
     def submit(self, job: Any) -> None:
-        """Build ``job`` in the worker thread (started when there is work, ended when there is
-        none); the build under way, if any, is cancelled, and jobs waiting collapse into this."""
-        generation, cancel = self._next(pending=True)
+        """Build ``job`` in the worker thread (started when there is work, ending when there is none)."""
         if sys.getswitchinterval() > SWITCH_INTERVAL:
             sys.setswitchinterval(SWITCH_INTERVAL)
         with self._lock:
-            self._job = (generation, job, cancel)
-            if self._worker:
-                return
-            self._worker = True
-        threading.Thread(target=self._run, daemon=True).start()
+            self._job = (*self._next(pending=True), job)
+            start, self._worker = not self._worker, True
+        if start:
+            threading.Thread(target=self._run, daemon=True).start()
 
     def build_here(self, job: Any) -> None:
         """Build ``job`` on this thread (a quick one) and use it; builds under way are superseded."""
-        self._next(pending=False)
+        with self._lock:
+            self._next(pending=False)
         self._deliver(self._built_from(job))
 
     def wait(self, timeout: float) -> bool:
         """Before spinning: wait up to ``timeout`` s for the newest result and use it here
-        (its error raised). True if it was used."""
+        (a failure raised). True if it was used."""
         if not self._built.wait(timeout):
             return False
-        with self._lock:
-            ready, self._ready = self._ready, None
-            self._built.clear()
-            if ready is None or ready[0] != self._generation:
-                return False
+        ready = self._take(self._generation)
+        if ready is None:
+            return False
         if isinstance(ready[1], Failed):
             raise ready[1].error
         self._deliver(ready[1])
@@ -97,16 +88,25 @@ class Rebuild:
         return None
 
     def _next(self, pending: bool) -> tuple[int, threading.Event]:
+        """A new generation (under the lock): the build under way cancelled, results dropped."""
+        self._cancel.set()
+        self._cancel = threading.Event()
+        self._generation += 1
+        self._job = self._ready = None
+        self._built.clear()
+        if pending and self.pending_since is None:
+            self.pending_since = time.monotonic()
+        return self._generation, self._cancel
+
+    def _take(self, generation: int) -> tuple[int, Any] | None:
+        """The result ready, if it is of ``generation`` and that is the newest; else None."""
         with self._lock:
-            self._cancel.set()
-            self._cancel = threading.Event()
-            self._generation += 1
-            self._job = None
+            ready = self._ready
+            if ready is None or ready[0] != generation or generation != self._generation:
+                return None
             self._ready = None
             self._built.clear()
-            if pending and self.pending_since is None:
-                self.pending_since = time.monotonic()
-            return self._generation, self._cancel
+        return ready
 
     def _deliver(self, result: Any) -> None:
         """Use a result (on the executor thread, or before spinning), or note its failure."""
@@ -131,13 +131,13 @@ class Rebuild:
         return result
 
     def _run(self) -> None:
-        """The worker thread: build the newest job until there is none."""
+        """The worker thread: build the newest job until there is none, handing each result over."""
         while True:
             with self._lock:
                 if self._job is None:
                     self._worker = False
                     return
-                (generation, job, cancel), self._job = self._job, None
+                (generation, cancel, job), self._job = self._job, None
             try:
                 with stopping(cancel):
                     result = self._built_from(job)
@@ -148,29 +148,18 @@ class Rebuild:
                     continue
                 self._ready = (generation, result)
                 self._built.set()
-            executor = self._executor(cancel)
-            if executor is not None:
+            node = self._node  # a build done while the node is being made waits for its executor
+            while node.executor is None:
+                if not node.context.ok() or cancel.wait(EXECUTOR_WAIT):
+                    break
+            else:
                 try:
-                    executor.create_task(self._hand_over, generation)
+                    node.executor.create_task(self._hand_over, generation)
                 except Exception:  # noqa: BLE001  (the executor shut down meanwhile: nothing to hand over to)
                     continue
 
-    def _executor(self, cancel: threading.Event):
-        """The node's executor; a build done while the node is being made waits for it
-        (None once superseded or shut down)."""
-        node = self._node
-        while node.executor is None:
-            if not node.context.ok() or cancel.wait(EXECUTOR_WAIT):
-                return None
-        return node.executor
-
     def _hand_over(self, generation: int) -> None:
-        """On the executor thread: use the result unless a newer job was submitted since
-        (or it was used already)."""
-        with self._lock:
-            ready = self._ready
-            if ready is None or ready[0] != generation or generation != self._generation:
-                return
-            self._ready = None
-            self._built.clear()
-        self._deliver(ready[1])
+        """On the executor thread: use the result unless a newer job came since (or it was used)."""
+        ready = self._take(generation)
+        if ready is not None:
+            self._deliver(ready[1])
