@@ -1,19 +1,27 @@
 """A parameter change loses no joint state: id_node as its own process (as ``ros2 run``
 starts it), joint states at 1 kHz, reliable, the default queue depth (qos.depth 10), and
 payload.mass set every 100 ms for 5 s through the parameter service: every joint state
-sent once the stream is answered gets its gravity_torques."""
+sent once the stream is answered gets its gravity_torques.
 
+A queue of 10 at 1 kHz holds 10 ms: a node the machine leaves unscheduled longer loses
+states whatever it does. As a 1 kHz controller is run, the node runs at a raised priority
+where the test may give one (as root: nice -10), so that what is measured is the node's own
+stalls, not the other work of a busy machine (the suite's other worker)."""
+
+import os
+import shutil
 import struct
 import threading
 import time
 import uuid
 
+import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 
-from ..support.node_process import TIMEOUT, wait_for_line
+from ..support.node_process import TIMEOUT, module_command, start, wait_for_line
 
 RATE = 1000.0  # Hz at most
 CHANGES = 50  # payload.mass set every CHANGE_PERIOD: 5 s of changes
@@ -22,10 +30,26 @@ NAMES = [f"joint_{i}" for i in range(1, 7)]
 STAMP = struct.Struct("<iI")  # a JointState's stamp, after the 4-byte CDR header
 
 
-def test_no_joint_state_goes_unanswered_while_the_payload_changes_every_100_ms(probe, process):
+def raised_priority(command: list[str]) -> list[str]:
+    """``command`` at nice -10 where this process may raise a priority (root), else as it is."""
+    return ["nice", "-n", "-10", *command] if os.geteuid() == 0 and shutil.which("nice") else command
+
+
+@pytest.fixture
+def id_node():
     namespace = f"/changes_{uuid.uuid4().hex[:8]}"
-    node = process("irb140_dynamics.nodes.id_node", "-p", "qos.reliability:=reliable", "-r", f"__ns:={namespace}")
-    assert wait_for_line(node, "ready:", [], TIMEOUT), "id_node did not start"
+    arguments = ("-p", "qos.reliability:=reliable", "-r", f"__ns:={namespace}")
+    node = start(raised_priority(module_command("irb140_dynamics.nodes.id_node", *arguments)))
+    try:
+        assert wait_for_line(node, "ready:", [], TIMEOUT), "id_node did not start"
+        yield namespace
+    finally:
+        node.kill()
+        node.communicate(timeout=10)
+
+
+def test_no_joint_state_goes_unanswered_while_the_payload_changes_every_100_ms(probe, id_node):
+    namespace = id_node
     answered: set[int] = set()
 
     def on_torques(raw: bytes) -> None:  # as bytes: the probe keeps up at 1 kHz
