@@ -46,7 +46,8 @@ from irb140_dynamics.tools.common import add_model_arguments, arm_of, model_inpu
 
 
 def parser() -> Parser:
-    from irb140_dynamics.core.monitoring.sensitivity import DEFAULT_GAIN, DEFAULT_MARGIN, MAX_GAIN, MIN_GAIN
+    from irb140_dynamics.core.monitoring.collision import DEFAULT_GAIN, MAX_GAIN, MIN_GAIN
+    from irb140_dynamics.core.monitoring.sensitivity import DEFAULT_MARGIN
     from irb140_dynamics.identification.recording import DEFAULT_TOPIC
 
     p = Parser(

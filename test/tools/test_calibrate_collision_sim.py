@@ -24,8 +24,9 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core.io.params_file import load_model, parameter_file_text, read_parameter_file
+from irb140_dynamics.core.monitoring.collision import OBSERVER_GAP as MAX_GAP
 from irb140_dynamics.core.monitoring.observer import MomentumObserver
-from irb140_dynamics.core.monitoring.sensitivity import AXES, MAX_GAP, detectable_force_at
+from irb140_dynamics.core.monitoring.sensitivity import AXES, detectable_force_at
 from irb140_dynamics.tools import calibrate_collision
 from irb140_dynamics.tools.common import arm_of
 

@@ -143,17 +143,16 @@ def test_rounded_up_never_shows_less_than_the_force():
 
 
 def test_the_defaults_and_ranges_are_id_node_s():
-    from irb140_dynamics.core.monitoring import sensitivity
-    from irb140_dynamics.nodes.id_node import collision
+    from irb140_dynamics.core.monitoring import collision
+    from irb140_dynamics.nodes.id_node.settings import NODE_PARAMETERS
 
-    gain = next(spec for spec in collision.COLLISION_PARAMETERS if spec.name == "collision.observer_gain")
-    assert (gain.default, gain.minimum, collision.MAX_GAIN, collision.OBSERVER_GAP) == (
-        sensitivity.DEFAULT_GAIN,
-        sensitivity.MIN_GAIN,
-        sensitivity.MAX_GAIN,
-        sensitivity.MAX_GAP,
+    gain = next(spec for spec in NODE_PARAMETERS if spec.name == "collision.observer_gain")
+    assert (gain.default, gain.minimum, gain.maximum) == (
+        collision.DEFAULT_GAIN,
+        collision.MIN_GAIN,
+        collision.MAX_GAIN,
     )
-    assert gain.maximum == collision.MAX_GAIN
+    assert calibrate_collision.parser().get_default("observer_gain") in (None, collision.DEFAULT_GAIN)
 
 
 def test_hostile_command_lines_fail_in_one_line_and_leave_nothing(tmp_path):

@@ -14,6 +14,8 @@ from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.monitoring.observer import MomentumObserver
 
 OBSERVER_GAP = 0.1  # s: a longer gap between samples restarts the observer
+DEFAULT_GAIN = 100.0  # 1/s: the observer's gain K (id_node's collision.observer_gain, calibrate_collision's)
+MIN_GAIN, MAX_GAIN = 1e-3, 1e4  # 1/s: the gains accepted
 RESTARTS = {  # MomentumObserver.restarted: what restarted it
     "gap": f"a gap of more than {OBSERVER_GAP:g} s between joint_states stamps",
     "repeated_stamp": "a repeated joint_states stamp",

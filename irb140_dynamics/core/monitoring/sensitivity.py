@@ -34,12 +34,10 @@ import numpy as np
 from irb140_dynamics.core.kinematics import flange_jacobian
 from irb140_dynamics.core.model.joints import MAX_TORQUE_LIMIT
 from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.monitoring.collision import DEFAULT_GAIN, MAX_GAIN, MIN_GAIN, OBSERVER_GAP
 from irb140_dynamics.core.monitoring.observer import MomentumObserver
 
-DEFAULT_GAIN = 100.0  # 1/s: id_node's collision.observer_gain
-MIN_GAIN, MAX_GAIN = 1e-3, 1e4  # 1/s: the range id_node accepts
 DEFAULT_MARGIN = 1.5  # threshold = margin x the largest |r_j| recorded
-MAX_GAP = 0.1  # s: a longer gap between samples restarts the observer, as in id_node
 AXES = ("+x", "-x", "+y", "-y", "+z", "-z")  # the base frame's directions, in print order
 UNFELT = 1e-12  # a joint loaded by less than this per N (m) does not feel the force
 
@@ -71,7 +69,7 @@ class ResidualPeaks:
         if not (math.isfinite(gain) and MIN_GAIN <= gain <= MAX_GAIN):
             raise CalibrationError(f"observer gain: must be within {MIN_GAIN:g} to {MAX_GAIN:g} 1/s, got {gain}")
         self.model, self.gain = model, float(gain)
-        self.observer = MomentumObserver(model, gain, MAX_GAP)
+        self.observer = MomentumObserver(model, gain, OBSERVER_GAP)
         self.peak = np.zeros(model.n)  # N m
         self.peak_time = np.full(model.n, np.nan)  # s
         self.observed = 0  # samples the observer took

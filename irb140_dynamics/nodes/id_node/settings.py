@@ -10,13 +10,13 @@ from irb140_dynamics.core import RigidBody, RobotModel
 from irb140_dynamics.core.codegen.kernels import Preparation, prepare
 from irb140_dynamics.core.codegen.recipes import WITH_FRICTION
 from irb140_dynamics.core.model.rigid_body import MAX_MASS
+from irb140_dynamics.core.monitoring import collision as observer
 from irb140_dynamics.core.monitoring.wrench import FRAMES
 from irb140_dynamics.core.payload.limits import RATED_PAYLOAD, derive_torque_limits
 from irb140_dynamics.core.payload.stop import stopping
 from irb140_dynamics.core.trajectories.tracking import ACCELERATION_MODES, EFFORT_SOURCES, Gains
 from irb140_dynamics.ros.parameters.specs import MAX_TORQUE, QOS_PARAMETERS, RELIABILITIES, Spec, check_choice
 
-MAX_OBSERVER_GAIN = 1e4  # 1/s: beyond any sampling rate a joint state stream has
 MAX_GAIN = 1e6  # computed-torque gains
 DEFAULT_KP, DEFAULT_KD = 400.0, 40.0  # 1/s^2, 1/s: natural frequency 20 rad/s, critically damped
 MAX_MARKER_RATE = 100.0  # Hz
@@ -65,11 +65,11 @@ NODE_PARAMETERS = [
     Spec("rated_payload.com", [0.0, 0.0, 0.0], "its centre of mass, in the flange frame", "m"),
     Spec(
         "collision.observer_gain",
-        100.0,
+        observer.DEFAULT_GAIN,
         "gain K of the momentum observer: external torques are seen through a lag of time constant 1/K",
         "1/s",
-        minimum=1e-3,
-        maximum=MAX_OBSERVER_GAIN,
+        minimum=observer.MIN_GAIN,
+        maximum=observer.MAX_GAIN,
     ),
     Spec(
         "external_wrench.frame",

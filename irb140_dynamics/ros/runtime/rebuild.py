@@ -10,9 +10,11 @@ interval (process-wide) so that the executor thread gets the lock quickly meanwh
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import threading
 import time
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -38,7 +40,8 @@ class Rebuild:
     job not yet in force; ``failure``: why the newest build failed."""
 
     def __init__(self, node, build: Callable[[Any, Any], Any], use: Callable[[Any], None], settled=None):
-        self._node, self._build, self._use, self._settled = node, build, use, settled
+        self._node = weakref.ref(node)  # a worker still building keeps no node alive (a failed start drops it)
+        self._build, self._use, self._settled = build, use, settled
         self._lock = threading.Lock()
         self._generation = 0  # of the newest job
         self._cancel = threading.Event()  # of the newest job
@@ -58,7 +61,7 @@ class Rebuild:
             self._job = (*self._next(pending=True), job)
             start, self._worker = not self._worker, True
         if start:
-            threading.Thread(target=self._run, daemon=True).start()
+            threading.Thread(target=_run, args=(weakref.ref(self), self._build), daemon=True).start()
 
     def build_here(self, job: Any) -> None:
         """Build ``job`` on this thread (a quick one) and use it; builds under way are superseded."""
@@ -114,7 +117,7 @@ class Rebuild:
         if isinstance(result, Failed):
             error = result.error
             self.failure = one_line(error) if isinstance(error, ValueError) else f"{type(error).__name__}: {error}"
-            self._node.get_logger().error(f"new parameters not applied, the previous stay in force: {self.failure}")
+            self._node().get_logger().error(f"new parameters not applied, the previous stay in force: {self.failure}")
         else:
             self.failure = None
             self._use(result)
@@ -122,44 +125,69 @@ class Rebuild:
             self._settled()
 
     def _built_from(self, job: Any) -> Any:
-        try:
-            result = self.previous = self._build(job, self.previous)
-        except Cancelled:
-            raise
-        except Exception as error:  # noqa: BLE001  (handed to the node, not raised in a thread)
-            return Failed(error)
+        result = self.previous = _built(self._build, job, self.previous)
         return result
 
-    def _run(self) -> None:
-        """The worker thread: build the newest job until there is none, handing each result over."""
-        while True:
-            with self._lock:
-                if self._job is None:
-                    self._worker = False
-                    return
-                (generation, cancel, job), self._job = self._job, None
-            try:
-                with stopping(cancel):
-                    result = self._built_from(job)
-            except Cancelled:
-                continue
-            with self._lock:
-                if generation != self._generation:
-                    continue
-                self._ready = (generation, result)
-                self._built.set()
-            node = self._node  # a build done while the node is being made waits for its executor
-            while node.executor is None:
-                if not node.context.ok() or cancel.wait(EXECUTOR_WAIT):
-                    break
-            else:
-                try:
-                    node.executor.create_task(self._hand_over, generation)
-                except Exception:  # noqa: BLE001  (the executor shut down meanwhile: nothing to hand over to)
-                    continue
+    def next_job(self) -> tuple[int, threading.Event, Any, Any] | None:
+        """The worker's: (generation, cancel, job, previous) of the newest job, or None (then
+        the worker ends)."""
+        with self._lock:
+            if self._job is None:
+                self._worker = False
+                return None
+            (generation, cancel, job), self._job = self._job, None
+            return generation, cancel, job, self.previous
 
-    def _hand_over(self, generation: int) -> None:
+    def keep(self, generation: int, result: Any):
+        """The worker's: keep a result of the newest job for the executor thread; the node
+        to hand it over on, or None when a newer job came meanwhile."""
+        with self._lock:
+            if generation != self._generation:
+                return None
+            if not isinstance(result, Failed):
+                self.previous = result
+            self._ready = (generation, result)
+            self._built.set()
+        return self._node()
+
+    def hand_over(self, generation: int) -> None:
         """On the executor thread: use the result unless a newer job came since (or it was used)."""
         ready = self._take(generation)
         if ready is not None:
             self._deliver(ready[1])
+
+
+def _built(build: Callable[[Any, Any], Any], job: Any, previous: Any) -> Any:
+    try:
+        return build(job, previous)
+    except Cancelled:
+        raise
+    except Exception as error:  # noqa: BLE001  (handed to the node, not raised in a thread)
+        return Failed(error)
+
+
+def _run(ref: weakref.ref, build: Callable[[Any, Any], Any]) -> None:
+    """The worker thread: build the newest job of the Rebuild ``ref`` until there is none,
+    handing each result over; it holds the Rebuild (and so its node) only between builds."""
+    while (rebuild := ref()) is not None:
+        taken = rebuild.next_job()
+        del rebuild
+        if taken is None:
+            return
+        generation, cancel, job, previous = taken
+        try:
+            with stopping(cancel):
+                result = _built(build, job, previous)
+        except Cancelled:
+            continue
+        rebuild = ref()
+        node = None if rebuild is None else rebuild.keep(generation, result)
+        del rebuild
+        while node is not None and node.executor is None:  # a build done while the node is made waits for it
+            if not node.context.ok() or cancel.wait(EXECUTOR_WAIT):
+                node = None
+        if node is None:
+            continue
+        with contextlib.suppress(Exception):  # the executor shut down meanwhile, or the node is gone: no one to tell
+            node.executor.create_task(ref().hand_over, generation)
+        del node
