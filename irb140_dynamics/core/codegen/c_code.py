@@ -21,11 +21,13 @@ from irb140_dynamics.core.codegen.program import Program
 from irb140_dynamics.core.codegen.python_code import statements
 
 INPUT_NOT_FINITE, OUTPUT_NOT_FINITE = 1, 2  # what a kernel returns instead of 0
-# Operations from which a kernel is compiled for size (GCC's optimize("Os")) and writes each
-# output as soon as it is computed (not kept to the end): straight-line code that large
+# Operations from which a kernel is compiled for size (GCC's optimize("Os")), writes each
+# output as soon as it is computed (not kept to the end) and sums its outputs for the
+# finiteness check in CHECK_SUMS independent sums: straight-line code that large
 # runs from the instruction cache's misses, and smaller code runs faster (the derivatives
 # of the dynamics); the operations and their order are the same.
 COMPACT_FROM = 1500
+CHECK_SUMS = 8  # partial sums of a large kernel's outputs in its finiteness check
 
 
 def kernel_source(program: Program, full_matrix: int = 0) -> tuple[str, int, int]:
@@ -65,8 +67,18 @@ def kernel_source(program: Program, full_matrix: int = 0) -> tuple[str, int, int
     else:
         lines += [f"    const double {var} = {expr};" for var, expr in body]
         lines += [f"    out[{j}] = {expression};" for j, expression in enumerate(results)]
-    lines.append("    check = 0.0;")
-    lines.append(f"    for (int i = 0; i < {len(results)}; ++i) check += out[i];")
+    if len(program.ops) >= COMPACT_FROM and len(results) >= 2 * CHECK_SUMS:
+        # CHECK_SUMS partial sums, not one chain of additions each waiting for the last
+        sums = ", ".join(f"check{m} = 0.0" for m in range(CHECK_SUMS))
+        lines.append(f"    double {sums};")
+        lines.append("    int i = 0;")
+        step = "; ".join(f"check{m} += out[i + {m}]" for m in range(CHECK_SUMS))
+        lines.append(f"    for (; i + {CHECK_SUMS} <= {len(results)}; i += {CHECK_SUMS}) {{ {step}; }}")
+        lines.append(f"    for (; i < {len(results)}; ++i) check0 += out[i];")
+        lines.append(f"    check = {' + '.join(f'check{m}' for m in range(CHECK_SUMS))};")
+    else:
+        lines.append("    check = 0.0;")
+        lines.append(f"    for (int i = 0; i < {len(results)}; ++i) check += out[i];")
     lines.append(f"    return isfinite(check) ? 0 : {OUTPUT_NOT_FINITE};")
     return "\n".join(lines) + "\n}\n", count, len(results)
 
