@@ -232,12 +232,12 @@ def _partials(bodies, Y, alpha, psid, psidd, parts, friction_slopes):
             momentum, force = _add(momentum, HC), _add(force, F)
             sym, spin = tuple(x + y for x, y in zip(sym, SC)), add(spin, KC)
         composite = momentum, force, sym, spin
-        linear, S = momentum[1], bodies[k][0]
+        twice_linear, S = scale(2.0, momentum[1]), bodies[k][0]
 
-        def coriolis(x, sym=sym, spin=spin, linear=linear):  # BC_k x, x's angular part
-            return add(_symmetric_times(sym, x), cross(x, spin)), scale(-2.0, cross(linear, x))
+        def coriolis(x, sym=sym, spin=spin, twice_linear=twice_linear):  # BC_k x, x's angular part
+            return add(_symmetric_times(sym, x), cross(x, spin)), cross(x, twice_linear)
 
-        beta[k] = add(_symmetric_times(sym, S[0]), cross(spin, S[0]), scale(2.0, cross(linear, S[1])))
+        beta[k] = add(_symmetric_times(sym, S[0]), cross(spin, S[0]), cross(twice_linear, S[1]))
         G[k] = _add(_fcross(S, force), _inertia_times(Y[k], psidd[k]), coriolis(psid[k][0]))
         H[k] = _add(_inertia_times(Y[k], twice[k]), coriolis(S[0]))
 
