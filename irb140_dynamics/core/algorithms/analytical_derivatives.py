@@ -186,9 +186,11 @@ def _sum_inertia(a, b):
 def rnea_partials(links, cs, qd, qdd, gravity, friction_slopes=None, reference: int = 0):
     """(d tau / dq, d tau / dqd, M), each n rows of n (friction given by its slopes d tau_f,i /
     d qd_i; armature on M's diagonal), computed in the frame of link ``reference``."""
+    first_turns = _turns_about_gravity(links, gravity)
     bodies, gravity = _bodies(links, cs, gravity, reference)
     Y, alpha, M = _composite_inertias(bodies, [link.armature for link in links])
-    dq, dqd = _partials(bodies, Y, alpha, *_motion(bodies, qd, qdd, gravity), friction_slopes)
+    motion = _motion(bodies, qd, qdd, gravity)
+    dq, dqd = _partials(bodies, Y, alpha, *motion, friction_slopes, first_turns)
     return dq, dqd, M
 
 
@@ -196,6 +198,7 @@ def forward_dynamics_partials(links, cs, qd, tau, gravity, friction=None, refere
     """(d qdd / dq, d qdd / dqd, M^-1) at qdd = FD(q, qd, tau); ``friction``: (torques,
     slopes) at qd, or None. The bias torques come from the same pass, at qdd = 0."""
     n = len(links)
+    first_turns = _turns_about_gravity(links, gravity)
     bodies, gravity = _bodies(links, cs, gravity, reference)
     Y, alpha, M = _composite_inertias(bodies, [link.armature for link in links])
     Minv = inverse(M)
@@ -214,13 +217,25 @@ def forward_dynamics_partials(links, cs, qd, tau, gravity, friction=None, refere
             psidd[i] = _add(psidd[i], _mcross(A, S))
         A = _scale(qdd[i], S) if A is None else _add(A, _scale(qdd[i], S))
         parts[i] = (part[0], _add(part[1], _inertia_times(inertia, A)), part[2])
-    dq, dqd = _partials(bodies, Y, alpha, psid, psidd, parts, friction and friction[1])
+    dq, dqd = _partials(bodies, Y, alpha, psid, psidd, parts, friction and friction[1], first_turns)
     negative = negated(Minv)  # once for both products
     return times(negative, dq), times(negative, dqd), Minv
 
 
-def _partials(bodies, Y, alpha, psid, psidd, parts, friction_slopes):
-    """(d tau / dq, d tau / dqd) from the forward pass (see the module)."""
+def _turns_about_gravity(links, gravity) -> bool:
+    """Whether the first joint turns the whole arm about the direction of gravity (its axis
+    and gravity parallel, as zeros of the traced constants show): then nothing depends on
+    q_0, and d tau / dq_0 is zero, exactly."""
+    first = links[0]
+    if first.prismatic:
+        return False
+    axis = first.u if first.R0 is None else rotate(first.R0, first.u)
+    return all(isinstance(c, float) and c == 0.0 for c in cross(gravity, axis))
+
+
+def _partials(bodies, Y, alpha, psid, psidd, parts, friction_slopes, first_turns=False):
+    """(d tau / dq, d tau / dqd) from the forward pass (see the module); ``first_turns``:
+    d tau / dq_0 is zero (see _turns_about_gravity)."""
     n = len(bodies)
     beta, G, H = [None] * n, [None] * n, [None] * n
     twice = [_scale(2.0, x) for x in psid]  # 2 psid_k
@@ -246,7 +261,9 @@ def _partials(bodies, Y, alpha, psid, psidd, parts, friction_slopes):
     for j in range(n):
         S = bodies[j][0]
         for k in range(n):
-            if k <= j:
+            if k == 0 and first_turns:
+                dq[j][k], dqd[j][k] = 0.0, _dot(alpha[j], twice[k]) + dot(beta[j], bodies[k][0][0])
+            elif k <= j:
                 dq[j][k] = _dot(alpha[j], psidd[k]) + dot(beta[j], psid[k][0])
                 dqd[j][k] = _dot(alpha[j], twice[k]) + dot(beta[j], bodies[k][0][0])
             else:
