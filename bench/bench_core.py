@@ -15,6 +15,9 @@ to bench/results/core.json. Sections:
 - URDF arms: the UR5 and the Panda of example-robot-data read by our URDF loader against
   Pinocchio's URDF parser on the same file, per call (rnea, gravity, mass matrix), with
   native kernels, then in the kernels' Python form (IRB140_NATIVE=0).
+- derivatives: rnea_derivatives, forward_dynamics_derivatives, inverse_mass_matrix against
+  Pinocchio's computeRNEADerivatives, computeABADerivatives, computeMinverse on the same
+  three arms, native, alternating blocks (derivatives_section).
 
 Every pair is checked to give the same numbers before it is timed.
 """
@@ -43,6 +46,7 @@ from common import (
     shown,
     write_results,
 )
+from derivatives_section import derivative_rows
 from prepare_section import preparation
 
 from irb140_dynamics.core import (
@@ -297,6 +301,13 @@ def urdf_arms() -> list[Row]:
     return rows
 
 
+def derivatives() -> list[Row]:
+    """The derivatives section (see derivatives_section) on the IRB-140, the UR5 and the Panda."""
+    arms = {"IRB-140 (DH)": (irb140(), None), **URDF_ARMS}
+    paired = {name: _paired_models(text, tip) for name, (text, tip) in arms.items()}
+    return derivative_rows(paired, paired_seconds_per_call, SEED + 3)
+
+
 def _paired_models(text, tip):
     """(our model, Pinocchio's) of a URDF's chain to ``tip``, or of a model."""
     if tip is None:
@@ -372,6 +383,7 @@ def main() -> None:
     data = pm.createData()
     generation, source_lines = kernel_generation()  # first: on fresh models, before any warm-up
     rows = single_state(model, pm, data) + batch(model, pm, data) + generation + preparation(URDF_PATHS) + urdf_arms()
+    rows += derivatives()
     print_table(rows, "irb140_dynamics core vs Pinocchio (ratio = ours / baseline)")
     path = write_results(
         "core",

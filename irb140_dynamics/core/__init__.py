@@ -6,6 +6,12 @@ array([  0.   , 243.382,  79.156,  -0.   ,   2.43 ,   0.   ])
 """
 
 from irb140_dynamics.core.codegen.kernels import Kernels, kernels_of
+from irb140_dynamics.core.derivatives import (
+    DERIVATIVE_KERNELS,
+    forward_dynamics_derivatives,
+    inverse_mass_matrix,
+    rnea_derivatives,
+)
 from irb140_dynamics.core.dynamics import (
     Preparation,
     coriolis,
@@ -40,6 +46,7 @@ from irb140_dynamics.core.payload import (
 )
 
 __all__ = [
+    "DERIVATIVE_KERNELS",
     "DH",
     "Preparation",
     "Friction",
@@ -64,8 +71,10 @@ __all__ = [
     "flange_pose",
     "forward_dynamics",
     "forward_dynamics_batch",
+    "forward_dynamics_derivatives",
     "gravity",
     "gravity_batch",
+    "inverse_mass_matrix",
     "irb140",
     "kernels_of",
     "link_frames",
@@ -77,5 +86,6 @@ __all__ = [
     "prepare",
     "rnea",
     "rnea_batch",
+    "rnea_derivatives",
     "workspace_load",
 ]

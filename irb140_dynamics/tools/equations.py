@@ -2,14 +2,17 @@
 
     equations --form c --out gen/                      (the package's IRB-140)
     equations [--params-file F] [--urdf arm.urdf [--base LINK --tip LINK]] [-p NAME:=VALUE] --form FORM --out DIR
-              [--what tau,M,C,g,regressor] [--symbolic-parameters] [--payload-mass KG] [--prefix NAME]
+              [--what tau,M,C,g,regressor,dtau,qdd,dqdd,Minv] [--symbolic-parameters] [--payload-mass KG]
+              [--prefix NAME]
 
 The model is read as every tool and node reads it (``core.io.arm_source``): the package's
 IRB-140, the params file's ``/**`` section over it, then -p; or the URDF's chain.
 
 Derived by running the package's own recursions on symbols (irb140_dynamics.core.equations).
-FORM: latex, sympy, c or python. --what defaults to tau,M,C,g (C: the torques C(q, qd) qd). --out may exist: the tool's files
-in it are replaced, nothing else is touched; on any error nothing is written there.
+FORM: latex, sympy, c or python. --what defaults to tau,M,C,g (C: the torques C(q, qd) qd);
+dtau, qdd, dqdd and Minv (the derivatives, the forward dynamics, M^-1) are written in the C
+form of a model with numbers. --out may exist: the tool's files in it are replaced, nothing
+else is touched; on any error nothing is written there.
 """
 
 from __future__ import annotations

@@ -305,13 +305,13 @@ def _rotate_inertia(link, rot, inertia):
     """R I R^T for the joint rotation R_i = R0 Rot R1, one factor after the other (a turn
     about z in closed form, fewer operations than by columns)."""
     if link.R1 is not None:
-        inertia = _turned(link.R1, inertia)
+        inertia = turned(link.R1, inertia)
     if rot is not None:
-        inertia = _turned_about_z(rot, inertia) if link.u == Z_AXIS else _turned(rot, inertia)
-    return inertia if link.R0 is None else _turned(link.R0, inertia)
+        inertia = _turned_about_z(rot, inertia) if link.u == Z_AXIS else turned(rot, inertia)
+    return inertia if link.R0 is None else turned(link.R0, inertia)
 
 
-def _turned(R, inertia):
+def turned(R, inertia):
     """R I R^T: columns of R I, then R (R I)^T."""
     xx, yy, zz, xy, xz, yz = inertia
     rows_of_ri = list(zip(*(rotate(R, col) for col in ((xx, xy, xz), (xy, yy, yz), (xz, yz, zz)))))

@@ -10,7 +10,8 @@ bit for bit (the ``native`` room checks that before use).
 with constants ``k`` as a Python function of NumPy arrays, called with METH_FASTCALL: it
 takes the argument groups but ``k`` (1-D float64 arrays of their lengths, any stride) and
 returns a new array, or None for anything else or a result that is not finite (the caller
-then takes the Python form, which says why).
+then takes the Python form, which says why). A program whose outputs are ``matrices`` (see
+``Program``) returns them as a tuple of new square arrays.
 """
 
 from __future__ import annotations
@@ -20,6 +21,13 @@ from irb140_dynamics.core.codegen.program import Program
 from irb140_dynamics.core.codegen.python_code import statements
 
 INPUT_NOT_FINITE, OUTPUT_NOT_FINITE = 1, 2  # what a kernel returns instead of 0
+# Operations from which a kernel is compiled for size (GCC's optimize("Os")), writes each
+# output as soon as it is computed (not kept to the end) and sums its outputs for the
+# finiteness check in CHECK_SUMS independent sums: straight-line code that large
+# runs from the instruction cache's misses, and smaller code runs faster (the derivatives
+# of the dynamics); the operations and their order are the same.
+COMPACT_FROM = 1500
+CHECK_SUMS = 8  # partial sums of a large kernel's outputs in its finiteness check
 
 
 def kernel_source(program: Program, full_matrix: int = 0) -> tuple[str, int, int]:
@@ -33,7 +41,10 @@ def kernel_source(program: Program, full_matrix: int = 0) -> tuple[str, int, int
     body, results = statements(program)
     if full_matrix:
         results = whole_matrix(results, full_matrix)
-    lines = ["#include <math.h>", "", "int kernel(const double *x, const double *k, double *out) {"]
+    lines = ["#include <math.h>", ""]
+    if len(program.ops) >= COMPACT_FROM:
+        lines += ["#if defined(__GNUC__) && !defined(__clang__)", '__attribute__((optimize("Os")))', "#endif"]
+    lines.append("int kernel(const double *x, const double *k, double *out) {")
     count = 0
     for group, length in program.groups:
         for i in range(length):
@@ -45,10 +56,29 @@ def kernel_source(program: Program, full_matrix: int = 0) -> tuple[str, int, int
     lines.append("    double check = 0.0;")
     lines.append(f"    for (int i = 0; i < {count}; ++i) check += x[i];")
     lines.append(f"    if (!isfinite(check)) return {INPUT_NOT_FINITE};")
-    lines += [f"    const double {var} = {expr};" for var, expr in body]
-    lines += [f"    out[{j}] = {expression};" for j, expression in enumerate(results)]
-    lines.append("    check = 0.0;")
-    lines.append(f"    for (int i = 0; i < {len(results)}; ++i) check += out[i];")
+    if len(program.ops) >= COMPACT_FROM:
+        stores: dict[str, list[int]] = {}
+        for j, expression in enumerate(results):
+            stores.setdefault(expression, []).append(j)
+        for var, expr in body:
+            lines.append(f"    const double {var} = {expr};")
+            lines += [f"    out[{j}] = {var};" for j in stores.pop(var, ())]
+        lines += [f"    out[{j}] = {expression};" for expression, js in stores.items() for j in js]
+    else:
+        lines += [f"    const double {var} = {expr};" for var, expr in body]
+        lines += [f"    out[{j}] = {expression};" for j, expression in enumerate(results)]
+    if len(program.ops) >= COMPACT_FROM and len(results) >= 2 * CHECK_SUMS:
+        # CHECK_SUMS partial sums, not one chain of additions each waiting for the last
+        sums = ", ".join(f"check{m} = 0.0" for m in range(CHECK_SUMS))
+        lines.append(f"    double {sums};")
+        lines.append("    int i = 0;")
+        step = "; ".join(f"check{m} += out[i + {m}]" for m in range(CHECK_SUMS))
+        lines.append(f"    for (; i + {CHECK_SUMS} <= {len(results)}; i += {CHECK_SUMS}) {{ {step}; }}")
+        lines.append(f"    for (; i < {len(results)}; ++i) check0 += out[i];")
+        lines.append(f"    check = {' + '.join(f'check{m}' for m in range(CHECK_SUMS))};")
+    else:
+        lines.append("    check = 0.0;")
+        lines.append(f"    for (int i = 0; i < {len(results)}; ++i) check += out[i];")
     lines.append(f"    return isfinite(check) ? 0 : {OUTPUT_NOT_FINITE};")
     return "\n".join(lines) + "\n}\n", count, len(results)
 
@@ -63,14 +93,27 @@ def extension_source(program: Program, module: str, full_matrix: int = 0) -> str
     for i, length in enumerate(lengths):
         takes.append(f"!take(args[{i}], x + {start}, {length})")
         start += length
+    takes = " || ".join(takes) or "0"
+    if program.matrices:
+        side = round((outputs // program.matrices) ** 0.5)
+        results = ", ".join(f"take_matrix(out + {m * side * side})" for m in range(program.matrices))
+        call = _MATRICES_CALL.format(
+            inputs=max(inputs, 1),
+            outputs=outputs,
+            side=side,
+            count=program.matrices,
+            results=results,
+            groups=len(lengths),
+            takes=takes,
+        )
+    else:
+        call = _ARRAY_CALL.format(
+            inputs=max(inputs, 1), groups=len(lengths), takes=takes, ndim=2 if full_matrix else 1, shape=shape
+        )
     return _EXTENSION.format(
+        call=call,
         kernel=kernel,
         module=module,
-        inputs=max(inputs, 1),
-        groups=len(lengths),
-        takes=" || ".join(takes) or "0",
-        ndim=2 if full_matrix else 1,
-        shape=shape,
     )
 
 
@@ -92,18 +135,7 @@ static int take(PyObject *o, double *x, npy_intp n) {{
     return 1;
 }}
 
-static PyObject *call(PyObject *k, PyObject *const *args, Py_ssize_t nargs) {{
-    double x[{inputs}];
-    if (nargs != {groups} || {takes}) Py_RETURN_NONE;
-    npy_intp shape[] = {shape};
-    PyObject *result = PyArray_SimpleNew({ndim}, shape, NPY_DOUBLE);
-    if (result == NULL) return NULL;
-    if (kernel(x, (const double *)PyBytes_AS_STRING(k), (double *)PyArray_DATA((PyArrayObject *)result)) != 0) {{
-        Py_DECREF(result);
-        Py_RETURN_NONE;
-    }}
-    return result;
-}}
+{call}
 
 static PyMethodDef call_method = {{"kernel", (PyCFunction)(void (*)(void))call, METH_FASTCALL, NULL}};
 
@@ -124,3 +156,41 @@ PyMODINIT_FUNC PyInit_{module}(void) {{
     return PyModule_Create(&definition);
 }}
 """
+
+_ARRAY_CALL = """static PyObject *call(PyObject *k, PyObject *const *args, Py_ssize_t nargs) {{
+    double x[{inputs}];
+    if (nargs != {groups} || {takes}) Py_RETURN_NONE;
+    npy_intp shape[] = {shape};
+    PyObject *result = PyArray_SimpleNew({ndim}, shape, NPY_DOUBLE);
+    if (result == NULL) return NULL;
+    if (kernel(x, (const double *)PyBytes_AS_STRING(k), (double *)PyArray_DATA((PyArrayObject *)result)) != 0) {{
+        Py_DECREF(result);
+        Py_RETURN_NONE;
+    }}
+    return result;
+}}"""
+
+_MATRICES_CALL = """/* a new {side} x {side} array of the doubles at p; NULL when out of memory */
+static PyObject *take_matrix(const double *p) {{
+    npy_intp shape[] = {{{side}, {side}}};
+    PyObject *m = PyArray_SimpleNew(2, shape, NPY_DOUBLE);
+    if (m != NULL) memcpy(PyArray_DATA((PyArrayObject *)m), p, sizeof(double) * {side} * {side});
+    return m;
+}}
+
+static PyObject *call(PyObject *k, PyObject *const *args, Py_ssize_t nargs) {{
+    double x[{inputs}], out[{outputs}];
+    if (nargs != {groups} || {takes}) Py_RETURN_NONE;
+    if (kernel(x, (const double *)PyBytes_AS_STRING(k), out) != 0) Py_RETURN_NONE;
+    PyObject *items[] = {{{results}}};
+    PyObject *result = PyTuple_New({count});
+    for (int i = 0; i < {count}; ++i) {{
+        if (items[i] == NULL || result == NULL) {{
+            for (int j = 0; j < {count}; ++j) Py_XDECREF(items[j]);
+            Py_XDECREF(result);
+            return NULL;
+        }}
+    }}
+    for (int i = 0; i < {count}; ++i) PyTuple_SET_ITEM(result, i, items[i]);
+    return result;
+}}"""

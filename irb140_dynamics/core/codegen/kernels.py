@@ -20,7 +20,7 @@ from __future__ import annotations
 import threading
 import time
 from dataclasses import dataclass, replace
-from functools import cached_property, lru_cache
+from functools import cached_property, lru_cache, partial
 
 from irb140_dynamics import native_hook
 from irb140_dynamics.core.algorithms import recursions as algorithms
@@ -143,6 +143,10 @@ class Kernels:
     momentum = _named("momentum")
     monitor = _named("monitor")
     rnea_with_friction = _named(WITH_FRICTION)
+    rnea_derivatives = _named("rnea_derivatives")
+    forward_dynamics_derivatives = _named("forward_dynamics_derivatives")
+    forward_dynamics_qdd = _named("forward_dynamics_qdd")
+    inverse_mass_matrix = _named("inverse_mass_matrix")
 
     def __init__(self, model):
         self.n = model.n
@@ -184,7 +188,7 @@ class Kernels:
             kernel = self._made.get(name)
             if kernel is None:
                 constants = self.constants
-                if name == WITH_FRICTION:
+                if (name == WITH_FRICTION or RECIPES[name].friction) and self._friction is not None:
                     f = self._friction
                     coulomb = f.coulomb.tolist() + [float(f.smoothing_velocity)] if f.coulomb.any() else []
                     constants += tuple(f.viscous.tolist() + coulomb)
@@ -228,6 +232,8 @@ class Kernels:
         return compiler is None or compiler.unavailable() is not None or compiler.bind_built(wanted)
 
     def _arm_name(self, name: str) -> str:
+        if name in RECIPES and RECIPES[name].friction and self._friction is not None:
+            return f"{name}_coulomb" if self._friction.coulomb.any() else f"{name}_viscous"
         if name != WITH_FRICTION:
             return name
         if self._friction is None:
@@ -295,11 +301,14 @@ class ArmKernels:
                 program = with_friction(self.trace("rnea").program, "qd", coulomb=name == "rnea_coulomb")
                 trace = Trace(program)
             else:
-                recipe = RECIPES[name]
+                base, friction = _friction_kind(name)
+                recipe = RECIPES[base]
                 inputs = {group: 6 if group == "wrench" else self.n for group in recipe.groups}
-                inputs["k"] = sum(self.nonzero)
-                algorithm = recipe.algorithm
+                inputs["k"] = sum(self.nonzero) + {None: 0, "viscous": self.n, "coulomb": 2 * self.n + 1}[friction]
+                algorithm = partial(recipe.algorithm, friction=friction) if recipe.friction else recipe.algorithm
                 program = traced(name, lambda *args: algorithm(self, *args), inputs, self.angles)
+                if recipe.matrices:
+                    program = replace(program, matrices=recipe.matrices)
                 trace = Trace(program, self.n if recipe.matrix else 0)
             self._traces[name] = trace
         return trace
@@ -316,3 +325,13 @@ class ArmKernels:
 
     def gravity_of(self, k):
         return self._spread(k)[10:13]
+
+
+def _friction_kind(name: str) -> tuple[str, str | None]:
+    """(recipe, friction kind) of an arm's kernel name: ``<recipe>_viscous`` or
+    ``<recipe>_coulomb`` for a recipe that takes friction."""
+    for kind in ("viscous", "coulomb"):
+        base = name.removesuffix(f"_{kind}")
+        if base != name and base in RECIPES and RECIPES[base].friction:
+            return base, kind
+    return name, None

@@ -31,12 +31,14 @@ ANGLES = ("cos", "sin")
 class Program:
     """A traced algorithm: ``groups`` the arguments ((name, length), q first when the joints
     are angles), ``ops`` the single assignments, ``outputs`` their values (an index into
-    ``ops``, or a float folded at tracing)."""
+    ``ops``, or a float folded at tracing); ``matrices``: when not 0, the outputs are that
+    many square matrices, row by row, one after the other (the C form returns them apart)."""
 
     name: str
     groups: tuple[tuple[str, int], ...]
     ops: tuple[tuple[str, tuple], ...]
     outputs: tuple
+    matrices: int = 0
 
     def group(self, name: str) -> int:
         """The length of the argument group ``name``."""
@@ -140,4 +142,31 @@ def with_constants(program: Program, group: str, values: tuple) -> Program:
         index.append(len(ops) - 1)
     outputs = tuple(index[out] if isinstance(out, int) else out for out in program.outputs)
     groups = tuple((g, length) for g, length in program.groups if g != group)
-    return Program(program.name, groups, tuple(ops), outputs)
+    return Program(program.name, groups, tuple(ops), outputs, program.matrices)
+
+
+def selected(program: Program, indices) -> Program:
+    """``program`` computing only its outputs at ``indices`` (in that order): the operations
+    they need, in their order (the same arithmetic)."""
+    outputs = [program.outputs[i] for i in indices]
+    needed, stack = set(), [out for out in outputs if isinstance(out, int)]
+    while stack:
+        k = stack.pop()
+        if k in needed:
+            continue
+        needed.add(k)
+        op, args = program.ops[k]
+        if op != "in":
+            stack += [a for a in (args[:1] if op in ANGLES else args) if isinstance(a, int)]
+    order = sorted(needed)
+    index = {old: new for new, old in enumerate(order)}
+    ops = []
+    for old in order:
+        op, args = program.ops[old]
+        if op != "in":
+            args = tuple(
+                index[a] if isinstance(a, int) and (op not in ANGLES or j == 0) else a for j, a in enumerate(args)
+            )
+        ops.append((op, args))
+    results = tuple(index[out] if isinstance(out, int) else out for out in outputs)
+    return Program(program.name, program.groups, tuple(ops), results)

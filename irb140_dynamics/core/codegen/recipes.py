@@ -8,17 +8,23 @@ from dataclasses import dataclass
 from irb140_dynamics.core.algorithms import recursions as algorithms
 from irb140_dynamics.core.algorithms.momentum import momentum_terms
 from irb140_dynamics.core.algorithms.regressor import rigid_body_regressor
+from irb140_dynamics.core.codegen import derivative_kernels as derivatives
 
 
 @dataclass(frozen=True)
 class Recipe:
     """How a kernel is traced: ``algorithm(arm, cs, *groups, k)`` -> outputs, the argument
-    groups after q (each n long, ``wrench`` 6), and whether its outputs are M's upper
-    triangle (the C form then writes M whole)."""
+    groups after q (each n long, ``wrench`` 6), whether its outputs are M's upper
+    triangle (the C form then writes M whole), whether it takes the model's joint
+    friction (``friction``: its coefficients appended to k, see ``derivative_kernels``;
+    the algorithm then gets the keyword ``friction``, None, "viscous" or "coulomb"), and
+    how many n x n matrices its outputs are, row by row (see ``Program.matrices``)."""
 
     algorithm: object
     groups: tuple[str, ...] = ()
     matrix: bool = False
+    friction: bool = False
+    matrices: int = 0
 
 
 def _rnea(arm, cs, qd, qdd, k):
@@ -78,6 +84,15 @@ RECIPES = {  # every kernel, by name; q comes first in each
     "regressor": Recipe(_regressor, ("qd", "qdd")),  # n x 10n, column by column
     "momentum": Recipe(_momentum, ("qd",)),  # (q, qd) -> [M qd, C^T qd] (see observer)
     "monitor": Recipe(_monitor, ("qd", "qdd")),  # [tau, g, M qd, C^T qd], one pass
+    # the derivatives (see derivative_kernels), n x n matrices row by row, friction inside
+    "rnea_derivatives": Recipe(  # [dtau/dq, dtau/dqd, M]
+        derivatives.rnea_derivatives, ("qd", "qdd"), friction=True, matrices=3
+    ),
+    "forward_dynamics_qdd": Recipe(derivatives.forward_dynamics, ("qd", "tau"), friction=True),  # (q, qd, tau) -> qdd
+    "forward_dynamics_derivatives": Recipe(  # [dqdd/dq, dqdd/dqd, M^-1]
+        derivatives.forward_dynamics_derivatives, ("qd", "tau"), friction=True, matrices=3
+    ),
+    "inverse_mass_matrix": Recipe(derivatives.inverse_mass_matrix, matrix=True),  # q -> upper triangle of M^-1
 }
 # rnea with the model's joint friction inside (its coefficients appended to k); the model's
 # plain ``rnea`` when it has none

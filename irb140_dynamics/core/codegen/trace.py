@@ -86,6 +86,19 @@ class Sym:
     def __rmul__(self, other):
         return self.__mul__(other)
 
+    def __truediv__(self, other):
+        if not isinstance(other, _SCALARS):
+            return NotImplemented
+        if _is_const(other) and other == 1:
+            return self
+        return Sym("/", (self, float(other) if _is_const(other) else other))
+
+    def __rtruediv__(self, other):
+        if not isinstance(other, _SCALARS):
+            return NotImplemented
+        _is_const(other)
+        return Sym("/", (float(other), self))
+
     def __neg__(self):
         if self.op == "neg":
             return self.args[0]
@@ -97,6 +110,11 @@ class Sym:
 
 
 _SCALARS = (Sym, float, int)
+
+
+def tanh(x):
+    """tanh of a traced scalar (recorded) or of a constant (computed)."""
+    return Sym("tanh", (x,)) if isinstance(x, Sym) else math.tanh(x)
 
 
 def _is_const(x) -> bool:

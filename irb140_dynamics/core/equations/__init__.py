@@ -1,4 +1,5 @@
-"""The equations of motion in closed form: LaTeX, SymPy, C99 and NumPy Python.
+"""The equations of motion in closed form: LaTeX, SymPy, C99 and NumPy Python; their
+derivatives and M^-1 in C99 (``derivative_code``).
 
 The core's own scalar recursions (``algorithms``) run on SymPy symbols (``symbolic``), the
 common subexpressions are shared, and one emitter per form writes the files. The C and
@@ -13,14 +14,16 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from . import c_code, latex, python_code, sympy_code
+from . import c_code, derivative_code, latex, python_code, sympy_code
 from .printing import reduced_quantities
-from .symbolic import DEFAULT_QUANTITIES, QUANTITIES, Equations, derive
+from .symbolic import DEFAULT_QUANTITIES, Equations, derive
+from .symbolic import QUANTITIES as SYMBOLIC_QUANTITIES
 from .traced import traced_bodies
 
 FORMS = ("latex", "sympy", "c", "python")
 _TRACED_EMITTERS = {"c": c_code.render, "python": python_code.render}  # numbers: the programs' bodies
 FILE_ENDINGS = {"latex": ("_eom.tex",), "sympy": ("_eom_sympy.py",), "c": ("_eom.h", "_eom.c"), "python": ("_eom.py",)}
+QUANTITIES = SYMBOLIC_QUANTITIES + derivative_code.DERIVATIVE_QUANTITIES
 
 __all__ = ["DEFAULT_QUANTITIES", "Equations", "FORMS", "QUANTITIES", "derive", "file_names", "generate"]
 
@@ -47,6 +50,10 @@ def generate(
     if not prefix.isidentifier() or not prefix.isascii():
         raise ValueError(f"prefix {prefix!r} is not a C identifier")
     progress = progress or (lambda stage: None)
+    derivatives = [w for w in what if w in derivative_code.DERIVATIVE_QUANTITIES]
+    if derivatives and (symbolic or any(form != "c" for form in forms)):
+        raise ValueError(f"{derivatives[0]}: the derivatives are written in the C form of a model with numbers")
+    what = tuple(w for w in what if w not in derivative_code.DERIVATIVE_QUANTITIES)
     equations = derive(model, what, symbolic, progress)
     progress("common subexpressions")
     reduced = reduced_quantities(equations)
@@ -60,5 +67,10 @@ def generate(
             files.update(sympy_code.render(equations, reduced, prefix, source))
         else:
             bodies = {} if symbolic else traced_bodies(model, reduced)
-            files.update(_TRACED_EMITTERS[form](equations, reduced, prefix, source, bodies))
+            if form == "c" and derivatives:
+                progress("the derivatives")
+                functions = derivative_code.c_functions(model, derivatives, prefix)
+                files.update(c_code.render(equations, reduced, prefix, source, bodies, functions))
+            else:
+                files.update(_TRACED_EMITTERS[form](equations, reduced, prefix, source, bodies))
     return files

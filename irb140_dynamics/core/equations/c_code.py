@@ -12,9 +12,12 @@ from .printing import DESCRIPTIONS, CPrinter, header_lines, used_names
 from .symbolic import Equations
 
 
-def render(eq: Equations, reduced: dict, prefix: str, source: str, bodies: dict | None = None) -> dict[str, str]:
+def render(
+    eq: Equations, reduced: dict, prefix: str, source: str, bodies: dict | None = None, functions=()
+) -> dict[str, str]:
     """{file name: text} of the .h and .c pair; a quantity in ``bodies`` (see traced)
-    written from its program, the others from ``reduced``."""
+    written from its program, the others from ``reduced``; then ``functions``
+    ((description, signature, body lines), see derivative_code)."""
     bodies = bodies or {}
     guard = f"{prefix.upper()}_EOM_H"
     comment = _comment(header_lines(eq, source, traced=bool(bodies)))
@@ -30,6 +33,9 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str, bodies: dict 
         signature = _signature(eq, name, prefix)
         h += [f"/* {DESCRIPTIONS[name]} */", f"{signature};", ""]
         body = _traced_body(eq, name, bodies[name]) if name in bodies else _body(eq, name, replacements, outputs)
+        c += [signature, "{", *body, "}", ""]
+    for description, signature, body in functions:
+        h += [f"/* {description} */", f"{signature};", ""]
         c += [signature, "{", *body, "}", ""]
     h += ["#ifdef __cplusplus", "}", "#endif", "", f"#endif /* {guard} */", ""]
     return {f"{prefix}_eom.h": "\n".join(h), f"{prefix}_eom.c": "\n".join(c)}

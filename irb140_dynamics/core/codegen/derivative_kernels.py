@@ -1,0 +1,71 @@
+"""The recipes of the derivative kernels (see ``kernels.RECIPES``): the derivatives of the
+dynamics in closed form (``algorithms.analytical_derivatives``), the forward dynamics and
+M^-1 (``algorithms.derivatives``, ``algorithms.linear``) on an arm's links.
+
+Each is ``recipe(arm, cs, *groups, k, friction)`` with ``arm`` an ``ArmKernels``. The joint
+friction is part of these kernels: its coefficients follow, in ``k``, the nonzero ones of
+the 13 numbers (payload, gravity): viscous v (n), then, with ``friction`` "coulomb", the
+Coulomb levels c (n) and the smoothing velocity v_s, as ``Kernels`` binds them; ``friction``
+None: none. Matrices are written row by row.
+"""
+
+from __future__ import annotations
+
+from irb140_dynamics.core.algorithms import analytical_derivatives as analytical
+from irb140_dynamics.core.algorithms import derivatives
+from irb140_dynamics.core.algorithms import recursions as algorithms
+from irb140_dynamics.core.algorithms.linear import inverse
+from irb140_dynamics.core.codegen.trace import operands_first, tanh
+
+REFERENCES = 2  # frames tried for the analytical derivatives: links 0 and 1 (see _shortest)
+
+
+def friction_terms(arm, k, qd, kind: str | None):
+    """(torques, slopes d tau_f,i / d qd_i) of the joint friction at qd, as ``JointFriction``
+    computes the torques (tau_f,i = v_i qd_i + c_i tanh(qd_i / v_s)); None without friction."""
+    if kind is None:
+        return None
+    start, n = sum(arm.nonzero), arm.n
+    viscous = k[start : start + n]
+    if kind == "viscous":
+        return [v * x for v, x in zip(viscous, qd)], list(viscous)
+    coulomb, s = k[start + n : start + 2 * n], k[start + 2 * n]
+    shapes = [tanh(x / s) for x in qd]
+    torques = [v * x + c * t for v, c, x, t in zip(viscous, coulomb, qd, shapes)]
+    return torques, [v + c * (1.0 - t * t) / s for v, c, t in zip(viscous, coulomb, shapes)]
+
+
+def rnea_derivatives(arm, cs, qd, qdd, k, friction=None):
+    """[d tau / dq, d tau / dqd, M]."""
+    links, terms = arm.links_with(k), friction_terms(arm, k, qd, friction)
+    return _shortest(
+        lambda r: analytical.rnea_partials(links, cs, qd, qdd, arm.gravity_of(k), terms and terms[1], r), arm.n
+    )
+
+
+def forward_dynamics(arm, cs, qd, tau, k, friction=None):
+    """qdd = M^-1 (tau - b(q, qd)), friction in b."""
+    terms = friction_terms(arm, k, qd, friction)
+    return derivatives.forward_dynamics(arm.links_with(k), cs, qd, tau, arm.gravity_of(k), terms and terms[0])[0]
+
+
+def forward_dynamics_derivatives(arm, cs, qd, tau, k, friction=None):
+    """[d qdd / dq, d qdd / dqd, M^-1]."""
+    links, terms = arm.links_with(k), friction_terms(arm, k, qd, friction)
+    return _shortest(
+        lambda r: analytical.forward_dynamics_partials(links, cs, qd, tau, arm.gravity_of(k), terms, r), arm.n
+    )
+
+
+def inverse_mass_matrix(arm, cs, k):
+    """The upper triangle of M^-1, row by row."""
+    Minv = inverse(algorithms.crba(arm.links_with(k), cs))
+    return [Minv[i][j] for i in range(arm.n) for j in range(i, arm.n)]
+
+
+def _shortest(matrices_in, n: int) -> list:
+    """The matrices (flat, row by row) of ``matrices_in(r)`` computed in the frame of link r,
+    for the r of the first REFERENCES links whose traced code is the shortest: which one is
+    depends on where the arm's geometry has its zeros."""
+    candidates = [[x for matrix in matrices_in(r) for row in matrix for x in row] for r in range(min(REFERENCES, n))]
+    return min(candidates, key=lambda outputs: len(operands_first(outputs)))

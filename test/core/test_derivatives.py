@@ -1,0 +1,322 @@
+"""The derivatives of the dynamics (rnea_derivatives, forward_dynamics_derivatives) and
+M^-1 against Pinocchio's (computeRNEADerivatives, computeABADerivatives, computeMinverse)
+and against central finite differences of the package's own rnea and forward_dynamics.
+
+Pinocchio has no joint friction: its side gets the friction's own derivatives, written
+here from the friction law (tau_f,i = v_i qd_i + c_i tanh(qd_i / v_s)), and its forward
+dynamics runs on tau - tau_f(qd). Armature is on both sides. 1e-9 relative to the largest
+entry of Pinocchio's matrix, on the IRB-140, random DH and URDF-form chains (armature and
+friction), URDF chains with prismatic and continuous joints, and the chains of
+example-robot-data that the corpus test compares.
+"""
+
+import math
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from irb140_dynamics.core import (
+    ModelError,
+    forward_dynamics,
+    forward_dynamics_derivatives,
+    inverse_mass_matrix,
+    irb140,
+    mass_matrix,
+    rnea,
+    rnea_derivatives,
+)
+from irb140_dynamics.core.algorithms import analytical_derivatives, derivatives
+from irb140_dynamics.core.algorithms import recursions as algorithms
+from irb140_dynamics.core.urdf import load_urdf
+
+from ..support import pinocchio_model
+from ..support.common import full_sweep, loaded_irb140, random_model, random_urdf_model
+from .test_urdf_any_chain import KINDS, chain_urdf
+from .test_urdf_corpus import FILES, chains
+
+RTOL = 1e-9  # relative to the largest entry of Pinocchio's matrix
+FD_RTOL = 1e-6  # against central differences (step FD_STEP): their truncation and rounding
+FD_STEP = 1e-6
+STATES = 3
+FLOOR = 1e-3  # the scale of a matrix that is zero (d tau / dqd of one joint): 1e-12 absolute
+
+MODELS = {
+    "irb140": irb140,
+    "irb140_offset_payload": loaded_irb140,
+    **{f"random_n{n}": (lambda n=n: random_model(np.random.default_rng(300 + n), n)) for n in (1, 3, 6, 7)},
+    **{
+        f"urdf_form_friction_n{n}": (lambda n=n: random_urdf_model(np.random.default_rng(400 + n), n, friction=True))
+        for n in (2, 6)
+    },
+}
+
+
+class Reference:
+    """Pinocchio's derivatives of a chain, with the chain's friction added: ``model`` the
+    Pinocchio model of the chain alone (in our joint order: ``index``), ``to_pin`` q as its
+    configuration; viscous, Coulomb and the smoothing velocity per joint of the chain."""
+
+    def __init__(self, model, to_pin, index, viscous, coulomb, smoothing):
+        self.model, self.data = model, model.createData()
+        self.to_pin, self.index = to_pin, np.array(index)
+        self.viscous, self.coulomb, self.smoothing = np.asarray(viscous), np.asarray(coulomb), smoothing
+
+    def _ours(self, matrix) -> np.ndarray:
+        return np.array(matrix)[np.ix_(self.index, self.index)]
+
+    def _full(self, x) -> np.ndarray:
+        v = np.zeros(self.model.nv)
+        v[self.index] = x
+        return v
+
+    def friction(self, qd):
+        """(torques, slopes d tau_f / d qd) of the friction law at qd."""
+        shape = np.tanh(qd / self.smoothing)
+        return self.viscous * qd + self.coulomb * shape, self.viscous + self.coulomb * (1 - shape**2) / self.smoothing
+
+    def rnea_derivatives(self, q, qd, qdd):
+        dq, dqd, M = (
+            self._ours(x)
+            for x in pin.computeRNEADerivatives(self.model, self.data, self.to_pin(q), self._full(qd), self._full(qdd))
+        )
+        M = np.triu(M) + np.triu(M, 1).T
+        return dq, dqd + np.diag(self.friction(qd)[1]), M
+
+    def forward_dynamics_derivatives(self, q, qd, tau):
+        torques, slopes = self.friction(qd)
+        dq, dqd, Minv = (
+            self._ours(x)
+            for x in pin.computeABADerivatives(
+                self.model, self.data, self.to_pin(q), self._full(qd), self._full(tau - torques)
+            )
+        )
+        Minv = np.triu(Minv) + np.triu(Minv, 1).T
+        return dq, dqd - Minv @ np.diag(slopes), Minv
+
+    def inverse_mass_matrix(self, q):
+        Minv = self._ours(pin.computeMinverse(self.model, self.data, self.to_pin(q)))
+        return np.triu(Minv) + np.triu(Minv, 1).T
+
+
+def of_robot_model(robot) -> Reference:
+    """The reference for a RobotModel, Pinocchio's model built from its joints
+    (support.pinocchio_model)."""
+    friction = [(j.friction.viscous, j.friction.coulomb) for j in robot.joints]
+    viscous, coulomb = zip(*friction)
+    return Reference(
+        pinocchio_model.build(robot),
+        lambda q: np.asarray(q),
+        range(robot.n),
+        viscous,
+        coulomb,
+        robot.smoothing_velocity,
+    )
+
+
+def of_urdf(text: str, model) -> Reference:
+    """The reference for a chain loaded from ``text``: Pinocchio's reading of the text, the
+    joints off the chain locked at zero; its friction from Pinocchio's damping and friction."""
+    full = pin.buildModelFromXML(text)
+    names = model.joint_names
+    counts = Counter(frame.name for frame in full.frames)
+    for k, frame in enumerate(full.frames):  # buildReducedModel finds frames by name: one each
+        if counts[frame.name] > 1 and frame.type != pin.FrameType.JOINT:
+            frame.name += f"#{k}"
+    kept = {full.getJointId(name) for name in names}
+    locked = [j for j in range(1, full.njoints) if j not in kept]
+    reduced = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
+    reduced.gravity.linear = full.gravity.linear
+    joints = [reduced.joints[reduced.getJointId(name)] for name in names]
+    index = [j.idx_v for j in joints]
+    assert sorted(index) == list(range(reduced.nv)) == list(range(model.n))
+
+    def to_pin(q):
+        pq = pin.neutral(reduced)
+        for joint, x in zip(joints, q):
+            if joint.nq == 2:  # continuous: (cos, sin)
+                pq[joint.idx_q : joint.idx_q + 2] = math.cos(x), math.sin(x)
+            else:
+                pq[joint.idx_q] = x
+        return pq
+
+    viscous = [full.damping[full.joints[full.getJointId(name)].idx_v] for name in names]
+    coulomb = [full.friction[full.joints[full.getJointId(name)].idx_v] for name in names]
+    return Reference(reduced, to_pin, index, viscous, coulomb, model.smoothing_velocity)
+
+
+def assert_agree(ours, theirs, rtol=RTOL, what=""):
+    theirs = np.asarray(theirs)
+    scale = max(np.max(np.abs(theirs)), FLOOR)
+    error = np.max(np.abs(np.asarray(ours) - theirs)) / scale
+    assert error <= rtol, f"{what}: {error:.2e} relative to the largest entry {scale:.3g}"
+
+
+def random_state(rng, n):
+    """q, qd, qdd, tau; the first joint slow, where Coulomb friction's slope is steep."""
+    qd = rng.uniform(-2.0, 2.0, n)
+    qd[0] = rng.uniform(-0.02, 0.02)
+    return rng.uniform(-1.5, 1.5, n), qd, rng.uniform(-4.0, 4.0, n), rng.uniform(-30, 30, n)
+
+
+def compare(model, reference: Reference, rng, states=STATES, label=""):
+    """Our three functions against the reference at ``states`` random states. A chain whose
+    M is singular (a last link without inertia) has no forward dynamics: refused."""
+    for _ in range(states):
+        q, qd, qdd, tau = random_state(rng, model.n)
+        M = mass_matrix(model, q)
+        singular = np.linalg.eigvalsh(M)[0] <= 1e-12 * np.abs(M).max()
+        cases = [("rnea_derivatives", rnea_derivatives(model, q, qd, qdd), reference.rnea_derivatives(q, qd, qdd))]
+        if singular:
+            with pytest.raises(ValueError, match="singular.*no inverse"):
+                forward_dynamics_derivatives(model, q, qd, tau)
+            with pytest.raises(ValueError, match="singular.*no inverse"):
+                inverse_mass_matrix(model, q)
+        else:
+            ours = forward_dynamics_derivatives(model, q, qd, tau)
+            cases.append(("forward_dynamics_derivatives", ours, reference.forward_dynamics_derivatives(q, qd, tau)))
+            assert_agree(inverse_mass_matrix(model, q), reference.inverse_mass_matrix(q), what=f"{label} M^-1")
+        for name, ours, theirs in cases:
+            for part, x, y in zip(("d/dq", "d/dqd", "matrix"), ours, theirs):
+                assert np.shape(x) == (model.n, model.n)
+                assert_agree(x, y, what=f"{label} {name} {part}")
+
+
+@pytest.fixture(scope="module", params=list(MODELS), ids=list(MODELS))
+def robot(request):
+    return MODELS[request.param]()
+
+
+def test_agree_with_pinocchio(robot):
+    compare(robot, of_robot_model(robot), np.random.default_rng(5), label=robot.joint_names[0])
+
+
+def test_the_friction_is_there_to_be_derived():
+    robot = MODELS["urdf_form_friction_n2"]()
+    assert robot.friction is not None and robot.friction.coulomb.all() and robot.friction.viscous.all()
+
+
+@pytest.mark.parametrize("kinds", list(KINDS), ids=list(KINDS))
+def test_urdf_chains_with_prismatic_and_continuous_joints_agree_with_pinocchio(kinds):
+    rng = np.random.default_rng(sorted(KINDS).index(kinds) + 61)
+    text = chain_urdf(rng, KINDS[kinds])
+    model = load_urdf(text, "base", "tip").model
+    assert [j.kind for j in model.joints].count("prismatic") == KINDS[kinds].count("prismatic")
+    compare(model, of_urdf(text, model), rng, label=kinds)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not FILES, reason="example-robot-data is not installed")
+def test_chains_of_example_robot_data_agree_with_pinocchio():
+    """Every file's chains that load: one (seeded) per file in the suite, all with
+    IRB140_SWEEP=full, as the corpus test compares rnea, gravity and M."""
+    rng = np.random.default_rng(42)
+    compared = 0
+    for path in FILES:
+        text = Path(path).read_text()
+        loaded = []
+        for base, tip in chains(text):
+            try:
+                loaded.append(load_urdf(text, base, tip).model)
+            except ModelError as refusal:  # mimic joints: the corpus test checks the refusals
+                assert "mimic" in str(refusal)
+        if not full_sweep() and len(loaded) > 1:
+            loaded = [loaded[rng.integers(len(loaded))]]
+        for model in loaded:
+            compare(model, of_urdf(text, model), rng, states=1, label=f"{path.split('/robots/')[-1]}")
+            compared += 1
+    assert compared >= 50
+
+
+# -- against central finite differences of the package's own functions ---------------------
+
+
+def central_differences(f, x, step=FD_STEP):
+    """d f / dx (columns by input) by central differences."""
+    columns = []
+    for j in range(len(x)):
+        dx = np.zeros(len(x))
+        dx[j] = step
+        columns.append((f(x + dx) - f(x - dx)) / (2 * step))
+    return np.array(columns).T
+
+
+@pytest.mark.parametrize(
+    "make", [irb140, MODELS["urdf_form_friction_n6"], MODELS["random_n7"]], ids=["irb140", "friction", "n7"]
+)
+def test_agree_with_finite_differences_of_rnea_and_forward_dynamics(make):
+    model = make()
+    rng = np.random.default_rng(17)
+    for _ in range(STATES):
+        q, qd, qdd, tau = random_state(rng, model.n)
+        dq, dqd, M = rnea_derivatives(model, q, qd, qdd)
+        assert_agree(dq, central_differences(lambda x: rnea(model, x, qd, qdd), q), FD_RTOL, "dtau/dq")
+        assert_agree(dqd, central_differences(lambda x: rnea(model, q, x, qdd), qd), FD_RTOL, "dtau/dqd")
+        assert_agree(M, central_differences(lambda x: rnea(model, q, qd, x), qdd), FD_RTOL, "M")
+        A, B, Minv = forward_dynamics_derivatives(model, q, qd, tau)
+        assert_agree(A, central_differences(lambda x: forward_dynamics(model, x, qd, tau), q), FD_RTOL, "dqdd/dq")
+        assert_agree(B, central_differences(lambda x: forward_dynamics(model, q, x, tau), qd), FD_RTOL, "dqdd/dqd")
+        assert_agree(Minv, central_differences(lambda x: forward_dynamics(model, q, qd, x), tau), FD_RTOL, "M^-1")
+
+
+def test_identities_of_the_matrices():
+    """M from rnea_derivatives is mass_matrix; M^-1 is its inverse, symmetric, the same from
+    forward_dynamics_derivatives; qdd's derivatives are -M^-1 times tau's at FD's qdd."""
+    model = MODELS["urdf_form_friction_n6"]()
+    rng = np.random.default_rng(8)
+    q, qd, _, tau = random_state(rng, model.n)
+    qdd = forward_dynamics(model, q, qd, tau)
+    dq, dqd, M = rnea_derivatives(model, q, qd, qdd)
+    A, B, Minv = forward_dynamics_derivatives(model, q, qd, tau)
+    assert_agree(M, mass_matrix(model, q), 1e-14)
+    assert np.array_equal(Minv, Minv.T)
+    assert_agree(Minv, inverse_mass_matrix(model, q), 1e-13)
+    assert_agree(Minv @ M, np.eye(model.n), 1e-12)
+    assert_agree(A, -Minv @ dq, 1e-9)
+    assert_agree(B, -Minv @ dqd, 1e-9)
+
+
+def test_bad_input_is_refused_naming_the_argument():
+    model = irb140()
+    zeros = np.zeros(6)
+    with pytest.raises(ValueError, match="^q: expected 6 values"):
+        rnea_derivatives(model, np.zeros(5), zeros, zeros)
+    with pytest.raises(ValueError, match="^tau: must be finite"):
+        forward_dynamics_derivatives(model, zeros, zeros, [0, 0, float("nan"), 0, 0, 0])
+    with pytest.raises(ValueError, match="^q: expected"):
+        inverse_mass_matrix(model, "q")
+    with pytest.raises(ValueError, match="not finite.*too large"):
+        rnea_derivatives(model, zeros, np.full(6, 1e200), zeros)
+
+
+# -- the closed forms against their definition -----------------------------------------------
+
+
+@pytest.mark.parametrize("kinds", list(KINDS), ids=list(KINDS))
+def test_closed_forms_are_the_recursions_on_dual_numbers_in_any_frame(kinds):
+    """The analytical derivatives (in the frame of any link: the kernels take link 0's or
+    1's) equal rnea's on dual numbers, and the forward dynamics' -M^-1 times them at FD's
+    qdd, friction slopes included."""
+    rng = np.random.default_rng(sorted(KINDS).index(kinds) + 90)
+    model = load_urdf(chain_urdf(rng, KINDS[kinds]), "base", "tip").model
+    links, n = algorithms.chain(model), model.n
+    for _ in range(3):
+        q, qd, qdd, tau = (x.tolist() for x in random_state(rng, n))
+        cs = [(x,) if link.prismatic else (math.cos(x), math.sin(x)) for link, x in zip(links, q)]
+        slopes = rng.uniform(0.0, 2.0, n).tolist()
+        torques = rng.uniform(-1.0, 1.0, n).tolist()
+        dq, dqd = derivatives.rnea_partials(links, cs, qd, qdd, model.gravity, slopes)
+        qdd_fd, _, Minv = derivatives.forward_dynamics(links, cs, qd, tau, model.gravity, torques)
+        fd_dq, fd_dqd = derivatives.rnea_partials(links, cs, qd, qdd_fd, model.gravity, slopes)
+        for r in range(n):
+            ours = analytical_derivatives.rnea_partials(links, cs, qd, qdd, model.gravity, slopes, r)
+            for x, y in zip(ours, (dq, dqd, mass_matrix(model, q))):
+                assert_agree(x, y, 1e-12, f"{kinds} frame {r}")
+            ours = analytical_derivatives.forward_dynamics_partials(
+                links, cs, qd, tau, model.gravity, (torques, slopes), r
+            )
+            want = (-np.array(Minv) @ fd_dq, -np.array(Minv) @ fd_dqd, Minv)
+            for x, y in zip(ours, want):
+                assert_agree(x, y, 1e-10, f"{kinds} forward, frame {r}")
