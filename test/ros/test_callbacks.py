@@ -158,7 +158,7 @@ def test_payload_check_drops_a_joint_state_without_finite_torques(payload_node):
     reply = check(node)
     assert reply.success, reply.message
     assert "nan" not in reply.message and reply.message.startswith("OK: ")
-    assert node.node.state.q == Q
+    assert list(node.node.state.q) == Q
 
 
 def test_payload_check_answers_an_internal_error_and_goes_on(payload_node, monkeypatch):

@@ -198,7 +198,7 @@ def test_fuzz_payload_check_node():
                 state = item.state
             assert (node.state is None) == (state is None)
             if state is not None:
-                assert (node.state.q, node.state.qd) == state
+                assert (list(node.state.q), list(node.state.qd)) == state
             if k % 10 == 0:
                 result, _ = node.check()
                 settings = node.settings

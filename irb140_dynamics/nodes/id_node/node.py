@@ -52,16 +52,15 @@ from trajectory_msgs.msg import JointTrajectory
 from irb140_dynamics.core.io.stamps import seconds
 from irb140_dynamics.core.monitoring.collision import RESTARTS, CollisionMonitor
 from irb140_dynamics.core.monitoring.wrench import WrenchStream
-from irb140_dynamics.core.trajectories.tracking import TorqueStream
-from irb140_dynamics.nodes.id_node.markers import MarkerPublisher
-from irb140_dynamics.nodes.id_node.settings import (
-    NODE_PARAMETERS,
-    PER_JOINT_PARAMETERS,
+from irb140_dynamics.core.trajectories.stream_settings import (
     IdNodeSettings,
     check_settings,
     finish_settings,
     kernels_text,
 )
+from irb140_dynamics.core.trajectories.tracking import TorqueStream
+from irb140_dynamics.nodes.id_node.markers import MarkerPublisher
+from irb140_dynamics.nodes.id_node.settings import NODE_PARAMETERS, PER_JOINT_PARAMETERS
 from irb140_dynamics.ros.messages.joint_messages import (
     BadMessage,
     JointOrder,

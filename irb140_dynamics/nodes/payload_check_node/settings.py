@@ -7,7 +7,7 @@ from dataclasses import dataclass, replace
 
 from irb140_dynamics.core import RigidBody, RobotModel
 from irb140_dynamics.core.payload.analysis import PayloadAnalysis, analyse
-from irb140_dynamics.ros.parameters.specs import MAX_MASS, QOS_PARAMETERS, RELIABILITIES, Spec, check_choice
+from irb140_dynamics.ros.parameters.specs import MAX_MASS, QOS_PARAMETERS, Spec
 
 MIN_PERIOD, MAX_PERIOD = 0.1, 3600.0  # s: diagnostics.period
 NODE_PARAMETERS = [
@@ -77,7 +77,6 @@ def check_settings(values: dict) -> Settings:
             f"diagnostics.period: must be 0 (only on ~/check) or between {MIN_PERIOD:g} and {MAX_PERIOD:g} s, "
             f"got {period}"
         )
-    check_choice("qos.reliability", values["qos.reliability"], RELIABILITIES)
     rest = values["estimation.rest_velocity"], values["estimation.rest_time"]
     return Settings(model, rated, values["diagnostics.warn_use"], *rest, values["check.analysis_timeout"])
 

@@ -22,9 +22,7 @@ __all__ = [
     "JointSample",
     "core_result",
     "finite_torques",
-    "read_effort",
     "read_joint_sample",
-    "read_joint_state",
     "read_trajectory",
     "trajectory_message",
     "trajectory_of",
@@ -56,11 +54,12 @@ class JointSample(NamedTuple):
 
 def read_joint_sample(msg: bytes | JointState, order: JointOrder, now: Callable[[], float]) -> JointSample:
     """The sample of a JointState or of its serialized bytes (read by joint_state_cdr), its
-    joints matched by name (see read_joint_state); ``now()`` [s] is read only for an
-    unstamped message. BadMessage (NotForThisModel for other joints only) if unusable."""
+    joints matched by name (in any order, others ignored; a message without names only if
+    its length fits the model); ``now()`` [s] is read only for an unstamped message.
+    BadMessage (NotForThisModel for other joints only) if unusable."""
     if type(msg) is bytes:
         msg = read_joint_state_cdr(msg)
-    index, length = _index(msg.name, len(msg.position), order)
+    index, length = order.for_values(msg.name, len(msg.position))
     q = _pick(msg.position, index, "position", length, required=True)
     qd = _pick(msg.velocity, index, "velocity", length, required=False)
     effort, bad_effort = msg.effort, None
@@ -76,33 +75,6 @@ def read_joint_sample(msg: bytes | JointState, order: JointOrder, now: Callable[
     stamp = msg.header.stamp
     t = seconds(stamp.sec, stamp.nanosec) or now()
     return JointSample(stamp, t, np.array(q), np.array(qd), effort, bad_effort)
-
-
-def read_joint_state(msg: JointState, order: JointOrder) -> tuple[list[float], list[float]]:
-    """(q, qd) of the model's joints; missing velocities count as zero.
-
-    Joints are matched by name, in any order, others ignored; a message without names is
-    taken positionally only if its length matches the model. ``effort`` is not used, but
-    its length must fit too. Raises NotForThisModel for a message about other joints only.
-    """
-    index, length = order.for_values(msg.name, len(msg.position))
-    q = _pick(msg.position, index, "position", length, required=True)
-    qd = _pick(msg.velocity, index, "velocity", length, required=False)
-    if len(msg.effort) not in (0, length):
-        raise BadMessage("length_mismatch", f"effort has {len(msg.effort)} values for {length} joints")
-    return q, qd
-
-
-def read_effort(msg: JointState, order: JointOrder) -> list[float] | None:
-    """The efforts of the model's joints, None when the message has none (BadMessage
-    ``effort_not_finite`` for a NaN or infinite one). Call after read_joint_state."""
-    if len(msg.effort) == 0:
-        return None
-    index, length = order.for_values(msg.name, len(msg.position))
-    try:
-        return _pick(msg.effort, index, "effort", length, required=True)
-    except BadMessage as error:
-        raise BadMessage("effort_not_finite", str(error)) from None
 
 
 def read_trajectory(msg: JointTrajectory, order: JointOrder):
@@ -161,7 +133,3 @@ def trajectory_message(tr, frame_id: str = "") -> JointTrajectory:
             )
         )
     return msg
-
-
-def _index(names, n_positions: int, order: JointOrder) -> tuple[list[int], int]:
-    return order.for_values(names, n_positions)
