@@ -36,9 +36,10 @@ from std_srvs.srv import Trigger
 from irb140_dynamics.core import gravity, rnea
 from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder, NotForThisModel
 from irb140_dynamics.core.payload import check_payload
+from irb140_dynamics.core.payload.analysis import Settings, check_settings, finish_settings
 from irb140_dynamics.core.payload.rest_samples import EstimationError, PayloadEstimator
 from irb140_dynamics.nodes.payload_check_node.check_service import CheckService, reply
-from irb140_dynamics.nodes.payload_check_node.settings import NODE_PARAMETERS, Settings, check_settings, finish_settings
+from irb140_dynamics.nodes.payload_check_node.settings import NODE_PARAMETERS
 from irb140_dynamics.ros.messages.joint_messages import finite_torques, read_joint_sample
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
