@@ -5,6 +5,7 @@ May import: ``core``. Never ``ros``, ``nodes``, ``tools``.
     base        the identifiable combinations (base parameters) of a model's structure
     excitation  periodic Fourier trajectories within the limits, optimised for them
     recording   ROS 2 bags (rosbags) and CSV files, read in chunks
+    bag_recording  a topic written to a new bag as it comes (the record tool's), and when it is complete
     signals     zero-phase filtering, differentiation and decimation, chunk by chunk
     least_squares  normal equations; weighted least squares on the base parameters
     correlation how correlated the residuals are: the estimate's covariance depends on it

@@ -1,20 +1,19 @@
-"""A topic recorded to a ROS 2 bag (.mcap) with rosbags' writer: `ros2 bag record` where
-rosbag2 is not installed (ROS 2 from PyPI wheels). See tools/record.py.
+"""The record tool's node: `ros2 bag record` of one topic where rosbag2 is not installed
+(ROS 2 from PyPI wheels). See tools/record.py; the bag and when it is complete are
+identification.bag_recording's.
 
 The recorder waits until the topic has a publisher (its type comes from the graph; after
 NAME_TOPICS_AFTER s one line names the topics that have one: a typo shows), then subscribes
-reliable when every publisher is, else best effort (as rosbag2 adapts), and writes each
-message as it comes (CDR) with its receive time on the node's clock (simulated with
-use_sim_time). It is ``finished`` ``duration`` s after the first message, or ``tail`` s after
-the end of the motion last sent on a ``reference`` topic (a JointTrajectory, timed from its
-header stamp, else from its arrival; a single point, a hold, is no motion). ``record`` spins
-it until then, a failure or a stop, and closes the bag; no message at all leaves no bag.
+reliable when every publisher is, else best effort (as rosbag2 adapts), and hands each
+message (CDR) to the bag with its receive time on the node's clock (simulated with
+use_sim_time). A motion on the ``reference`` topic (a JointTrajectory) is timed from its
+header stamp, else from its arrival; a single point, a hold, is no motion. ``record`` spins
+it until the bag is complete, a failure or a stop, and closes the bag.
 """
 
 from __future__ import annotations
 
 import importlib
-import shutil
 import time
 from pathlib import Path
 
@@ -29,10 +28,9 @@ from rclpy.signals import SignalHandlerOptions
 from rclpy.validate_full_topic_name import validate_full_topic_name
 from trajectory_msgs.msg import JointTrajectory
 
-from irb140_dynamics.core.errors import counted
 from irb140_dynamics.core.io.params_file import rcl_refusal
 from irb140_dynamics.core.io.stamps import nanoseconds
-from irb140_dynamics.identification.recording import bag_connection, open_bag
+from irb140_dynamics.identification.bag_recording import BagRecording
 
 POLL_PERIOD = 0.1  # s between looks at the graph while waiting for the topic
 DRAIN_TIME = 1.0  # s: after a stop is asked for, messages already received are written, for at most this long
@@ -76,13 +74,13 @@ def record(argv: list[str], options, out: Path, stop, progress) -> tuple[str, st
             why = _spin_until_done(recorder, stop, progress)
         finally:  # whatever happened: the bag closed whole (signals only set flags meanwhile)
             try:
-                summary = recorder.close()
+                summary = recorder.bag.close()
             except (OSError, ValueError) as error:  # a full disk
-                recorder.failure = recorder.failure or f"{options.out}: cannot close the bag ({error})"
+                recorder.bag.failure = recorder.bag.failure or f"{options.out}: cannot close the bag ({error})"
             recorder.destroy_node()
     finally:
         rclpy.try_shutdown()
-    return why, summary, recorder.failure
+    return why, summary, recorder.bag.failure
 
 
 def _spin_until_done(recorder: Recorder, stop, progress) -> str:
@@ -94,38 +92,35 @@ def _spin_until_done(recorder: Recorder, stop, progress) -> str:
     except (ImportError, OSError, ValueError):  # (it enables faulthandler: a stderr without a file fails)
         executor = SingleThreadedExecutor(context=recorder.context)
     executor.add_node(recorder)
+    bag = recorder.bag
     try:
-        while not stop and not recorder.failure and not recorder.check() and recorder.context.ok():
+        while not stop and not bag.failure and not recorder.check() and recorder.context.ok():
             executor.spin_once(timeout_sec=0.1)
-            progress(recorder.progress())
-        if stop and not recorder.finished:  # what is queued was received before the stop
+            progress(bag.progress())
+        if stop and not bag.finished:  # what is queued was received before the stop
             deadline, count, quiet = time.monotonic() + DRAIN_TIME, -1, time.monotonic()
-            while time.monotonic() < min(deadline, quiet + DRAIN_QUIET) and not recorder.failure:
-                if recorder.count != count:
-                    count, quiet = recorder.count, time.monotonic()
+            while time.monotonic() < min(deadline, quiet + DRAIN_QUIET) and not bag.failure:
+                if bag.count != count:
+                    count, quiet = bag.count, time.monotonic()
                 executor.spin_once(timeout_sec=0.01)
     finally:
         progress.end()
         executor.shutdown()
-    return recorder.failure or recorder.finished or ("interrupted" if stop else "the ROS context shut down")
+    return bag.failure or bag.finished or ("interrupted" if stop else "the ROS context shut down")
 
 
 class Recorder(Node):
-    """Records ``options.topic`` into a new bag at ``out`` until ``finished`` (see the module's docstring)."""
+    """Records ``options.topic`` into a new bag at ``out`` (``bag``) until it is finished (see
+    the module's docstring)."""
 
     def __init__(self, options, out: Path):
         super().__init__("record")
-        self.topic, self.out, self.options = self.resolve_topic_name(options.topic), Path(out), options
-        self.duration, self.tail = options.duration, options.tail
-        self.finished: str | None = None  # why the recording is complete
-        self.failure: str | None = None  # why it cannot go on (one line)
-        self.reference_end: int | None = None  # ns, node clock: where the last motion ends
-        if options.reference is not None:
-            self.reference = self.resolve_topic_name(options.reference)
-            self.create_subscription(JointTrajectory, self.reference, self._on_reference, 10)
-        self._writer, self._connection = open_bag(self.out), None
-        self._waiting_since, self._named = time.monotonic(), False
-        self.count, self.first, self.last = 0, None, None  # messages, receive times [ns]
+        self.topic, self.options = self.resolve_topic_name(options.topic), options
+        reference = None if options.reference is None else self.resolve_topic_name(options.reference)
+        self.bag = BagRecording(out, self.topic, options.duration, options.tail, reference)
+        if reference is not None:
+            self.create_subscription(JointTrajectory, reference, self._on_reference, 10)
+        self._named = False
         # on the steady clock: with use_sim_time, simulated time may stand still until then
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self._waiting = self.create_timer(POLL_PERIOD, self._subscribe_when_published, clock=steady)
@@ -133,10 +128,10 @@ class Recorder(Node):
 
     def _subscribe_when_published(self) -> None:
         publishers = self.get_publishers_info_by_topic(self.topic)
-        if self.failure:
+        if self.bag.failure:
             return
         if not publishers:
-            if not self._named and time.monotonic() - self._waiting_since >= NAME_TOPICS_AFTER:
+            if not self._named and time.monotonic() - self.bag.waiting_since >= NAME_TOPICS_AFTER:
                 self._named = True
                 self.get_logger().warning(f"{self._others()}; still waiting for {self.topic} (Ctrl-C stops)")
             return
@@ -145,9 +140,9 @@ class Recorder(Node):
         try:
             package, kind, name = type_name.split("/")  # sensor_msgs/msg/JointState
             message = getattr(importlib.import_module(f"{package}.{kind}"), name)
-            self._connection = bag_connection(self._writer, self.topic, type_name)
+            self.bag.start(type_name)
         except Exception as error:  # noqa: BLE001  (an unknown type: rosbags and importlib raise many kinds)
-            self.failure = f"{self.topic}: cannot record its type {type_name} ({type(error).__name__}: {error})"
+            self.bag.failure = f"{self.topic}: cannot record its type {type_name} ({type(error).__name__}: {error})"
             return
         reliable = all(p.qos_profile.reliability == ReliabilityPolicy.RELIABLE for p in publishers)
         policy = ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT
@@ -155,7 +150,7 @@ class Recorder(Node):
             message, self.topic, self._on_message, QoSProfile(depth=self.options.depth, reliability=policy), raw=True
         )
         kind = "reliable" if reliable else "best effort"
-        self.get_logger().info(f"recording {self.topic} ({type_name}, {kind}) to {self.out}")
+        self.get_logger().info(f"recording {self.topic} ({type_name}, {kind}) to {self.bag.out}")
 
     def _others(self) -> str:
         """The topics with a publisher (those of every node left out), in a line."""
@@ -170,19 +165,7 @@ class Recorder(Node):
         return f"no publisher of {self.topic}; topics with one: {', '.join(names[:TOPICS_NAMED])}{more}"
 
     def _on_message(self, raw: bytes) -> None:
-        if self.finished or self.failure:
-            return
-        now = self.get_clock().now().nanoseconds
-        if self.first is None:
-            self.first = now
-        elif self.check(now):
-            return
-        try:
-            self._writer.write(self._connection, now, raw)
-        except (OSError, ValueError) as error:  # a full disk
-            self.failure = f"{self.out}: cannot write ({getattr(error, 'strerror', None) or error})"
-            return
-        self.count, self.last = self.count + 1, now
+        self.bag.write(self.get_clock().now().nanoseconds, raw)
 
     def _on_reference(self, msg: JointTrajectory) -> None:
         if not msg.points:
@@ -192,38 +175,13 @@ class Recorder(Node):
         if length <= 0:  # a hold, not a motion
             return
         stamp = nanoseconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
-        if self.reference_end is None:
+        if self.bag.reference_end is None:
             self.get_logger().info(
-                f"following {self.reference}: stops {self.tail:g} s after its motion ends ({length * 1e-9:g} s long)"
+                f"following {self.bag.reference}: stops {self.bag.tail:g} s after its motion ends "
+                f"({length * 1e-9:g} s long)"
             )
-        self.reference_end = (stamp if stamp > 0 else self.get_clock().now().nanoseconds) + length
+        self.bag.reference_end = (stamp if stamp > 0 else self.get_clock().now().nanoseconds) + length
 
-    def check(self, now: int | None = None) -> bool:
-        """Is the recording complete at ``now`` (node clock, ns)? Sets ``finished``."""
-        if self.finished:
-            return True
-        now = self.get_clock().now().nanoseconds if now is None else now
-        if self.duration and self.first is not None and now - self.first >= self.duration * 1e9:
-            self.finished = f"{self.duration:g} s after the first message"
-        elif self.reference_end is not None and now >= self.reference_end + self.tail * 1e9:
-            self.finished = f"{self.tail:g} s after the end of the motion on {self.reference}"
-        return self.finished is not None
-
-    def progress(self) -> str:
-        """What is recorded so far, in a line."""
-        if self._connection is None:
-            return f"waiting for a publisher of {self.topic}: {time.monotonic() - self._waiting_since:.0f} s"
-        goal = f" of {self.duration:g} s" if self.duration else ""
-        return f"recording {self.topic}: {counted(self.count, 'message')}, {self._span():.1f} s{goal}"
-
-    def close(self) -> str:
-        """Close the bag (once, with signals held off: a bag half closed is unreadable); what it
-        holds, in a line. A bag without a message is removed (the folder was new)."""
-        self._writer.close()
-        if self.count == 0:
-            shutil.rmtree(self.out, ignore_errors=True)
-            return f"no message came on {self.topic}: nothing written"
-        return f"wrote {self.out}: {counted(self.count, 'message')} of {self.topic} over {self._span():.3f} s"
-
-    def _span(self) -> float:
-        return 0.0 if self.first is None else (self.last - self.first) * 1e-9
+    def check(self) -> bool:
+        """Is the recording complete now (node clock)?"""
+        return self.bag.check(self.get_clock().now().nanoseconds)

@@ -14,8 +14,8 @@ from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import RigidBody, gravity, irb140
 from irb140_dynamics.core.payload import analysis as payload_analysis
+from irb140_dynamics.core.trajectories import stream_settings as id_settings
 from irb140_dynamics.nodes.id_node import node as id_module
-from irb140_dynamics.nodes.id_node import settings as id_settings
 from irb140_dynamics.nodes.id_node.node import IdNode
 from irb140_dynamics.nodes.payload_check_node import node as payload_module
 from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode

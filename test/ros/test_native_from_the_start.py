@@ -12,9 +12,9 @@ from sensor_msgs.msg import JointState
 from irb140_dynamics import native
 from irb140_dynamics.core import gravity
 from irb140_dynamics.core.codegen.kernels import kernels_of
-from irb140_dynamics.nodes.id_node import settings as id_settings
+from irb140_dynamics.core.trajectories import stream_settings as id_settings
+from irb140_dynamics.core.trajectories.stream_settings import KERNELS, kernels_text
 from irb140_dynamics.nodes.id_node.node import IdNode
-from irb140_dynamics.nodes.id_node.settings import KERNELS, kernels_text
 
 from ..support.ros_harness import running
 

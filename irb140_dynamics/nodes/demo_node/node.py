@@ -24,11 +24,11 @@ from irb140_dynamics.core.io.stamps import nanoseconds
 from irb140_dynamics.core.monitoring.tracking import TrackingLog
 from irb140_dynamics.core.trajectories import Trajectory
 from irb140_dynamics.core.trajectories.reference import swing
+from irb140_dynamics.node_help import Usage
 from irb140_dynamics.ros.messages.joint_messages import trajectory_message
 from irb140_dynamics.ros.parameters.arm import declare_fixed
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.spec import Spec
-from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.spin import run
 
 NAMES = [f"joint_{i}" for i in range(1, 7)]

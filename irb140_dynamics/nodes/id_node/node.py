@@ -52,16 +52,16 @@ from trajectory_msgs.msg import JointTrajectory
 from irb140_dynamics.core.io.stamps import seconds
 from irb140_dynamics.core.monitoring.collision import RESTARTS, CollisionMonitor
 from irb140_dynamics.core.monitoring.wrench import WrenchStream
-from irb140_dynamics.core.trajectories.tracking import TorqueStream
-from irb140_dynamics.nodes.id_node.markers import MarkerPublisher
-from irb140_dynamics.nodes.id_node.settings import (
-    NODE_PARAMETERS,
-    PER_JOINT_PARAMETERS,
+from irb140_dynamics.core.trajectories.stream_settings import (
     IdNodeSettings,
     check_settings,
     finish_settings,
     kernels_text,
 )
+from irb140_dynamics.core.trajectories.tracking import TorqueStream
+from irb140_dynamics.node_help import Usage
+from irb140_dynamics.nodes.id_node.markers import MarkerPublisher
+from irb140_dynamics.nodes.id_node.settings import NODE_PARAMETERS, PER_JOINT_PARAMETERS
 from irb140_dynamics.ros.messages.joint_messages import (
     BadMessage,
     JointOrder,
@@ -76,7 +76,6 @@ from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import joint_states_qos
 from irb140_dynamics.ros.parameters.usage import JOINT, model_sections, per_joint_section
-from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.diagnostics import message_status
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
 from irb140_dynamics.ros.runtime.listened import ListenedPublisher

@@ -36,15 +36,16 @@ from std_srvs.srv import Trigger
 from irb140_dynamics.core import gravity, rnea
 from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder, NotForThisModel
 from irb140_dynamics.core.payload import check_payload
+from irb140_dynamics.core.payload.analysis import Settings, check_settings, finish_settings
 from irb140_dynamics.core.payload.rest_samples import EstimationError, PayloadEstimator
+from irb140_dynamics.node_help import Usage
 from irb140_dynamics.nodes.payload_check_node.check_service import CheckService, reply
-from irb140_dynamics.nodes.payload_check_node.settings import NODE_PARAMETERS, Settings, check_settings, finish_settings
+from irb140_dynamics.nodes.payload_check_node.settings import NODE_PARAMETERS
 from irb140_dynamics.ros.messages.joint_messages import finite_torques, read_joint_sample
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import joint_states_qos
 from irb140_dynamics.ros.parameters.usage import model_sections
-from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.diagnostics import payload_statuses
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
 from irb140_dynamics.ros.runtime.rebuild import Rebuild

@@ -34,13 +34,13 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, String
 from std_srvs.srv import Trigger
 
+from irb140_dynamics.node_help import Usage
 from irb140_dynamics.nodes.sim_node.settings import NODE_PARAMETERS, build_setup
 from irb140_dynamics.ros.messages.joint_messages import BadMessage
 from irb140_dynamics.ros.messages.wrench import chain_links, read_wrench
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.usage import model_sections
-from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
 from irb140_dynamics.ros.runtime.rebuild import Rebuild
 from irb140_dynamics.ros.runtime.spin import run

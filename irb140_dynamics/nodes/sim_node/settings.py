@@ -5,8 +5,9 @@ from __future__ import annotations
 from rclpy.parameter import Parameter
 
 from irb140_dynamics.core import RobotModel
+from irb140_dynamics.core.errors import check_choice
 from irb140_dynamics.ros.parameters.arm import STAND_IN
-from irb140_dynamics.ros.parameters.specs import MAX_QOS_DEPTH, Spec, check_choice
+from irb140_dynamics.ros.parameters.specs import MAX_QOS_DEPTH, Spec
 from irb140_dynamics.sim.engine import DEFAULT_INTEGRATOR, SimulatedArm
 from irb140_dynamics.sim.mjcf import INTEGRATORS
 from irb140_dynamics.sim.simulation import Setup, initial_positions

@@ -30,12 +30,12 @@ from trajectory_msgs.msg import JointTrajectory
 from irb140_dynamics.core import RobotModel
 from irb140_dynamics.core.errors import one_line
 from irb140_dynamics.core.trajectories import TrajectoryChecker, TrajectoryError
+from irb140_dynamics.node_help import Usage
 from irb140_dynamics.ros.messages.joint_messages import trajectory_message, trajectory_of
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
 from irb140_dynamics.ros.parameters.specs import Spec
 from irb140_dynamics.ros.parameters.usage import model_sections
-from irb140_dynamics.ros.runtime.command_line import Usage
 from irb140_dynamics.ros.runtime.guard import Tally, guarded
 from irb140_dynamics.ros.runtime.rebuild import Rebuild
 from irb140_dynamics.ros.runtime.spin import run

@@ -54,12 +54,12 @@ class JointSample(NamedTuple):
 
 def read_joint_sample(msg: bytes | JointState, order: JointOrder, now: Callable[[], float]) -> JointSample:
     """The sample of a JointState or of its serialized bytes (read by joint_state_cdr), its
-    joints matched by name, in any order, others ignored (a message without names taken
-    positionally only if its length matches the model); ``now()`` [s] is read only for an
-    unstamped message. BadMessage (NotForThisModel for other joints only) if unusable."""
+    joints matched by name (in any order, others ignored; a message without names only if
+    its length fits the model); ``now()`` [s] is read only for an unstamped message.
+    BadMessage (NotForThisModel for other joints only) if unusable."""
     if type(msg) is bytes:
         msg = read_joint_state_cdr(msg)
-    index, length = _index(msg.name, len(msg.position), order)
+    index, length = order.for_values(msg.name, len(msg.position))
     q = _pick(msg.position, index, "position", length, required=True)
     qd = _pick(msg.velocity, index, "velocity", length, required=False)
     effort, bad_effort = msg.effort, None
@@ -133,7 +133,3 @@ def trajectory_message(tr, frame_id: str = "") -> JointTrajectory:
             )
         )
     return msg
-
-
-def _index(names, n_positions: int, order: JointOrder) -> tuple[list[int], int]:
-    return order.for_values(names, n_positions)

@@ -22,7 +22,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from irb140_dynamics.core import Joint, RigidBody, RobotModel
-from irb140_dynamics.core.errors import one_line
+from irb140_dynamics.core.errors import check_choice, one_line
 from irb140_dynamics.core.io.arm_source import SOURCES, read_arm, read_urdf_file
 from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.core.io.urdf import LoadedUrdf, load_urdf
@@ -35,8 +35,8 @@ from irb140_dynamics.ros.parameters.spec import Spec, as_type
 from irb140_dynamics.ros.parameters.specs import (
     DESCRIPTION_PARAMETERS,
     MODEL_NAME,
+    RELIABILITIES,
     SOURCE,
-    check_choice,
     joint_names_spec,
     model_specs,
 )
@@ -159,7 +159,9 @@ class ArmParameters:
     def draft(self, check: Callable[[dict], Any], values: dict[str, Any], urdf: LoadedUrdf | None = None) -> Any:
         """``check`` (a node's: its settings, not built yet, or ValueError naming the
         parameter) of the model's values; None while no URDF has come, the node's own values
-        checked meanwhile on a one-joint stand-in arm."""
+        checked meanwhile on a one-joint stand-in arm. The shared qos.reliability is checked here."""
+        if "qos.reliability" in values:
+            check_choice("qos.reliability", values["qos.reliability"], RELIABILITIES)
         model_values = self.model_values(values, urdf)
         if model_values is not None:
             return check(model_values)

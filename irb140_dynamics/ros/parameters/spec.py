@@ -33,6 +33,10 @@ class Spec:
         return self.default if not self.has_default else Parameter.Type.from_parameter_value(self.default)
 
     @property
+    def type_name(self) -> str:
+        return TYPE_NAMES[self.type]
+
+    @property
     def has_default(self) -> bool:
         return not isinstance(self.default, Parameter.Type)
 

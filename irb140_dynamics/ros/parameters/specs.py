@@ -1,6 +1,5 @@
 """The parameters every node shares: where the arm comes from, the model's own (with the
-finite ranges of its numbers), the joint_states QoS; and ``check_choice``, the one rule a
-descriptor cannot state for a string (its choices)."""
+finite ranges of its numbers), the joint_states QoS."""
 
 from __future__ import annotations
 
@@ -70,11 +69,6 @@ DESCRIPTION_PARAMETERS = [  # model.source robot_description
         ("model.tip_link", "the URDF link where the chain ends, the payload's frame; empty: the only leaf"),
     )
 ]
-
-
-def check_choice(name: str, value, choices) -> None:
-    if value not in choices:
-        raise ValueError(f"{name}: must be one of {', '.join(choices)}; got {value!r}")
 
 
 def joint_states_qos(node: Node) -> QoSProfile:

@@ -1,21 +1,16 @@
 """A node's command line before ROS starts: ``--help``, and what rcl would silently ignore.
 
 A node takes no arguments of its own: everything comes after ``--ros-args``. ``--help``
-prints its parameters from their Specs (name, type, default, range, unit, description)
-without starting ROS. A ROS argument typed before ``--ros-args`` (``id_node -p
+prints its parameters (irb140_dynamics.node_help) without starting ROS. A ROS argument typed before ``--ros-args`` (``id_node -p
 payload.mass:=2.0``) would leave the default in force without a word: it is refused, with
 the line to type instead; so is a params file rcl should not be given (a folder, /dev/zero).
 """
 
 from __future__ import annotations
 
-import textwrap
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 from irb140_dynamics.core.io.text_files import InputFileError, read_text_file
-from irb140_dynamics.ros.parameters.spec import TYPE_NAMES, Spec
 
 ROS_ARGS = "--ros-args"
 HELP = ("-h", "--help")
@@ -23,62 +18,6 @@ ROS_FLAGS = (  # what rcl reads after --ros-args (design.ros2.org "ROS command l
     *("-p", "--param", "--params-file", "-r", "--remap", "-e", "--enclave", "--log-level", "--log-config-file"),
     *(f"--{switch}-{logs}-logs" for logs in ("rosout", "stdout", "external-lib") for switch in ("enable", "disable")),
 )
-
-
-@dataclass
-class Usage:
-    """What ``--help`` prints for a node: a summary, notes and its parameters by section."""
-
-    name: str
-    summary: str
-    sections: list[tuple[str, list[Spec]]] = field(default_factory=list)  # (title, Specs)
-    notes: list[str] = field(default_factory=list)
-
-    def text(self) -> str:
-        lines = [
-            f"usage: {self.name} [-h] [--ros-args [--params-file FILE] [-p NAME:=VALUE] ...]",
-            f"       ros2 run irb140_dynamics {self.name} --ros-args -p NAME:=VALUE",
-            "",
-            self.summary.strip(),
-            "",
-            "Parameters are given after --ros-args: -p NAME:=VALUE, or --params-file FILE (YAML, as",
-            "config/irb140.yaml); most can be changed while running (ros2 param set), each change",
-            "validated whole, a bad value refused with its reason.",
-        ]
-        for note in self.notes:
-            lines += ["", *textwrap.wrap(note, 92)]
-        for title, specs in self.sections:
-            lines += ["", f"{title}:"]
-            for spec in specs:
-                lines += describe_spec(spec)
-        return "\n".join(lines) + "\n"
-
-
-def describe_spec(spec: Spec) -> list[str]:
-    """``name (type, default, range, unit, read-only)`` and the description below it."""
-    unit = f" {spec.unit}" if spec.unit else ""
-    facts = [TYPE_NAMES[spec.type]]
-    if spec.has_default:
-        facts.append(f"default {default_text(spec.default)}{unit}")
-    if spec.minimum is not None and spec.maximum is not None:
-        facts.append(f"{spec.minimum:g} to {spec.maximum:g}{unit}")
-    elif unit and not spec.has_default:
-        facts.append(spec.unit)
-    if spec.read_only:
-        facts.append("read-only: set at startup")
-    body = textwrap.wrap(spec.description, 88, initial_indent="      ", subsequent_indent="      ")
-    return [f"  {spec.name} ({', '.join(facts)})", *body]
-
-
-def default_text(default: Any) -> str:
-    """A default as a user would write it."""
-    if isinstance(default, bool):
-        return "true" if default else "false"
-    if isinstance(default, str):
-        return f"'{default}'"
-    if isinstance(default, (list, tuple)):
-        return "[" + ", ".join(default_text(x) for x in default) + "]"
-    return repr(default)
 
 
 def split_arguments(argv: list[str]) -> tuple[list[str], list[str]]:

@@ -24,7 +24,8 @@ from rclpy.utilities import remove_ros_args
 
 from irb140_dynamics.core.errors import one_line
 from irb140_dynamics.core.io.params_file import rcl_refusal
-from irb140_dynamics.ros.runtime.command_line import Usage, before_start
+from irb140_dynamics.node_help import Usage
+from irb140_dynamics.ros.runtime.command_line import before_start
 
 EXECUTORS = ("events", "single_threaded")
 INTERRUPTED = "interrupted (Ctrl-C) before the node was ready"
