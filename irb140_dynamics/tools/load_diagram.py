@@ -135,7 +135,12 @@ def _diagram(argv: list[str], interrupts) -> int:
 
     source = arm_of(args)
     try:
-        rated, stated = rated_payload(source.given, args.rated_mass)
+        given = source.given
+        if not (args.params_file or args.urdf):  # the package's own arm: its file states its rated payload
+            from irb140_dynamics.core.io.params_file import read_parameter_file
+
+            given = {**read_parameter_file(source.origin), **given}
+        rated, stated = rated_payload(given, args.rated_mass)
     except ValueError as error:
         raise ToolError(str(error).splitlines()[0]) from None
     model = source.model

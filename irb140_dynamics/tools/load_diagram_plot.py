@@ -9,6 +9,8 @@ import math
 
 import numpy as np
 
+from irb140_dynamics.core.errors import counted
+
 COLUMNS = ("z_m", "l_m", "max_mass_kg", "status", "limiting_joint", "reason")
 
 
@@ -91,7 +93,7 @@ SHEET_LINES = 5  # the spec-sheet form: at most this many values of L
 def _title(diagram, arm: str, rated_mass, finite) -> str:
     joints = len(diagram.joint_names)
     first = f"Load diagram of {arm} ({joints} joints): the largest payload held at rest in every pose"
-    second = f"{100 * diagram.proven_share:.0f} % of {len(diagram.points)} points proven"
+    second = f"{100 * diagram.proven_share:.0f} % of {counted(len(diagram.points), 'point')} proven"
     if rated_mass is None:
         second += "; no rated payload stated"
     elif finite.size and rated_mass > finite.max():
