@@ -67,7 +67,10 @@ class Rebuild:
         """Build ``job`` on this thread (a quick one) and use it; builds under way are superseded."""
         with self._lock:
             self._next(pending=False)
-        self._deliver(self._built_from(job))
+        result = _built(self._build, job, self.previous)
+        if not isinstance(result, Failed):
+            self.previous = result
+        self._deliver(result)
 
     def wait(self, timeout: float) -> bool:
         """Before spinning: wait up to ``timeout`` s for the newest result and use it here
@@ -123,10 +126,6 @@ class Rebuild:
             self._use(result)
         if self._settled is not None:
             self._settled()
-
-    def _built_from(self, job: Any) -> Any:
-        result = self.previous = _built(self._build, job, self.previous)
-        return result
 
     def next_job(self) -> tuple[int, threading.Event, Any, Any] | None:
         """The worker's: (generation, cancel, job, previous) of the newest job, or None (then
