@@ -5,6 +5,7 @@ line naming both, before any work), and with the modes the user's umask gives.""
 import os
 import shutil
 import stat
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -279,3 +280,18 @@ def test_every_file_a_tool_writes_has_the_mode_the_umask_gives(tool, umask, reco
     files = [p for p in (tmp_path / "o").rglob("*") if p.is_file()]
     assert len(files) == count, files
     assert modes(tmp_path / "o", umask) == {}
+
+
+def test_a_file_in_a_missing_folder_is_named_as_asked_not_by_its_temporary(tmp_path):
+    target = tmp_path / "missing" / "out.yaml"
+    with pytest.raises(OSError) as raised:
+        write_files({target: b"x"})
+    assert raised.value.filename == str(target)
+    assert not (tmp_path / "missing").exists()
+
+
+def test_retime_names_the_output_asked_for_when_its_folder_is_missing(tmp_path, capsys):
+    example = Path(__file__).parents[2] / "docs" / "trajectory_example.yaml"
+    assert retime.main([str(example), str(tmp_path / "missing" / "out.yaml")]) == 1
+    err = capsys.readouterr().err.strip()
+    assert f"{tmp_path / 'missing' / 'out.yaml'}: cannot write" in err and ".irb140-" not in err, err

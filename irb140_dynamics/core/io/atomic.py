@@ -46,7 +46,10 @@ def write_files(files: dict) -> list[Path]:
     try:
         for path, data in files.items():
             target = Path(path)
-            descriptor, temporary = new_temporary(target.parent)
+            try:
+                descriptor, temporary = new_temporary(target.parent)
+            except OSError as error:  # named as the file asked for, not the temporary's name
+                raise OSError(error.errno, error.strerror, str(target)) from None
             staged.append((temporary, target))
             with os.fdopen(descriptor, "wb") as stream:
                 stream.write(data)
