@@ -146,6 +146,20 @@ def _inside(box, frame, slack: float = 0.5) -> bool:
     )
 
 
+def _level_paths(curves) -> list:
+    """One path per level of a ContourSet: its own since matplotlib 3.8; before (Ubuntu
+    24.04's 3.6), the paths of each level's collection joined."""
+    import matplotlib
+    import numpy as np
+    from matplotlib.path import Path
+
+    if tuple(int(part) for part in matplotlib.__version__.split(".")[:2]) >= (3, 8):
+        return list(curves.get_paths())
+    return [
+        Path.make_compound_path(*c.get_paths()) if c.get_paths() else Path(np.empty((0, 2))) for c in curves.collections
+    ]
+
+
 def label_curves(axes, curves, texts, **style) -> list:
     """Label each curve of ``curves`` (a ContourSet: one path per level) with its text of
     ``texts`` (None: no label), level, upright, on a light box where the curve lies
@@ -160,7 +174,7 @@ def label_curves(axes, curves, texts, **style) -> list:
     style = {"fontsize": 9, "ha": "center", "va": "center", "zorder": 6, **style}
     style.setdefault("bbox", dict(boxstyle="round,pad=0.15", facecolor="white", edgecolor="none", alpha=0.85))
     placed, boxes = [], [t.get_window_extent(renderer) for t in _texts(figure)]
-    for path, text in zip(curves.get_paths(), texts):
+    for path, text in zip(_level_paths(curves), texts):
         if text is None or len(path.vertices) == 0:
             continue
         points = axes.transData.transform(path.vertices)

@@ -142,6 +142,7 @@ def test_rounded_up_never_shows_less_than_the_force():
         assert len(shown.replace(".", "").lstrip("0")) >= 3 or math.floor(math.log10(value)) >= 2
 
 
+@pytest.mark.ros  # the node's parameters, or record's ROS side: rclpy
 def test_the_defaults_and_ranges_are_id_node_s():
     from irb140_dynamics.core.monitoring import collision
     from irb140_dynamics.nodes.id_node.settings import NODE_PARAMETERS

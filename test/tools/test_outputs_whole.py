@@ -218,6 +218,7 @@ def test_no_tool_writes_over_one_of_its_inputs(case, recording, tmp_path, capsys
     assert left_in(tmp_path) == sorted({*files, *folders})
 
 
+@pytest.mark.ros  # the node's parameters, or record's ROS side: rclpy
 def test_record_refuses_an_existing_input_as_its_bag(tmp_path, capsys, monkeypatch):
     """record's bag must be new: an existing file (its parameter file here) is refused."""
     monkeypatch.chdir(tmp_path)
