@@ -18,7 +18,6 @@ from ..support.doc_blocks import (
     first_word,
     is_synopsis,
     logical_lines,
-    make_ros2,
     read_blocks,
     synopsis_options,
 )
@@ -67,7 +66,8 @@ def users_shell() -> dict:
 def environment(tmp_path_factory) -> dict:
     """The shell the README leaves: its set-up run (scripts/setup.sh, what run.sh runs
     first), then `source .venv/bin/activate && source install/setup.bash`. The harness adds
-    only the ros2 stand-in (after everything else on PATH) and settings of no executable."""
+    settings of no executable, nothing to PATH: a command the set-up does not install (the
+    ros2 CLI included) is not found."""
     shell = users_shell()
     done = subprocess.run([str(SETUP)], cwd=ROOT, env=shell, capture_output=True, text=True, timeout=SETUP_TIMEOUT)
     assert done.returncode == 0, f"scripts/setup.sh exited {done.returncode}:\n{done.stdout}{done.stderr}"
@@ -82,10 +82,8 @@ def environment(tmp_path_factory) -> dict:
     env = dict(item.split("=", 1) for item in sourced.stdout.decode().split("\0") if "=" in item)
     for key in SHELL_ONLY:
         env.pop(key, None)
-    ros2 = make_ros2(tmp_path_factory.mktemp("ros2"))
     return {
         **env,
-        "PATH": f"{env['PATH']}{os.pathsep}{ros2}",
         "PYTHONUNBUFFERED": "1",
         "MPLBACKEND": "Agg",
         # a benchmark a doc shows writes its figures here, not over the clone's bench/results
@@ -94,10 +92,8 @@ def environment(tmp_path_factory) -> dict:
 
 
 def node_of(line: str) -> str | None:
-    """The node a line starts (directly or through ros2 run), or None."""
+    """The node a line starts, or None."""
     words = line.split()
-    if words[:2] == ["ros2", "run"] and len(words) > 3:
-        words = words[3:]
     if "--help" in words or "-h" in words:
         return None  # usage, not a node
     return words[0] if words and words[0] in NODES else None

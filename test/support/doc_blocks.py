@@ -19,11 +19,10 @@ them in theirs.
 
 A shell block is run as a user who followed the README types it: in the shell the set-up
 leaves (``scripts/setup.sh`` run, ``.venv`` activated, ``install/setup.bash`` sourced:
-nothing else on PATH), in the clone's folder (a copy of its tracked files per doc, the
-doc's blocks in order, so that a walkthrough's files carry over), with ``ros2`` a stand-in
-that runs ``ros2 run irb140_dynamics X ARGS`` as ros2 does, from install/ (anything else it
-refuses: such blocks need a skip with its reason). A command not found fails the block
-(exit 127), and so does a tracked file the blocks changed. A line starting a node
+nothing else on PATH: no ``ros2`` CLI, which the PyPI wheels lack, so a ``ros2 ...`` block
+needs a skip naming the ROS 2 install), in the clone's folder (a copy of its tracked files
+per doc, the doc's blocks in order, so that a walkthrough's files carry over). A command not
+found fails the block (exit 127), and so does a tracked file the blocks changed. A line starting a node
 is run in the background, as in a terminal of its own: the next line waits for its
 ``ready``; at the end of the block every node is stopped with Ctrl-C and must exit 0
 without a traceback. A usage synopsis (a line with ``[--option ...]``) is checked against
@@ -187,37 +186,3 @@ def is_synopsis(line: str) -> bool:
 
 def synopsis_options(line: str) -> list[str]:
     return sorted(set(re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*|-[a-zA-Z])\b", line)))
-
-
-ROS2_STANDIN = '''#!/usr/bin/env python3
-"""ros2, as far as the doc-test harness has it: `ros2 run PACKAGE X ARGS` runs X where ros2
-run looks for it (PREFIX/lib/PACKAGE/X for each PREFIX of AMENT_PREFIX_PATH, which
-install/setup.bash sets); `ros2 param set|get NODE NAME [VALUE]` and `ros2 service call
-SERVICE std_srvs/srv/Trigger` through rclpy, as ros2cli does them."""
-import os, sys
-args = sys.argv[1:]
-if len(args) >= 3 and args[0] == "run":
-    for prefix in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep):
-        found = os.path.join(prefix, "lib", args[1], args[2])
-        if prefix and os.access(found, os.X_OK):
-            os.execv(found, [found, *args[3:]])
-    sys.stderr.write(f"No executable found ({{args[1]}} {{args[2]}}: is install/setup.bash sourced?)\\n")
-    sys.exit(1)
-if args[:2] in (["param", "set"], ["param", "get"], ["service", "call"]):
-    sys.path.insert(0, {root!r})
-    from test.support.ros2_calls import main
-    sys.exit(main(args))
-sys.stderr.write("ros2 " + " ".join(args[:2]) + ": needs the ros2 CLI, which this environment has not; "
-                 "give the block a <!-- doc-test: skip (REASON) --> comment\\n")
-sys.exit(127)
-'''
-
-
-def make_ros2(directory: Path) -> Path:
-    """A directory holding only the ros2 stand-in (the package's executables come from the
-    set-up, never from here)."""
-    directory.mkdir(parents=True, exist_ok=True)
-    path = directory / "ros2"
-    path.write_text(ROS2_STANDIN.format(root=str(Path(__file__).resolve().parents[2])))
-    path.chmod(0o755)
-    return directory
