@@ -50,7 +50,7 @@ def generate_launch_description():
                 executable="sim_node",
                 name="sim_node",
                 output="screen",
-                parameters=[LaunchConfiguration("true_arm_file"), {"initial_positions": START, "reset_hold": 1.0}],
+                parameters=[LaunchConfiguration("true_arm_file"), {"initial_positions": START}],
             ),
             Node(
                 package=PACKAGE,

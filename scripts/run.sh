@@ -120,7 +120,7 @@ with_args=()
 if [ ${#ros_args[@]} -gt 0 ]; then with_args=(--ros-args "${ros_args[@]}"); fi
 if $demo; then
     start sim_node --ros-args --params-file "$share/config/true_arm.yaml" \
-        -p initial_positions:="[0.0, -0.6, 1.0, 0.0, 0.5, 0.0]" -p reset_hold:=1.0
+        -p initial_positions:="[0.0, -0.6, 1.0, 0.0, 0.5, 0.0]"
     start id_node --ros-args -p effort_commands.enabled:=true -p effort_commands.source:=computed_torque \
         ${ros_args[@]+"${ros_args[@]}"}
     start payload_check_node ${with_args[@]+"${with_args[@]}"}

@@ -3,7 +3,9 @@ how well the simulated arm (sim_node) follows it under computed-torque control.
 
 Publishes    /id_node/reference         trajectory_msgs/JointTrajectory: one period of a
                                         smooth motion of every joint, sent again each period
-Subscribes   joint_states, /id_node/tracking_error (sensor_msgs/JointState)
+Subscribes   joint_states, /id_node/tracking_error (sensor_msgs/JointState); effort_commands
+             (std_msgs/Float64MultiArray): the first one releases the simulated arm's
+             brakes, and the reference starts then, not before
 Prints       the tracking error RMS per joint [mrad] over the last second, every second,
              each figure labelled with its joint; at the end (Ctrl-C, or ``duration``
              after the first figures) a plot of reference and actual positions per joint is written to
@@ -17,7 +19,9 @@ from pathlib import Path
 
 import numpy as np
 from rclpy.node import Node
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
 from irb140_dynamics.core.io.stamps import nanoseconds
@@ -63,6 +67,9 @@ class DemoNode(Node):
         self._reference_pub = self.create_publisher(JointTrajectory, "/id_node/reference", 10)
         self.create_subscription(JointState, "joint_states", self._on_joint_state, 10)
         self.create_subscription(JointState, "/id_node/tracking_error", self._on_error, 10)
+        self._released = False  # an effort command has come: the arm is off its brakes
+        best_effort = QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT)  # as sim_node takes them
+        self._commands = self.create_subscription(Float64MultiArray, "effort_commands", self._on_command, best_effort)
         self._start = self.get_clock().now()
         self._headed = False  # the printout's header printed
         self._sender = self.create_timer(0.1, self._start_when_heard)
@@ -72,9 +79,14 @@ class DemoNode(Node):
             f"({self.label}); the plot goes to {self.plot_file} at the end"
         )
 
+    def _on_command(self, msg: Float64MultiArray) -> None:
+        self._released = True
+        self.destroy_subscription(self._commands)
+
     def _start_when_heard(self) -> None:
-        """Send the first reference once id_node listens, then one every period."""
-        if self._reference_pub.get_subscription_count() == 0:
+        """Send the first reference once id_node listens and the arm is off its brakes (its
+        first command: the motion starts from a held arm), then one every period."""
+        if self._reference_pub.get_subscription_count() == 0 or not self._released:
             return
         self._sender.cancel()
         self._send_reference()
