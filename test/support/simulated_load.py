@@ -11,13 +11,14 @@ the step's start and the torque MuJoCo applied during it, with Gaussian noise of
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from irb140_dynamics.core import Friction, RigidBody, RobotModel, mass_matrix, rnea_batch
 from irb140_dynamics.identification.payload_excitation import EffortNoise
+
+from .simulated_ur5 import write_csv  # noqa: F401  (the loads' recordings as the UR5's: one writer)
 
 CONTROL_RATE = 1000.0  # Hz
 RECORD_EVERY = 2  # control steps per recorded sample: 500 Hz
@@ -43,9 +44,10 @@ def with_drive_losses(model: RobotModel) -> RobotModel:
     return replace(model, joints=joints)
 
 
-def run(arm: RobotModel, trajectory, duration: float, noise: EffortNoise, seed: int = 0):
+def run(arm: RobotModel, trajectory, duration: float, noise: EffortNoise, seed: int = 0, pushes=()):
     """(t, Q, QD, TAU measured) at 500 Hz of the MuJoCo ``arm`` (payload included) following
-    ``trajectory`` for ``duration`` s under computed torque at 1 kHz."""
+    ``trajectory`` for ``duration`` s under computed torque at 1 kHz; ``pushes``: forces on
+    the flange origin, base axes, each held over [start, end) s (``simulated_pushes.Push``)."""
     from irb140_dynamics.sim.engine import SimulatedArm
 
     steps = int(round(duration * CONTROL_RATE))
@@ -59,20 +61,12 @@ def run(arm: RobotModel, trajectory, duration: float, noise: EffortNoise, seed: 
     Q, QD, TAU = (np.empty((len(kept), arm.n)) for _ in range(3))
     for k in range(steps):
         q, qd = sim.q, sim.qd
-        sim.step(feed_forward[k] + scale * (KP * (Q_ref[k] - q) + KD * (QD_ref[k] - qd)))
+        force = next((p.force for p in pushes if p.start <= t[k] < p.end), None)
+        wrench = None if force is None else np.concatenate([force, np.zeros(3)])
+        sim.step(feed_forward[k] + scale * (KP * (Q_ref[k] - q) + KD * (QD_ref[k] - qd)), wrench)
         if k % RECORD_EVERY == 0:
             i = k // RECORD_EVERY
             Q[i], QD[i], TAU[i] = q, qd, sim.applied
     sigma = noise.sigma(arm, np.abs(TAU).max(axis=0))
     measured = TAU + np.random.default_rng(seed).normal(size=TAU.shape) * sigma
     return t[::RECORD_EVERY], Q, QD, measured
-
-
-def write_csv(path: Path, names, t, Q, QD, TAU) -> Path:
-    columns = (
-        ["time"] + [f"position_{n}" for n in names] + [f"velocity_{n}" for n in names] + [f"effort_{n}" for n in names]
-    )
-    np.savetxt(
-        path, np.column_stack([t, Q, QD, TAU]), delimiter=",", header=",".join(columns), comments="", fmt="%.12g"
-    )
-    return path

@@ -17,13 +17,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from irb140_dynamics.core import RobotModel, mass_matrix, rnea_batch
+from irb140_dynamics.core import RobotModel
 from irb140_dynamics.identification.excitation import Limits, shaped
 from irb140_dynamics.identification.payload_excitation import EffortNoise
 
-CONTROL_RATE = 1000.0  # Hz
-RECORD_EVERY = 2  # control steps per recorded sample: 500 Hz
-KP, KD = 400.0, 40.0  # 1/s^2, 1/s
+from . import simulated_load
+
 NOISE = EffortNoise(0.01)
 PERIOD, HARMONICS = 10.0, 5  # s: the motion's period, and its harmonics
 
@@ -44,29 +43,9 @@ def normal_motion(model: RobotModel, seed: int):
 
 def run(arm: RobotModel, trajectory, duration: float, seed: int = 0, pushes=()):
     """(t, Q, QD, TAU measured) at 500 Hz of the MuJoCo ``arm`` following ``trajectory``
-    for ``duration`` s under computed torque at 1 kHz, pushed as ``pushes`` say."""
-    from irb140_dynamics.sim.engine import SimulatedArm
-
-    steps = int(round(duration * CONTROL_RATE))
-    t = np.arange(steps) / CONTROL_RATE
-    Q_ref, QD_ref, QDD_ref = trajectory.evaluate(t)
-    feed_forward = rnea_batch(arm, Q_ref, QD_ref, QDD_ref)
-    scale = np.diag(mass_matrix(arm, Q_ref[0])) + np.array([j.armature for j in arm.joints])
-    sim = SimulatedArm(arm, period=1.0 / CONTROL_RATE)
-    sim.reset(Q_ref[0], QD_ref[0])
-    kept = range(0, steps, RECORD_EVERY)
-    Q, QD, TAU = (np.empty((len(kept), arm.n)) for _ in range(3))
-    for k in range(steps):
-        q, qd = sim.q, sim.qd
-        force = next((p.force for p in pushes if p.start <= t[k] < p.end), None)
-        wrench = None if force is None else np.concatenate([force, np.zeros(3)])
-        sim.step(feed_forward[k] + scale * (KP * (Q_ref[k] - q) + KD * (QD_ref[k] - qd)), wrench)
-        if k % RECORD_EVERY == 0:
-            i = k // RECORD_EVERY
-            Q[i], QD[i], TAU[i] = q, qd, sim.applied
-    sigma = NOISE.sigma(arm, np.abs(TAU).max(axis=0))
-    measured = TAU + np.random.default_rng(seed).normal(size=TAU.shape) * sigma
-    return t[::RECORD_EVERY], Q, QD, measured
+    for ``duration`` s under computed torque at 1 kHz, pushed as ``pushes`` say, with NOISE
+    (``simulated_load.run``: the same loop)."""
+    return simulated_load.run(arm, trajectory, duration, NOISE, seed, pushes)
 
 
 def write_csv(path, names, t, Q, QD, TAU):
