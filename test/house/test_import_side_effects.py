@@ -79,9 +79,8 @@ def test_importing_every_module_of_the_package_changes_nothing():
         "irb140_dynamics.entry",
         "irb140_dynamics.tools.identify",
         "irb140_dynamics.tools.record",
-        "irb140_dynamics.tools.programs",
+        "irb140_dynamics.programs",
         "irb140_dynamics.nodes.id_node.node",
-        "irb140_dynamics.nodes.sim_node.__main__",
         "irb140_dynamics.ros.runtime.spin",
         "irb140_dynamics.core.dynamics",
     ):

@@ -6,7 +6,6 @@ them, as ros2 launch would start them."""
 from __future__ import annotations
 
 import runpy
-import sys
 from pathlib import Path
 
 import pytest
@@ -14,7 +13,7 @@ import yaml
 
 from ..support.doc_blocks import console_scripts
 from ..support.launch_stub import arguments_of, load_description, nodes_of, resolve
-from ..support.node_process import interrupt, start, wait_for_line
+from ..support.node_process import console_script, interrupt, start, wait_for_line
 from ..support.paths import ROOT
 
 LAUNCH_FILES = sorted((ROOT / "launch").glob("*.launch.py"))
@@ -73,7 +72,7 @@ def test_runs_with_no_argument_on_installed_files_and_executables(launch_file, m
 
 def node_command(node, arguments: dict) -> list[str]:
     """The node's command line as ros2 launch builds it (params files, then -p for a dict)."""
-    command = [sys.executable, "-m", f"irb140_dynamics.nodes.{node.executable}", "--ros-args"]
+    command = console_script(node.executable, "--ros-args")
     if node.name:
         command += ["-r", f"__node:={node.name}"]
     for item in resolve(node.parameters, arguments, SHARE):

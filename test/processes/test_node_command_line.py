@@ -7,13 +7,12 @@ from __future__ import annotations
 
 import re
 import signal
-import sys
 import time
 
 import pytest
 
 from ..support.common import full_sweep
-from ..support.node_process import handles_sigterm, interrupt, module_command, run_to_exit, start, wait_for_line
+from ..support.node_process import console_script, handles_sigterm, interrupt, run_to_exit, start, wait_for_line
 from ..support.paths import CONFIG
 
 NODES = ("id_node", "payload_check_node", "sim_node", "demo_node")
@@ -23,7 +22,7 @@ START_LIMIT = 10.0  # s: a node that cannot start says so within this
 
 def command(node: str, *arguments: str) -> list[str]:
     """The node as its console script runs it (through irb140_dynamics.entry)."""
-    return [sys.executable, "-m", f"irb140_dynamics.nodes.{node}", *arguments]
+    return console_script(node, *arguments)
 
 
 def test_help_is_the_usage_on_standard_output_and_exit_0():
@@ -72,7 +71,7 @@ def test_the_log_names_the_params_file(tmp_path):
 def test_a_params_file_rcl_cannot_parse_is_one_line_with_its_line(tmp_path):
     path = tmp_path / "broken.yaml"
     path.write_text("garbage: [\n")
-    code, output = run_to_exit(module_command("irb140_dynamics.nodes.id_node.node", "--params-file", str(path)))
+    code, output = run_to_exit(console_script("id_node", "--ros-args", "--params-file", str(path)))
     lines = output.strip().splitlines()
     assert code == 1 and len(lines) == 1, output  # rcl's own "Failed to parse global arguments" held back
     assert f"{path}:1:" in lines[0] and "garbage: [" in lines[0], output

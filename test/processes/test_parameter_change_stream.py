@@ -21,7 +21,7 @@ from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 
-from ..support.node_process import TIMEOUT, module_command, start, wait_for_line
+from ..support.node_process import TIMEOUT, console_script, start, wait_for_line
 
 RATE = 1000.0  # Hz at most
 CHANGES = 50  # payload.mass set every CHANGE_PERIOD: 5 s of changes
@@ -38,7 +38,7 @@ def raised_priority(command: list[str]) -> list[str]:
 def id_node():
     namespace = f"/changes_{uuid.uuid4().hex[:8]}"
     arguments = ("-p", "qos.reliability:=reliable", "-r", f"__ns:={namespace}")
-    node = start(raised_priority(module_command("irb140_dynamics.nodes.id_node", *arguments)))
+    node = start(raised_priority(console_script("id_node", "--ros-args", *arguments)))
     try:
         assert wait_for_line(node, "ready:", [], TIMEOUT), "id_node did not start"
         yield namespace

@@ -1,6 +1,6 @@
 """The tools as processes, smoke tests of what test/tools/test_programs.py checks in-process
 for every tool: ``python -m irb140_dynamics.tools.<name>`` and a console script's function
-(irb140_dynamics.tools.programs) answer --help with the usage, exit 0, no traceback."""
+(irb140_dynamics.programs) answer --help with the usage, exit 0, no traceback."""
 
 import sys
 
@@ -13,6 +13,6 @@ def test_python_m_answers_help():
 
 
 def test_a_console_script_answers_help():
-    script = "from irb140_dynamics.tools.programs import record; record()"
+    script = "from irb140_dynamics.programs import record; record()"
     code, output = run_to_exit([sys.executable, "-c", script, "-h"])
     assert code == 0 and output.startswith("usage: record") and "Traceback" not in output, output

@@ -19,8 +19,19 @@ def start(command: list[str], env: dict | None = None) -> subprocess.Popen:
     return subprocess.Popen(command, env=environment, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 
 
+def console_script(name: str, *arguments: str) -> list[str]:
+    """The executable ``name`` as its console script runs it (irb140_dynamics.programs)."""
+    return [sys.executable, "-c", f"from irb140_dynamics.programs import {name}; {name}()", *arguments]
+
+
 def module_command(module: str, *ros_args: str) -> list[str]:
-    command = [sys.executable, "-m", module]
+    """``python -m module --ros-args ...``; a node's module (``irb140_dynamics.nodes.<name>.node``)
+    as its console script runs it."""
+    parts = module.split(".")
+    if parts[:2] == ["irb140_dynamics", "nodes"] and parts[3:] == ["node"]:
+        command = console_script(parts[2])
+    else:
+        command = [sys.executable, "-m", module]
     return command + ["--ros-args", *ros_args] if ros_args else command
 
 

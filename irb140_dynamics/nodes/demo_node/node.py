@@ -149,7 +149,3 @@ def usage() -> Usage:
 
 def main(args=None):
     raise SystemExit(run("demo_node", DemoNode, args, usage=usage))
-
-
-if __name__ == "__main__":
-    main()

@@ -315,7 +315,3 @@ def usage() -> Usage:
 
 def main(args=None):
     raise SystemExit(run("id_node", IdNode, args, usage=usage))
-
-
-if __name__ == "__main__":
-    main()

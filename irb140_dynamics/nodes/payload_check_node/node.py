@@ -277,7 +277,3 @@ def usage() -> Usage:
 
 def main(args=None):
     raise SystemExit(run("payload_check_node", PayloadCheckNode, args, executor="single_threaded", usage=usage))
-
-
-if __name__ == "__main__":
-    main()

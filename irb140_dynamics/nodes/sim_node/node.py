@@ -269,7 +269,3 @@ def usage() -> Usage:
 
 def main(args=None):
     raise SystemExit(run("sim_node", SimNode, args, usage=usage))
-
-
-if __name__ == "__main__":
-    main()

@@ -166,7 +166,3 @@ def usage() -> Usage:
 
 def main(args=None):
     raise SystemExit(run("trajectory_check_node", TrajectoryCheckNode, args, usage=usage))
-
-
-if __name__ == "__main__":
-    main()

@@ -1,6 +1,0 @@
-"""``python -m irb140_dynamics.nodes.demo_node``: the node, as its console script starts it."""
-
-if __name__ == "__main__":
-    from irb140_dynamics.nodes.demo_node import main
-
-    main()

@@ -1,6 +1,0 @@
-"""``python -m irb140_dynamics.nodes.payload_check_node``: the node, as its console script starts it."""
-
-if __name__ == "__main__":
-    from irb140_dynamics.nodes.payload_check_node import main
-
-    main()
