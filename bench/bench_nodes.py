@@ -8,7 +8,7 @@
 Prints one table and writes the raw figures to bench/results/nodes.json. Sections:
 
 - end to end, per rate and executor (bench/stream.py): the node under test runs in its
-  own process (id_node as ``python -m irb140_dynamics.nodes.id_node.node``, or the baseline
+  own process (id_node as its console script runs it, or the baseline
   bench/relay_node.py, which republishes joint_states unchanged on feedforward_torques
   with the same QoS). This process publishes JointState at a fixed rate for a warm-up and
   then ``--duration`` seconds, and takes the torque messages as they arrive: their delay,

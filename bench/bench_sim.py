@@ -73,8 +73,8 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
     sim = NodeProcess(
         [
             sys.executable,
-            "-m",
-            "irb140_dynamics.nodes.sim_node.node",
+            "-c",
+            "from irb140_dynamics.programs import sim_node; sim_node()",
             *ros_args,
             "-p",
             f"rate:={rate}",
@@ -91,8 +91,8 @@ def run(loop: bool, rate: float, duration: float, warmup: float, env: dict, inde
         controller = NodeProcess(
             [
                 sys.executable,
-                "-m",
-                "irb140_dynamics.nodes.id_node.node",
+                "-c",
+                "from irb140_dynamics.programs import id_node; id_node()",
                 *ros_args,
                 "-p",
                 "effort_commands.enabled:=true",

@@ -112,7 +112,7 @@ def node_command(kind: str, executor: str, namespace: str, lean: bool = False, d
         if kind == MARKERS_OFF:
             ros_args += ["-p", "markers.rate:=0"]
         if executor == "events" and not lean:
-            return [sys.executable, "-m", "irb140_dynamics.nodes.id_node.node", *ros_args]
+            return [sys.executable, "-c", "from irb140_dynamics.programs import id_node; id_node()", *ros_args]
     lean_flag = ["--no-event-handlers"] if lean else []
     return [sys.executable, str(REPO / "bench" / "relay_node.py"), kind, "--executor", executor, *lean_flag, *ros_args]
 

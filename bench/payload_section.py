@@ -107,8 +107,8 @@ def _time_service_calls(env: dict) -> tuple[float, list[float], float]:
     process = NodeProcess(
         [
             sys.executable,
-            "-m",
-            "irb140_dynamics.nodes.payload_check_node.node",
+            "-c",
+            "from irb140_dynamics.programs import payload_check_node; payload_check_node()",
             "--ros-args",
             "-r",
             f"__ns:={namespace}",
