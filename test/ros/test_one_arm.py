@@ -83,11 +83,12 @@ def node_model(make_node, cli_args):
 
 def test_a_turned_base_urdf_with_gravity_in_the_params_file(tmp_path):
     urdf = turned_urdf(tmp_path)
-    chain = {"model.base_link": "base_link", "model.tip_link": "tool0", "gravity": GRAVITY_IN_ROOT}
+    drive = {"shoulder_pan_joint": {"torque_limit": 42.0, "friction": {"viscous": 1.5}}}  # what URDF has no place for
+    chain = {"model.base_link": "base_link", "model.tip_link": "tool0", "gravity": GRAVITY_IN_ROOT, **drive}
     described = params_file(
         tmp_path, "described.yaml", {"model.source": "robot_description", "model.urdf_file": urdf, **chain}
     )
-    beside = params_file(tmp_path, "gravity.yaml", {"gravity": GRAVITY_IN_ROOT})
+    beside = params_file(tmp_path, "gravity.yaml", {"gravity": GRAVITY_IN_ROOT, **drive})
     expected_gravity = Rotation.from_euler("xyz", ROOT_TURN).as_matrix().T @ np.array(GRAVITY_IN_ROOT)
     assert abs(expected_gravity[2]) < 9.0  # turned: not along the base's -z
     models = {}
@@ -101,6 +102,8 @@ def test_a_turned_base_urdf_with_gravity_in_the_params_file(tmp_path):
     reference = models["IdNode"]
     assert reference.joint_names[0] == "shoulder_pan_joint" and reference.n == 6
     np.testing.assert_allclose(reference.gravity, expected_gravity, rtol=0, atol=1e-12)
+    pan = reference.joints[0]
+    assert (pan.torque_limit, pan.friction.viscous) == (42.0, 1.5), pan
     differing = {name: model.gravity for name, model in models.items() if model != reference}
     assert not differing, f"{reference.gravity} by IdNode; {differing}"
 

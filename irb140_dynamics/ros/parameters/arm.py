@@ -37,6 +37,7 @@ from irb140_dynamics.ros.parameters.specs import (
     MODEL_NAME,
     RELIABILITIES,
     SOURCE,
+    drive_specs,
     joint_names_spec,
     model_specs,
 )
@@ -85,7 +86,7 @@ class ArmParameters:
             joint_names = check_joint_names(overrides.declare(joint_names_spec(defaults["joint_names"])))
             self.robot_name = overrides.declare(MODEL_NAME)
             arm = model_specs(joint_names, defaults)
-        self.declare([*arm, *specs, *([] if joint_names is None else self._per_joint(joint_names))])
+        self.declare([*arm, *specs, *([] if joint_names is None else self._joint_specs(joint_names))])
         overrides.warn_unknown(joint_names)
         if self.urdf is not None:
             self._announce(origin)
@@ -106,6 +107,13 @@ class ArmParameters:
                     self._overrides.declare(spec)
         finally:
             self.declaring = False
+
+    def _joint_specs(self, joint_names: Sequence[str]) -> list[Spec]:
+        """The node's own per-joint parameters; on a URDF arm, also the drive values given at
+        startup (``<joint>.torque_limit``, friction, ...), which its model takes as every tool's does."""
+        given = self._overrides.given
+        drives = [spec for name in joint_names for spec in drive_specs(name) if spec.name in given]
+        return [*self._per_joint(joint_names), *drives]
 
     def values(self, changes: Sequence[Parameter] = ()) -> dict[str, Any]:
         """Every parameter value by name, ``changes`` applied on top."""
@@ -143,7 +151,7 @@ class ArmParameters:
         try:
             if isinstance(urdf, Exception):
                 raise urdf
-            self.declare(self._per_joint(urdf.model.joint_names))
+            self.declare(self._joint_specs(urdf.model.joint_names))
             draft = self.draft(check, self.values(), urdf)
         except Exception as error:  # noqa: BLE001 (nothing of ours may leave a callback)
             self.refused += 1

@@ -107,7 +107,7 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
     ]
     for name in joint_names:
         joint = param_prefix(name)  # the joint's parameter prefix (its name, if a parameter name)
-        dh, limits = f"{joint}.dh", f"{joint}.position_limits"
+        dh = f"{joint}.dh"
         specs += [
             Spec(
                 dh,
@@ -116,13 +116,23 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
                 "m, rad, m, rad",
             ),
             *_body_specs(f"{joint}.link", f"the link {joint} moves", "its DH frame", default),
-            Spec(limits, default(limits, [-math.pi, math.pi]), "[lower, upper] joint position", "rad"),
-            *(
-                Spec(f"{joint}.{suffix}", default(f"{joint}.{suffix}", 0.0), text, unit, minimum=0.0, maximum=maximum)
-                for suffix, text, unit, maximum in JOINT_NUMBERS
-            ),
+            *drive_specs(name, default),
         ]
     return specs
+
+
+def drive_specs(name: str, default=lambda name, kind: kind) -> list[Spec]:
+    """A joint's drive: its position limits and JOINT_NUMBERS (a URDF arm's too: what URDF
+    has no sure place for)."""
+    joint = param_prefix(name)
+    limits = f"{joint}.position_limits"
+    return [
+        Spec(limits, default(limits, [-math.pi, math.pi]), "[lower, upper] joint position", "rad"),
+        *(
+            Spec(f"{joint}.{suffix}", default(f"{joint}.{suffix}", 0.0), text, unit, minimum=0.0, maximum=maximum)
+            for suffix, text, unit, maximum in JOINT_NUMBERS
+        ),
+    ]
 
 
 def _body_specs(prefix: str, what: str, frame: str, default) -> list[Spec]:
