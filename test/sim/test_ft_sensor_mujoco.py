@@ -1,4 +1,4 @@
-"""The wrist force/torque sensor in MuJoCo (issue 41, item 2): the IRB-140 with a 2 kg tool
+"""The wrist force/torque sensor in MuJoCo: the IRB-140 with a 2 kg tool
 (CoM off the flange, a full inertia) behind a simulated sensor (MuJoCo's force and torque
 sensors on a site at the flange), following a smooth motion under computed torque (the flange's
 acceleration up to 2 m/s^2) and pushed on the tool by a hand: 20 N, reached and let go

@@ -16,8 +16,10 @@ from collections import deque
 
 import numpy as np
 
-from irb140_dynamics.core.ft_sensor.contact import FRAMES, NO_BIAS, contact_wrench
+from irb140_dynamics.core.errors import check_choice
+from irb140_dynamics.core.ft_sensor.contact import FRAMES, NO_BIAS, contact_wrench, sensor_mount
 from irb140_dynamics.core.ft_sensor.load_estimation import FtLoadEstimate, estimate_ft_load
+from irb140_dynamics.core.io.urdf.writer import exported_links
 from irb140_dynamics.core.model.joint_order import BadMessage
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.monitoring.filters import VelocityDifferentiator
@@ -35,27 +37,42 @@ class FtSensorStream:
 
     def __init__(self):
         self.model: RobotModel | None = None  # None: off
-        self.mount, self.frame, self.bias = np.eye(4), "sensor", NO_BIAS.copy()
+        self.link, self.mount, self.frame, self.bias = "", np.eye(4), "sensor", NO_BIAS.copy()
         self.rests = RestDetector(REST_VELOCITY, REST_TIME)
         self._states: deque = deque(maxlen=HISTORY)
         self._differentiator: VelocityDifferentiator | None = None
 
-    def use(self, model: RobotModel | None, mount: np.ndarray, frame: str, cutoff: float) -> None:
-        """The settings in force (``model`` None: off); a model of other joints forgets the
-        joint states and rests seen."""
-        if frame not in FRAMES:
-            raise ValueError(f"ft_contact_wrench.frame: must be one of {', '.join(FRAMES)}; got {frame!r}")
-        if model is None or self.model is None or model.joint_names != self.model.joint_names:
+    def use(self, model: RobotModel, link: str, frame: str, links, cutoff: float, strict: bool = True) -> str | None:
+        """The settings in force: the sensor on ``link`` ("" = off) of ``model``'s chain
+        ``links`` (``LoadedUrdf.links``; None: ``exported_links``, the model's of parameters;
+        see ``contact.sensor_mount``), the contact wrench in ``frame``'s axes, qdd through a
+        low-pass of ``cutoff`` [Hz]. A link or frame refused: ValueError, nothing changed
+        (``strict``), or the sensor off and the refusal returned. A model of other joints
+        forgets the joint states and rests seen."""
+        try:
+            check_choice("ft_contact_wrench.frame", frame, FRAMES)
+            mount = sensor_mount(model, link, exported_links(model) if links is None else links) if link else None
+        except ValueError as error:
+            if strict:
+                raise
+            self.use(model, "", "sensor", links, cutoff)
+            return f"{error}; the force/torque sensor is off"
+        if not link or self.model is None or model.joint_names != self.model.joint_names:
             self._states.clear()
             self.rests.clear()
-        if self._differentiator is None or model is None or self._differentiator.n != model.n:
-            self._differentiator = None if model is None else VelocityDifferentiator(model.n, cutoff)
-        elif self._differentiator.time_constant != 1.0 / (2.0 * math.pi * cutoff):
-            self._differentiator = VelocityDifferentiator(model.n, cutoff)
-        self.model, self.mount, self.frame = model, mount, frame
+        differentiator = self._differentiator
+        if not link:
+            differentiator = None
+        elif differentiator is None or differentiator.n != model.n or differentiator.time_constant != _lag(cutoff):
+            differentiator = VelocityDifferentiator(model.n, cutoff)
+        self._differentiator = differentiator
+        self.model, self.link, self.mount, self.frame = model if link else None, link, mount, frame
+        return None
 
     def note(self, t: float, q, qd) -> None:
-        """A joint state at t [s] (finite q, qd of the model's joints)."""
+        """A joint state at t [s] (finite q, qd of the model's joints); nothing while off."""
+        if self.model is None:
+            return
         qdd = np.array(self._differentiator.update(t, qd.tolist()))
         if not np.isfinite(qdd).all():
             self._differentiator.reset()
@@ -74,7 +91,7 @@ class FtSensorStream:
             raise BadMessage("absurd_wrench", f"|force| {force:.3g} N, |torque| {torque:.3g} N m")
         if not self._states:
             raise BadMessage("no_joint_state", "no joint state yet")
-        t_near, q, qd, qdd = min(self._states, key=lambda s: abs(s[0] - t))
+        t_near, q, qd, qdd = min(reversed(self._states), key=lambda s: abs(s[0] - t))  # ties: the latest
         if abs(t_near - t) > MAX_GAP:
             raise BadMessage("no_joint_state", f"the nearest joint state is {abs(t_near - t):.3g} s from the reading")
         self.rests.update(t, q, qd, reading)
@@ -90,3 +107,8 @@ class FtSensorStream:
         self.bias = estimate.bias
         self.rests.clear()
         return estimate
+
+
+def _lag(cutoff: float) -> float:
+    """The time constant [s] of a first-order low-pass of ``cutoff`` [Hz] (as VelocityDifferentiator's)."""
+    return 1.0 / (2.0 * math.pi * cutoff)
