@@ -137,7 +137,7 @@ def test_too_few_orientations_are_refused():
 def test_the_stream_matches_readings_to_the_nearest_joint_state_and_estimates_from_its_rests():
     model = irb140().with_payload(TOOL)
     stream = FtSensorStream()
-    stream.use(model, np.eye(4), "sensor", 20.0)
+    stream.use(model, "flange", "sensor", None, 20.0)
     with pytest.raises(EstimationError, match="^the sensor rested in 0 orientation"):
         stream.estimate()
     bias, rng = np.array([1.0, 2.0, -3.0, 0.1, 0.0, -0.2]), np.random.default_rng(6)
@@ -161,3 +161,14 @@ def test_the_stream_matches_readings_to_the_nearest_joint_state_and_estimates_fr
             stream.contact(t, bad)
     with pytest.raises(ValueError, match=r"^no_joint_state: the nearest joint state is 1 s from the reading"):
         stream.contact(t + 0.5, sample.effort)
+
+
+def test_the_stream_refuses_a_bad_frame_or_link_or_turns_off_when_told():
+    model, stream = irb140().with_payload(TOOL), FtSensorStream()
+    stream.use(model, "flange", "sensor", None, 20.0)
+    with pytest.raises(ValueError, match=r"^ft_contact_wrench.frame: must be one of sensor, base; got 'tool'$"):
+        stream.use(model, "flange", "tool", None, 20.0)
+    assert stream.model is model and stream.frame == "sensor"  # nothing changed
+    refused = stream.use(model, "link_2", "sensor", None, 20.0, strict=False)
+    assert refused.startswith("ft_sensor.link: 'link_2' is moved by 2 of the 6 joints") and stream.model is None
+    assert refused.endswith("; the force/torque sensor is off")

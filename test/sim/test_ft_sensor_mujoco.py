@@ -86,7 +86,7 @@ def test_a_push_on_the_tool_reads_as_it_was_and_no_push_reads_nothing():
     exact = np.array([contact_wrench(MODEL, q, qd, qdd, w, frame="base") - truth for _, q, qd, qdd, w, truth in rows])
     assert np.max(np.abs(exact)) < 1e-6
     stream = FtSensorStream()
-    stream.use(MODEL, np.eye(4), "base", 20.0)
+    stream.use(MODEL, "flange", "base", None, 20.0)
     errors, pushed = [], []
     for step, (t, q, qd, _, reading, truth) in enumerate(rows):
         if step % 2 == 0:  # joint states at 500 Hz
