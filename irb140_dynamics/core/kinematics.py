@@ -146,10 +146,11 @@ def flange_motion(model: RobotModel, q, qd, qdd) -> tuple[np.ndarray, np.ndarray
     (sliding), a point moved along a link by r: a + alpha x r + w x (w x r)."""
     qd, qdd = state(qd, model.n, "qd"), state(qdd, model.n, "qdd")
     frames = link_frames(model, q)
+    placements = _placements(model)
+    joint_frames = frames[:-1] @ np.array([pre for pre, *_ in placements])  # one batched product
+    axes = np.einsum("nij,nj->ni", joint_frames[:, :3, :3], np.array([p[2] for p in placements])).tolist()
     w, alpha, a, point = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
-    for frame, (pre, _, turning_axis, _, prismatic), qd_i, qdd_i in zip(frames[:-1], _placements(model), qd, qdd):
-        joint_frame = frame @ pre
-        z, origin = (joint_frame[:3, :3] @ turning_axis).tolist(), joint_frame[:3, 3].tolist()
+    for z, origin, (*_, prismatic), qd_i, qdd_i in zip(axes, joint_frames[:, :3, 3].tolist(), placements, qd, qdd):
         a = _carried(a, w, alpha, _minus(origin, point))
         point = origin
         w_z = _cross(w, z)

@@ -91,11 +91,23 @@ class FtSensorStream:
             raise BadMessage("absurd_wrench", f"|force| {force:.3g} N, |torque| {torque:.3g} N m")
         if not self._states:
             raise BadMessage("no_joint_state", "no joint state yet")
-        t_near, q, qd, qdd = min(reversed(self._states), key=lambda s: abs(s[0] - t))  # ties: the latest
-        if abs(t_near - t) > MAX_GAP:
-            raise BadMessage("no_joint_state", f"the nearest joint state is {abs(t_near - t):.3g} s from the reading")
+        gap, (_, q, qd, qdd) = self._nearest(t)
+        if gap > MAX_GAP:
+            raise BadMessage("no_joint_state", f"the nearest joint state is {gap:.3g} s from the reading")
         self.rests.update(t, q, qd, reading)
         return contact_wrench(self.model, q, qd, qdd, reading, self.mount, self.bias, self.frame)
+
+    def _nearest(self, t: float) -> tuple[float, tuple]:
+        """(|gap| [s], the joint state nearest t): searched from the newest back, until the
+        states are older than the best gap (they come in time order; ties: the newest)."""
+        best = None
+        for joint_state in reversed(self._states):
+            gap = abs(joint_state[0] - t)
+            if best is None or gap < best[0]:
+                best = (gap, joint_state)
+            elif joint_state[0] < t - best[0]:
+                break
+        return best
 
     def estimate(self) -> FtLoadEstimate:
         """The bias and the tool's load from the rests since the start or the last estimate,
