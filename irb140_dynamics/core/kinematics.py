@@ -135,3 +135,44 @@ def _flange_jacobian(model: RobotModel, frames: np.ndarray, pose: np.ndarray | N
         J[:3, i] = (ay * rz - az * ry, az * rx - ax * rz, ax * ry - ay * rx)  # axis x r (np.cross: 10x slower)
         J[3:, i] = axis
     return J
+
+
+def flange_motion(model: RobotModel, q, qd, qdd) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(pose, w, alpha, a): the flange's pose (4x4), angular velocity [rad/s], angular
+    acceleration [rad/s^2] and its origin's linear acceleration [m/s^2], in the base frame,
+    at (q, qd, qdd). Forward recursion from the base at rest, each joint's axis carried by
+    the links before it: w_i = w + z qd_i, alpha_i = alpha + z qdd_i + w x z qd_i (turning;
+    the acceleration of a point on the axis unchanged), a_i = a + z qdd_i + 2 w x z qd_i
+    (sliding), a point moved along a link by r: a + alpha x r + w x (w x r)."""
+    qd, qdd = state(qd, model.n, "qd"), state(qdd, model.n, "qdd")
+    frames = link_frames(model, q)
+    placements = _placements(model)
+    joint_frames = frames[:-1] @ np.array([pre for pre, *_ in placements])  # one batched product
+    axes = np.einsum("nij,nj->ni", joint_frames[:, :3, :3], np.array([p[2] for p in placements])).tolist()
+    w, alpha, a, point = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    for z, origin, (*_, prismatic), qd_i, qdd_i in zip(axes, joint_frames[:, :3, 3].tolist(), placements, qd, qdd):
+        a = _carried(a, w, alpha, _minus(origin, point))
+        point = origin
+        w_z = _cross(w, z)
+        if prismatic:
+            a = tuple(a_k + z_k * qdd_i + 2.0 * c_k * qd_i for a_k, z_k, c_k in zip(a, z, w_z))
+        else:
+            alpha = tuple(al_k + z_k * qdd_i + c_k * qd_i for al_k, z_k, c_k in zip(alpha, z, w_z))
+            w = tuple(w_k + z_k * qd_i for w_k, z_k in zip(w, z))
+    pose = frames[-1] @ _flange_matrix(model)
+    a = _carried(a, w, alpha, _minus(pose[:3, 3].tolist(), point))
+    return pose, np.array(w), np.array(alpha), np.array(a)
+
+
+def _carried(a, w, alpha, r) -> tuple:
+    """The acceleration of a point r further along a rigid body whose point has acceleration a."""
+    return tuple(map(sum, zip(a, _cross(alpha, r), _cross(w, _cross(w, r)))))
+
+
+def _cross(u, v) -> tuple:
+    (ux, uy, uz), (vx, vy, vz) = u, v
+    return (uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx)
+
+
+def _minus(u, v) -> tuple:
+    return tuple(x - y for x, y in zip(u, v))

@@ -12,6 +12,7 @@ import numpy as np
 from irb140_dynamics.core.codegen.kernels import Preparation, prepare
 from irb140_dynamics.core.codegen.recipes import WITH_FRICTION
 from irb140_dynamics.core.errors import check_choice
+from irb140_dynamics.core.ft_sensor.contact import FRAMES as FT_FRAMES
 from irb140_dynamics.core.model.rigid_body import RigidBody
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.monitoring.wrench import FRAMES
@@ -42,6 +43,8 @@ class IdNodeSettings:
     collision: CollisionSettings
     gains: Gains
     wrench_frame: str  # "tip" or "base"
+    ft_link: str = ""  # the link of a wrist force/torque sensor, "" = none (core.ft_sensor)
+    ft_frame: str = "sensor"  # the axes of its contact wrench: "sensor" or "base"
     rated_payload: RigidBody = RATED_PAYLOAD  # the torque limits are derived from it (joints without torque_limit)
     torque_limits: tuple[float, ...] | None = None  # N m (inf: none), the payload check's; set by finish_settings
     kernels: Preparation | None = None  # how the model's kernels were made ready (set by finish_settings)
@@ -53,6 +56,8 @@ def check_settings(values: dict) -> IdNodeSettings:
     check_choice("acceleration.mode", values["acceleration.mode"], ACCELERATION_MODES)
     check_choice("effort_commands.source", values["effort_commands.source"], EFFORT_SOURCES)
     check_choice("external_wrench.frame", values["external_wrench.frame"], FRAMES)
+    ft_link, ft_frame = values.get("ft_sensor.link", ""), values.get("ft_contact_wrench.frame", "sensor")
+    check_choice("ft_contact_wrench.frame", ft_frame, FT_FRAMES)
 
     def per_joint(kind: str) -> np.ndarray:
         return np.array([values[f"{name}.{kind}"] for name in model.joint_names], dtype=float)
@@ -66,6 +71,8 @@ def check_settings(values: dict) -> IdNodeSettings:
         CollisionSettings(values["collision.observer_gain"], per_joint("collision_threshold")),
         Gains(per_joint("kp"), per_joint("kd")),
         values["external_wrench.frame"],
+        ft_link,
+        ft_frame,
         RigidBody.validated("rated_payload", values["rated_payload.mass"], values["rated_payload.com"]),
     )
 

@@ -25,6 +25,7 @@ Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, q
                                    base link's (the torque about the flange origin in both)
              ~/markers             visualization_msgs/MarkerArray at markers.rate: loads, payload,
                                    external force, collision (see id_node.markers)
+             ft_contact_wrench     WrenchStamped: ft_wrench freed of its tool; ~/estimate_ft_load (id_node.ft_sensor)
              /diagnostics          diagnostic_msgs/DiagnosticArray, 1 Hz: message counts; a
                                    collision now or since the last report (ERROR); the wrench's
                                    nearness to a singularity (WARN)
@@ -60,6 +61,7 @@ from irb140_dynamics.core.trajectories.stream_settings import (
 )
 from irb140_dynamics.core.trajectories.tracking import TorqueStream
 from irb140_dynamics.node_help import Usage
+from irb140_dynamics.nodes.id_node.ft_sensor import FtSensor
 from irb140_dynamics.nodes.id_node.markers import MarkerPublisher
 from irb140_dynamics.nodes.id_node.settings import NODE_PARAMETERS, PER_JOINT_PARAMETERS
 from irb140_dynamics.ros.messages.joint_messages import (
@@ -113,6 +115,7 @@ class IdNode(Node):
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self._command_msg, self._wrench_msg = Float64MultiArray(), WrenchStamped()
         self.markers = MarkerPublisher(self, self.get_parameter("markers.rate").value)
+        self.ft = FtSensor(self, depth)
         first = self.parameters.draft(check_settings, self.parameters.values())
         if first is not None:  # built here: a model that cannot be built stops the start (one line)
             self._use(finish_settings(first, None))
@@ -173,6 +176,7 @@ class IdNode(Node):
         if not self.stream.use(model, mode, cutoff, timeout, source, settings.gains):
             self.tally.drop("reference", BadMessage("non_finite_torques", "the new model gives none at the reference"))
         self.collision.use(model, settings.collision.gain, settings.collision.thresholds)
+        self.ft.use(settings, self._started)
         self.settings = settings
         if old is None and self._started:  # the model came after startup
             self._log_ready()
@@ -196,6 +200,7 @@ class IdNode(Node):
             return
         try:
             sample = read_joint_sample(msg, self._order, self._now)
+            self.ft.stream.note(sample.t, sample.q, sample.qd)
             tau, g, command, reference, terms = self.stream.torques(
                 sample.t, sample.q, sample.qd, sample.effort is not None, self._now
             )

@@ -75,6 +75,9 @@ NODE_PARAMETERS = [
         maximum=MAX_MARKER_RATE,
         read_only=True,
     ),
+    Spec("ft_sensor.link", "", "link of the wrist F/T sensor (ft_wrench), on the last link; '' = off", read_only=True),
+    Spec("ft_contact_wrench.frame", "sensor", "its axes: 'sensor' or 'base' (torque about the sensor's origin)"),
+    Spec("ft_sensor.apply_load", False, "~/estimate_ft_load also sets payload.mass and payload.com"),
     *QOS_PARAMETERS,
 ]
 

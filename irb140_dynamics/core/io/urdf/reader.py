@@ -74,6 +74,7 @@ class LoadedUrdf:
     notes: tuple[str, ...] = ()  # invalid inertials off the chain, ignored
     base_rotation: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))  # base_link's axes in the root's
     robot_name: str = ""  # <robot name="...">: the hardware_id of the nodes' /diagnostics
+    links: tuple[tuple[str, int, Placement], ...] = ()  # the chain's links: (name, k, placement in link frame k)
 
     def in_base(self, vector) -> tuple[float, float, float]:
         """A vector given in the root link's frame (gravity) in base_link's frame."""
@@ -149,7 +150,21 @@ def load_urdf(
         if name not in on_chain and (problem := inertial_problem(name, body))
     ]
     rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
-    return LoadedUrdf(model, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name)
+    links = tuple(_chain_links(base, path))
+    return LoadedUrdf(model, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name, links)
+
+
+def _chain_links(base: str, path: list[UrdfJoint]):
+    """Each link of the chain as (name, k, its placement in link frame k), k the moving
+    joints before it (0: the base frame): a moving joint's child is link frame k itself."""
+    k, placement = 0, Placement()
+    yield base, k, placement
+    for joint in path:
+        if joint.kind == "fixed":
+            placement = compose(placement, joint.origin)
+        else:
+            k, placement = k + 1, Placement()
+        yield joint.child, k, placement
 
 
 def _checked_inertials(tree: UrdfTree, carried: list[list[str]]) -> tuple[list[str], list[bool]]:

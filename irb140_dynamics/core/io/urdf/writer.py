@@ -87,6 +87,20 @@ def export_urdf(model: RobotModel, name: str = "robot", shapes: Mapping[str, Box
     return '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n"
 
 
+def exported_links(model: RobotModel) -> tuple[tuple[str, int, Placement], ...]:
+    """The links ``export_urdf`` writes, as ``LoadedUrdf.links``: (name, k, its placement in
+    link frame k); link_i's frame is joint i's frame (before post_i)."""
+    links = [(f"link_{k}", k, _inverse(joint.post)) for k, joint in enumerate(model.joints, 1)]
+    return ((BASE, 0, Placement()), *links, (FLANGE, model.n, model.flange))
+
+
+def _inverse(placement: Placement) -> Placement:
+    if placement.is_identity:
+        return placement
+    R = placement.rotation()
+    return Placement(tuple((-R.T @ np.array(placement.xyz)).tolist()), matrix_rpy(R.T))
+
+
 def _joint(robot: ET.Element, name: str, kind: str, parent: str, child: str, origin: Placement) -> ET.Element:
     element = ET.SubElement(robot, "joint", name=name, type=kind)
     ET.SubElement(element, "parent", link=parent)
