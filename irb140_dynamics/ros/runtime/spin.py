@@ -15,7 +15,7 @@ from contextlib import contextmanager
 
 import rclpy
 import rclpy.logging
-from rclpy.executors import ExternalShutdownException
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions as Options
@@ -123,11 +123,12 @@ def spin(node: Node, executor: str = "events") -> None:
     """Run the node's callbacks until its context shuts down or Ctrl-C.
 
     ``events``: rclpy's EventsExecutor, where this rclpy has it (under half the CPU per
-    message of the default executor, bench/bench_nodes.py), driven by spin_once (its spin()
-    in the 7.1 wheels busy-loops) with Ctrl-C read between calls (``ctrl_c_as_a_flag``).
-    ``single_threaded``: rclpy.spin. The objects of startup (modules, rclpy, NumPy, the
-    model: some 40,000) are frozen out of the garbage collector's full passes first: a pass
-    over them all is a stall in which a 1 kHz stream can overflow its queue.
+    message of the default executor, bench/bench_nodes.py); ``single_threaded``: rclpy's
+    SingleThreadedExecutor. Either is driven by spin_once (the EventsExecutor's spin() in the
+    7.1 wheels busy-loops) with Ctrl-C read between calls (``ctrl_c_as_a_flag``). The objects
+    of startup (modules, rclpy, NumPy, the model: some 40,000) are frozen out of the garbage
+    collector's full passes first: a pass over them all is a stall in which a 1 kHz stream
+    can overflow its queue.
     """
     gc.collect()
     gc.freeze()
@@ -135,17 +136,15 @@ def spin(node: Node, executor: str = "events") -> None:
         from rclpy.experimental import EventsExecutor
     except ImportError:
         executor = "single_threaded"
-    if executor == "single_threaded":
-        rclpy.spin(node)
-        return
-    events = EventsExecutor(context=node.context)
-    events.add_node(node)
+    kind = EventsExecutor if executor == "events" else SingleThreadedExecutor
+    spinner = kind(context=node.context)
+    spinner.add_node(node)
     with ctrl_c_as_a_flag() as interrupted:
         try:
             while node.context.ok() and not interrupted:
-                events.spin_once(timeout_sec=WAKE_PERIOD)
+                spinner.spin_once(timeout_sec=WAKE_PERIOD)
         finally:
-            events.shutdown()
+            spinner.shutdown()
 
 
 @contextmanager
