@@ -185,7 +185,7 @@ def test_bad_message_is_dropped_and_counted(node, msg, kind):
 
 def test_undecodable_bytes_on_joint_states_are_dropped_as_malformed(node):
     """A publisher may send any bytes under the JointState type (rclpy's publish(bytes)):
-    id_node reads them itself (ros.messages.joint_state_cdr), drops them, and goes on."""
+    id_node reads them itself (core.io.joint_state_cdr), drops them, and goes on."""
     garbage = [
         b"",
         b"\x00\x01\x00\x00",

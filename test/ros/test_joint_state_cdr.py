@@ -9,9 +9,9 @@ import pytest
 from rclpy.serialization import deserialize_message, serialize_message
 from sensor_msgs.msg import JointState
 
+from irb140_dynamics.core.io.joint_state_cdr import EffortMessage
 from irb140_dynamics.core.model.joint_order import BadMessage, JointOrder, NotForThisModel
-from irb140_dynamics.ros.messages.joint_messages import read_joint_sample
-from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage, read_joint_state_cdr
+from irb140_dynamics.ros.messages.joint_messages import read_joint_sample, read_joint_state_cdr
 
 CHARACTERS = "abz_09é€😀"  # names of 1- to 4-byte UTF-8 characters shift every alignment
 

@@ -1,5 +1,5 @@
 """sensor_msgs/JointState as the bytes DDS carries (CDR): a file format of the wire, read and
-written here without ROS (``ros.messages.joint_state_cdr`` hands anything else to rclpy).
+written here without ROS (``ros.messages.joint_messages`` hands anything else to rclpy).
 
 rclpy converts every message taken into Python field by field, and every one published back;
 id_node reads its joint states from the bytes with ``struct`` (strings as rclpy reads them)

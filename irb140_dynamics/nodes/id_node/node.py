@@ -33,7 +33,7 @@ Publishes    feedforward_torques   sensor_msgs/JointState, effort = tau(q, qd, q
 Torques are in N m, named and ordered as the model's joints, stamped with the input stamp.
 A message that cannot give finite torques is dropped and counted (per topic), never
 answered; no exception leaves a callback. Joint states are read, and torques published, as
-serialized bytes (ros.messages.joint_state_cdr: a third of rclpy's cost per message).
+serialized bytes (core.io.joint_state_cdr: a third of rclpy's cost per message).
 """
 
 from __future__ import annotations
@@ -50,6 +50,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Bool, Float64MultiArray, String
 from trajectory_msgs.msg import JointTrajectory
 
+from irb140_dynamics.core.io.joint_state_cdr import EffortMessage
 from irb140_dynamics.core.io.stamps import seconds
 from irb140_dynamics.core.monitoring.collision import RESTARTS, CollisionMonitor
 from irb140_dynamics.core.monitoring.wrench import WrenchStream
@@ -72,7 +73,6 @@ from irb140_dynamics.ros.messages.joint_messages import (
     read_joint_sample,
     read_trajectory,
 )
-from irb140_dynamics.ros.messages.joint_state_cdr import EffortMessage
 from irb140_dynamics.ros.messages.wrench import fill_wrench
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS, ArmParameters
 from irb140_dynamics.ros.parameters.overrides import NODE_OPTIONS
@@ -193,7 +193,7 @@ class IdNode(Node):
 
     @guarded("joint_states")
     def _on_joint_state(self, msg: bytes | JointState) -> None:
-        """A joint state as DDS carries it (see ros.messages.joint_state_cdr), or as a JointState."""
+        """A joint state as DDS carries it (see core.io.joint_state_cdr), or as a JointState."""
         self.counts["joint_states.received"] += 1
         if self.settings is None:
             self.counts["joint_states.no_model_yet"] += 1
