@@ -85,6 +85,54 @@ def test_the_check_finds_each_defect():
     plt.close(clean)
 
 
+def test_the_check_finds_a_legend_over_data_and_negative_ticks_of_positive_data():
+    """A legend over a line's trough, over bars, over a scatter point, over a contour line
+    (real_arm.png's, the load diagram's), and negative ticks beside a quantity >= 0 (a
+    one-point load diagram's axes), each found; the same figures with the legend beside
+    the data and the view from 0 pass."""
+    t = np.linspace(0.0, 25.0, 500)
+    figure, (line, bars, points, contours) = plt.subplots(1, 4, figsize=(16, 4))
+    line.plot(t, 35 * np.sin(t), label="measured")
+    line.legend(loc="lower left")  # over the trough at t = 4.7 s
+    bars.bar([1, 2, 3], [40.0, 3.0, 25.0], label="URDF prior")
+    bars.legend(loc="upper left")  # over the first bar
+    points.plot([0.0, 0.29], [0.0, 0.29], "x", label="unproven")
+    points.legend(loc="upper right")  # over the crossed point in the corner
+    x, y = np.meshgrid(np.linspace(0, 1, 20), np.linspace(0, 1, 20))
+    contours.contour(x, y, x + y, levels=[1.0, 1.9])
+    contours.plot([], [], "k", label="a contour")
+    contours.legend(loc="upper right")  # over the level 1.9
+    for axis in (line, bars, points, contours):
+        axis.set_title(axis.get_legend().get_texts()[0].get_text())
+    legends = [p for p in figure_problems(figure) if p.startswith("legend over data")]
+    assert legends == [
+        "legend over data: 'measured'",
+        "legend over data: 'URDF prior'",
+        "legend over data: 'unproven'",
+        "legend over data: 'a contour'",
+    ], legends
+    for axis in (line, bars, points, contours):
+        axis.get_legend().remove()
+    figure.legend(*line.get_legend_handles_labels(), loc="upper right")  # over no axes
+    assert not [p for p in figure_problems(figure) if p.startswith("legend over data")]
+    plt.close(figure)
+    single, axis = plt.subplots(figsize=(10, 5))
+    axis.set_title("one point at L = 0, Z = 0")
+    axis.scatter([0.0], [0.0])  # matplotlib centres the view on it, either side of 0
+    assert [p for p in figure_problems(single) if p.startswith("negative ticks")] == [
+        "negative ticks [-0.04, -0.02] on one point at L = 0, Z = 0 (x), its data all >= 0",
+        "negative ticks [-0.04, -0.02] on one point at L = 0, Z = 0 (y), its data all >= 0",
+    ]
+    axis.set_xlim(-0.004, 0.104)
+    axis.set_ylim(-0.004, 0.104)
+    assert figure_problems(single) == []
+    axis.plot([0.0, 1.0], [-0.5, 0.5])  # a signed quantity: its negative ticks are fine
+    axis.relim()
+    axis.autoscale()
+    assert figure_problems(single) == []
+    plt.close(single)
+
+
 def test_the_check_fails_on_a_title_wider_than_its_figure():
     figure, axis = plt.subplots(figsize=(4, 3))
     figure.suptitle(LABEL)
@@ -204,9 +252,14 @@ def test_the_load_diagram(saved, arm):
 
 
 def test_a_load_diagram_of_one_row_and_of_one_point(saved):
-    for z, l in (([0.0, 0.1, 0.2], [0.0]), ([0.1], [0.05])):
-        diagram_png(synthetic_diagram(z, l, 2.0, 3.0), "arm.urdf", None)
-    assert saved.problems == [[], []]
+    shapes = (([0.0, 0.1, 0.2], [0.0]), ([0.1], [0.05]), ([0.0], [0.0]))
+    for z, l in shapes:
+        diagram_png(synthetic_diagram(z, l, 2.0, 3.0), "arm.urdf", 6.0)
+    assert saved.problems == [[]] * len(shapes)  # no negative Z or L, no legend over a point
+    for figure in saved.figures:
+        plane, sheet = figure.axes[:2]  # (then the colour bar)
+        for low, high in (plane.get_xlim(), plane.get_ylim(), sheet.get_xlim()):  # L and Z: from 0
+            assert -0.05 * high < low <= 0.0 < high
 
 
 class _Sized:
