@@ -173,16 +173,42 @@ def test_identify_plots(saved, tmp_path):
         plot_points=_Sized(points, count),
         prior=model,
         fit=SimpleNamespace(pi=inertial_parameters(model)),
-        held_out_source=LONG,
+        held_out_source="the last 20 % of the moving fit points of the recording",
+        tallies=[SimpleNamespace(path=LONG)],
     )
     points.tau[10, 0] = 3.5  # a point above the rest: shown, not cut, not under the legend
-    assert write_plots(result, tmp_path) == ["torques.png", "residuals.png"]
+    assert write_plots(result, tmp_path, "ur5 from ur5.urdf (world -> tool0)") == ["torques.png", "residuals.png"]
     assert saved.problems == [[], []]
     for figure in saved.figures:
+        title = figure.get_suptitle().replace("\n", " ")  # (wrapped at spaces to fit)
+        assert "of ur5 from ur5.urdf (world -> tool0) on held-out data" in title, title  # the arm
+        assert f"of the recording {LONG}" in title, title  # the recording, by its path
         top = figure.axes[0]
         assert top.get_ylim()[1] >= 3.5 - 0.0  # (the residuals: 3.5 less a prediction, within the view)
         legend = legends_of(figure)
         assert legend and all(a.get_legend() is None for a in figure.axes)  # one legend, above the panels
+
+
+def test_the_real_arm_picture(saved, tmp_path):
+    """docs/real_arm.py's picture (drawn on the arm's torques, here a sine with a trough
+    where its legend stood): the arm and the recordings in the title, one legend over no data."""
+    model, count = irb140(), 400
+    time = np.linspace(0.0, 25.0, count)
+    q = np.column_stack([np.sin(time + k) for k in range(6)])
+    tau = np.column_stack([35 * np.sin(time)] * 6)
+    points = SimpleNamespace(time=time, q=q, qd=np.cos(q), qdd=-q, tau=tau)
+    result = SimpleNamespace(prior=model, plot_points=points, fit=SimpleNamespace(pi=inertial_parameters(model)))
+    pi = inertial_parameters(model)
+    moving = {
+        label: np.array([0.4, 0.04, 0.25, 0.06, 0.5, 0.9]) * k
+        for k, label in enumerate(("URDF prior", "plain LS", "ours"), 1)
+    }
+    script = runpy.run_path(str(ROOT / "docs" / "real_arm.py"))
+    script["plot"](result, pi, pi, moving, np.ones(6), tmp_path / "real_arm.png")
+    assert saved.problems == [[]]
+    title = titles_of(saved.figures[0])
+    assert all(name in title for name in ("KUKA LWR4+", "kuka_lwr4.urdf", "traj1", "traj3")), title
+    assert legends_of(saved.figures[0]) == ["measured", "URDF prior", "plain LS", "ours"]
 
 
 def test_retime_plot(saved):
