@@ -5,7 +5,7 @@ nothing of the package, serves every floor).
 ``fit_text`` wraps each text wider than the figure at spaces (a title naming a long path,
 a label) and then lays the figure out tight; ``round_steps`` gives round, evenly spaced
 values (contour levels, colour keys); ``label_curves`` labels contours upright where the
-labels fit.
+labels fit; ``clear_legend`` puts a legend inside its axes where it covers no data.
 ``figure_problems`` names what keeps a figure from reading well, which tests check is
 nothing: narrower than MIN_WIDTH pixels as saved, no title, a text outside the figure
 (``texts_outside``) or over another text, a text upside down, tick values that are not
@@ -246,24 +246,47 @@ def _legends(figure) -> list:
 def legends_over_data(figure) -> list[str]:
     """The legends (each named by its entries) that cover plotted data of an axes where the
     axes show it: a line or a marker, a bar, a scatter point, a contour line."""
-    from matplotlib.transforms import Bbox
-
     figure.canvas.draw()
     renderer = figure.canvas.get_renderer()
-    covering = []
-    for legend in _legends(figure):
-        box = legend.get_window_extent(renderer)
-        for axes in figure.axes:
-            if axes.get_label() == "<colorbar>":
-                continue
-            region = Bbox.intersection(box, axes.bbox)
-            if region is None or region.width < 2 * OVERLAP or region.height < 2 * OVERLAP:
-                continue
-            region = region.padded(-OVERLAP)
-            if any(_covers(artist, region, renderer) for artist in _data_of(axes)):
-                covering.append(repr(", ".join(t.get_text() for t in legend.get_texts())))
-                break
-    return covering
+    return [
+        repr(", ".join(t.get_text() for t in legend.get_texts()))
+        for legend in _legends(figure)
+        if _over_data(legend, figure, renderer)
+    ]
+
+
+def _over_data(legend, figure, renderer) -> bool:
+    from matplotlib.transforms import Bbox
+
+    box = legend.get_window_extent(renderer)
+    for axes in figure.axes:
+        if axes.get_label() == "<colorbar>":
+            continue
+        region = Bbox.intersection(box, axes.bbox)
+        if region is None or region.width < 2 * OVERLAP or region.height < 2 * OVERLAP:
+            continue
+        if any(_covers(artist, region.padded(-OVERLAP), renderer) for artist in _data_of(axes)):
+            return True
+    return False
+
+
+PLACES = ("best", "upper right", "upper left", "lower left", "lower right", "center right", "center left")
+
+
+def clear_legend(axes, rect=(0.0, 0.0, 1.0, 1.0), **style):
+    """The legend of ``axes`` at the first of PLACES where it covers no data (matplotlib's
+    "best" only picks the place that covers least), else beside the axes, on the right, the
+    figure laid out again (``fit_text`` with ``rect``). Call after the layout: the places
+    are judged in pixels."""
+    figure = axes.figure
+    for place in PLACES:
+        legend = axes.legend(loc=place, **style)
+        figure.canvas.draw()
+        if not _over_data(legend, figure, figure.canvas.get_renderer()):
+            return legend
+    legend = axes.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), **style)
+    fit_text(figure, rect)
+    return legend
 
 
 def _data_of(axes) -> list:

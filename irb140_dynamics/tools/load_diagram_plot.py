@@ -48,7 +48,7 @@ def diagram_png(diagram, arm: str, rated_mass: float | None = None) -> bytes:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from irb140_dynamics.figures import fit_text, label_curves
+    from irb140_dynamics.figures import clear_legend, fit_text, label_curves
 
     masses = np.where(np.isfinite(diagram.masses()), diagram.masses(), np.nan)
     finite = masses[np.isfinite(masses)]
@@ -81,7 +81,9 @@ def diagram_png(diagram, arm: str, rated_mass: float | None = None) -> bytes:
     if handles:  # below the panels: over no contour, no crossed point
         fig.legend(handles, labels, loc="lower center", bbox_to_anchor=(0.5, 0.0), ncol=len(handles), fontsize=9)
     _sheet(sheet, diagram, masses, unproven, rated_mass)
-    fit_text(fig, rect=(0.0, LEGEND_BAND if handles else 0.0, 1.0, 1.0))
+    rect = (0.0, LEGEND_BAND if handles else 0.0, 1.0, 1.0)
+    fit_text(fig, rect)
+    clear_legend(sheet, rect, fontsize=9, framealpha=0.9)
     if contoured:  # after the layout: the labels are placed where they fit
         label_curves(plane, lines, [f"{level:g} kg" for level in levels])
         if rated is not None:
@@ -136,7 +138,7 @@ def _sheet(axes, diagram, masses, unproven, rated_mass) -> None:
     axes.set_ylabel("largest payload [kg]")
     axes.set_title("spec-sheet form: largest payload against Z, per L")
     axes.grid(True, linewidth=0.3)
-    axes.legend(loc="best", fontsize=9, framealpha=0.9)
+    axes.legend(loc="best", fontsize=9, framealpha=0.9)  # (moved where it covers no line after the layout)
 
 
 def matplotlib_colours(count: int):

@@ -22,7 +22,7 @@ from irb140_dynamics.core.payload.diagram import DiagramPoint, LoadDiagram  # no
 from irb140_dynamics.core.regressor import inertial_parameters  # noqa: E402
 from irb140_dynamics.core.trajectories.limits import trajectory_limits  # noqa: E402
 from irb140_dynamics.core.trajectories.message import Trajectory  # noqa: E402
-from irb140_dynamics.figures import figure_problems, fit_text, texts_outside  # noqa: E402
+from irb140_dynamics.figures import clear_legend, figure_problems, fit_text, texts_outside  # noqa: E402
 from irb140_dynamics.identification.plots import write_plots  # noqa: E402
 from irb140_dynamics.nodes.demo_node.node import DemoNode  # noqa: E402
 from irb140_dynamics.tools.load_diagram_plot import diagram_png  # noqa: E402
@@ -131,6 +131,28 @@ def test_the_check_finds_a_legend_over_data_and_negative_ticks_of_positive_data(
     axis.autoscale()
     assert figure_problems(single) == []
     plt.close(single)
+
+
+def test_a_legend_is_put_where_it_covers_no_data():
+    """Lines along the top and the bottom and a dashed line across the middle (the spec-sheet
+    form's rated payload): matplotlib's "best" still covers one; clear_legend finds a free
+    place inside, else puts it beside the axes."""
+    x = np.linspace(0.0, 1.0, 50)
+    for middle in (True, False):
+        figure, axis = plt.subplots(figsize=(10, 5))
+        axis.set_title("lines at the top and the bottom" + (", one across the middle" if middle else ""))
+        axis.plot(x, 0.1 + 0.1 * x, "o-", label="low")
+        axis.plot(x, 0.9 - 0.1 * x, "o-", label="high")
+        if middle:
+            axis.axhline(0.5, color="tab:red", linestyle="--", label="rated")
+        axis.legend(loc="lower center")
+        assert [p for p in figure_problems(figure) if p.startswith("legend over data")], "the check misses it"
+        fit_text(figure)
+        legend = clear_legend(axis)
+        assert figure_problems(figure) == []
+        inside = legend.get_window_extent().x1 <= axis.get_window_extent().x1
+        assert inside is not middle  # free places inside when nothing crosses the middle
+        plt.close(figure)
 
 
 def test_the_check_fails_on_a_title_wider_than_its_figure():
