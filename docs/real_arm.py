@@ -23,7 +23,7 @@ sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
 
-from irb140_dynamics.core.io.model_source import tool_model  # noqa: E402
+from irb140_dynamics.core.io.arm_source import read_arm, read_urdf_file  # noqa: E402
 from irb140_dynamics.core.regressor import inertial_parameters, regressor_batch  # noqa: E402
 from irb140_dynamics.identification.pipeline import IdentificationSettings, identify  # noqa: E402
 
@@ -61,7 +61,7 @@ def main() -> None:
     folder = Path(tempfile.mkdtemp())
     for name in ("traj1", "traj3"):
         (folder / f"{name}.csv").write_bytes(lzma.decompress((KUKA / f"{name}.csv.xz").read_bytes()))
-    prior = tool_model(urdf_file=KUKA / "kuka_lwr4.urdf").model
+    prior = read_arm({}, urdf=read_urdf_file(KUKA / "kuka_lwr4.urdf")).model
     runs = {}
     for label, settings in [
         ("ours (default)", IdentificationSettings()),
@@ -102,20 +102,23 @@ def main() -> None:
 
 
 def plot(result, prior_pi, plain, moving, peak, path: Path) -> None:
+    """Held-out errors per joint (bars), and the torques of joints 2 and 4 along traj3; one
+    legend above the panels, over no data; the title names the arm and the recordings."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from irb140_dynamics.figures import fit_text
+
     names = result.prior.joint_names
-    figure, axes = plt.subplots(1, 3, figsize=(15, 4.2), gridspec_kw={"width_ratios": [1.2, 1, 1]})
+    figure, axes = plt.subplots(1, 3, figsize=(15, 4.6), gridspec_kw={"width_ratios": [1.2, 1, 1]})
     width = 0.27
     for k, (label, rms) in enumerate(moving.items()):
         axes[0].bar(np.arange(len(names)) + (k - 1) * width, 100 * rms / peak, width, label=label)
     axes[0].set_xticks(np.arange(len(names)), [str(j + 1) for j in range(len(names))])
     axes[0].set_yscale("log")
-    axes[0].set(xlabel="joint", ylabel="held-out RMS error [% of peak]", title="traj3, identified on traj1")
-    axes[0].legend()
+    axes[0].set(xlabel="joint", ylabel="held-out RMS error [% of peak]", title="held-out RMS error per joint")
     points = result.plot_points
     order = np.argsort(points.time)
     t = points.time[order] - points.time[order][0]
@@ -125,9 +128,17 @@ def plot(result, prior_pi, plain, moving, peak, path: Path) -> None:
         axis.plot(t, Y[:, j] @ prior_pi, lw=0.9, label="URDF prior")
         axis.plot(t, Y[:, j] @ plain, lw=0.9, label="plain LS")
         axis.plot(t, Y[:, j] @ result.fit.pi, lw=0.9, label="ours")
-        axis.set(xlabel="t [s]", ylabel="torque [N m]", title=f"joint {j + 1} ({names[j]}), traj3")
-    axes[1].legend(fontsize=8)
-    figure.tight_layout()
+        axis.set(xlabel="t [s]", ylabel="torque [N m]", title=f"joint {j + 1} ({names[j]}) along traj3")
+    figure.suptitle(
+        f"KUKA LWR4+ ({KUKA.name}/{KUKA.name}.urdf): identified on traj1.csv, predicting the held-out traj3.csv",
+        fontsize=12,
+    )
+    fit_text(figure, rect=(0.0, 0.0, 1.0, 0.9))
+    renderer = figure.canvas.get_renderer()
+    top = max(axis.title.get_window_extent(renderer).y1 for axis in axes) / figure.bbox.height  # above the titles
+    figure.legend(  # the same four colours in every panel: one legend, above the panels
+        *axes[1].get_legend_handles_labels(), loc="lower center", bbox_to_anchor=(0.5, top), ncol=4, frameon=False
+    )
     figure.savefig(path, dpi=90)
     print(f"wrote {path}")
 

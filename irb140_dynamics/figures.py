@@ -5,12 +5,15 @@ nothing of the package, serves every floor).
 ``fit_text`` wraps each text wider than the figure at spaces (a title naming a long path,
 a label) and then lays the figure out tight; ``round_steps`` gives round, evenly spaced
 values (contour levels, colour keys); ``label_curves`` labels contours upright where the
-labels fit.
+labels fit; ``clear_legend`` puts a legend inside its axes where it covers no data.
 ``figure_problems`` names what keeps a figure from reading well, which tests check is
 nothing: narrower than MIN_WIDTH pixels as saved, no title, a text outside the figure
 (``texts_outside``) or over another text, a text upside down, tick values that are not
 round (evenly spaced by 1, 2, 2.5 or 5 times a power of ten, on a log axis each such a
-multiple).
+multiple), a legend over plotted data (``legends_over_data``: a line, a marker, a bar or a
+scatter point under it; a filled field such as a filled contour is a background, not
+counted), a negative tick on an axis whose data are all >= 0 (a distance, a mass: the
+view should start at 0).
 """
 
 from __future__ import annotations
@@ -128,6 +131,8 @@ def figure_problems(figure, dpi=None) -> list[str]:
             if wide > OVERLAP and high > OVERLAP:
                 problems.append(f"over each other: {a.get_text()!r} and {b.get_text()!r}")
     problems += [f"upside down: {t.get_text()!r}" for t in texts if 90 < t.get_rotation() % 360 < 270]
+    problems += [f"legend over data: {name}" for name in legends_over_data(figure)]
+    problems += negative_ticks(figure)
     for axes in figure.axes:
         for axis in (axes.xaxis, axes.yaxis):
             values = _labelled_ticks(axis)
@@ -230,3 +235,134 @@ def _round_number(x: float) -> bool:
     power = 10.0 ** math.floor(math.log10(x))
     mantissa = x / power
     return any(abs(mantissa - k) < 1e-6 * k or abs(mantissa - 10 * k) < 1e-5 * k for k in ROUND)
+
+
+def _legends(figure) -> list:
+    """The legends drawn: the figure's and each axes'."""
+    legends = list(figure.legends) + [a.get_legend() for a in figure.axes if a.get_legend() is not None]
+    return [legend for legend in legends if legend.get_visible()]
+
+
+def legends_over_data(figure) -> list[str]:
+    """The legends (each named by its entries) that cover plotted data of an axes where the
+    axes show it: a line or a marker, a bar, a scatter point, a contour line."""
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    return [
+        repr(", ".join(t.get_text() for t in legend.get_texts()))
+        for legend in _legends(figure)
+        if _over_data(legend, figure, renderer)
+    ]
+
+
+def _over_data(legend, figure, renderer) -> bool:
+    from matplotlib.transforms import Bbox
+
+    box = legend.get_window_extent(renderer)
+    for axes in figure.axes:
+        if axes.get_label() == "<colorbar>":
+            continue
+        region = Bbox.intersection(box, axes.bbox)
+        if region is None or region.width < 2 * OVERLAP or region.height < 2 * OVERLAP:
+            continue
+        if any(_covers(artist, region.padded(-OVERLAP), renderer) for artist in _data_of(axes)):
+            return True
+    return False
+
+
+PLACES = ("best", "upper right", "upper left", "lower left", "lower right", "center right", "center left")
+
+
+def clear_legend(axes, rect=(0.0, 0.0, 1.0, 1.0), **style):
+    """The legend of ``axes`` at the first of PLACES where it covers no data (matplotlib's
+    "best" only picks the place that covers least), else beside the axes, on the right, the
+    figure laid out again (``fit_text`` with ``rect``). Call after the layout: the places
+    are judged in pixels."""
+    figure = axes.figure
+    for place in PLACES:
+        legend = axes.legend(loc=place, **style)
+        figure.canvas.draw()
+        if not _over_data(legend, figure, figure.canvas.get_renderer()):
+            return legend
+    legend = axes.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), **style)
+    fit_text(figure, rect)
+    return legend
+
+
+def _data_of(axes) -> list:
+    """The artists of ``axes`` that draw data (lines, patches such as bars, collections)."""
+    return [a for a in (*axes.lines, *axes.patches, *axes.collections) if a.get_visible()]
+
+
+def _covers(artist, region, renderer) -> bool:
+    """Does ``artist`` draw inside ``region`` (a box in pixels)?"""
+    import numpy as np
+    from matplotlib.collections import Collection
+    from matplotlib.lines import Line2D
+
+    if isinstance(artist, Line2D):
+        path = artist.get_transform().transform_path(artist.get_path())
+        vertices = path.vertices[np.isfinite(path.vertices).all(axis=1)]
+        if artist.get_marker() not in (None, "None", "none", "", " ") and _any_inside(
+            vertices, region.padded(artist.get_markersize() * renderer.points_to_pixels(1.0) / 2)
+        ):
+            return True
+        drawn = artist.get_linestyle() not in ("None", "none", "", " ") and artist.get_linewidth() > 0
+        return drawn and _path_crosses(path, region)
+    if isinstance(artist, Collection):
+        if getattr(artist, "filled", False):  # a filled contour: a field under everything
+            return False
+        offsets, sizes = artist.get_offsets(), getattr(artist, "get_sizes", lambda: ())()
+        if len(sizes) and len(offsets) and artist.get_offset_transform() is not None:  # a scatter
+            points = artist.get_offset_transform().transform(np.asarray(offsets, dtype=float))
+            size = float(np.sqrt(np.max(artist.get_sizes()))) * renderer.points_to_pixels(1.0) / 2
+            return _any_inside(points[np.isfinite(points).all(axis=1)], region.padded(size))
+        faces = np.asarray(artist.get_facecolor())
+        if len(faces) and np.any(faces[:, 3] > 0):  # a filled area: a background
+            return False
+        transform = artist.get_transform()
+        return any(_path_crosses(transform.transform_path(path), region) for path in artist.get_paths())
+    extent = artist.get_window_extent(renderer)  # a patch: a bar
+    return extent.width > 0 and extent.height > 0 and extent.overlaps(region)
+
+
+def _any_inside(points, region) -> bool:
+    import numpy as np
+
+    x, y = points[:, 0], points[:, 1]
+    return bool(np.any((x > region.x0) & (x < region.x1) & (y > region.y0) & (y < region.y1)))
+
+
+def _path_crosses(path, region) -> bool:
+    """Does the open path (pixels; NaNs break it) pass through ``region``?"""
+    import numpy as np
+    from matplotlib.path import Path
+
+    vertices = path.vertices
+    if len(vertices) == 0:
+        return False
+    finite = np.isfinite(vertices).all(axis=1)
+    if finite.all():
+        return path.intersects_bbox(region, filled=False) or _any_inside(vertices, region)
+    return _any_inside(vertices[finite], region) or any(
+        Path(vertices[k : k + 2]).intersects_bbox(region, filled=False)
+        for k in np.flatnonzero(finite[:-1] & finite[1:])
+    )
+
+
+def negative_ticks(figure) -> list[str]:
+    """An axis labelling negative values where every value drawn on it is >= 0: a
+    distance, a mass, a share whose view should start at 0."""
+    problems = []
+    for axes in figure.axes:
+        if axes.get_label() == "<colorbar>":
+            continue
+        limits = axes.dataLim
+        for axis, low in ((axes.xaxis, limits.x0), (axes.yaxis, limits.y0)):
+            if not (math.isfinite(low) and low >= 0.0) or axis.get_scale() != "linear":
+                continue
+            below = [float(f"{v:.6g}") for v in _labelled_ticks(axis) if v < 0.0]
+            if below:
+                name = axes.get_title() or axes.get_label() or "axes"
+                problems.append(f"negative ticks {below} on {name} ({axis.axis_name}), its data all >= 0")
+    return problems

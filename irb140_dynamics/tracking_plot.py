@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from irb140_dynamics.figures import fit_text
+from irb140_dynamics.figures import clear_legend, fit_text
 
 WINDOW = 10.0  # s of positions shown: the run's last
 DPI = 100
@@ -45,7 +45,9 @@ def write_tracking_plot(path, t, reference, actual, joint_names, label: str) -> 
                 axis.tick_params(labelbottom=False)
     since = f"the last {WINDOW:g} s" if t[-1] - t[0] > WINDOW else "the whole run"
     axes[0, 0].set_title(f"positions over {since}", fontsize=10)
-    axes[0, 0].legend(loc="best", fontsize=9, ncol=2, framealpha=0.9)
+    axes[0, 0].legend(
+        loc="best", fontsize=9, ncol=2, framealpha=0.9
+    )  # (moved where it covers no line after the layout)
     axes[-1, 0].set_xlabel("t [s]")
     axes[-1, 1].set_xlabel("t [s]")
     figure.suptitle(
@@ -53,6 +55,7 @@ def write_tracking_plot(path, t, reference, actual, joint_names, label: str) -> 
         fontsize=11,
     )
     fit_text(figure)
+    clear_legend(axes[0, 0], fontsize=9, ncol=2, framealpha=0.9)
     try:
         figure.savefig(path, format="png", dpi=DPI)
     finally:

@@ -16,9 +16,10 @@ DPI = 100
 Save = Callable[[str, Callable[[BinaryIO], None]], None]  # (file name, writer of its bytes)
 
 
-def write_plots(result: Result, directory: str | Path | Save) -> list[str]:
+def write_plots(result: Result, directory: str | Path | Save, arm: str) -> list[str]:
     """torques.png and residuals.png of the held-out fit points, in ``directory`` or, when it
-    is a ``Save`` function, through it (the tools stage them: all outputs or none); their names."""
+    is a ``Save`` function, through it (the tools stage them: all outputs or none); their names.
+    Their titles name what was drawn: ``arm`` (its name and file) and the recording held out."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -61,7 +62,7 @@ def write_plots(result: Result, directory: str | Path | Save) -> list[str]:
             axis.grid(True, linewidth=0.3)
             axis.margins(y=0.08)  # every point inside, none on the frame
         axes[-1, 0].set_xlabel("time [s] (held-out fit points)")
-        figure.suptitle(f"{kind.capitalize()} on held-out data: {result.held_out_source}", fontsize=12)
+        figure.suptitle(f"{kind.capitalize()} of {arm} on held-out data: {held_out(result)}", fontsize=12)
         handles, labels = axes[0, 0].get_legend_handles_labels()
         fit_text(figure, rect=(0, 0, 1, 0.95))  # the title names the held-out recording's path: wrapped, never cut
         top = max(axis.get_position().y1 for axis in axes[:, 0])
@@ -74,3 +75,11 @@ def write_plots(result: Result, directory: str | Path | Save) -> list[str]:
             plt.close(figure)
         written.append(f"{kind}.png")
     return written
+
+
+def held_out(result: Result) -> str:
+    """Which recording's points were held out, by its path: a --validate recording's name is
+    the source itself; else the fitted recording's part, with the recording named."""
+    if len(result.tallies) > 1:
+        return result.held_out_source
+    return f"{result.held_out_source} {result.tallies[0].path}"

@@ -184,7 +184,8 @@ def _identify(argv: list[str], interrupts) -> int:
 
             outputs.directory(plots, args.plots)
             shown = {path.name: typed for typed, path in plot_files}
-            names = write_plots(result, lambda name, save: outputs.stage(plots / name, shown[name], save))
+            arm = f"{source.robot_name} from {Path(source.origin).name}"
+            names = write_plots(result, lambda name, save: outputs.stage(plots / name, shown[name], save), arm)
             if not names:
                 print(f"no held-out points to plot: nothing written in {args.plots}")
         for typed in outputs.commit():

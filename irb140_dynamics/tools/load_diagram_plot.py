@@ -40,13 +40,15 @@ def diagram_png(diagram, arm: str, rated_mass: float | None = None) -> bytes:
     labelled, a colour key of round, even steps, unproven points crossed; and the spec-sheet
     form, the largest mass against Z for a few L (one line each, a legend). ``rated_mass``
     [kg], where the arm states one: its curve in bold red (or a note where no point holds
-    it) and a dashed line at it. ``arm`` names the arm in the title."""
+    it) and a dashed line at it. ``arm`` names the arm in the title. The plane's legend
+    stands below the panels (a legend inside would cover contours or crossed points), and
+    the axes of Z and L start at 0 however few points (one point included)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from irb140_dynamics.figures import fit_text, label_curves
+    from irb140_dynamics.figures import clear_legend, fit_text, label_curves
 
     masses = np.where(np.isfinite(diagram.masses()), diagram.masses(), np.nan)
     finite = masses[np.isfinite(masses)]
@@ -63,6 +65,9 @@ def diagram_png(diagram, arm: str, rated_mass: float | None = None) -> bytes:
     elif finite.size:
         points = plane.scatter(L, Z, c=masses, cmap="viridis_r", s=60)
         fig.colorbar(points, ax=plane, label="largest payload [kg]")
+    if not contoured:  # (filled contours span the grid, 0 to its largest value, themselves)
+        plane.set_xlim(*from_zero(diagram.l))
+        plane.set_ylim(*from_zero(diagram.z))
     rated = None
     if contoured and rated_mass is not None and finite.min() <= rated_mass <= finite.max():
         rated = plane.contour(L, Z, masses, levels=[rated_mass], colors="tab:red", linewidths=2.5)
@@ -72,10 +77,13 @@ def diagram_png(diagram, arm: str, rated_mass: float | None = None) -> bytes:
     plane.set_xlabel("L: CoM off the flange axis, any direction [m]")
     plane.set_ylabel("Z: CoM along the flange axis [m]")
     plane.set_title("largest payload [kg] over the CoM's position")
-    if plane.get_legend_handles_labels()[0]:
-        plane.legend(loc="upper right", fontsize=9, framealpha=0.9)
+    handles, labels = plane.get_legend_handles_labels()
+    if handles:  # below the panels: over no contour, no crossed point
+        fig.legend(handles, labels, loc="lower center", bbox_to_anchor=(0.5, 0.0), ncol=len(handles), fontsize=9)
     _sheet(sheet, diagram, masses, unproven, rated_mass)
-    fit_text(fig)
+    rect = (0.0, LEGEND_BAND if handles else 0.0, 1.0, 1.0)
+    fit_text(fig, rect)
+    clear_legend(sheet, rect, fontsize=9, framealpha=0.9)
     if contoured:  # after the layout: the labels are placed where they fit
         label_curves(plane, lines, [f"{level:g} kg" for level in levels])
         if rated is not None:
@@ -88,6 +96,15 @@ def diagram_png(diagram, arm: str, rated_mass: float | None = None) -> bytes:
 
 DPI = 100
 SHEET_LINES = 5  # the spec-sheet form: at most this many values of L
+LEGEND_BAND = 0.055  # of the figure's height: the band below the panels that holds the plane's legend
+LEAST_SPAN = 0.1  # m: the shortest axis of Z or L drawn (a grid of one value, 0 included)
+
+
+def from_zero(values) -> tuple[float, float]:
+    """Axis limits [m] for grid values >= 0: from 0 (a margin of 4 % either side, which
+    labels no negative value) to the largest value, over at least LEAST_SPAN."""
+    high = max(float(np.max(values)), LEAST_SPAN)
+    return -0.04 * high, 1.04 * high
 
 
 def _title(diagram, arm: str, rated_mass, finite) -> str:
@@ -116,11 +133,12 @@ def _sheet(axes, diagram, masses, unproven, rated_mass) -> None:
             axes.plot(diagram.z[crossed], masses[crossed, k], "x", color="tab:red", markersize=8)
     if rated_mass is not None:
         axes.axhline(rated_mass, color="tab:red", linestyle="--", linewidth=1.5, label=f"rated {rated_mass:g} kg")
+    axes.set_xlim(*from_zero(diagram.z))
     axes.set_xlabel("Z: CoM along the flange axis [m]")
     axes.set_ylabel("largest payload [kg]")
     axes.set_title("spec-sheet form: largest payload against Z, per L")
     axes.grid(True, linewidth=0.3)
-    axes.legend(loc="best", fontsize=9, framealpha=0.9)
+    axes.legend(loc="best", fontsize=9, framealpha=0.9)  # (moved where it covers no line after the layout)
 
 
 def matplotlib_colours(count: int):

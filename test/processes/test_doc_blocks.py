@@ -5,6 +5,7 @@ from __future__ import annotations
 import hashlib
 import os
 import shutil
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -103,20 +104,27 @@ NOT_FOUND = 127  # bash's exit status for a command not found
 
 
 def run_shell(script: str, cwd: Path, env: dict, timeout: float = LINE_TIMEOUT) -> tuple[int, str]:
+    """Run ``script`` in bash, in a session of its own: on a timeout the whole session is
+    killed (a command it started, e.g. a ``python - <<EOF`` waiting on a topic, included),
+    so that nothing of a hung block lives on into the next ones (its DDS participant would)."""
+    shell = subprocess.Popen(
+        ["bash", "-e", "-o", "pipefail", "-c", script],
+        cwd=cwd,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
     try:
-        done = subprocess.run(
-            ["bash", "-e", "-o", "pipefail", "-c", script],
-            cwd=cwd,
-            env=env,
-            capture_output=True,
-            text=True,
-            timeout=timeout,
-        )
-    except subprocess.TimeoutExpired as error:
-        return -1, f"still running after {timeout:g} s: {error.output or ''}"
-    if done.returncode == NOT_FOUND:
-        return NOT_FOUND, f"command not found (exit 127) after the README's set-up:\n{done.stdout}{done.stderr}"
-    return done.returncode, done.stdout + done.stderr
+        stdout, stderr = shell.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(shell.pid, signal.SIGKILL)
+        stdout, stderr = shell.communicate()
+        return -1, f"still running after {timeout:g} s: {stdout}{stderr}"
+    if shell.returncode == NOT_FOUND:
+        return NOT_FOUND, f"command not found (exit 127) after the README's set-up:\n{stdout}{stderr}"
+    return shell.returncode, stdout + stderr
 
 
 def check_synopsis(line: str, cwd: Path, env: dict) -> str | None:

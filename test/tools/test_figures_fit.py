@@ -22,7 +22,7 @@ from irb140_dynamics.core.payload.diagram import DiagramPoint, LoadDiagram  # no
 from irb140_dynamics.core.regressor import inertial_parameters  # noqa: E402
 from irb140_dynamics.core.trajectories.limits import trajectory_limits  # noqa: E402
 from irb140_dynamics.core.trajectories.message import Trajectory  # noqa: E402
-from irb140_dynamics.figures import figure_problems, fit_text, texts_outside  # noqa: E402
+from irb140_dynamics.figures import clear_legend, figure_problems, fit_text, texts_outside  # noqa: E402
 from irb140_dynamics.identification.plots import write_plots  # noqa: E402
 from irb140_dynamics.nodes.demo_node.node import DemoNode  # noqa: E402
 from irb140_dynamics.tools.load_diagram_plot import diagram_png  # noqa: E402
@@ -85,6 +85,76 @@ def test_the_check_finds_each_defect():
     plt.close(clean)
 
 
+def test_the_check_finds_a_legend_over_data_and_negative_ticks_of_positive_data():
+    """A legend over a line's trough, over bars, over a scatter point, over a contour line
+    (real_arm.png's, the load diagram's), and negative ticks beside a quantity >= 0 (a
+    one-point load diagram's axes), each found; the same figures with the legend beside
+    the data and the view from 0 pass."""
+    t = np.linspace(0.0, 25.0, 500)
+    figure, (line, bars, points, contours) = plt.subplots(1, 4, figsize=(16, 4))
+    line.plot(t, 35 * np.sin(t), label="measured")
+    line.legend(loc="lower left")  # over the trough at t = 4.7 s
+    bars.bar([1, 2, 3], [40.0, 3.0, 25.0], label="URDF prior")
+    bars.legend(loc="upper left")  # over the first bar
+    points.plot([0.0, 0.29], [0.0, 0.29], "x", label="unproven")
+    points.legend(loc="upper right")  # over the crossed point in the corner
+    x, y = np.meshgrid(np.linspace(0, 1, 20), np.linspace(0, 1, 20))
+    contours.contour(x, y, x + y, levels=[1.0, 1.9])
+    contours.plot([], [], "k", label="a contour")
+    contours.legend(loc="upper right")  # over the level 1.9
+    for axis in (line, bars, points, contours):
+        axis.set_title(axis.get_legend().get_texts()[0].get_text())
+    legends = [p for p in figure_problems(figure) if p.startswith("legend over data")]
+    assert legends == [
+        "legend over data: 'measured'",
+        "legend over data: 'URDF prior'",
+        "legend over data: 'unproven'",
+        "legend over data: 'a contour'",
+    ], legends
+    for axis in (line, bars, points, contours):
+        axis.get_legend().remove()
+    figure.legend(*line.get_legend_handles_labels(), loc="upper right")  # over no axes
+    assert not [p for p in figure_problems(figure) if p.startswith("legend over data")]
+    plt.close(figure)
+    single, axis = plt.subplots(figsize=(10, 5))
+    axis.set_title("one point at L = 0, Z = 0")
+    axis.scatter([0.0], [0.0])  # matplotlib centres the view on it, either side of 0
+    assert [p for p in figure_problems(single) if p.startswith("negative ticks")] == [
+        "negative ticks [-0.04, -0.02] on one point at L = 0, Z = 0 (x), its data all >= 0",
+        "negative ticks [-0.04, -0.02] on one point at L = 0, Z = 0 (y), its data all >= 0",
+    ]
+    axis.set_xlim(-0.004, 0.104)
+    axis.set_ylim(-0.004, 0.104)
+    assert figure_problems(single) == []
+    axis.plot([0.0, 1.0], [-0.5, 0.5])  # a signed quantity: its negative ticks are fine
+    axis.relim()
+    axis.autoscale()
+    assert figure_problems(single) == []
+    plt.close(single)
+
+
+def test_a_legend_is_put_where_it_covers_no_data():
+    """Lines along the top and the bottom and a dashed line across the middle (the spec-sheet
+    form's rated payload): matplotlib's "best" still covers one; clear_legend finds a free
+    place inside, else puts it beside the axes."""
+    x = np.linspace(0.0, 1.0, 50)
+    for middle in (True, False):
+        figure, axis = plt.subplots(figsize=(10, 5))
+        axis.set_title("lines at the top and the bottom" + (", one across the middle" if middle else ""))
+        axis.plot(x, 0.1 + 0.1 * x, "o-", label="low")
+        axis.plot(x, 0.9 - 0.1 * x, "o-", label="high")
+        if middle:
+            axis.axhline(0.5, color="tab:red", linestyle="--", label="rated")
+        axis.legend(loc="lower center")
+        assert [p for p in figure_problems(figure) if p.startswith("legend over data")], "the check misses it"
+        fit_text(figure)
+        legend = clear_legend(axis)
+        assert figure_problems(figure) == []
+        inside = legend.get_window_extent().x1 <= axis.get_window_extent().x1
+        assert inside is not middle  # free places inside when nothing crosses the middle
+        plt.close(figure)
+
+
 def test_the_check_fails_on_a_title_wider_than_its_figure():
     figure, axis = plt.subplots(figsize=(4, 3))
     figure.suptitle(LABEL)
@@ -125,16 +195,42 @@ def test_identify_plots(saved, tmp_path):
         plot_points=_Sized(points, count),
         prior=model,
         fit=SimpleNamespace(pi=inertial_parameters(model)),
-        held_out_source=LONG,
+        held_out_source="the last 20 % of the moving fit points of the recording",
+        tallies=[SimpleNamespace(path=LONG)],
     )
     points.tau[10, 0] = 3.5  # a point above the rest: shown, not cut, not under the legend
-    assert write_plots(result, tmp_path) == ["torques.png", "residuals.png"]
+    assert write_plots(result, tmp_path, "ur5 from ur5.urdf (world -> tool0)") == ["torques.png", "residuals.png"]
     assert saved.problems == [[], []]
     for figure in saved.figures:
+        title = figure.get_suptitle().replace("\n", " ")  # (wrapped at spaces to fit)
+        assert "of ur5 from ur5.urdf (world -> tool0) on held-out data" in title, title  # the arm
+        assert f"of the recording {LONG}" in title, title  # the recording, by its path
         top = figure.axes[0]
         assert top.get_ylim()[1] >= 3.5 - 0.0  # (the residuals: 3.5 less a prediction, within the view)
         legend = legends_of(figure)
         assert legend and all(a.get_legend() is None for a in figure.axes)  # one legend, above the panels
+
+
+def test_the_real_arm_picture(saved, tmp_path):
+    """docs/real_arm.py's picture (drawn on the arm's torques, here a sine with a trough
+    where its legend stood): the arm and the recordings in the title, one legend over no data."""
+    model, count = irb140(), 400
+    time = np.linspace(0.0, 25.0, count)
+    q = np.column_stack([np.sin(time + k) for k in range(6)])
+    tau = np.column_stack([35 * np.sin(time)] * 6)
+    points = SimpleNamespace(time=time, q=q, qd=np.cos(q), qdd=-q, tau=tau)
+    result = SimpleNamespace(prior=model, plot_points=points, fit=SimpleNamespace(pi=inertial_parameters(model)))
+    pi = inertial_parameters(model)
+    moving = {
+        label: np.array([0.4, 0.04, 0.25, 0.06, 0.5, 0.9]) * k
+        for k, label in enumerate(("URDF prior", "plain LS", "ours"), 1)
+    }
+    script = runpy.run_path(str(ROOT / "docs" / "real_arm.py"))
+    script["plot"](result, pi, pi, moving, np.ones(6), tmp_path / "real_arm.png")
+    assert saved.problems == [[]]
+    title = titles_of(saved.figures[0])
+    assert all(name in title for name in ("KUKA LWR4+", "kuka_lwr4.urdf", "traj1", "traj3")), title
+    assert legends_of(saved.figures[0]) == ["measured", "URDF prior", "plain LS", "ours"]
 
 
 def test_retime_plot(saved):
@@ -204,9 +300,14 @@ def test_the_load_diagram(saved, arm):
 
 
 def test_a_load_diagram_of_one_row_and_of_one_point(saved):
-    for z, l in (([0.0, 0.1, 0.2], [0.0]), ([0.1], [0.05])):
-        diagram_png(synthetic_diagram(z, l, 2.0, 3.0), "arm.urdf", None)
-    assert saved.problems == [[], []]
+    shapes = (([0.0, 0.1, 0.2], [0.0]), ([0.1], [0.05]), ([0.0], [0.0]))
+    for z, l in shapes:
+        diagram_png(synthetic_diagram(z, l, 2.0, 3.0), "arm.urdf", 6.0)
+    assert saved.problems == [[]] * len(shapes)  # no negative Z or L, no legend over a point
+    for figure in saved.figures:
+        plane, sheet = figure.axes[:2]  # (then the colour bar)
+        for low, high in (plane.get_xlim(), plane.get_ylim(), sheet.get_xlim()):  # L and Z: from 0
+            assert -0.05 * high < low <= 0.0 < high
 
 
 class _Sized:

@@ -338,7 +338,7 @@ def test_plots_and_result_are_written_together_or_not_at_all(workflow, tmp_path,
 
     real = plots.write_plots
 
-    def failing(result, save):
+    def failing(result, save, *rest):
         calls = []
 
         def second_fails(name, write):
@@ -347,7 +347,7 @@ def test_plots_and_result_are_written_together_or_not_at_all(workflow, tmp_path,
                 raise OSError(28, "No space left on device")
             save(name, write)
 
-        return real(result, second_fails)
+        return real(result, second_fails, *rest)
 
     monkeypatch.setattr(plots, "write_plots", failing)
     out, folder = tmp_path / "o.yaml", tmp_path / "new" / "plots"

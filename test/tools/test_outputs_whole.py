@@ -13,7 +13,16 @@ import pytest
 from irb140_dynamics.core import irb140, rnea_batch
 from irb140_dynamics.core.io.atomic import replace_all, write_files
 from irb140_dynamics.identification.excitation import optimise_excitation
-from irb140_dynamics.tools import equations, excitation, export_urdf, identify, load_diagram, record, retime
+from irb140_dynamics.tools import (
+    calibrate_collision,
+    equations,
+    excitation,
+    export_urdf,
+    identify,
+    load_diagram,
+    record,
+    retime,
+)
 from irb140_dynamics.tools.cli import ToolError
 from irb140_dynamics.tools.outputs import Outputs
 
@@ -27,13 +36,17 @@ ONE_POINT = ["--z-max", "0", "--l-max", "0"]  # load_diagram's smallest grid
 
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory):
-    """A 6 s CSV recording of a synthetic IRB-140 along an excitation."""
+    """A 6 s CSV recording of a synthetic IRB-140 along an excitation, with velocities (as
+    calibrate_collision's observer needs them)."""
     trajectory = optimise_excitation(irb140(), 3.0, 3, seed=1, iterations=0).trajectory
     t = np.arange(6 * 200) / 200.0
     Q, QD, QDD = trajectory.evaluate(t)
     tau = rnea_batch(true_arm(1), Q, QD, QDD)
     return write_csv(
-        tmp_path_factory.mktemp("recording") / "run.csv", Samples(t, Q, QD, tau, tau), irb140().joint_names
+        tmp_path_factory.mktemp("recording") / "run.csv",
+        Samples(t, Q, QD, tau, tau),
+        irb140().joint_names,
+        with_velocity=True,
     )
 
 
@@ -249,6 +262,7 @@ def modes(folder, mask) -> dict:
 
 
 RUNS = {
+    "calibrate_collision": (calibrate_collision.main, ["RECORDING", "--out", "o/collision.yaml", "--quiet"], 1),
     "load_diagram": (load_diagram.main, ["--out", "o/diagram", *ONE_POINT], 2),
     "excitation": (
         excitation.main,
