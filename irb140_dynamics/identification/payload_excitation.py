@@ -20,7 +20,8 @@ What is optimised is what `identify --payload-only` will know. Its weighted leas
     F = sum over joints j of  (rate x duration / S) sum_k Y_kj^T Y_kj / sigma_j^2
 
 Y_kj joint j's row of the payload's regressor (``payload.payload_regressor``, flange frame)
-at S states of one period, sigma_j joint j's effort noise per recorded sample
+at S states of one period (the rows `identify` uses: a moving joint's where it is fast
+enough for its Coulomb model, see ``information``), sigma_j joint j's effort noise per recorded sample
 (``EffortNoise``, as the user states it), rate the recording's sample rate and duration
 what is recorded (the periods that fit in MAX_PAYLOAD_DURATION); F^-1 is the covariance of
 the ten parameters, and sqrt(diag F^-1) what the motion promises. The cost is
@@ -60,6 +61,9 @@ from irb140_dynamics.identification.payload import (
     excitation,
     payload_regressor,
 )
+from irb140_dynamics.identification.pipeline import SLOW_SPEEDS
+from irb140_dynamics.identification.selection import rows_used
+from irb140_dynamics.identification.signals import FilterDesign
 
 WRIST_JOINTS = 3
 PERIODS = (2.0, 3.0, 5.0, 7.5, 10.0, 15.0)  # s the design chooses among (each divides 30 s)
@@ -249,13 +253,19 @@ def information(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(F (10, 10), sigma (n,), peak (n,)): the information matrix of the payload's ten
     parameters that a recording of ``duration`` s (default one period) at ``rate`` Hz gives
-    at that noise, each joint's noise [N m] and the arm's own peak torque [N m] along the motion."""
+    at that noise, each joint's noise [N m] and the arm's own peak torque [N m] along the motion.
+    Only the rows `identify` uses count: a moving joint's where it is fast enough for the
+    Coulomb model throughout its filter's window (``selection.rows_used``, at identify's
+    default cut-off for that rate), and every row of a joint held still."""
     duration = trajectory.period if duration is None else duration
     states = trajectory.evaluate(np.linspace(0.0, trajectory.period, samples, endpoint=False))
     Y, tau_arm = payload_regressor(model, *states)
     peak = np.abs(tau_arm).max(axis=0)
     sigma = noise.sigma(model, peak)
-    weighted = (Y / sigma[None, :, None]).reshape(-1, Y.shape[-1])
+    filter_design = FilterDesign.of(rate)
+    used = rows_used(states[1], states[2], SLOW_SPEEDS * model.smoothing_velocity, filter_design.half / rate)
+    used |= ~used.any(axis=0)  # a joint held still: all its rows
+    weighted = (Y * (used / sigma)[:, :, None]).reshape(-1, Y.shape[-1])
     return weighted.T @ weighted * (rate * duration / samples), sigma, peak
 
 
