@@ -49,6 +49,7 @@ from irb140_dynamics.identification.excitation import (
     CHECK_POINTS_PER_HARMONIC,
     DEFAULT_ACCELERATION,
     DEFAULT_MARGIN,
+    DEFAULT_SPEED,
     FourierTrajectory,
     Limits,
     iterations_to,
@@ -136,18 +137,20 @@ class PayloadExcitation:
     rate: float  # Hz
     duration: float  # s
     assumed: dict[str, float]  # rad/s^2: the acceleration limits assumed for wrist joints that state none
+    unlimited_speed: tuple[str, ...] = ()  # the wrist joints that state no velocity limit (DEFAULT_SPEED used)
 
     def expectation(self) -> list[str]:
         """What the motion promises, as lines to print (or to write as comments)."""
         values = ", ".join(f"{label} +- {s:.2g} {unit}" for label, s, unit in zip(PARAMETER_LABELS, self.std, UNITS))
-        assumed = [
+        speeds = f"no velocity limit given for {', '.join(self.unlimited_speed)}: assumed {DEFAULT_SPEED:g} rad/s"
+        accelerations = (
             f"no acceleration limit given for {', '.join(self.assumed)}: assumed "
             f"{', '.join(f'{a:.3g}' for a in self.assumed.values())} rad/s^2 (the velocity limit reached in "
-            f"{RAMP_TIME:g} s, at least {DEFAULT_ACCELERATION:g}; a params file's <joint>.acceleration_limit "
-            "sets yours)"
-        ]
+            f"{RAMP_TIME:g} s, at least {DEFAULT_ACCELERATION:g}"
+        )
         return [
-            *(assumed if self.assumed else []),
+            *([f"{speeds} (a params file's <joint>.velocity_limit sets yours)"] if self.unlimited_speed else []),
+            *([f"{accelerations}; a params file's <joint>.acceleration_limit sets yours)"] if self.assumed else []),
             f"expected at an effort noise of {self.noise} ({', '.join(f'{s:.3g}' for s in self.sigma)} N m), "
             f"recorded at {self.rate:g} Hz for {self.duration:g} s: one standard deviation of",
             f"  {values}",
@@ -183,9 +186,10 @@ def with_assumed_accelerations(model: RobotModel) -> RobotModel:
 
 
 def payload_limits(model: RobotModel, margin: float = DEFAULT_MARGIN, pose=None) -> Limits:
-    """The limits of the model (with ``with_assumed_accelerations``) with the joints before the wrist pinned at ``pose`` (default: the
-    middle of their ranges; the wrist's own values are not used, it moves over its range);
-    ValueError naming a pose outside its joint's range, the wrist's included."""
+    """The model's limits (its wrist's acceleration limits ``with_assumed_accelerations``) with
+    the joints before the wrist pinned at ``pose`` (default: the middle of their ranges; the
+    wrist's own values are not used, it moves over its range); ValueError naming a pose
+    outside its joint's range, the wrist's included."""
     limits = Limits.of(with_assumed_accelerations(model), margin)
     held = np.setdiff1d(np.arange(model.n), wrist(model))
     centre = (limits.lower + limits.upper) / 2.0
@@ -321,6 +325,7 @@ def optimise_payload_excitation(
         given = f"{period:g} s" if period is not None else f"{min(PERIODS):g} s at least"
         raise ValueError(f"periods: {periods} x {given} is more than {MAX_PAYLOAD_DURATION:g} s")
     assumed = assumed_accelerations(model)
+    unlimited_speed = tuple(model.joints[j].name for j in wrist(model) if not model.joints[j].velocity_limit)
     model = with_assumed_accelerations(model)
     moving = wrist(model)
     rng = np.random.default_rng(seed)
@@ -380,5 +385,15 @@ def optimise_payload_excitation(
         )
     std = np.sqrt(np.diag(np.linalg.inv(F)))
     return PayloadExcitation(
-        trajectory, condition, start_condition, evaluations, std, sigma, noise, rate, recorded(period, periods), assumed
+        trajectory,
+        condition,
+        start_condition,
+        evaluations,
+        std,
+        sigma,
+        noise,
+        rate,
+        recorded(period, periods),
+        assumed,
+        unlimited_speed,
     )

@@ -379,3 +379,27 @@ def test_a_wrist_without_an_acceleration_limit_is_taken_to_reach_its_speed_in_a_
     peaks, printed, _ = peak_accelerations("--params-file", str(stated))
     assert "no acceleration limit given" not in printed
     assert np.all(peaks <= 8.0 + 1e-6)
+
+
+def test_a_wrist_without_a_velocity_limit_is_said_to_be_designed_at_the_default_speed():
+    """A model that states no velocity limit (an MJCF's, as Menagerie's FR3) is designed at
+    1 rad/s and 5 rad/s^2 there, and the expectation says so first."""
+    from dataclasses import replace
+
+    from irb140_dynamics.core.io.arm_source import read_arm, read_urdf_file
+    from irb140_dynamics.identification.payload_excitation import optimise_payload_excitation
+
+    from ..support.paths import URDF_DATA
+
+    arm = read_arm({}, urdf=read_urdf_file(str(URDF_DATA / "ur5.urdf")), tip_link="tool0").model
+    arm = replace(arm, joints=tuple(replace(j, velocity_limit=0.0) if k >= 3 else j for k, j in enumerate(arm.joints)))
+    design = optimise_payload_excitation(arm, period=3.0, iterations=0, pose=[0.0, -1.2, 1.5, 0.0, 0.0, 0.0])
+    lines = design.expectation()
+    assert lines[0].startswith(
+        "no velocity limit given for wrist_1_joint, wrist_2_joint, wrist_3_joint: assumed 1 rad/s"
+    )
+    assert lines[1].startswith(
+        "no acceleration limit given for wrist_1_joint, wrist_2_joint, wrist_3_joint: assumed 5, 5, 5"
+    )
+    QD = design.trajectory.evaluate(np.linspace(0.0, 3.0, 3000))[1]
+    assert 0.9 < np.abs(QD[:, 3:]).max() <= 1.0
