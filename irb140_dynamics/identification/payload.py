@@ -32,6 +32,7 @@ phi_hat that is physical is kept as it is.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import lru_cache
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -103,11 +104,19 @@ def flange_map(model: RobotModel) -> np.ndarray:
 def payload_regressor(arm: RobotModel, Q, QD, QDD) -> tuple[np.ndarray, np.ndarray]:
     """(Y_p (N, n, 10), tau_arm (N, n)): the payload's regressor in the flange frame and the
     torques of the arm without its payload (friction and rotor inertia included)."""
-    free = arm.with_payload(RigidBody())
+    free, theta, T = _regressor_constants(arm)
     n = arm.n
     Y = regressor_batch(free, Q, QD, QDD)
-    tau_arm = Y @ inertial_parameters(free)
-    return Y[:, :, 10 * (n - 1) : 10 * n] @ flange_map(arm), tau_arm
+    tau_arm = Y @ theta
+    return Y[:, :, 10 * (n - 1) : 10 * n] @ T, tau_arm
+
+
+@lru_cache(maxsize=16)
+def _regressor_constants(arm: RobotModel) -> tuple[RobotModel, np.ndarray, np.ndarray]:
+    """(the arm without payload, its inertial parameters, ``flange_map``): the same for every
+    batch of one arm (a design evaluates hundreds)."""
+    free = arm.with_payload(RigidBody())
+    return free, inertial_parameters(free), flange_map(arm)
 
 
 def payload_parameters(payload: RigidBody) -> np.ndarray:

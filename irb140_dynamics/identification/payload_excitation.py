@@ -7,7 +7,12 @@ load, which tells its mass from its first moments, and the wrist's turns, speeds
 accelerations show its inertia. The wrist's motion is scaled to its limits like
 ``excitation``'s (position range less ``margin``, 98 % of the velocity and acceleration
 limits); where a joint's speed or acceleration limit, not its range, bounds it, the centre
-of its motion (the wrist's pose) is a design variable too.
+of its motion (the wrist's pose) is a design variable too. A wrist joint that states no
+acceleration limit (a URDF gives none) is given the one that reaches its velocity limit in
+RAMP_TIME (``assumed_accelerations``; at least excitation's DEFAULT_ACCELERATION): the
+payload's inertia shows in torques proportional to the wrist's accelerations and to
+products of its speeds, and a fixed 5 rad/s^2 leaves a fast wrist's inertia torques below
+the noise of a strong drive (1 % of the UR5's 28 N m).
 
 What is optimised is what `identify --payload-only` will know. Its weighted least squares
 (``payload``) has the information matrix
@@ -15,7 +20,8 @@ What is optimised is what `identify --payload-only` will know. Its weighted leas
     F = sum over joints j of  (rate x duration / S) sum_k Y_kj^T Y_kj / sigma_j^2
 
 Y_kj joint j's row of the payload's regressor (``payload.payload_regressor``, flange frame)
-at S states of one period, sigma_j joint j's effort noise per recorded sample
+at S states of one period (the rows `identify` uses: a moving joint's where it is fast
+enough for its Coulomb model, see ``information``), sigma_j joint j's effort noise per recorded sample
 (``EffortNoise``, as the user states it), rate the recording's sample rate and duration
 what is recorded (the periods that fit in MAX_PAYLOAD_DURATION); F^-1 is the covariance of
 the ten parameters, and sqrt(diag F^-1) what the motion promises. The cost is
@@ -33,7 +39,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import minimize
@@ -41,7 +47,9 @@ from scipy.optimize import minimize
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.identification.excitation import (
     CHECK_POINTS_PER_HARMONIC,
+    DEFAULT_ACCELERATION,
     DEFAULT_MARGIN,
+    DEFAULT_SPEED,
     FourierTrajectory,
     Limits,
     iterations_to,
@@ -54,6 +62,9 @@ from irb140_dynamics.identification.payload import (
     excitation,
     payload_regressor,
 )
+from irb140_dynamics.identification.pipeline import SLOW_SPEEDS
+from irb140_dynamics.identification.selection import rows_used
+from irb140_dynamics.identification.signals import FilterDesign
 
 WRIST_JOINTS = 3
 PERIODS = (2.0, 3.0, 5.0, 7.5, 10.0, 15.0)  # s the design chooses among (each divides 30 s)
@@ -68,6 +79,8 @@ MAX_TORQUE_USE = 0.3  # of a torque limit the arm's own torques may take at a ch
 SAMPLES = 80  # states of one period the design sums over
 MAX_CONDITION = 1e3  # above: a parameter (nearly) in the others' span; a good pose gives 4 to 15
 WEAKLY_SEEN = 0.01  # sine of the angle between a parameter's column and the others': named when refused
+RAMP_TIME = 0.25  # s: a wrist joint without an acceleration limit reaches its velocity limit in this time
+# (the IRB-140's stated limits do, to 1 %; Franka's reach theirs in 0.13 to 0.15 s)
 UNITS = ("kg", "kg m", "kg m", "kg m", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2")
 
 
@@ -123,11 +136,21 @@ class PayloadExcitation:
     noise: EffortNoise
     rate: float  # Hz
     duration: float  # s
+    assumed: dict[str, float]  # rad/s^2: the acceleration limits assumed for wrist joints that state none
+    unlimited_speed: tuple[str, ...] = ()  # the wrist joints that state no velocity limit (DEFAULT_SPEED used)
 
     def expectation(self) -> list[str]:
         """What the motion promises, as lines to print (or to write as comments)."""
         values = ", ".join(f"{label} +- {s:.2g} {unit}" for label, s, unit in zip(PARAMETER_LABELS, self.std, UNITS))
+        speeds = f"no velocity limit given for {', '.join(self.unlimited_speed)}: assumed {DEFAULT_SPEED:g} rad/s"
+        accelerations = (
+            f"no acceleration limit given for {', '.join(self.assumed)}: assumed "
+            f"{', '.join(f'{a:.3g}' for a in self.assumed.values())} rad/s^2 (the velocity limit reached in "
+            f"{RAMP_TIME:g} s, at least {DEFAULT_ACCELERATION:g}"
+        )
         return [
+            *([f"{speeds} (a params file's <joint>.velocity_limit sets yours)"] if self.unlimited_speed else []),
+            *([f"{accelerations}; a params file's <joint>.acceleration_limit sets yours)"] if self.assumed else []),
             f"expected at an effort noise of {self.noise} ({', '.join(f'{s:.3g}' for s in self.sigma)} N m), "
             f"recorded at {self.rate:g} Hz for {self.duration:g} s: one standard deviation of",
             f"  {values}",
@@ -141,11 +164,33 @@ def wrist(model: RobotModel) -> np.ndarray:
     return np.arange(max(model.n - WRIST_JOINTS, 0), model.n)
 
 
+def assumed_accelerations(model: RobotModel) -> dict[str, float]:
+    """{name: rad/s^2} for each wrist joint that states no acceleration limit: the acceleration
+    that reaches its velocity limit in RAMP_TIME, at least DEFAULT_ACCELERATION (and that
+    where it states no velocity limit either)."""
+    return {
+        model.joints[j].name: max(DEFAULT_ACCELERATION, model.joints[j].velocity_limit / RAMP_TIME)
+        for j in wrist(model)
+        if not model.joints[j].acceleration_limit
+    }
+
+
+def with_assumed_accelerations(model: RobotModel) -> RobotModel:
+    """The model with ``assumed_accelerations`` as its wrist joints' acceleration limits: the
+    limits the payload motion is designed, and checked, within."""
+    assumed = assumed_accelerations(model)
+    if not assumed:
+        return model
+    joints = tuple(replace(j, acceleration_limit=assumed[j.name]) if j.name in assumed else j for j in model.joints)
+    return replace(model, joints=joints)
+
+
 def payload_limits(model: RobotModel, margin: float = DEFAULT_MARGIN, pose=None) -> Limits:
-    """The model's limits with the joints before the wrist pinned at ``pose`` (default: the
-    middle of their ranges; the wrist's own values are not used, it moves over its range);
-    ValueError naming a pose outside its joint's range, the wrist's included."""
-    limits = Limits.of(model, margin)
+    """The model's limits (its wrist's acceleration limits ``with_assumed_accelerations``) with
+    the joints before the wrist pinned at ``pose`` (default: the middle of their ranges; the
+    wrist's own values are not used, it moves over its range); ValueError naming a pose
+    outside its joint's range, the wrist's included."""
+    limits = Limits.of(with_assumed_accelerations(model), margin)
     held = np.setdiff1d(np.arange(model.n), wrist(model))
     centre = (limits.lower + limits.upper) / 2.0
     pose = centre if pose is None else np.asarray(pose, dtype=float)
@@ -212,13 +257,19 @@ def information(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(F (10, 10), sigma (n,), peak (n,)): the information matrix of the payload's ten
     parameters that a recording of ``duration`` s (default one period) at ``rate`` Hz gives
-    at that noise, each joint's noise [N m] and the arm's own peak torque [N m] along the motion."""
+    at that noise, each joint's noise [N m] and the arm's own peak torque [N m] along the motion.
+    Only the rows `identify` uses count: a moving joint's where it is fast enough for the
+    Coulomb model throughout its filter's window (``selection.rows_used``, at identify's
+    default cut-off for that rate), and every row of a joint held still."""
     duration = trajectory.period if duration is None else duration
     states = trajectory.evaluate(np.linspace(0.0, trajectory.period, samples, endpoint=False))
     Y, tau_arm = payload_regressor(model, *states)
     peak = np.abs(tau_arm).max(axis=0)
     sigma = noise.sigma(model, peak)
-    weighted = (Y / sigma[None, :, None]).reshape(-1, Y.shape[-1])
+    filter_design = FilterDesign.of(rate)
+    used = rows_used(states[1], states[2], SLOW_SPEEDS * model.smoothing_velocity, filter_design.half / rate)
+    used |= ~used.any(axis=0)  # a joint held still: all its rows
+    weighted = (Y * (used / sigma)[:, :, None]).reshape(-1, Y.shape[-1])
     return weighted.T @ weighted * (rate * duration / samples), sigma, peak
 
 
@@ -273,6 +324,9 @@ def optimise_payload_excitation(
     if not choices:
         given = f"{period:g} s" if period is not None else f"{min(PERIODS):g} s at least"
         raise ValueError(f"periods: {periods} x {given} is more than {MAX_PAYLOAD_DURATION:g} s")
+    assumed = assumed_accelerations(model)
+    unlimited_speed = tuple(model.joints[j].name for j in wrist(model) if not model.joints[j].velocity_limit)
+    model = with_assumed_accelerations(model)
     moving = wrist(model)
     rng = np.random.default_rng(seed)
     starts = [np.r_[rng.normal(size=2 * len(moving) * (harmonics - 1)), np.zeros(len(moving))] for _ in range(STARTS)]
@@ -331,5 +385,15 @@ def optimise_payload_excitation(
         )
     std = np.sqrt(np.diag(np.linalg.inv(F)))
     return PayloadExcitation(
-        trajectory, condition, start_condition, evaluations, std, sigma, noise, rate, recorded(period, periods)
+        trajectory,
+        condition,
+        start_condition,
+        evaluations,
+        std,
+        sigma,
+        noise,
+        rate,
+        recorded(period, periods),
+        assumed,
+        unlimited_speed,
     )

@@ -113,6 +113,38 @@ class SimulatedArm:
             self.reset(*self._reset_state)
             raise SimulationError("the simulation diverged (non-finite state); the arm was reset")
 
+    def follow(self, feed_forward, Q_ref, QD_ref, stiffness, damping) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(Q, QD, TAU), each (N, n): a drive's computed-torque loop at the arm's period, one
+        step per row of the (N, n) references: at each step's start the state (q, qd) is read
+        and tau = feed_forward + stiffness (q_ref - q) + damping (qd_ref - qd) (per joint,
+        (n,) gains) is applied for the period, clipped to the torque limits; TAU is what was
+        applied. The same physics as ``step`` N times, without its per-step checks (the
+        loop of a long recording): the state is checked finite at the end (SimulationError
+        and the arm reset, as ``step``)."""
+        feed_forward, Q_ref, QD_ref = (np.asarray(x, dtype=float) for x in (feed_forward, Q_ref, QD_ref))
+        if not feed_forward.shape == Q_ref.shape == QD_ref.shape or feed_forward.shape[1:] != (self.n,):
+            raise ValueError(
+                f"references: expected three (N, {self.n}) arrays, got {feed_forward.shape}, "
+                f"{Q_ref.shape}, {QD_ref.shape}"
+            )
+        stiffness, damping = np.asarray(stiffness, dtype=float), np.asarray(damping, dtype=float)
+        Q, QD, TAU = (np.empty_like(feed_forward) for _ in range(3))
+        data, mj_model, low, high = self.data, self.mj_model, -self.torque_limits, self.torque_limits
+        qpos, qvel, applied = data.qpos, data.qvel, data.qfrc_applied
+        for k in range(len(feed_forward)):
+            Q[k], QD[k] = qpos, qvel
+            tau = feed_forward[k] + stiffness * (Q_ref[k] - Q[k]) + damping * (QD_ref[k] - QD[k])
+            np.clip(tau, low, high, out=TAU[k])
+            applied[:] = TAU[k]
+            for _ in range(self.substeps):
+                mujoco.mj_step(mj_model, data)
+        if len(TAU):
+            self.applied = TAU[-1].copy()
+        if not (np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()) or self._diverged():
+            self.reset(*self._reset_state)
+            raise SimulationError("the simulation diverged (non-finite state); the arm was reset")
+        return Q, QD, TAU
+
     def flange_pose(self) -> np.ndarray:
         """The flange's pose in the base frame as MuJoCo has it at the current state, 4x4."""
         body = np.eye(4)

@@ -207,7 +207,10 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
     model, path = source.model, source.origin
     expectation = []
     if args.payload:
+        from irb140_dynamics.identification.payload_excitation import with_assumed_accelerations
+
         result, regressor = _payload_excitation(model, path, args), "the payload's noise-weighted regressor"
+        model = with_assumed_accelerations(model)  # the limits it was designed within, checked below
         args.period = result.trajectory.period
         args.periods = int(round(result.duration / args.period))
         expectation = result.expectation()

@@ -114,6 +114,39 @@ def test_torques_saturate_at_the_torque_limits():
     assert arm.applied[0] == -10.0
 
 
+def test_following_a_reference_is_stepping_it_under_pd_bit_for_bit():
+    """follow (the loop of a long recording) is step at each row with the PD torque on the
+    state at the step's start: the same states and applied torques, clipped alike."""
+    joints = list(irb140().joints)
+    joints[1] = dataclasses.replace(joints[1], torque_limit=40.0)  # joint 2 saturates at times
+    model = dataclasses.replace(irb140(), joints=tuple(joints))
+    t = np.arange(300) * PERIOD
+    Q_ref = POSE + 0.3 * np.sin(2 * np.pi * 2.0 * t)[:, None]
+    QD_ref = 0.3 * 2 * np.pi * 2.0 * np.cos(2 * np.pi * 2.0 * t)[:, None] * np.ones(6)
+    feed_forward = np.array([gravity(model, q) for q in Q_ref])
+    kp, kd = np.array([400.0, 400.0, 100.0, 10.0, 10.0, 5.0]), np.array([40.0, 40.0, 10.0, 1.0, 1.0, 0.5])
+    stepped = SimulatedArm(model, PERIOD, substeps=2)
+    stepped.reset(POSE)
+    rows = []
+    for k in range(len(t)):
+        q, qd = stepped.q, stepped.qd
+        stepped.step(feed_forward[k] + kp * (Q_ref[k] - q) + kd * (QD_ref[k] - qd))
+        rows.append((q, qd, stepped.applied))
+    followed = SimulatedArm(model, PERIOD, substeps=2)
+    followed.reset(POSE)
+    Q, QD, TAU = followed.follow(feed_forward, Q_ref, QD_ref, kp, kd)
+    for got, expected in zip((Q, QD, TAU), (np.array(x) for x in zip(*rows))):
+        np.testing.assert_array_equal(got, expected)
+    assert np.abs(TAU[:, 1]).max() == 40.0
+    np.testing.assert_array_equal(followed.q, stepped.q)
+    np.testing.assert_array_equal(followed.applied, stepped.applied)
+    with pytest.raises(ValueError, match="references"):
+        followed.follow(feed_forward, Q_ref[:-1], QD_ref, kp, kd)
+    with pytest.raises(SimulationError, match="diverged"):
+        followed.follow(np.full((100, 6), 1e14), Q_ref[:100], QD_ref[:100], kp, kd)
+    np.testing.assert_array_equal(followed.q, POSE)  # reset to where it was last reset
+
+
 def test_a_blow_up_resets_the_arm_and_says_so():
     arm = SimulatedArm(irb140(), PERIOD)
     arm.reset(POSE)

@@ -57,16 +57,20 @@ def run(arm: RobotModel, trajectory, duration: float, noise: EffortNoise, seed: 
     scale = np.diag(mass_matrix(arm, Q_ref[0])) + np.array([j.armature for j in arm.joints])
     sim = SimulatedArm(arm, period=1.0 / CONTROL_RATE)
     sim.reset(Q_ref[0], QD_ref[0])
-    kept = range(0, steps, RECORD_EVERY)
-    Q, QD, TAU = (np.empty((len(kept), arm.n)) for _ in range(3))
-    for k in range(steps):
-        q, qd = sim.q, sim.qd
-        force = next((p.force for p in pushes if p.start <= t[k] < p.end), None)
-        wrench = None if force is None else np.concatenate([force, np.zeros(3)])
-        sim.step(feed_forward[k] + scale * (KP * (Q_ref[k] - q) + KD * (QD_ref[k] - qd)), wrench)
-        if k % RECORD_EVERY == 0:
-            i = k // RECORD_EVERY
-            Q[i], QD[i], TAU[i] = q, qd, sim.applied
+    kp, kd = scale * KP, scale * KD
+    if not pushes:  # the same loop in one call (SimulatedArm.follow)
+        Q, QD, TAU = (x[::RECORD_EVERY] for x in sim.follow(feed_forward, Q_ref, QD_ref, kp, kd))
+    else:
+        kept = range(0, steps, RECORD_EVERY)
+        Q, QD, TAU = (np.empty((len(kept), arm.n)) for _ in range(3))
+        for k in range(steps):
+            q, qd = sim.q, sim.qd
+            force = next((p.force for p in pushes if p.start <= t[k] < p.end), None)
+            wrench = None if force is None else np.concatenate([force, np.zeros(3)])
+            sim.step(feed_forward[k] + kp * (Q_ref[k] - q) + kd * (QD_ref[k] - qd), wrench)
+            if k % RECORD_EVERY == 0:
+                i = k // RECORD_EVERY
+                Q[i], QD[i], TAU[i] = q, qd, sim.applied
     sigma = noise.sigma(arm, np.abs(TAU).max(axis=0))
     measured = TAU + np.random.default_rng(seed).normal(size=TAU.shape) * sigma
     return t[::RECORD_EVERY], Q, QD, measured

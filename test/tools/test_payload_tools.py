@@ -345,3 +345,61 @@ def test_efforts_not_in_newton_metres_are_refused_naming_their_scale(workflow, t
     assert len(err) == 1 and found, err
     assert float(found[1]) == pytest.approx(factor, rel=0.01) and float(found[2]) < 0.01 * factor
     assert not out.exists()
+
+
+def test_a_wrist_without_an_acceleration_limit_is_taken_to_reach_its_speed_in_a_quarter_second(tmp_path, capsys):
+    """The UR5's URDF states velocity limits (3.2 rad/s at the wrist) and no acceleration limit:
+    the motion uses up to 3.2 / 0.25 = 12.8 rad/s^2 there, says so before anything moves (and
+    in the file), and keeps to a limit a params file states instead."""
+    from irb140_dynamics.core.io.params_file import parameter_file_text
+
+    from ..support.paths import URDF_DATA
+
+    urdf = ["--urdf", str(URDF_DATA / "ur5.urdf"), "--tip", "tool0", "--pose", "0,-1.2,1.5,0,0,0", "--period", "3"]
+    wrist_joints = ("wrist_1_joint", "wrist_2_joint", "wrist_3_joint")
+
+    def peak_accelerations(*arguments):
+        out = tmp_path / "motion.yaml"
+        assert (
+            excitation_tool.main(
+                ["--payload", "--iterations", "0", "--rate", "50", *urdf, *arguments, "--out", str(out)]
+            )
+            == 0
+        )
+        document = yaml.safe_load(out.read_text())
+        QDD = np.array([p["accelerations"] for p in document["points"]])
+        return np.abs(QDD).max(axis=0)[3:], capsys.readouterr().out, out.read_text()
+
+    peaks, printed, written = peak_accelerations()
+    line = f"no acceleration limit given for {', '.join(wrist_joints)}: assumed 12.8, 12.8, 12.8 rad/s^2"
+    assert line in printed and line in written
+    assert np.all(peaks <= 12.8 + 1e-6) and peaks.max() > 2 * 5.0  # used, not the old 5 rad/s^2
+    stated = tmp_path / "limits.yaml"
+    stated.write_text(parameter_file_text({f"{name}.acceleration_limit": 8.0 for name in wrist_joints}, []))
+    peaks, printed, _ = peak_accelerations("--params-file", str(stated))
+    assert "no acceleration limit given" not in printed
+    assert np.all(peaks <= 8.0 + 1e-6)
+
+
+def test_a_wrist_without_a_velocity_limit_is_said_to_be_designed_at_the_default_speed():
+    """A model that states no velocity limit (an MJCF's, as Menagerie's FR3) is designed at
+    1 rad/s and 5 rad/s^2 there, and the expectation says so first."""
+    from dataclasses import replace
+
+    from irb140_dynamics.core.io.arm_source import read_arm, read_urdf_file
+    from irb140_dynamics.identification.payload_excitation import optimise_payload_excitation
+
+    from ..support.paths import URDF_DATA
+
+    arm = read_arm({}, urdf=read_urdf_file(str(URDF_DATA / "ur5.urdf")), tip_link="tool0").model
+    arm = replace(arm, joints=tuple(replace(j, velocity_limit=0.0) if k >= 3 else j for k, j in enumerate(arm.joints)))
+    design = optimise_payload_excitation(arm, period=3.0, iterations=0, pose=[0.0, -1.2, 1.5, 0.0, 0.0, 0.0])
+    lines = design.expectation()
+    assert lines[0].startswith(
+        "no velocity limit given for wrist_1_joint, wrist_2_joint, wrist_3_joint: assumed 1 rad/s"
+    )
+    assert lines[1].startswith(
+        "no acceleration limit given for wrist_1_joint, wrist_2_joint, wrist_3_joint: assumed 5, 5, 5"
+    )
+    QD = design.trajectory.evaluate(np.linspace(0.0, 3.0, 3000))[1]
+    assert 0.9 < np.abs(QD[:, 3:]).max() <= 1.0
