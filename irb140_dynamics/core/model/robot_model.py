@@ -60,18 +60,41 @@ from irb140_dynamics.core.model.rigid_body import (
 
 MAX_NAME = 200  # characters of a joint name
 DEFAULT_SMOOTHING_VELOCITY = 0.01  # rad/s: Coulomb friction reaches 76 % of its level at 0.01 rad/s
-__all__ = ["DH", "Friction", "Joint", "ModelError", "Placement", "RobotModel"]
+__all__ = ["DH", "Friction", "Joint", "Mimic", "ModelError", "Placement", "RobotModel"]
+
+
+@dataclass(frozen=True)
+class Mimic:
+    """A joint that follows another (URDF <mimic>): q = multiplier * q_joint + offset, its
+    velocity and acceleration ``multiplier`` times the followed joint's. ``joint``: the
+    followed joint's name, an independent joint of the model."""
+
+    joint: str
+    multiplier: float = 1.0
+    offset: float = 0.0  # rad (m for a prismatic joint)
 
 
 @dataclass(frozen=True)
 class RobotModel:
-    """A validated serial-chain model; raises ModelError naming the bad field."""
+    """A validated model of a serial chain or a kinematic tree; raises ModelError naming
+    the bad field.
+
+    ``joints`` are every moving joint, parents before children; ``parent[i]`` is the index
+    in ``joints`` of joint i's parent joint (the joint moving the link joint i hangs from),
+    -1 for the base (spatial_v2's ``model.parent``); None: a chain, parent[i] = i - 1.
+    ``mimics``: per joint, None or the ``Mimic`` it follows (None: no mimic joint). The
+    model's coordinates are its independent joints (``joint_names``, ``n``, the states
+    q, qd, qdd, tau); the mimic joints follow them (``mimic_matrix``). The payload and the
+    flange are on the last joint's link.
+    """
 
     joints: tuple[Joint, ...]
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     payload: RigidBody = field(default_factory=RigidBody)
     flange: Placement = Placement()  # the payload's frame in the last link's frame
     smoothing_velocity: float = DEFAULT_SMOOTHING_VELOCITY  # rad/s, Coulomb friction's tanh
+    parent: tuple[int, ...] | None = None  # per joint: its parent joint's index, -1 the base
+    mimics: tuple[Mimic | None, ...] | None = None  # per joint: the joint it follows, or None
 
     def __post_init__(self):
         object.__setattr__(self, "joints", tuple(validated_joint(j) for j in self.joints))
@@ -83,19 +106,64 @@ class RobotModel:
         if not smoothing > 0.0:
             raise ModelError("friction.smoothing_velocity", f"must be > 0, got {smoothing}")
         object.__setattr__(self, "smoothing_velocity", smoothing)
-        check_joint_names(self.joint_names)
+        check_joint_names([j.name for j in self.joints])
+        object.__setattr__(self, "parent", checked_parents(self.parent, len(self.joints)))
+        object.__setattr__(self, "mimics", checked_mimics(self.mimics, self.joints))
 
     @property
     def n(self) -> int:
-        return len(self.joints)
+        """The number of independent joints: the length of a state."""
+        return len(self.independent)
+
+    @cached_property
+    def independent(self) -> tuple[int, ...]:
+        """The indices in ``joints`` of the independent joints (all but the mimic joints)."""
+        if self.mimics is None:
+            return tuple(range(len(self.joints)))
+        return tuple(i for i, mimic in enumerate(self.mimics) if mimic is None)
 
     @property
     def joint_names(self) -> tuple[str, ...]:
-        return tuple(j.name for j in self.joints)
+        """The independent joints' names, the order of every state."""
+        return tuple(self.joints[i].name for i in self.independent)
+
+    @property
+    def is_chain(self) -> bool:
+        """A serial chain (each joint's parent the joint before), no mimic joint."""
+        return self.mimics is None and all(p == i - 1 for i, p in enumerate(self.parent))
+
+    @cached_property
+    def coordinates(self) -> tuple[tuple[int, float, float], ...]:
+        """Per joint of ``joints``: (k, multiplier, offset), its position being
+        multiplier * q_k + offset of the state q; (k, 1.0, 0.0) for an independent joint."""
+        index = {self.joints[i].name: k for k, i in enumerate(self.independent)}
+        if self.mimics is None:
+            return tuple((k, 1.0, 0.0) for k in range(len(self.joints)))
+        return tuple(
+            (index[j.name], 1.0, 0.0) if m is None else (index[m.joint], m.multiplier, m.offset)
+            for j, m in zip(self.joints, self.mimics)
+        )
+
+    def mimic_matrix(self):
+        """G, (len(joints), n): every joint's velocity is G qd; its torque is carried by the
+        independent joints as G^T tau_all (virtual work), M = G^T M_all G."""
+        import numpy as np
+
+        G = np.zeros((len(self.joints), self.n))
+        for i, (k, multiplier, _) in enumerate(self.coordinates):
+            G[i, k] = multiplier
+        return G
+
+    def all_positions(self, q):
+        """Every joint's position, mimic joints included, from the state q (n numbers)."""
+        import numpy as np
+
+        q = np.asarray(q, dtype=float)
+        return np.array([multiplier * q[k] + offset for k, multiplier, offset in self.coordinates])
 
     @property
     def torque_limits(self) -> tuple[float, ...]:
-        return tuple(j.torque_limit for j in self.joints)
+        return tuple(self.joints[i].torque_limit for i in self.independent)
 
     @property
     def bodies(self) -> tuple[RigidBody, ...]:
@@ -244,6 +312,58 @@ def _raw_joint(joint_name: str, params: Mapping[str, Any], get) -> Joint:
         armature=get(f"{name}.armature", 0.0),
         **kinematics,
     )
+
+
+def checked_parents(parent, count: int) -> tuple[int, ...]:
+    """The parent indices as a tuple (None: a chain), or ModelError: one per joint, each
+    -1 (the base) or an earlier joint's index."""
+    if parent is None:
+        return tuple(range(-1, count - 1))
+    if not isinstance(parent, (list, tuple)) or len(parent) != count:
+        raise ModelError("joint_parents", f"expected one parent index per joint ({count}), got {parent!r}"[:250])
+    out = []
+    for i, p in enumerate(parent):
+        if isinstance(p, bool) or not isinstance(p, int) or not -1 <= p < i:
+            raise ModelError("joint_parents", f"joint {i}'s parent must be -1 or an earlier joint's index, got {p!r}")
+        out.append(int(p))
+    return tuple(out)
+
+
+def checked_mimics(mimics, joints) -> tuple | None:
+    """The mimic joints as a tuple (None: none), or ModelError: one entry per joint, each
+    None or a Mimic following an independent joint of the model (not a mimic joint, not
+    itself), a finite multiplier and offset."""
+    if mimics is None or all(m is None for m in mimics):
+        return None
+    if len(mimics) != len(joints):
+        raise ModelError("mimic_joints", f"expected one entry per joint ({len(joints)}), got {len(mimics)}")
+    followers = {j.name for j, m in zip(joints, mimics) if m is not None}
+    names = {j.name for j in joints}
+    out = []
+    for joint, mimic in zip(joints, mimics):
+        if mimic is None:
+            out.append(None)
+            continue
+        key = f"{param_prefix(joint.name)}.mimic"
+        if not isinstance(mimic, Mimic):
+            raise ModelError(key, f"expected a Mimic, got {mimic!r}"[:200])
+        leader = mimic.joint
+        if leader == joint.name:
+            raise ModelError(key, f"joint {joint.name!r} cannot follow itself")
+        if leader not in names:
+            raise ModelError(key, f"follows {str(leader)[:80]!r}, not a joint of the model")
+        if leader in followers:
+            raise ModelError(key, f"follows {leader!r}, itself a mimic joint (a mimic of a mimic is not supported)")
+        multiplier = finite_number(f"{key}.multiplier", mimic.multiplier)
+        offset = finite_number(f"{key}.offset", mimic.offset)
+        capped(f"{key}.multiplier", "|multiplier|", abs(multiplier), 1e3, "")
+        if joint.friction.coulomb and abs(multiplier) != 1.0:
+            raise ModelError(
+                f"{param_prefix(joint.name)}.friction.coulomb",
+                f"a mimic joint's Coulomb friction is supported with multiplier +-1 only, got {multiplier}",
+            )
+        out.append(Mimic(leader, multiplier, offset))
+    return tuple(out)
 
 
 def check_joint_names(names) -> list[str]:
