@@ -31,12 +31,16 @@ def dh_transform(dh: DH, q: float) -> np.ndarray:
 
 
 def link_frames(model: RobotModel, q) -> np.ndarray:
-    """The poses of the base and the link frames 0..n in the base frame, (n + 1, 4, 4)."""
+    """The poses of the base and the link frames 0..n in the base frame, (n + 1, 4, 4); on a
+    tree or with mimic joints, of the base and every joint's link (``model.joints``' order)."""
+    q = state(q, model.n, "q")
+    if model.mimics is not None:
+        q = model.all_positions(q).tolist()
     frames = [np.eye(4)]
-    for (pre, post, axis, offset, prismatic), q_i in zip(_placements(model), state(q, model.n, "q")):
+    for (pre, post, axis, offset, prismatic), q_i, parent in zip(_placements(model), q, model.parent):
         # as Joint.transform, its constant matrices kept with the model
         move = _slide(axis, q_i) if prismatic else _turn(axis, q_i + offset)
-        frames.append(frames[-1] @ (pre @ move @ post))
+        frames.append(frames[parent + 1] @ (pre @ move @ post))
     return np.array(frames)
 
 
@@ -106,7 +110,8 @@ def joint_origins_and_flange(model: RobotModel, q) -> tuple[np.ndarray, np.ndarr
 
 
 def _origins(model: RobotModel, frames: np.ndarray) -> np.ndarray:
-    return np.array([(frame @ placed[0])[:3, 3] for frame, placed in zip(frames[:-1], _placements(model))])
+    """Each joint's origin (every joint of ``model.joints`` on a tree), from its parent's frame."""
+    return np.array([(frames[p + 1] @ placed[0])[:3, 3] for p, placed in zip(model.parent, _placements(model))])
 
 
 def flange_jacobian(model: RobotModel, q) -> np.ndarray:
@@ -122,8 +127,31 @@ def flange_pose_and_jacobian(model: RobotModel, q) -> tuple[np.ndarray, np.ndarr
     return pose, _flange_jacobian(model, frames, pose)
 
 
+def link_pose(model: RobotModel, q, joint: str) -> np.ndarray:
+    """The pose of the link ``joint`` moves (its frame) in the base frame, 4x4."""
+    return link_frames(model, q)[_joint_index(model, joint) + 1]
+
+
+def link_jacobian(model: RobotModel, q, joint: str) -> np.ndarray:
+    """The 6 x n geometric Jacobian of the origin of the link ``joint`` moves, rows (v; w)
+    in the base frame: the columns of the joints it hangs from (a mimic joint's added to
+    its joint's, times its multiplier), zero for the others."""
+    frames = link_frames(model, q)
+    index = _joint_index(model, joint)
+    return _jacobian(model, frames, frames[index + 1][:3, 3], index)
+
+
+def _joint_index(model: RobotModel, joint: str) -> int:
+    for i, j in enumerate(model.joints):
+        if j.name == joint:
+            return i
+    raise ValueError(f"joint: no joint {str(joint)[:80]!r} in the model")
+
+
 def _flange_jacobian(model: RobotModel, frames: np.ndarray, pose: np.ndarray | None = None) -> np.ndarray:
     flange = (frames[-1] @ _flange_matrix(model) if pose is None else pose)[:3, 3]
+    if not model.is_chain:
+        return _jacobian(model, frames, flange, len(model.joints) - 1)
     J = np.empty((6, model.n))
     for i, (frame, (pre, _, turning_axis, _, prismatic)) in enumerate(zip(frames[:-1], _placements(model))):
         joint_frame = frame @ pre  # joint i+1's axis passes through its origin
@@ -134,4 +162,24 @@ def _flange_jacobian(model: RobotModel, frames: np.ndarray, pose: np.ndarray | N
         (ax, ay, az), (rx, ry, rz) = axis.tolist(), (flange - origin).tolist()
         J[:3, i] = (ay * rz - az * ry, az * rx - ax * rz, ax * ry - ay * rx)  # axis x r (np.cross: 10x slower)
         J[3:, i] = axis
+    return J
+
+
+def _jacobian(model: RobotModel, frames: np.ndarray, point: np.ndarray, link: int) -> np.ndarray:
+    """The 6 x n Jacobian of ``point`` (base frame) fixed to joint ``link``'s link, on a tree
+    and with mimic joints: the link's ancestors' columns, the others zero."""
+    J = np.zeros((6, model.n))
+    placements, coordinates = _placements(model), model.coordinates
+    i = link
+    while i >= 0:
+        pre, _, turning_axis, _, prismatic = placements[i]
+        joint_frame = frames[model.parent[i] + 1] @ pre
+        axis, origin = joint_frame[:3, :3] @ turning_axis, joint_frame[:3, 3]
+        k, multiplier, _ = coordinates[i]
+        if prismatic:
+            J[:3, k] += multiplier * axis
+        else:
+            J[:3, k] += multiplier * np.cross(axis, point - origin)
+            J[3:, k] += multiplier * axis
+        i = model.parent[i]
     return J

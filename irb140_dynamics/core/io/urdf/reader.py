@@ -21,8 +21,12 @@
   moments, as vendor files have them): taken as given, with a ``warning`` naming the link.
 - A joint that moves no mass (nothing after it has an inertial) is a ``warning``: M(q) is
   then singular, forward dynamics needs a payload.
-- Refused, with UrdfError naming the element: floating and planar joints and mimic joints
-  in the chain; a revolute or prismatic joint without <limit>; a chain of more than
+- Mimic joints (<mimic joint multiplier offset>) follow their joint (``model.Mimic``): the
+  model's ``joint_names`` are the others. One following a joint that is not in the model
+  is refused, as a mimic of a mimic.
+- With no tip_link and several leaves below base_link, the whole tree (``whole_tree``).
+- Refused, with UrdfError naming the element: floating and planar joints in the chain
+  (or the tree); a revolute or prismatic joint without <limit>; a chain of more than
   ``max_joints`` moving joints; besides everything ``tree`` refuses (size, binary input,
   loops).
 """
@@ -54,7 +58,7 @@ from irb140_dynamics.core.model.joints import (
     matrix_rpy,
 )
 from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, combine, placed
-from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.model.robot_model import Mimic, RobotModel
 
 MOVING = ("revolute", "continuous", "prismatic")
 CONTINUOUS_LIMITS = (-4 * math.pi, 4 * math.pi)  # rad: two turns either way, every angle within
@@ -87,10 +91,18 @@ def load_urdf(
     max_chars: int | None = None,
     max_joints: int = MAX_JOINTS,
 ) -> LoadedUrdf:
-    """The chain from ``base_link`` (default: the root link) to ``tip_link`` (default: the
-    only leaf below base_link) as a RobotModel (gravity: the root's -z; payload: none).
-    ``max_chars``: the text's size limit (default: MAX_URDF_CHARS, or IRB140_MAX_FILE_BYTES)."""
+    """The chain from ``base_link`` (default: the root link) to ``tip_link`` as a RobotModel
+    (gravity: the root's -z; payload: none). With no ``tip_link``, every moving joint below
+    base_link: the chain to the only leaf, or the whole tree (see ``whole_tree``) when there
+    are several. Mimic joints follow their joint (``model.Mimic``). ``max_chars``: the text's
+    size limit (default: MAX_URDF_CHARS, or IRB140_MAX_FILE_BYTES)."""
     tree = parse_tree(text, max_chars)
+    if not tip_link:
+        tree._known("base_link", base_link or tree.root)
+        if len(tree.leaves(base_link or tree.root)) > 1:
+            from irb140_dynamics.core.io.urdf.whole_tree import load_tree
+
+            return load_tree(tree, base_link or tree.root, max_joints)
     base, tip, path = tree.chain(base_link, tip_link)
     span = f"from {clipped(repr(base), 60)} to {clipped(repr(tip), 60)}"
     for joint in path:
@@ -100,14 +112,8 @@ def load_urdf(
                 f"a {joint.kind} joint in the chain {span}: only revolute, continuous, "
                 "prismatic and fixed joints are supported there",
             )
-        mimic = joint.element.find("mimic")
-        if mimic is not None:
-            raise UrdfError(
-                f"{joint.label} <mimic>",
-                f"a mimic joint (following {clipped(repr(mimic.get('joint')), 60)}"
-                ") in the chain is not supported: end the chain before it (tip_link)",
-            )
     moving = [joint for joint in path if joint.kind in MOVING]
+    mimics = mimics_of(moving)
     if not moving:
         raise UrdfError("chain", f"no revolute, continuous or prismatic joint {span}")
     if len(moving) > max_joints:
@@ -139,7 +145,7 @@ def load_urdf(
         _joint(joint, placement, body, ok) for joint, placement, (body, _), ok in zip(moving, origins, bodies, physical)
     ]
     try:
-        model = RobotModel(tuple(joints), gravity=base_gravity(tree, base), flange=since_last)
+        model = RobotModel(tuple(joints), gravity=base_gravity(tree, base), flange=since_last, mimics=mimics)
     except ModelError as error:
         raise UrdfError("chain", str(error)) from None
     on_chain = {name for names in carried for name in names}
@@ -150,6 +156,30 @@ def load_urdf(
     ]
     rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
     return LoadedUrdf(model, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name)
+
+
+def mimics_of(moving: list[UrdfJoint]) -> tuple | None:
+    """Per moving joint, the ``Mimic`` its <mimic joint= multiplier= offset=> gives (None:
+    not a mimic joint); UrdfError for one following a joint that is not among ``moving``."""
+    names = {joint.name for joint in moving}
+    mimics = []
+    for joint in moving:
+        element = joint.element.find("mimic")
+        if element is None:
+            mimics.append(None)
+            continue
+        where = f"{joint.label} <mimic>"
+        leader = element.get("joint")
+        if not leader:
+            raise UrdfError(where, "names no joint")
+        if leader not in names:
+            raise UrdfError(
+                where,
+                f"follows {clipped(repr(leader), 60)}, which is not a moving joint of the model "
+                "(name a base_link/tip_link taking it in, or one leaving the mimic joint out)",
+            )
+        mimics.append(Mimic(leader, number(element, "multiplier", where, 1.0), number(element, "offset", where, 0.0)))
+    return tuple(mimics) if any(m is not None for m in mimics) else None
 
 
 def _checked_inertials(tree: UrdfTree, carried: list[list[str]]) -> tuple[list[str], list[bool]]:
@@ -214,12 +244,12 @@ def compose(a: Placement, b: Placement) -> Placement:
     return Placement(xyz, matrix_rpy(a.rotation() @ b.rotation()))
 
 
-def lumped(
-    tree: UrdfTree, link: str, stop: str | None, held: list[str], carried: list[list[str]]
-) -> tuple[RigidBody, bool]:
+def lumped(tree: UrdfTree, link: str, stop, held: list[str], carried: list[list[str]]) -> tuple[RigidBody, bool]:
     """Everything rigidly attached to ``link`` (joints off the chain at zero), up to the
-    chain joint ``stop``, as one body in ``link``'s frame; and whether any had an inertial.
-    The names of the links with an inertial are appended to ``carried`` as a list."""
+    chain joint ``stop`` (a name, None, or a set of names), as one body in ``link``'s frame;
+    and whether any had an inertial. The names of the links with an inertial are appended
+    to ``carried`` as a list."""
+    stops = stop if isinstance(stop, (set, frozenset)) else {stop}
     bodies, stack, names = [], [(link, np.eye(4))], []
     carried.append(names)
     with np.errstate(all="ignore"):  # a non-finite inertial is refused by _checked_inertials
@@ -232,7 +262,7 @@ def lumped(
                     continue
                 bodies.append(placed(inertial, T[:3, :3], T[:3, 3]) if name != link else inertial)
             for joint in tree.child_joints[name]:
-                if joint.name == stop:
+                if joint.name in stops:
                     continue
                 if joint.kind != "fixed":
                     held.append(joint.name)
