@@ -18,12 +18,14 @@ import pytest
 
 from irb140_dynamics.core import (
     ModelError,
+    RobotModel,
     coriolis,
     forward_dynamics,
     gravity,
     mass_matrix,
     rnea,
 )
+from irb140_dynamics.core.derivatives import forward_dynamics_derivatives, rnea_derivatives
 from irb140_dynamics.core.kinematics import flange_jacobian, link_jacobian, link_pose
 from irb140_dynamics.core.regressor import regressor
 from irb140_dynamics.core.urdf import load_urdf
@@ -123,6 +125,7 @@ def test_a_handmade_tree_with_mimic_joints_agrees_with_pinocchio():
     assert worst_error(TWO_ARMS, model, np.random.default_rng(3), states=3) <= RTOL
     # finger_b's damping is carried by r2: m^2 v
     assert model.friction.viscous.tolist() == [0.0, 0.0, 0.0, 0.0, 0.25 * 0.3]
+    assert RobotModel.from_params(model.to_params()) == model  # the nodes' path: the parameter form
 
 
 def test_the_tree_identities_hold():
@@ -181,3 +184,26 @@ def _parameters(model) -> np.ndarray:
     from irb140_dynamics.core.regressor import inertial_parameters
 
     return inertial_parameters(model)
+
+
+def test_derivatives_on_a_tree_are_the_finite_differences_and_refused_with_mimic_joints():
+    model = load_urdf(_without_mimics(TWO_ARMS)).model
+    rng = np.random.default_rng(11)
+    q, qd, qdd = rng.uniform(-1, 1, model.n), rng.uniform(-1, 1, model.n), rng.uniform(-1, 1, model.n)
+    dq, dqd, M = rnea_derivatives(model, q, qd, qdd)
+    tau = rnea(model, q, qd, qdd)
+    dqdd_dq, _, Minv = forward_dynamics_derivatives(model, q, qd, tau)
+    step, unit = 1e-6, np.eye(model.n)
+    for k in range(model.n):
+        up, down = q + step * unit[k], q - step * unit[k]
+        np.testing.assert_allclose(
+            dq[:, k], (rnea(model, up, qd, qdd) - rnea(model, down, qd, qdd)) / (2 * step), atol=1e-7
+        )
+        moved = (forward_dynamics(model, up, qd, tau) - forward_dynamics(model, down, qd, tau)) / (2 * step)
+        np.testing.assert_allclose(dqdd_dq[:, k], moved, atol=1e-6)
+        moved = (rnea(model, q, qd + step * unit[k], qdd) - rnea(model, q, qd - step * unit[k], qdd)) / (2 * step)
+        np.testing.assert_allclose(dqd[:, k], moved, atol=1e-7)
+    np.testing.assert_allclose(M, mass_matrix(model, q), rtol=1e-14, atol=1e-14)
+    np.testing.assert_allclose(Minv @ M, np.eye(model.n), atol=1e-9)
+    with pytest.raises(ValueError, match="not available for a model with mimic joints"):
+        rnea_derivatives(load_urdf(TWO_ARMS).model, q, qd, qdd)

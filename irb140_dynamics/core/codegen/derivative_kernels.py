@@ -14,7 +14,7 @@ from __future__ import annotations
 from irb140_dynamics.core.algorithms import analytical_derivatives as analytical
 from irb140_dynamics.core.algorithms import derivatives
 from irb140_dynamics.core.algorithms import recursions as algorithms
-from irb140_dynamics.core.algorithms.linear import inverse
+from irb140_dynamics.core.algorithms.linear import inverse, negated, times
 from irb140_dynamics.core.codegen.trace import operands_first, tanh
 
 REFERENCES = 2  # frames tried for the analytical derivatives: links 0 and 1 (see _shortest)
@@ -35,9 +35,24 @@ def friction_terms(arm, k, qd, kind: str | None):
     return torques, [v + c * (1.0 - t * t) / s for v, c, t in zip(viscous, coulomb, shapes)]
 
 
+def _on_a_tree(arm) -> bool:
+    """Whether the arm is a tree (not a chain): its derivatives then come from the
+    definitions on dual numbers (``derivatives``); refused with mimic joints."""
+    if arm.coupled is not None:
+        raise ValueError("the derivatives of the dynamics are not available for a model with mimic joints")
+    return any(link.parent is not None for link in arm.links)
+
+
+def _flat(*matrices) -> list:
+    return [x for matrix in matrices for row in matrix for x in row]
+
+
 def rnea_derivatives(arm, cs, qd, qdd, k, friction=None):
     """[d tau / dq, d tau / dqd, M]."""
     links, terms = arm.links_with(k), friction_terms(arm, k, qd, friction)
+    if _on_a_tree(arm):
+        dq, dqd = derivatives.rnea_partials(links, cs, qd, qdd, arm.gravity_of(k), terms and terms[1])
+        return _flat(dq, dqd, algorithms.crba(links, cs))
     return _shortest(
         lambda r: analytical.rnea_partials(links, cs, qd, qdd, arm.gravity_of(k), terms and terms[1], r), arm.n
     )
@@ -45,13 +60,20 @@ def rnea_derivatives(arm, cs, qd, qdd, k, friction=None):
 
 def forward_dynamics(arm, cs, qd, tau, k, friction=None):
     """qdd = M^-1 (tau - b(q, qd)), friction in b."""
+    _on_a_tree(arm)
     terms = friction_terms(arm, k, qd, friction)
     return derivatives.forward_dynamics(arm.links_with(k), cs, qd, tau, arm.gravity_of(k), terms and terms[0])[0]
 
 
 def forward_dynamics_derivatives(arm, cs, qd, tau, k, friction=None):
-    """[d qdd / dq, d qdd / dqd, M^-1]."""
+    """[d qdd / dq, d qdd / dqd, M^-1]: on a tree -M^-1 d tau / d(q, qd) at qdd = FD(q, qd, tau)."""
     links, terms = arm.links_with(k), friction_terms(arm, k, qd, friction)
+    if _on_a_tree(arm):
+        gravity = arm.gravity_of(k)
+        qdd, _, Minv = derivatives.forward_dynamics(links, cs, qd, tau, gravity, terms and terms[0])
+        dq, dqd = derivatives.rnea_partials(links, cs, qd, qdd, gravity, terms and terms[1])
+        minus = negated(Minv)
+        return _flat(times(minus, dq), times(minus, dqd), Minv)
     return _shortest(
         lambda r: analytical.forward_dynamics_partials(links, cs, qd, tau, arm.gravity_of(k), terms, r), arm.n
     )
@@ -59,6 +81,7 @@ def forward_dynamics_derivatives(arm, cs, qd, tau, k, friction=None):
 
 def inverse_mass_matrix(arm, cs, k):
     """The upper triangle of M^-1, row by row."""
+    _on_a_tree(arm)
     Minv = inverse(algorithms.crba(arm.links_with(k), cs))
     return [Minv[i][j] for i in range(arm.n) for j in range(i, arm.n)]
 

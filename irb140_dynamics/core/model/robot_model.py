@@ -28,6 +28,13 @@ parameter to fix:
     <joint>.friction.coulomb    N m
     <joint>.armature            kg m^2
 
+and for a tree or a model with mimic joints (absent for a chain):
+
+    tree.joints                 [name, ...] every moving joint, parents first
+    tree.parents                [parent joint's name or "" (the base), ...] per tree.joints
+    <joint>.mimic.joint         the joint it follows (a mimic joint only)
+    <joint>.mimic.multiplier, <joint>.mimic.offset
+
 (prismatic joints: m, N, N s/m, N, kg). ``<joint>`` is the joint's name when it is a
 parameter name ([A-Za-z][A-Za-z0-9_]*), else its ``param_prefix`` ("arm-left.1" ->
 "arm_left_1"); ``joint_names`` holds the names themselves.
@@ -198,6 +205,16 @@ class RobotModel:
         }
         if not self.flange.is_identity:
             params["flange"] = self.flange.flat()
+        if not self.is_chain:
+            names = [j.name for j in self.joints]
+            params["tree.joints"] = names
+            params["tree.parents"] = [names[p] if p >= 0 else "" for p in self.parent]
+            for joint, mimic in zip(self.joints, self.mimics or ()):
+                if mimic is not None:
+                    key = param_prefix(joint.name)
+                    params[f"{key}.mimic.joint"] = mimic.joint
+                    params[f"{key}.mimic.multiplier"] = mimic.multiplier
+                    params[f"{key}.mimic.offset"] = mimic.offset
         params.update(_body_params("payload", self.payload))
         for j in self.joints:
             key = param_prefix(j.name)
@@ -232,6 +249,12 @@ class RobotModel:
             raise ModelError(name, "missing")
 
         names = check_joint_names(get("joint_names"))
+        parent = mimics = None
+        if params.get("tree.joints") is not None:
+            names, independent = check_joint_names(get("tree.joints")), names
+            parent, mimics = _tree_from_params(names, params, get)
+            if [name for name, mimic in zip(names, mimics) if mimic is None] != independent:
+                raise ModelError("joint_names", "must be tree.joints but the mimic joints, in that order")
         joints = tuple(_joint_from_params(name, params, get) for name in names)
         payload = _body_from_params("payload", get, optional=True)
         return cls(
@@ -240,7 +263,33 @@ class RobotModel:
             payload,
             Placement.validated("flange", get("flange", (0.0,) * 6)),
             get("friction.smoothing_velocity", DEFAULT_SMOOTHING_VELOCITY),
+            parent,
+            mimics,
         )
+
+
+def _tree_from_params(names: list[str], params: Mapping[str, Any], get) -> tuple[tuple, tuple]:
+    """(parent, mimics) of ``tree.joints`` from tree.parents and <joint>.mimic.*."""
+    parents = get("tree.parents")
+    if not isinstance(parents, (list, tuple)) or len(parents) != len(names):
+        raise ModelError("tree.parents", f'expected one name (or "") per joint of tree.joints ({len(names)})')
+    index = {name: i for i, name in enumerate(names)}
+    parent = []
+    for i, name in enumerate(parents):
+        if name != "" and index.get(name, i) >= i:
+            raise ModelError("tree.parents", f"{str(name)[:80]!r} is not a joint before {names[i]!r} in tree.joints")
+        parent.append(-1 if name == "" else index[name])
+    mimics = []
+    for name in names:
+        key = f"{param_prefix(name)}.mimic"
+        leader = params.get(f"{key}.joint")
+        if leader is None or leader == "":
+            mimics.append(None)
+        elif not isinstance(leader, str):
+            raise ModelError(f"{key}.joint", f"expected a joint's name, got {leader!r}"[:200])
+        else:
+            mimics.append(Mimic(leader, get(f"{key}.multiplier", 1.0), get(f"{key}.offset", 0.0)))
+    return tuple(parent), tuple(mimics)
 
 
 # a joint's limits, friction and rotor inertia: what a URDF's model may take from a params file
