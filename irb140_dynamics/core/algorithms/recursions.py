@@ -37,6 +37,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from irb140_dynamics.core.algorithms.topology import ancestors, children, parents  # noqa: F401 (part of this module's interface)
 from irb140_dynamics.core.model.joints import Z_AXIS, snap
 from irb140_dynamics.core.model.rigid_body import ZERO3, Inertia6, Vector3, shift_inertia
 from irb140_dynamics.core.scalars.dual import Dual, dual_angles, partial  # noqa: F401 (Dual: part of this module's interface)
@@ -78,30 +79,6 @@ def chain(model) -> tuple[Link, ...]:
         )
         for i, (joint, body, parent) in enumerate(zip(model.joints, model.bodies, model.parent))
     )
-
-
-def parents(links) -> list[int]:
-    """Each link's parent index (-1: the base), parents before children: a chain's when the
-    links give none (i - 1)."""
-    return [i - 1 if link.parent is None else link.parent for i, link in enumerate(links)]
-
-
-def children(links) -> list[list[int]]:
-    """Each link's children, in increasing order."""
-    out = [[] for _ in links]
-    for i, p in enumerate(parents(links)):
-        if p >= 0:
-            out[p].append(i)
-    return out
-
-
-def ancestors(links, i: int) -> list[int]:
-    """Link i's ancestors, its parent first."""
-    parent, out = parents(links), []
-    while parent[i] >= 0:
-        i = parent[i]
-        out.append(i)
-    return out
 
 
 def _slide(joint) -> tuple:

@@ -24,6 +24,7 @@ from functools import cached_property, lru_cache, partial
 
 from irb140_dynamics import native_hook
 from irb140_dynamics.core.algorithms import recursions as algorithms
+from irb140_dynamics.core.algorithms.mimic import Coordinates, coupling
 from irb140_dynamics.core.codegen.array_code import compile_into
 from irb140_dynamics.core.codegen.program import Program, traced, with_friction
 from irb140_dynamics.core.codegen.python_code import compile_python
@@ -263,18 +264,6 @@ def _arm(links, flange, nonzero: tuple[bool, ...], coupled=None) -> ArmKernels:
     return ArmKernels(links, flange, nonzero, coupled)
 
 
-def coupling(model) -> tuple | None:
-    """Per link of the model, the index k of its coordinate q_k (an independent joint) or
-    (k, multiplier, offset) (a mimic joint: multiplier q_k + offset); None: no mimic joint,
-    link i is q_i."""
-    if model.mimics is None:
-        return None
-    return tuple(
-        k if mimic is None else (k, multiplier, offset)
-        for (k, multiplier, offset), mimic in zip(model.coordinates, model.mimics)
-    )
-
-
 @dataclass(frozen=True)
 class _Flange:
     """What algorithms.flange_wrench reads of a model."""
@@ -282,7 +271,7 @@ class _Flange:
     flange: object
 
 
-class ArmKernels:
+class ArmKernels(Coordinates):
     """The traces of an arm (its links, the last one's inertia left out), each made once on
     first use; the last link's inertia and gravity come from the argument ``k``, its
     nonzero ones of the 13 numbers (``nonzero``), the others are zero."""
@@ -291,63 +280,9 @@ class ArmKernels:
         self.links = links
         self.flange = _Flange(flange)
         self.nonzero = nonzero
-        self.coupled = coupled  # see ``coupling``: None, every link its own coordinate
-        self.n_links = len(links)
         self._traces: dict[str, Trace] = {}
         self._lock = threading.RLock()  # one trace of a kernel, also when threads ask at once
-        if coupled is None:
-            self.n = len(links)
-            self.angles = [None if link.prismatic else link.theta_offset for link in links]
-            self.mimic_angles = ()
-            return
-        independent = [i for i, c in enumerate(coupled) if isinstance(c, int)]
-        followers = [i for i, c in enumerate(coupled) if not isinstance(c, int)]
-        self.n = len(independent)
-        self.angles = [None if links[i].prismatic else links[i].theta_offset for i in independent]
-        self.mimic_angles = tuple(
-            (
-                coupled[i][0],
-                coupled[i][1],
-                coupled[i][2] + (0.0 if links[i].prismatic else links[i].theta_offset),
-                links[i].prismatic,
-            )  # fmt: skip
-            for i in followers
-        )
-        # where each link's (cos, sin) is in the traced cs: the coordinates', then the followers'
-        self._slot = {i: coupled[i] for i in independent}
-        self._slot.update({i: self.n + j for j, i in enumerate(followers)})
-
-    def expanded(self, cs, *vectors):
-        """(every link's cs, every link's value of each vector) from the traced cs (the
-        coordinates', then the mimic joints', see trace) and vectors of the coordinates: a
-        mimic joint's velocity or acceleration is multiplier times its joint's."""
-        if self.coupled is None:
-            return (cs, *vectors)
-        all_cs = [cs[self._slot[i]] for i in range(self.n_links)]
-        out = [all_cs]
-        for v in vectors:
-            out.append([v[c] if isinstance(c, int) else v[c[0]] * c[1] for c in self.coupled])
-        return tuple(out)
-
-    def projected(self, tau):
-        """G^T tau: every link's torque carried by the coordinates (virtual work)."""
-        if self.coupled is None:
-            return list(tau)
-        out = [None] * self.n
-        for c, t in zip(self.coupled, tau):
-            if isinstance(c, int):
-                out[c] = t
-        for c, t in zip(self.coupled, tau):
-            if not isinstance(c, int):
-                out[c[0]] = out[c[0]] + c[1] * t
-        return out
-
-    def projected_matrix(self, M):
-        """G^T M G, rows then columns."""
-        if self.coupled is None:
-            return M
-        columns = [self.projected([row[j] for row in M]) for j in range(self.n_links)]  # of G^T M
-        return [self.projected([column[a] for column in columns]) for a in range(self.n)]
+        Coordinates.__init__(self, links, coupled)
 
     def has(self, name: str) -> bool:
         return name in self._traces

@@ -64,21 +64,11 @@ from irb140_dynamics.core.model.rigid_body import (
     finite_numbers,
     placed,
 )
+from irb140_dynamics.core.model.tree import Mimic, checked_mimics, checked_parents, tree_from_params, tree_params
 
 MAX_NAME = 200  # characters of a joint name
 DEFAULT_SMOOTHING_VELOCITY = 0.01  # rad/s: Coulomb friction reaches 76 % of its level at 0.01 rad/s
 __all__ = ["DH", "Friction", "Joint", "Mimic", "ModelError", "Placement", "RobotModel"]
-
-
-@dataclass(frozen=True)
-class Mimic:
-    """A joint that follows another (URDF <mimic>): q = multiplier * q_joint + offset, its
-    velocity and acceleration ``multiplier`` times the followed joint's. ``joint``: the
-    followed joint's name, an independent joint of the model."""
-
-    joint: str
-    multiplier: float = 1.0
-    offset: float = 0.0  # rad (m for a prismatic joint)
 
 
 @dataclass(frozen=True)
@@ -128,6 +118,14 @@ class RobotModel:
         if self.mimics is None:
             return tuple(range(len(self.joints)))
         return tuple(i for i, mimic in enumerate(self.mimics) if mimic is None)
+
+    @property
+    def independent_joints(self) -> tuple[Joint, ...]:
+        """The independent joints (``joints`` but the mimic joints): one per coordinate, their
+        limits the state's (a mimic joint's friction is its joint's: ``friction``)."""
+        if self.mimics is None:
+            return self.joints
+        return tuple(self.joints[i] for i in self.independent)
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -206,15 +204,7 @@ class RobotModel:
         if not self.flange.is_identity:
             params["flange"] = self.flange.flat()
         if not self.is_chain:
-            names = [j.name for j in self.joints]
-            params["tree.joints"] = names
-            params["tree.parents"] = [names[p] if p >= 0 else "" for p in self.parent]
-            for joint, mimic in zip(self.joints, self.mimics or ()):
-                if mimic is not None:
-                    key = param_prefix(joint.name)
-                    params[f"{key}.mimic.joint"] = mimic.joint
-                    params[f"{key}.mimic.multiplier"] = mimic.multiplier
-                    params[f"{key}.mimic.offset"] = mimic.offset
+            params.update(tree_params(self))
         params.update(_body_params("payload", self.payload))
         for j in self.joints:
             key = param_prefix(j.name)
@@ -252,7 +242,7 @@ class RobotModel:
         parent = mimics = None
         if params.get("tree.joints") is not None:
             names, independent = check_joint_names(get("tree.joints")), names
-            parent, mimics = _tree_from_params(names, params, get)
+            parent, mimics = tree_from_params(names, params, get)
             if [name for name, mimic in zip(names, mimics) if mimic is None] != independent:
                 raise ModelError("joint_names", "must be tree.joints but the mimic joints, in that order")
         joints = tuple(_joint_from_params(name, params, get) for name in names)
@@ -266,30 +256,6 @@ class RobotModel:
             parent,
             mimics,
         )
-
-
-def _tree_from_params(names: list[str], params: Mapping[str, Any], get) -> tuple[tuple, tuple]:
-    """(parent, mimics) of ``tree.joints`` from tree.parents and <joint>.mimic.*."""
-    parents = get("tree.parents")
-    if not isinstance(parents, (list, tuple)) or len(parents) != len(names):
-        raise ModelError("tree.parents", f'expected one name (or "") per joint of tree.joints ({len(names)})')
-    index = {name: i for i, name in enumerate(names)}
-    parent = []
-    for i, name in enumerate(parents):
-        if name != "" and index.get(name, i) >= i:
-            raise ModelError("tree.parents", f"{str(name)[:80]!r} is not a joint before {names[i]!r} in tree.joints")
-        parent.append(-1 if name == "" else index[name])
-    mimics = []
-    for name in names:
-        key = f"{param_prefix(name)}.mimic"
-        leader = params.get(f"{key}.joint")
-        if leader is None or leader == "":
-            mimics.append(None)
-        elif not isinstance(leader, str):
-            raise ModelError(f"{key}.joint", f"expected a joint's name, got {leader!r}"[:200])
-        else:
-            mimics.append(Mimic(leader, get(f"{key}.multiplier", 1.0), get(f"{key}.offset", 0.0)))
-    return tuple(parent), tuple(mimics)
 
 
 # a joint's limits, friction and rotor inertia: what a URDF's model may take from a params file
@@ -361,58 +327,6 @@ def _raw_joint(joint_name: str, params: Mapping[str, Any], get) -> Joint:
         armature=get(f"{name}.armature", 0.0),
         **kinematics,
     )
-
-
-def checked_parents(parent, count: int) -> tuple[int, ...]:
-    """The parent indices as a tuple (None: a chain), or ModelError: one per joint, each
-    -1 (the base) or an earlier joint's index."""
-    if parent is None:
-        return tuple(range(-1, count - 1))
-    if not isinstance(parent, (list, tuple)) or len(parent) != count:
-        raise ModelError("joint_parents", f"expected one parent index per joint ({count}), got {parent!r}"[:250])
-    out = []
-    for i, p in enumerate(parent):
-        if isinstance(p, bool) or not isinstance(p, int) or not -1 <= p < i:
-            raise ModelError("joint_parents", f"joint {i}'s parent must be -1 or an earlier joint's index, got {p!r}")
-        out.append(int(p))
-    return tuple(out)
-
-
-def checked_mimics(mimics, joints) -> tuple | None:
-    """The mimic joints as a tuple (None: none), or ModelError: one entry per joint, each
-    None or a Mimic following an independent joint of the model (not a mimic joint, not
-    itself), a finite multiplier and offset."""
-    if mimics is None or all(m is None for m in mimics):
-        return None
-    if len(mimics) != len(joints):
-        raise ModelError("mimic_joints", f"expected one entry per joint ({len(joints)}), got {len(mimics)}")
-    followers = {j.name for j, m in zip(joints, mimics) if m is not None}
-    names = {j.name for j in joints}
-    out = []
-    for joint, mimic in zip(joints, mimics):
-        if mimic is None:
-            out.append(None)
-            continue
-        key = f"{param_prefix(joint.name)}.mimic"
-        if not isinstance(mimic, Mimic):
-            raise ModelError(key, f"expected a Mimic, got {mimic!r}"[:200])
-        leader = mimic.joint
-        if leader == joint.name:
-            raise ModelError(key, f"joint {joint.name!r} cannot follow itself")
-        if leader not in names:
-            raise ModelError(key, f"follows {str(leader)[:80]!r}, not a joint of the model")
-        if leader in followers:
-            raise ModelError(key, f"follows {leader!r}, itself a mimic joint (a mimic of a mimic is not supported)")
-        multiplier = finite_number(f"{key}.multiplier", mimic.multiplier)
-        offset = finite_number(f"{key}.offset", mimic.offset)
-        capped(f"{key}.multiplier", "|multiplier|", abs(multiplier), 1e3, "")
-        if joint.friction.coulomb and abs(multiplier) != 1.0:
-            raise ModelError(
-                f"{param_prefix(joint.name)}.friction.coulomb",
-                f"a mimic joint's Coulomb friction is supported with multiplier +-1 only, got {multiplier}",
-            )
-        out.append(Mimic(leader, multiplier, offset))
-    return tuple(out)
 
 
 def check_joint_names(names) -> list[str]:

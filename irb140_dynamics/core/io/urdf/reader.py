@@ -50,17 +50,16 @@ from irb140_dynamics.core.io.urdf.tree import (
     number,
     parse_tree,
 )
+from irb140_dynamics.core.io.urdf.whole_tree import MOVING, compose, moving_joints
 from irb140_dynamics.core.model.joints import (
     MAX_TORQUE_LIMIT,
     Friction,
     Joint,
     Placement,
-    matrix_rpy,
 )
 from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, combine, placed
 from irb140_dynamics.core.model.robot_model import Mimic, RobotModel
 
-MOVING = ("revolute", "continuous", "prismatic")
 CONTINUOUS_LIMITS = (-4 * math.pi, 4 * math.pi)  # rad: two turns either way, every angle within
 MAX_JOINTS = 100  # moving joints in a chain at most (the longest public arms and legs have 10)
 GRAVITY = 9.81  # m/s^2, along the root link's -z
@@ -100,9 +99,7 @@ def load_urdf(
     if not tip_link:
         tree._known("base_link", base_link or tree.root)
         if len(tree.leaves(base_link or tree.root)) > 1:
-            from irb140_dynamics.core.io.urdf.whole_tree import load_tree
-
-            return load_tree(tree, base_link or tree.root, max_joints)
+            return _load_tree(tree, base_link or tree.root, max_joints)
     base, tip, path = tree.chain(base_link, tip_link)
     span = f"from {clipped(repr(base), 60)} to {clipped(repr(tip), 60)}"
     for joint in path:
@@ -230,20 +227,6 @@ def read_urdf(path, max_chars: int | None = None) -> str:
         raise UrdfError("file", f"{clipped(str(path), 120)}: {error.reason}") from None
 
 
-def compose(a: Placement, b: Placement) -> Placement:
-    """The placement a * b; exact when either is a pure translation or the identity."""
-    if a.is_identity:
-        return b
-    if b.is_identity:
-        return a
-    xyz = tuple((np.array(a.xyz) + a.rotation() @ np.array(b.xyz)).tolist())
-    if b.rpy == (0.0, 0.0, 0.0):
-        return Placement(xyz, a.rpy)
-    if a.rpy == (0.0, 0.0, 0.0):
-        return Placement(xyz, b.rpy)
-    return Placement(xyz, matrix_rpy(a.rotation() @ b.rotation()))
-
-
 def lumped(tree: UrdfTree, link: str, stop, held: list[str], carried: list[list[str]]) -> tuple[RigidBody, bool]:
     """Everything rigidly attached to ``link`` (joints off the chain at zero), up to the
     chain joint ``stop`` (a name, None, or a set of names), as one body in ``link``'s frame;
@@ -307,3 +290,47 @@ def _joint(joint: UrdfJoint, origin: Placement, body: RigidBody, physical: bool)
         kind="prismatic" if joint.kind == "prismatic" else "revolute",
         physical=physical,
     )
+
+
+def _load_tree(tree: UrdfTree, base: str, max_joints: int) -> LoadedUrdf:
+    """The whole tree below ``base`` as a LoadedUrdf (see ``whole_tree``)."""
+    moving, parents, origins = moving_joints(tree, base)
+    where = f"below {clipped(repr(base), 60)}"
+    if not moving:
+        raise UrdfError("tree", f"no revolute, continuous or prismatic joint {where}")
+    if len(moving) > max_joints:
+        raise UrdfError(
+            "tree", f"{len(moving)} moving joints {where}, more than the limit of {max_joints} (max_joints)"
+        )
+    stops = {joint.name for joint in moving}
+    held: list[str] = []
+    carried: list[list[str]] = []
+    bodies = [lumped(tree, joint.child, stops, held, carried) for joint in moving]
+    warnings, physical = _checked_inertials(tree, carried)
+    subtree_mass = [body.mass for body, _ in bodies]
+    for i in reversed(range(len(moving))):
+        if parents[i] >= 0:
+            subtree_mass[parents[i]] += subtree_mass[i]
+    for joint, mass in zip(moving, subtree_mass):
+        if mass == 0.0:
+            warnings.append(
+                f'URDF joint "{clipped(joint.name, 100)}": moves no mass (M(q) is singular: forward '
+                "dynamics needs a payload)"
+            )
+    joints = [
+        _joint(joint, placement, body, ok) for joint, placement, (body, _), ok in zip(moving, origins, bodies, physical)
+    ]
+    try:
+        model = RobotModel(
+            tuple(joints), gravity=base_gravity(tree, base), parent=tuple(parents), mimics=mimics_of(moving)
+        )
+    except ModelError as error:
+        raise UrdfError("tree", str(error)) from None
+    in_model = {name for names in carried for name in names}
+    notes = [
+        f"{problem[1]} (not moved by the tree: ignored)"
+        for name, body in tree.inertials.items()
+        if name not in in_model and (problem := inertial_problem(name, body))
+    ]
+    rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
+    return LoadedUrdf(model, base, moving[-1].child, (), tuple(warnings), tuple(notes), rotation, tree.name)

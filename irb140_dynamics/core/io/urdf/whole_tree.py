@@ -1,5 +1,6 @@
-"""A URDF's whole kinematic tree below base_link as one RobotModel (``load_urdf`` with no
-tip_link and several leaves: two arms on a torso, an arm with a head).
+"""A URDF's whole kinematic tree below base_link: its moving joints, as ``load_urdf`` reads
+them with no tip_link and several leaves (two arms on a torso, an arm with a head); and
+``compose``, of placements.
 
 - Every revolute, continuous and prismatic joint below base_link is a joint of the model,
   depth first in the file's order (a joint, then everything below it, then the next joint
@@ -18,21 +19,12 @@ tip_link and several leaves: two arms on a torso, an arm with a head).
 
 from __future__ import annotations
 
-from irb140_dynamics.core.io.urdf.reader import (
-    MOVING,
-    LoadedUrdf,
-    _checked_inertials,
-    _joint,
-    base_gravity,
-    base_rotation,
-    compose,
-    lumped,
-    mimics_of,
-)
-from irb140_dynamics.core.io.urdf.tree import UrdfError, UrdfTree, clipped, inertial_problem
-from irb140_dynamics.core.model.joints import Placement
-from irb140_dynamics.core.model.rigid_body import ModelError
-from irb140_dynamics.core.model.robot_model import RobotModel
+import numpy as np
+
+from irb140_dynamics.core.io.urdf.tree import UrdfError, UrdfTree, clipped
+from irb140_dynamics.core.model.joints import Placement, matrix_rpy
+
+MOVING = ("revolute", "continuous", "prismatic")
 
 
 def moving_joints(tree: UrdfTree, base: str) -> tuple[list, list[int], list[Placement]]:
@@ -64,45 +56,15 @@ def moving_joints(tree: UrdfTree, base: str) -> tuple[list, list[int], list[Plac
     return moving, parents, origins
 
 
-def load_tree(tree: UrdfTree, base: str, max_joints: int) -> LoadedUrdf:
-    """The whole tree below ``base`` as a LoadedUrdf (see the module)."""
-    moving, parents, origins = moving_joints(tree, base)
-    where = f"below {clipped(repr(base), 60)}"
-    if not moving:
-        raise UrdfError("tree", f"no revolute, continuous or prismatic joint {where}")
-    if len(moving) > max_joints:
-        raise UrdfError(
-            "tree", f"{len(moving)} moving joints {where}, more than the limit of {max_joints} (max_joints)"
-        )
-    stops = {joint.name for joint in moving}
-    held: list[str] = []
-    carried: list[list[str]] = []
-    bodies = [lumped(tree, joint.child, stops, held, carried) for joint in moving]
-    warnings, physical = _checked_inertials(tree, carried)
-    subtree_mass = [body.mass for body, _ in bodies]
-    for i in reversed(range(len(moving))):
-        if parents[i] >= 0:
-            subtree_mass[parents[i]] += subtree_mass[i]
-    for joint, mass in zip(moving, subtree_mass):
-        if mass == 0.0:
-            warnings.append(
-                f'URDF joint "{clipped(joint.name, 100)}": moves no mass (M(q) is singular: forward '
-                "dynamics needs a payload)"
-            )
-    joints = [
-        _joint(joint, placement, body, ok) for joint, placement, (body, _), ok in zip(moving, origins, bodies, physical)
-    ]
-    try:
-        model = RobotModel(
-            tuple(joints), gravity=base_gravity(tree, base), parent=tuple(parents), mimics=mimics_of(moving)
-        )
-    except ModelError as error:
-        raise UrdfError("tree", str(error)) from None
-    in_model = {name for names in carried for name in names}
-    notes = [
-        f"{problem[1]} (not moved by the tree: ignored)"
-        for name, body in tree.inertials.items()
-        if name not in in_model and (problem := inertial_problem(name, body))
-    ]
-    rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
-    return LoadedUrdf(model, base, moving[-1].child, (), tuple(warnings), tuple(notes), rotation, tree.name)
+def compose(a: Placement, b: Placement) -> Placement:
+    """The placement a * b; exact when either is a pure translation or the identity."""
+    if a.is_identity:
+        return b
+    if b.is_identity:
+        return a
+    xyz = tuple((np.array(a.xyz) + a.rotation() @ np.array(b.xyz)).tolist())
+    if b.rpy == (0.0, 0.0, 0.0):
+        return Placement(xyz, a.rpy)
+    if a.rpy == (0.0, 0.0, 0.0):
+        return Placement(xyz, b.rpy)
+    return Placement(xyz, matrix_rpy(a.rotation() @ b.rotation()))
