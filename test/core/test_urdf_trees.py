@@ -25,6 +25,7 @@ from irb140_dynamics.core import (
     mass_matrix,
     rnea,
 )
+from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.derivatives import forward_dynamics_derivatives, rnea_derivatives
 from irb140_dynamics.core.kinematics import flange_jacobian, link_jacobian, link_pose
 from irb140_dynamics.core.regressor import regressor
@@ -207,3 +208,20 @@ def test_derivatives_on_a_tree_are_the_finite_differences_and_refused_with_mimic
     np.testing.assert_allclose(Minv @ M, np.eye(model.n), atol=1e-9)
     with pytest.raises(ValueError, match="not available for a model with mimic joints"):
         rnea_derivatives(load_urdf(TWO_ARMS).model, q, qd, qdd)
+
+
+def test_the_momentum_terms_on_a_tree_with_mimic_joints():
+    """The observer's [p, dT/dq] (see algorithms.momentum): p = M qd, and dT/dq the slope of
+    T = qd^T M(q) qd / 2 (central differences)."""
+    model = load_urdf(TWO_ARMS).model
+    rng = np.random.default_rng(12)
+    q, qd = rng.uniform(-1, 1, model.n), rng.uniform(-1, 1, model.n)
+    terms = np.array(kernels_of(model).momentum.scalar(q.tolist(), qd.tolist()))
+    np.testing.assert_allclose(terms[: model.n], mass_matrix(model, q) @ qd, rtol=1e-12, atol=1e-14)
+    step, unit = 1e-6, np.eye(model.n)
+
+    def energy(x):
+        return 0.5 * qd @ mass_matrix(model, x) @ qd
+
+    slope = [(energy(q + step * unit[k]) - energy(q - step * unit[k])) / (2 * step) for k in range(model.n)]
+    np.testing.assert_allclose(terms[model.n :], slope, atol=1e-8)
