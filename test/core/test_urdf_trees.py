@@ -64,7 +64,7 @@ def test_every_tree_of_example_robot_data_agrees_with_pinocchio():
         except ModelError as refusal:
             assert "\n" not in str(refusal) and any(reason in str(refusal) for reason in REFUSALS), (path, refusal)
             refused.append(path)
-    assert len(loaded) >= 60 and len(refused) <= 5
+    assert len(loaded) >= 65 and len(refused) <= 4
     with_mimics = [entry for entry in loaded if entry[2].mimics is not None]
     assert len(with_mimics) >= 6  # Baxter's, the Panda's, the PR2's grippers, Romeo's, TALOS', TIAGo's hands
     chosen = loaded
