@@ -30,6 +30,7 @@ from irb140_dynamics.core.derivatives import forward_dynamics_derivatives, rnea_
 from irb140_dynamics.core.kinematics import flange_jacobian, link_jacobian, link_pose
 from irb140_dynamics.core.regressor import regressor
 from irb140_dynamics.core.urdf import load_urdf
+from irb140_dynamics.identification.base import find_base_parameters
 
 from ..support.common import full_sweep
 from ..support.pinocchio_trees import worst_error
@@ -151,6 +152,9 @@ def test_the_tree_identities_hold():
     Y = regressor(tree, q, qd, qdd)
     pi = _parameters(tree)
     np.testing.assert_allclose(Y @ pi, rnea(tree, q, qd, qdd), rtol=1e-12, atol=1e-12)
+    base = find_base_parameters(tree)  # the tree's base parameters: Y_b beta = Y pi
+    assert 0 < base.count < len(pi)
+    np.testing.assert_allclose(base.columns(Y) @ base.of(pi), Y @ pi, rtol=1e-9, atol=1e-9)
     J = link_jacobian(model, q[: model.n], "l2")
     assert not J[:, model.joint_names.index("r1")].any()
     step = 1e-6
