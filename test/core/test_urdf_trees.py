@@ -229,3 +229,12 @@ def test_the_momentum_terms_on_a_tree_with_mimic_joints():
 
     slope = [(energy(q + step * unit[k]) - energy(q - step * unit[k])) / (2 * step) for k in range(model.n)]
     np.testing.assert_allclose(terms[model.n :], slope, atol=1e-8)
+
+
+def test_the_payload_analysis_refuses_a_tree_in_one_line():
+    """Its proofs slice a chain: a tree's payload is the nodes' (payload.link)."""
+    from irb140_dynamics.core import RigidBody
+    from irb140_dynamics.core.payload.family import payload_family
+
+    with pytest.raises(ValueError, match="takes a serial chain without mimic joints: load the URDF with its tip_link"):
+        payload_family(load_urdf(TWO_ARMS).model, RigidBody(1.0))
