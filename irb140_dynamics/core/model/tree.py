@@ -32,10 +32,10 @@ class Mimic:
 
 
 def checked_parents(parent, count: int) -> tuple[int, ...]:
-    """The parent indices as a tuple (None: a chain), or ModelError: one per joint, each
-    -1 (the base) or an earlier joint's index."""
-    if parent is None:
-        return tuple(range(-1, count - 1))
+    """The parent indices as a tuple (None, or a chain's of any length: a chain), or
+    ModelError: one per joint, each -1 (the base) or an earlier joint's index."""
+    if parent is None or (isinstance(parent, tuple) and parent == tuple(range(-1, len(parent) - 1))):
+        return tuple(range(-1, count - 1))  # a chain's, also when joints are added (dataclasses.replace)
     if not isinstance(parent, (list, tuple)) or len(parent) != count:
         raise ModelError("joint_parents", f"expected one parent index per joint ({count}), got {parent!r}"[:250])
     out = []
