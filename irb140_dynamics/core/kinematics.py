@@ -84,7 +84,7 @@ def _joint_placements(model: RobotModel) -> list[tuple]:
     ]
 
 
-# The flange's placement on the last link (4x4), and per joint (pre, post as 4x4, axis,
+# The flange's placement on its link (the last one's, 4x4), and per joint (pre, post as 4x4, axis,
 # offset, prismatic): made on first use and kept while the model lives (see per_model).
 _FLANGES, _PLACEMENTS = PerModel(_flange), PerModel(_joint_placements)
 _flange_matrix, _placements = _FLANGES.get, _PLACEMENTS.get
@@ -92,7 +92,7 @@ _flange_matrix, _placements = _FLANGES.get, _PLACEMENTS.get
 
 def flange_pose(model: RobotModel, q) -> np.ndarray:
     """The flange pose in the base frame, 4x4 (for DH models frame n)."""
-    return link_frames(model, q)[-1] @ _flange_matrix(model)
+    return link_frames(model, q)[model.carrier + 1] @ _flange_matrix(model)
 
 
 def joint_origins(model: RobotModel, q) -> np.ndarray:
@@ -105,7 +105,7 @@ def joint_origins_and_flange(model: RobotModel, q) -> tuple[np.ndarray, np.ndarr
     """``joint_origins``, ``flange_pose`` and ``flange_jacobian`` from one pass of forward
     kinematics."""
     frames = link_frames(model, q)
-    pose = frames[-1] @ _flange_matrix(model)
+    pose = frames[model.carrier + 1] @ _flange_matrix(model)
     return _origins(model, frames), pose, _flange_jacobian(model, frames, pose)
 
 
@@ -123,7 +123,7 @@ def flange_jacobian(model: RobotModel, q) -> np.ndarray:
 def flange_pose_and_jacobian(model: RobotModel, q) -> tuple[np.ndarray, np.ndarray]:
     """``flange_pose`` and ``flange_jacobian`` from one pass of forward kinematics."""
     frames = link_frames(model, q)
-    pose = frames[-1] @ _flange_matrix(model)
+    pose = frames[model.carrier + 1] @ _flange_matrix(model)
     return pose, _flange_jacobian(model, frames, pose)
 
 
@@ -149,9 +149,9 @@ def _joint_index(model: RobotModel, joint: str) -> int:
 
 
 def _flange_jacobian(model: RobotModel, frames: np.ndarray, pose: np.ndarray | None = None) -> np.ndarray:
-    flange = (frames[-1] @ _flange_matrix(model) if pose is None else pose)[:3, 3]
+    flange = (frames[model.carrier + 1] @ _flange_matrix(model) if pose is None else pose)[:3, 3]
     if not model.is_chain:
-        return _jacobian(model, frames, flange, len(model.joints) - 1)
+        return _jacobian(model, frames, flange, model.carrier)
     J = np.empty((6, model.n))
     for i, (frame, (pre, _, turning_axis, _, prismatic)) in enumerate(zip(frames[:-1], _placements(model))):
         joint_frame = frame @ pre  # joint i+1's axis passes through its origin

@@ -70,7 +70,7 @@ def mjcf(
     for i, parent in enumerate(model.parent):
         if parent >= 0:
             below[parent].append(i)
-    last = len(model.joints) - 1
+    last = model.carrier  # the payload's link
     # depth first along model.parent: ("open", i) writes body i, ("close", i) ends it
     stack = [("open", i) for i, parent in reversed(list(enumerate(model.parent))) if parent < 0]
     indent = "    "

@@ -27,7 +27,7 @@ from irb140_dynamics.core import (
 )
 from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.derivatives import forward_dynamics_derivatives, rnea_derivatives
-from irb140_dynamics.core.kinematics import flange_jacobian, link_jacobian, link_pose
+from irb140_dynamics.core.kinematics import flange_jacobian, flange_pose, link_jacobian, link_pose
 from irb140_dynamics.core.regressor import regressor
 from irb140_dynamics.core.urdf import load_urdf
 from irb140_dynamics.identification.base import find_base_parameters
@@ -238,3 +238,36 @@ def test_the_payload_analysis_refuses_a_tree_in_one_line():
 
     with pytest.raises(ValueError, match="takes a serial chain without mimic joints: load the URDF with its tip_link"):
         payload_family(load_urdf(TWO_ARMS).model, RigidBody(1.0))
+
+
+def test_a_payload_and_a_flange_wrench_on_another_link_than_the_last():
+    """flange_joint: the payload on the left arm's link (the flange placed there), against
+    Pinocchio with the payload as a body on that joint; the flange wrench there is -J^T f."""
+    from dataclasses import replace
+
+    from irb140_dynamics.core import RigidBody
+    from irb140_dynamics.core.model.joints import Placement
+
+    from ..support.pinocchio_model import build
+
+    tree = load_urdf(_without_mimics(TWO_ARMS).replace('type="prismatic"', 'type="revolute"')).model  # build's joints
+    payload = RigidBody(2.5, (0.01, 0.02, 0.05), (0.01, 0.02, 0.015, 0.001, 0.0, 0.0))
+    model = replace(tree, payload=payload, flange=Placement((0.0, 0.0, 0.1), (0.3, 0.0, 0.0)), flange_joint="l2")
+    assert model.carrier == 2 and not model.is_chain
+    assert RobotModel.from_params(model.to_params()) == model
+    pm = build(model)  # the payload appended to the flange's joint
+    rng = np.random.default_rng(8)
+    for q, qd, qdd in zip(*(rng.uniform(-1, 1, (3, model.n)) for _ in range(3))):
+        import pinocchio as pin
+
+        tau = pin.rnea(pm, pm.createData(), q, qd, qdd)
+        np.testing.assert_allclose(rnea(model, q, qd, qdd) - model.friction.torques(qd), tau, rtol=1e-10, atol=1e-10)
+        M = pin.crba(pm, pm.createData(), q)
+        np.testing.assert_allclose(mass_matrix(model, q), np.triu(M) + np.triu(M, 1).T, rtol=1e-10, atol=1e-10)
+        pose = link_pose(model, q, "l2") @ model.flange.matrix()
+        np.testing.assert_allclose(flange_pose(model, q), pose, atol=1e-15)
+        wrench = rng.uniform(-5, 5, 6)  # on the flange, in the flange frame
+        J = flange_jacobian(model, q)
+        R = pose[:3, :3]
+        expected = rnea(model, q, qd, qdd) - J.T @ np.concatenate([R @ wrench[:3], R @ wrench[3:]])
+        np.testing.assert_allclose(rnea(model, q, qd, qdd, f_ext=wrench), expected, rtol=1e-10, atol=1e-10)

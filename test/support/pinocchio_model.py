@@ -55,7 +55,7 @@ def build(robot) -> pin.Model:
         model.armature[i] = joint.armature
         bodies.append(body_placement(joint))
         model.appendBodyToJoint(joint_id, spatial_inertia(joint.link), bodies[-1])
-        if i == len(robot.joints) - 1:
+        if i == robot.carrier:  # the payload on the flange's link
             model.appendBodyToJoint(joint_id, spatial_inertia(robot.payload), bodies[-1] * se3(robot.flange))
     return model
 

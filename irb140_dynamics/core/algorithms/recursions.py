@@ -219,12 +219,12 @@ def steps(links, cs):
 # -- algorithms ---------------------------------------------------------------------
 
 
-def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3):
+def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3, at: int = -1):
     """Joint torques tau(q, qd, qdd) by the recursive Newton-Euler algorithm.
 
     ``cs`` holds (cos, sin) of each joint angle theta_i = q_i + theta_offset_i.
-    (f_ext, n_ext) is the wrench the environment exerts on the last link, in its frame, the
-    moment taken about its origin (see ``flange_wrench``); tau balances it (a load pressing
+    (f_ext, n_ext) is the wrench the environment exerts on the last link (link ``at``), in
+    its frame, the moment taken about its origin (see ``flange_wrench``); tau balances it (a load pressing
     on the flange raises tau like a weight would). Friction is not included.
     """
     moves = steps(links, cs)
@@ -234,7 +234,7 @@ def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3):
     # the wrench each link's children (the environment, for the last one) exert on it, about
     # its origin o_i in its frame; gathered as the backward pass reaches them
     carried = [None] * len(links)
-    carried[-1] = scale(-1.0, f_ext), scale(-1.0, n_ext)
+    carried[at] = scale(-1.0, f_ext), scale(-1.0, n_ext)
     for i in reversed(range(len(links))):
         link, (w, dw, a) = links[i], motion[i]
         f, n = carried[i] or (ZERO3, ZERO3)

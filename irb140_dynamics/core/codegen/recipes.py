@@ -35,7 +35,8 @@ def _rnea(arm, cs, qd, qdd, k):
 def _rnea_wrench(arm, cs, qd, qdd, wrench, k):
     cs, qd, qdd = arm.expanded(cs, qd, qdd)
     force, moment = algorithms.flange_wrench(arm.flange, wrench[:3], wrench[3:])
-    return arm.projected(algorithms.rnea(arm.links_with(k), cs, qd, qdd, arm.gravity_of(k), force, moment))
+    links, gravity = arm.links_with(k), arm.gravity_of(k)
+    return arm.projected(algorithms.rnea(links, cs, qd, qdd, gravity, force, moment, at=arm.carrier))
 
 
 def _gravity(arm, cs, k):

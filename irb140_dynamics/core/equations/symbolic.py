@@ -109,6 +109,8 @@ def derive(model, what=DEFAULT_QUANTITIES, symbolic: bool = False, progress: Cal
     q, qd, qdd = joint_symbols(n)
     if model.mimics is not None and (symbolic or "regressor" in what):
         raise ValueError("a model with mimic joints is written with its numbers, without the regressor")
+    if model.flange_joint is not None and symbolic:
+        raise ValueError("symbolic parameters take the payload on the last link (no flange_joint)")
     links, parameters, friction = links_of(model, symbolic)
     coordinates = Coordinates(links, coupling(model))
     cs = coordinates.expanded(_angles(coordinates, q))[0]

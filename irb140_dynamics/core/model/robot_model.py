@@ -15,6 +15,7 @@ parameter to fix:
     payload.mass / .com / .inertia
     friction.smoothing_velocity rad/s, of the Coulomb friction's tanh
     flange                      [x, y, z, roll, pitch, yaw] in the last link (identity if absent)
+    flange_joint                the joint whose link carries the flange instead (a tree's)
     <joint>.type                "revolute" (default) or "prismatic" (URDF form only)
     <joint>.dh                  [a, alpha, d, theta_offset], or in URDF form:
     <joint>.origin, .axis       [x, y, z, roll, pitch, yaw] in the parent link; [x, y, z]
@@ -92,6 +93,7 @@ class RobotModel:
     smoothing_velocity: float = DEFAULT_SMOOTHING_VELOCITY  # rad/s, Coulomb friction's tanh
     parent: tuple[int, ...] | None = None  # per joint: its parent joint's index, -1 the base
     mimics: tuple[Mimic | None, ...] | None = None  # per joint: the joint it follows, or None
+    flange_joint: str | None = None  # the joint whose link carries the flange; None: the last one
 
     def __post_init__(self):
         object.__setattr__(self, "joints", tuple(validated_joint(j) for j in self.joints))
@@ -106,6 +108,11 @@ class RobotModel:
         check_joint_names([j.name for j in self.joints])
         object.__setattr__(self, "parent", checked_parents(self.parent, len(self.joints)))
         object.__setattr__(self, "mimics", checked_mimics(self.mimics, self.joints))
+        if self.flange_joint is not None:
+            if self.flange_joint not in [j.name for j in self.joints]:
+                raise ModelError("flange_joint", f"{str(self.flange_joint)[:80]!r} is not a joint of the model")
+            if self.flange_joint == self.joints[-1].name:
+                object.__setattr__(self, "flange_joint", None)  # the default, said once
 
     @property
     def n(self) -> int:
@@ -134,8 +141,16 @@ class RobotModel:
 
     @property
     def is_chain(self) -> bool:
-        """A serial chain (each joint's parent the joint before), no mimic joint."""
-        return self.mimics is None and all(p == i - 1 for i, p in enumerate(self.parent))
+        """A serial chain (each joint's parent the joint before), no mimic joint, the flange
+        on the last link."""
+        return self.mimics is None and self.flange_joint is None and all(p == i - 1 for i, p in enumerate(self.parent))
+
+    @cached_property
+    def carrier(self) -> int:
+        """The index in ``joints`` of the joint whose link carries the flange and payload."""
+        if self.flange_joint is None:
+            return len(self.joints) - 1
+        return [j.name for j in self.joints].index(self.flange_joint)
 
     @cached_property
     def coordinates(self) -> tuple[tuple[int, float, float], ...]:
@@ -172,12 +187,12 @@ class RobotModel:
 
     @property
     def bodies(self) -> tuple[RigidBody, ...]:
-        """The moving bodies, the payload merged into the last link."""
+        """The moving bodies, the payload merged into the flange's link (the last one's)."""
         bodies = [j.link for j in self.joints]
         payload = self.payload
         if not self.flange.is_identity:
             payload = placed(payload, self.flange.rotation(), self.flange.xyz)
-        bodies[-1] = combine(bodies[-1], payload)
+        bodies[self.carrier] = combine(bodies[self.carrier], payload)
         return tuple(bodies)
 
     @cached_property
@@ -205,6 +220,8 @@ class RobotModel:
             params["flange"] = self.flange.flat()
         if not self.is_chain:
             params.update(tree_params(self))
+        if self.flange_joint is not None:
+            params["flange_joint"] = self.flange_joint
         params.update(_body_params("payload", self.payload))
         for j in self.joints:
             key = param_prefix(j.name)
@@ -255,6 +272,7 @@ class RobotModel:
             get("friction.smoothing_velocity", DEFAULT_SMOOTHING_VELOCITY),
             parent,
             mimics,
+            params.get("flange_joint") or None,
         )
 
 
