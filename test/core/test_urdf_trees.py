@@ -271,3 +271,26 @@ def test_a_payload_and_a_flange_wrench_on_another_link_than_the_last():
         R = pose[:3, :3]
         expected = rnea(model, q, qd, qdd) - J.T @ np.concatenate([R @ wrench[:3], R @ wrench[3:]])
         np.testing.assert_allclose(rnea(model, q, qd, qdd, f_ext=wrench), expected, rtol=1e-10, atol=1e-10)
+
+
+def test_the_flange_at_a_urdf_link_is_where_that_link_is():
+    """with_flange_at: the payload's link named as in the URDF (a fixed bracket, a moving
+    link), its pose that of the link in Pinocchio's model of the file."""
+    import pinocchio as pin
+
+    loaded = load_urdf(TWO_ARMS)
+    full = pin.buildModelFromXML(TWO_ARMS)
+    rng = np.random.default_rng(9)
+    q = rng.uniform(-1, 1, loaded.model.n)
+    pq = np.zeros(full.nq)
+    for name, x in zip([j.name for j in loaded.model.joints], loaded.model.all_positions(q)):
+        pq[full.joints[full.getJointId(name)].idx_q] = x
+    data = full.createData()
+    pin.framesForwardKinematics(full, data, pq)
+    for link, joint in (("bracket", "torso"), ("la2", "l2"), ("fb", "finger_b")):
+        model = loaded.with_flange_at(link)
+        assert model.flange_joint in (joint, None) and model.carrier == [j.name for j in model.joints].index(joint)
+        expected = data.oMf[full.getFrameId(link, pin.FrameType.BODY)].homogeneous
+        np.testing.assert_allclose(flange_pose(model, q), expected, atol=1e-12)
+    with pytest.raises(ValueError, match="'base' is not moved by the model's joints"):
+        loaded.with_flange_at("base")

@@ -34,7 +34,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from functools import reduce
 
 import numpy as np
@@ -50,7 +50,7 @@ from irb140_dynamics.core.io.urdf.tree import (
     number,
     parse_tree,
 )
-from irb140_dynamics.core.io.urdf.whole_tree import MOVING, compose, moving_joints
+from irb140_dynamics.core.io.urdf.whole_tree import MOVING, carried_links, compose, moving_joints
 from irb140_dynamics.core.model.joints import (
     MAX_TORQUE_LIMIT,
     Friction,
@@ -77,6 +77,16 @@ class LoadedUrdf:
     notes: tuple[str, ...] = ()  # invalid inertials off the chain, ignored
     base_rotation: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))  # base_link's axes in the root's
     robot_name: str = ""  # <robot name="...">: the hardware_id of the nodes' /diagnostics
+    carried: dict = field(default_factory=dict, compare=False, hash=False, repr=False)  # see with_flange_at
+
+    def with_flange_at(self, link: str) -> RobotModel:
+        """The model with its flange (where the payload sits) at URDF link ``link``: on the
+        link of the joint that carries it (``model.flange_joint``), placed as the URDF does
+        (the joints off the chain at zero); UrdfError unless the model moves that link."""
+        if link not in self.carried:
+            raise UrdfError("link", f"{clipped(repr(link), 80)} is not moved by the model's joints")
+        joint, placement = self.carried[link]
+        return replace(self.model, flange_joint=joint, flange=placement)
 
     def in_base(self, vector) -> tuple[float, float, float]:
         """A vector given in the root link's frame (gravity) in base_link's frame."""
@@ -152,7 +162,8 @@ def load_urdf(
         if name not in on_chain and (problem := inertial_problem(name, body))
     ]
     rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
-    return LoadedUrdf(model, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name)
+    carried = carried_links(tree, moving)
+    return LoadedUrdf(model, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name, carried)
 
 
 def mimics_of(moving: list[UrdfJoint]) -> tuple | None:
@@ -333,4 +344,5 @@ def _load_tree(tree: UrdfTree, base: str, max_joints: int) -> LoadedUrdf:
         if name not in in_model and (problem := inertial_problem(name, body))
     ]
     rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
-    return LoadedUrdf(model, base, moving[-1].child, (), tuple(warnings), tuple(notes), rotation, tree.name)
+    carried = carried_links(tree, moving)
+    return LoadedUrdf(model, base, moving[-1].child, (), tuple(warnings), tuple(notes), rotation, tree.name, carried)

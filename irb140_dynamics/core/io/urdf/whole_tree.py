@@ -56,6 +56,20 @@ def moving_joints(tree: UrdfTree, base: str) -> tuple[list, list[int], list[Plac
     return moving, parents, origins
 
 
+def carried_links(tree: UrdfTree, moving: list) -> dict[str, tuple[str, Placement]]:
+    """Every link a moving joint of the model carries, fixed to its link or behind joints
+    held at zero: link -> (that joint's name, the link's frame in the joint's link frame)."""
+    names = {joint.name for joint in moving}
+    found = {}
+    for joint in moving:
+        stack = [(joint.child, Placement())]
+        while stack:
+            link, placement = stack.pop()
+            found[link] = (joint.name, placement)
+            stack += [(j.child, compose(placement, j.origin)) for j in tree.child_joints[link] if j.name not in names]
+    return found
+
+
 def compose(a: Placement, b: Placement) -> Placement:
     """The placement a * b; exact when either is a pure translation or the identity."""
     if a.is_identity:
