@@ -45,7 +45,7 @@ REFUSED = {
             f'<joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/>{LIMIT}<mimic joint="j2"/></joint>'
             '<link name="l3"/>'
         ).replace(LIMIT + '</joint>\n  <link name="l2"', LIMIT + '<mimic joint="j3"/></joint>\n  <link name="l2"'),
-        {},
+        {"tip_link": "l3"},
         "follows 'j3', itself a mimic joint (a mimic of a mimic is not supported)",
     ),
     "mimic_of_a_missing_joint": (
@@ -55,7 +55,7 @@ REFUSED = {
     ),
     "floating_in_a_tree": (
         extra('<joint name="f" type="floating"><parent link="l1"/><child link="cam"/></joint><link name="cam"/>'),
-        {},
+        {"base_link": "base"},  # no tip_link: the whole tree
         "URDF joint \"f\": a floating joint below 'base'",
     ),
     "floating_in_chain": (edited((J2, J2.replace("revolute", "floating"))), {}, 'URDF joint "j2": a floating joint'),
