@@ -20,6 +20,7 @@ from irb140_dynamics.core import (
     ModelError,
     RobotModel,
     coriolis,
+    coriolis_matrix,
     forward_dynamics,
     gravity,
     mass_matrix,
@@ -191,13 +192,14 @@ def _parameters(model) -> np.ndarray:
     return inertial_parameters(model)
 
 
-def test_derivatives_on_a_tree_are_the_finite_differences_and_refused_with_mimic_joints():
-    model = load_urdf(_without_mimics(TWO_ARMS)).model
+@pytest.mark.parametrize("mimics", [False, True], ids=["tree", "tree with mimic joints"])
+def test_derivatives_and_the_coriolis_matrix_on_a_tree_are_the_finite_differences(mimics):
+    model = load_urdf(TWO_ARMS if mimics else _without_mimics(TWO_ARMS)).model
     rng = np.random.default_rng(11)
     q, qd, qdd = rng.uniform(-1, 1, model.n), rng.uniform(-1, 1, model.n), rng.uniform(-1, 1, model.n)
     dq, dqd, M = rnea_derivatives(model, q, qd, qdd)
     tau = rnea(model, q, qd, qdd)
-    dqdd_dq, _, Minv = forward_dynamics_derivatives(model, q, qd, tau)
+    dqdd_dq, dqdd_dqd, Minv = forward_dynamics_derivatives(model, q, qd, tau)
     step, unit = 1e-6, np.eye(model.n)
     for k in range(model.n):
         up, down = q + step * unit[k], q - step * unit[k]
@@ -206,12 +208,19 @@ def test_derivatives_on_a_tree_are_the_finite_differences_and_refused_with_mimic
         )
         moved = (forward_dynamics(model, up, qd, tau) - forward_dynamics(model, down, qd, tau)) / (2 * step)
         np.testing.assert_allclose(dqdd_dq[:, k], moved, atol=1e-6)
-        moved = (rnea(model, q, qd + step * unit[k], qdd) - rnea(model, q, qd - step * unit[k], qdd)) / (2 * step)
-        np.testing.assert_allclose(dqd[:, k], moved, atol=1e-7)
+        fast, slow = qd + step * unit[k], qd - step * unit[k]
+        np.testing.assert_allclose(
+            dqd[:, k], (rnea(model, q, fast, qdd) - rnea(model, q, slow, qdd)) / (2 * step), atol=1e-7
+        )
+        moved = (forward_dynamics(model, q, fast, tau) - forward_dynamics(model, q, slow, tau)) / (2 * step)
+        np.testing.assert_allclose(dqdd_dqd[:, k], moved, atol=1e-6)
     np.testing.assert_allclose(M, mass_matrix(model, q), rtol=1e-14, atol=1e-14)
     np.testing.assert_allclose(Minv @ M, np.eye(model.n), atol=1e-9)
-    with pytest.raises(ValueError, match="not available for a model with mimic joints"):
-        rnea_derivatives(load_urdf(TWO_ARMS).model, q, qd, qdd)
+    np.testing.assert_allclose(forward_dynamics(model, q, qd, tau), qdd, atol=1e-9)
+    C = coriolis_matrix(model, q, qd)  # C qd is the Coriolis torque, Mdot - 2C is skew-symmetric
+    np.testing.assert_allclose(C @ qd, coriolis(model, q, qd), atol=1e-12)
+    Mdot = (mass_matrix(model, q + step * qd) - mass_matrix(model, q - step * qd)) / (2 * step)
+    np.testing.assert_allclose(Mdot - 2 * C, -(Mdot - 2 * C).T, atol=1e-8)
 
 
 def test_the_momentum_terms_on_a_tree_with_mimic_joints():

@@ -5,6 +5,8 @@ recursions, so that the kernels trace them (see ``codegen.kernels``)."""
 
 from __future__ import annotations
 
+from irb140_dynamics.core.scalars.dual import Dual
+
 
 def coupling(model) -> tuple | None:
     """Per link of the model, the index k of its coordinate q_k (an independent joint) or
@@ -80,3 +82,20 @@ class Coordinates:
             return M
         columns = [self.projected([row[j] for row in M]) for j in range(self.n_links)]  # of G^T M
         return [self.projected([column[a] for column in columns]) for a in range(self.n)]
+
+    def dual_angles(self, cs, parts: int):
+        """The traced cs (coordinates', then mimic joints') as dual numbers of ``parts``
+        parts carrying d/dq_k (parts 0..n-1): a mimic joint's multiplier times its joint's
+        (d/dq_k cos(m q_k + o) = -m sin(m q_k + o))."""
+        zeros = (0.0,) * parts
+
+        def unit(k, value):
+            return zeros[:k] + (value,) + zeros[k + 1 :]
+
+        scales = [(k, 1.0) for k in range(self.n)] + [(k, m) for k, m, _, _ in self.mimic_angles]
+        return [
+            (Dual(x[0], unit(k, m)),)
+            if len(x) == 1
+            else (Dual(x[0], unit(k, x[1] * -m if m != 1.0 else -x[1])), Dual(x[1], unit(k, x[0] * m)))
+            for x, (k, m) in zip(cs, scales)
+        ]

@@ -373,8 +373,12 @@ def christoffel_coriolis(links, cs, qd):
     Coriolis/centrifugal torque and Mdot - 2C is skew-symmetric. The partial derivatives
     of M are exact: crba runs on dual numbers carrying d/dq of each scalar.
     """
-    n = len(links)
-    M = crba(links, dual_angles(cs))
+    return christoffel(crba(links, dual_angles(cs)), qd)
+
+
+def christoffel(M, qd):
+    """C(q, qd) of M(q) given on dual numbers carrying d/dq (see christoffel_coriolis)."""
+    n = len(M)
     dM = [[[partial(M[i][j], k) for k in range(n)] for j in range(n)] for i in range(n)]
     return [
         [sum(0.5 * (dM[i][j][k] + dM[i][k][j] - dM[j][k][i]) * qd[k] for k in range(n)) for j in range(n)]

@@ -57,8 +57,11 @@ def _mass_matrix(arm, cs, k):
 
 
 def _coriolis_matrix(arm, cs, qd, k):
-    _only_without_mimic(arm, "the Coriolis matrix")
-    return [x for row in algorithms.christoffel_coriolis(arm.links_with(k), cs, qd) for x in row]
+    if arm.coupled is None:
+        return [x for row in algorithms.christoffel_coriolis(arm.links_with(k), cs, qd) for x in row]
+    (angles,) = arm.expanded(arm.dual_angles(cs, arm.n))  # M(q) of the coordinates, on dual numbers
+    M = arm.projected_matrix(algorithms.crba(arm.links_with(k), angles))
+    return [x for row in algorithms.christoffel(M, qd) for x in row]
 
 
 def _regressor(arm, cs, qd, qdd, k):
