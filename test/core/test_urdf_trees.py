@@ -303,3 +303,19 @@ def test_the_flange_at_a_urdf_link_is_where_that_link_is():
         np.testing.assert_allclose(flange_pose(model, q), expected, atol=1e-12)
     with pytest.raises(ValueError, match="'base' is not moved by the model's joints"):
         loaded.with_flange_at("base")
+
+
+def test_a_floating_base_is_refused_naming_it_and_the_tree_below_it_is_read():
+    """A humanoid written with its free-flyer joint: refused from the root, in one line
+    naming the joint; from the link under it, the tree below, fixed there."""
+    floating = TWO_ARMS.replace(
+        '<link name="base"/>',
+        '<link name="world"/><joint name="free" type="floating"><parent link="world"/><child link="base"/>'
+        '<origin xyz="0 0 1" rpy="0 0 0"/></joint><link name="base"/>',
+    )
+    with pytest.raises(ModelError) as refusal:
+        load_urdf(floating)
+    assert str(refusal.value).startswith("URDF joint \"free\": a floating joint below 'world'")
+    assert "name the link under it as base_link" in str(refusal.value) and "\n" not in str(refusal.value)
+    below = load_urdf(floating, base_link="base").model
+    assert below == load_urdf(TWO_ARMS).model
