@@ -14,7 +14,8 @@ to bench/results/core.json. Sections:
 - kernel generation: the one-off cost of tracing and compiling each kernel of a fresh model.
 - URDF arms: the UR5 and the Panda of example-robot-data read by our URDF loader against
   Pinocchio's URDF parser on the same file, per call (rnea, gravity, mass matrix), with
-  native kernels, then in the kernels' Python form (IRB140_NATIVE=0).
+  native kernels, then in the kernels' Python form (IRB140_NATIVE=0); and a whole tree,
+  Baxter's two arms and head pan (15 joints).
 - derivatives: rnea_derivatives, forward_dynamics_derivatives, inverse_mass_matrix against
   Pinocchio's computeRNEADerivatives, computeABADerivatives, computeMinverse on the same
   three arms, native, alternating blocks (derivatives_section).
@@ -26,6 +27,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import time
 import timeit
 from contextlib import contextmanager
@@ -268,26 +270,34 @@ def urdf_arms() -> list[Row]:
     URDF damping: inside our native call; pin.rnea has none, so the check takes it out).
     Ours with native kernels (the default where a C compiler is), then in their Python form."""
     rows = []
-    arms = {"IRB-140 (DH)": (irb140(), None), **URDF_ARMS}
+    arms = {"IRB-140 (DH)": (irb140(), None), **URDF_ARMS, **TREE_ARMS}
     for name, (text, tip) in arms.items():
         model, pm = _paired_models(text, tip)
         data = pm.createData()
         q, qd, qdd = (x[0] for x in random_states(model, 1, np.random.default_rng(SEED + 2)))
+        # Pinocchio's joint order (a tree's differs): its state and ours compared through it
+        order = [pm.joints[pm.getJointId(name)].idx_v for name in model.joint_names] if tip == "" else None
+        pq, pv, pa = (np.array(x) for x in (q, qd, qdd))
+        if order is not None:
+            for x, ours in zip((pq, pv, pa), (q, qd, qdd)):
+                x[order] = ours
+        ours_order = slice(None) if order is None else order
         friction = model.friction.torques(qd) if model.friction is not None else 0.0
-        check_same(f"{name} rnea", rnea(model, q, qd, qdd) - friction, pin.rnea(pm, data, q, qd, qdd))
-        check_same(f"{name} gravity", gravity(model, q), pin.computeGeneralizedGravity(pm, data, q))
-        check_same(f"{name} mass_matrix", mass_matrix(model, q), symmetric_from_upper(pin.crba(pm, data, q)))
+        check_same(f"{name} rnea", rnea(model, q, qd, qdd) - friction, pin.rnea(pm, data, pq, pv, pa)[ours_order])
+        check_same(f"{name} gravity", gravity(model, q), pin.computeGeneralizedGravity(pm, data, pq)[ours_order])
+        M = symmetric_from_upper(pin.crba(pm, data, pq))
+        check_same(f"{name} mass_matrix", mass_matrix(model, q), M if order is None else M[np.ix_(order, order)])
         label = f"{name}{' (with its friction)' if model.friction is not None else ''}"
         for form in ("native", "Python"):
             ours = with_native(model) if form == "native" else replace(model)  # a fresh model: no kernels yet
             cases = [
-                ("rnea vs pin.rnea", lambda m=ours: rnea(m, q, qd, qdd), lambda: pin.rnea(pm, data, q, qd, qdd)),
+                ("rnea vs pin.rnea", lambda m=ours: rnea(m, q, qd, qdd), lambda: pin.rnea(pm, data, pq, pv, pa)),
                 (
                     "gravity vs computeGeneralizedGravity",
                     lambda m=ours: gravity(m, q),
-                    lambda: pin.computeGeneralizedGravity(pm, data, q),
+                    lambda: pin.computeGeneralizedGravity(pm, data, pq),
                 ),
-                ("mass_matrix vs pin.crba", lambda m=ours: mass_matrix(m, q), lambda: pin.crba(pm, data, q)),
+                ("mass_matrix vs pin.crba", lambda m=ours: mass_matrix(m, q), lambda: pin.crba(pm, data, pq)),
             ]
             group = f"arms, ours {form}, alternating blocks (URDF: load_urdf vs buildModelFromXML), per call"
             for case, call, baseline in cases:
@@ -309,9 +319,15 @@ def derivatives() -> list[Row]:
 
 
 def _paired_models(text, tip):
-    """(our model, Pinocchio's) of a URDF's chain to ``tip``, or of a model."""
+    """(our model, Pinocchio's) of a URDF's chain to ``tip`` (``""``: its whole tree), or of
+    a model."""
     if tip is None:
         return text, pinocchio_model(text)
+    if tip == "":
+        model = load_urdf(text).model
+        pm = pin.buildModelFromXML(text)
+        pm.gravity.linear = np.array(model.gravity)
+        return model, pm
     loaded = load_urdf(text, tip_link=tip)
     model = loaded.model
     pm = pin.buildModelFromXML(text)
@@ -343,8 +359,16 @@ def _urdf_paths() -> dict[str, tuple[Path, str]]:
     return {name: (example_robot_urdf(path), tip) for name, (path, tip) in arms.items()}
 
 
+def _baxter() -> str:
+    """example-robot-data's Baxter, both arms and the head pan (15 joints): its grippers'
+    fingers made fixed joints, in the text both read."""
+    text = example_robot_urdf("baxter_description/urdf/baxter.urdf").read_text()
+    return re.sub(r'(<joint\s+name="[lr]_gripper_[lr]_finger_joint"\s+type=)"prismatic"', r'\1"fixed"', text)
+
+
 URDF_PATHS = _urdf_paths()
 URDF_ARMS = {name: (path.read_text(), tip) for name, (path, tip) in URDF_PATHS.items()}
+TREE_ARMS = {"Baxter (tree, 15 joints)": (_baxter(), "")}  # the whole tree: tip ""
 
 
 def kernel_generation() -> tuple[list[Row], dict]:

@@ -1,6 +1,6 @@
 """The generated C against Pinocchio's C++, both compiled here and timed in one process.
 
-    .venv/bin/python bench/bench_cpp.py            # IRB-140, UR5, Panda (a few minutes)
+    .venv/bin/python bench/bench_cpp.py            # IRB-140, UR5, Panda, Baxter (a few minutes)
     .venv/bin/python bench/bench_cpp.py --arms IRB-140
 
 For each arm, the `equations` tool's C (``generate(model, ("c",), what=("tau", "M"))``:
@@ -28,6 +28,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -73,7 +74,10 @@ TARGET = 0.2
 URDF_ARMS = {
     "UR5": ("ur_description/urdf/ur5_robot.urdf", "tool0"),
     "Panda": ("panda_description/urdf/panda.urdf", "panda_link8"),
+    # a whole tree: both arms and the head pan, the grippers' fingers made fixed joints
+    "Baxter": ("baxter_description/urdf/baxter.urdf", ""),
 }
+FIXED_FINGERS = re.compile(r'(<joint\s+name="[lr]_gripper_[lr]_finger_joint"\s+type=)"prismatic"')
 
 
 def arms(names: list[str]) -> dict:
@@ -84,7 +88,8 @@ def arms(names: list[str]) -> dict:
             model = irb140()
         else:
             path, tip = URDF_ARMS[name]
-            model = load_urdf(example_robot_urdf(path).read_text(), tip_link=tip).model
+            text = FIXED_FINGERS.sub(r'\1"fixed"', example_robot_urdf(path).read_text())
+            model = load_urdf(text, tip_link=tip or None).model
         joints = tuple(replace(joint, friction=Friction()) for joint in model.joints)
         found[name] = replace(model, joints=joints)
     return found

@@ -28,11 +28,18 @@ from irb140_dynamics.core.dynamics import (
     rnea_batch,
 )
 from irb140_dynamics.core.io.params_file import load_model, read_parameter_file
-from irb140_dynamics.core.kinematics import dh_transform, flange_jacobian, flange_pose, link_frames
+from irb140_dynamics.core.kinematics import (
+    dh_transform,
+    flange_jacobian,
+    flange_pose,
+    link_frames,
+    link_jacobian,
+    link_pose,
+)
 from irb140_dynamics.core.model.irb140 import irb140
 from irb140_dynamics.core.model.joints import DH, Friction, Joint, Placement
 from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody
-from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.model.robot_model import Mimic, RobotModel
 from irb140_dynamics.core.payload import (
     RATED_PAYLOAD,
     MaxPayload,
@@ -53,6 +60,7 @@ __all__ = [
     "Joint",
     "Kernels",
     "MaxPayload",
+    "Mimic",
     "ModelError",
     "PayloadCheck",
     "Placement",
@@ -78,6 +86,8 @@ __all__ = [
     "irb140",
     "kernels_of",
     "link_frames",
+    "link_jacobian",
+    "link_pose",
     "load_model",
     "mass_matrix",
     "mass_matrix_batch",

@@ -31,12 +31,16 @@ def dh_transform(dh: DH, q: float) -> np.ndarray:
 
 
 def link_frames(model: RobotModel, q) -> np.ndarray:
-    """The poses of the base and the link frames 0..n in the base frame, (n + 1, 4, 4)."""
+    """The poses of the base and the link frames 0..n in the base frame, (n + 1, 4, 4); on a
+    tree or with mimic joints, of the base and every joint's link (``model.joints``' order)."""
+    q = state(q, model.n, "q")
+    if model.mimics is not None:
+        q = model.all_positions(q).tolist()
     frames = [np.eye(4)]
-    for (pre, post, axis, offset, prismatic), q_i in zip(_placements(model), state(q, model.n, "q")):
+    for (pre, post, axis, offset, prismatic), q_i, parent in zip(_placements(model), q, model.parent):
         # as Joint.transform, its constant matrices kept with the model
         move = _slide(axis, q_i) if prismatic else _turn(axis, q_i + offset)
-        frames.append(frames[-1] @ (pre @ move @ post))
+        frames.append(frames[parent + 1] @ (pre @ move @ post))
     return np.array(frames)
 
 
@@ -80,7 +84,7 @@ def _joint_placements(model: RobotModel) -> list[tuple]:
     ]
 
 
-# The flange's placement on the last link (4x4), and per joint (pre, post as 4x4, axis,
+# The flange's placement on its link (the last one's, 4x4), and per joint (pre, post as 4x4, axis,
 # offset, prismatic): made on first use and kept while the model lives (see per_model).
 _FLANGES, _PLACEMENTS = PerModel(_flange), PerModel(_joint_placements)
 _flange_matrix, _placements = _FLANGES.get, _PLACEMENTS.get
@@ -88,7 +92,7 @@ _flange_matrix, _placements = _FLANGES.get, _PLACEMENTS.get
 
 def flange_pose(model: RobotModel, q) -> np.ndarray:
     """The flange pose in the base frame, 4x4 (for DH models frame n)."""
-    return link_frames(model, q)[-1] @ _flange_matrix(model)
+    return link_frames(model, q)[model.carrier + 1] @ _flange_matrix(model)
 
 
 def joint_origins(model: RobotModel, q) -> np.ndarray:
@@ -101,12 +105,13 @@ def joint_origins_and_flange(model: RobotModel, q) -> tuple[np.ndarray, np.ndarr
     """``joint_origins``, ``flange_pose`` and ``flange_jacobian`` from one pass of forward
     kinematics."""
     frames = link_frames(model, q)
-    pose = frames[-1] @ _flange_matrix(model)
+    pose = frames[model.carrier + 1] @ _flange_matrix(model)
     return _origins(model, frames), pose, _flange_jacobian(model, frames, pose)
 
 
 def _origins(model: RobotModel, frames: np.ndarray) -> np.ndarray:
-    return np.array([(frame @ placed[0])[:3, 3] for frame, placed in zip(frames[:-1], _placements(model))])
+    """Each joint's origin (every joint of ``model.joints`` on a tree), from its parent's frame."""
+    return np.array([(frames[p + 1] @ placed[0])[:3, 3] for p, placed in zip(model.parent, _placements(model))])
 
 
 def flange_jacobian(model: RobotModel, q) -> np.ndarray:
@@ -118,12 +123,35 @@ def flange_jacobian(model: RobotModel, q) -> np.ndarray:
 def flange_pose_and_jacobian(model: RobotModel, q) -> tuple[np.ndarray, np.ndarray]:
     """``flange_pose`` and ``flange_jacobian`` from one pass of forward kinematics."""
     frames = link_frames(model, q)
-    pose = frames[-1] @ _flange_matrix(model)
+    pose = frames[model.carrier + 1] @ _flange_matrix(model)
     return pose, _flange_jacobian(model, frames, pose)
 
 
+def link_pose(model: RobotModel, q, joint: str) -> np.ndarray:
+    """The pose of the link ``joint`` moves (its frame) in the base frame, 4x4."""
+    return link_frames(model, q)[_joint_index(model, joint) + 1]
+
+
+def link_jacobian(model: RobotModel, q, joint: str) -> np.ndarray:
+    """The 6 x n geometric Jacobian of the origin of the link ``joint`` moves, rows (v; w)
+    in the base frame: the columns of the joints it hangs from (a mimic joint's added to
+    its joint's, times its multiplier), zero for the others."""
+    frames = link_frames(model, q)
+    index = _joint_index(model, joint)
+    return _jacobian(model, frames, frames[index + 1][:3, 3], index)
+
+
+def _joint_index(model: RobotModel, joint: str) -> int:
+    for i, j in enumerate(model.joints):
+        if j.name == joint:
+            return i
+    raise ValueError(f"joint: no joint {str(joint)[:80]!r} in the model")
+
+
 def _flange_jacobian(model: RobotModel, frames: np.ndarray, pose: np.ndarray | None = None) -> np.ndarray:
-    flange = (frames[-1] @ _flange_matrix(model) if pose is None else pose)[:3, 3]
+    flange = (frames[model.carrier + 1] @ _flange_matrix(model) if pose is None else pose)[:3, 3]
+    if not model.is_chain:
+        return _jacobian(model, frames, flange, model.carrier)
     J = np.empty((6, model.n))
     for i, (frame, (pre, _, turning_axis, _, prismatic)) in enumerate(zip(frames[:-1], _placements(model))):
         joint_frame = frame @ pre  # joint i+1's axis passes through its origin
@@ -143,7 +171,10 @@ def flange_motion(model: RobotModel, q, qd, qdd) -> tuple[np.ndarray, np.ndarray
     at (q, qd, qdd). Forward recursion from the base at rest, each joint's axis carried by
     the links before it: w_i = w + z qd_i, alpha_i = alpha + z qdd_i + w x z qd_i (turning;
     the acceleration of a point on the axis unchanged), a_i = a + z qdd_i + 2 w x z qd_i
-    (sliding), a point moved along a link by r: a + alpha x r + w x (w x r)."""
+    (sliding), a point moved along a link by r: a + alpha x r + w x (w x r). A chain only
+    (ValueError for a tree or mimic joints)."""
+    if not model.is_chain:
+        raise ValueError("flange_motion: a chain with its flange on the last joint only")
     qd, qdd = state(qd, model.n, "qd"), state(qdd, model.n, "qdd")
     frames = link_frames(model, q)
     placements = _placements(model)
@@ -176,3 +207,23 @@ def _cross(u, v) -> tuple:
 
 def _minus(u, v) -> tuple:
     return tuple(x - y for x, y in zip(u, v))
+
+
+def _jacobian(model: RobotModel, frames: np.ndarray, point: np.ndarray, link: int) -> np.ndarray:
+    """The 6 x n Jacobian of ``point`` (base frame) fixed to joint ``link``'s link, on a tree
+    and with mimic joints: the link's ancestors' columns, the others zero."""
+    J = np.zeros((6, model.n))
+    placements, coordinates = _placements(model), model.coordinates
+    i = link
+    while i >= 0:
+        pre, _, turning_axis, _, prismatic = placements[i]
+        joint_frame = frames[model.parent[i] + 1] @ pre
+        axis, origin = joint_frame[:3, :3] @ turning_axis, joint_frame[:3, 3]
+        k, multiplier, _ = coordinates[i]
+        if prismatic:
+            J[:3, k] += multiplier * axis
+        else:
+            J[:3, k] += multiplier * np.cross(axis, point - origin)
+            J[3:, k] += multiplier * axis
+        i = model.parent[i]
+    return J

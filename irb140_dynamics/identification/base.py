@@ -86,9 +86,9 @@ def _term(coefficient: float, name: str, digits: int) -> str:
 def random_states(model: RobotModel, count: int, rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(Q, QD, QDD) uniform within the joints' position, velocity and acceleration limits
     (+-2 rad/s and +-10 rad/s^2 where a joint gives none)."""
-    lower, upper = np.array([j.position_limits for j in model.joints]).T
-    speed = np.array([j.velocity_limit or 2.0 for j in model.joints])
-    acceleration = np.array([j.acceleration_limit or 10.0 for j in model.joints])
+    lower, upper = np.array([j.position_limits for j in model.independent_joints]).T
+    speed = np.array([j.velocity_limit or 2.0 for j in model.independent_joints])
+    acceleration = np.array([j.acceleration_limit or 10.0 for j in model.independent_joints])
     shape = (count, model.n)
     return (
         rng.uniform(lower, upper, shape),

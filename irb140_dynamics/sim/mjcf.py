@@ -1,6 +1,7 @@
 """A RobotModel as MuJoCo's model format (MJCF text), generated from the model directly.
 
-One body per link, its frame the link frame i. Body i sits in body i-1 at its zero-pose
+One body per link, its frame the link frame i, nested along ``model.parent`` (a tree: the
+bodies of two arms in the body of their torso). Body i sits in its parent's at its zero-pose
 placement pre_i * Rot(axis_i, offset_i) * post_i; its hinge turns it by
 post_i^-1 * Rot(axis_i, q_i) * post_i, i.e. about the axis R_post^T axis_i through the
 point -R_post^T t_post (the joint frame's origin) in body i's frame. Then
@@ -63,8 +64,23 @@ def mjcf(
         "  </option>",
         "  <worldbody>",
     ]
+    if model.mimics is not None:
+        raise ValueError("a model with mimic joints is not simulated yet (its joints would move freely)")
+    below = [[] for _ in model.joints]
+    for i, parent in enumerate(model.parent):
+        if parent >= 0:
+            below[parent].append(i)
+    last = model.carrier  # the payload's link
+    # depth first along model.parent: ("open", i) writes body i, ("close", i) ends it
+    stack = [("open", i) for i, parent in reversed(list(enumerate(model.parent))) if parent < 0]
     indent = "    "
-    for joint in model.joints:
+    while stack:
+        action, i = stack.pop()
+        if action == "close":
+            indent = indent[:-2]
+            lines.append(f"{indent}</body>")
+            continue
+        joint = model.joints[i]
         zero_pose = joint.transform(0.0)
         post = joint.post.matrix()
         R_post, t_post = post[:3, :3], post[:3, 3]
@@ -88,13 +104,12 @@ def mjcf(
         lines.append(f"{indent}<joint {' '.join(f'{k}={quoteattr(v)}' for k, v in attributes.items())}/>")
         if joint.link.mass > 0.0:
             lines.append(f"{indent}{_inertial(joint.link)}")
-    if model.payload.mass > 0.0:
-        lines.append(f"{indent}<body {_placement(model.flange.matrix())}>")  # unnamed: no clash with a link
-        lines.append(f"{indent}  {_inertial(model.payload)}")
-        lines.append(f"{indent}</body>")
-    for _ in model.joints:
-        indent = indent[:-2]
-        lines.append(f"{indent}</body>")
+        if i == last and model.payload.mass > 0.0:
+            lines.append(f"{indent}<body {_placement(model.flange.matrix())}>")  # unnamed: no clash with a link
+            lines.append(f"{indent}  {_inertial(model.payload)}")
+            lines.append(f"{indent}</body>")
+        stack.append(("close", i))
+        stack += [("open", child) for child in reversed(below[i])]
     lines += ["  </worldbody>", "</mujoco>", ""]
     return "\n".join(lines)
 

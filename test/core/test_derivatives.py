@@ -219,9 +219,12 @@ def test_chains_of_example_robot_data_agree_with_pinocchio():
         loaded = []
         for base, tip in chains(text):
             try:
-                loaded.append(load_urdf(text, base, tip).model)
+                model = load_urdf(text, base, tip).model
             except ModelError as refusal:  # mimic joints: the corpus test checks the refusals
                 assert "mimic" in str(refusal)
+                continue
+            if model.mimics is None:  # with mimic joints the derivatives are refused (test_urdf_trees)
+                loaded.append(model)
         if not full_sweep() and len(loaded) > 1:
             loaded = [loaded[rng.integers(len(loaded))]]
         for model in loaded:

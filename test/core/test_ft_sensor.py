@@ -14,7 +14,7 @@ from irb140_dynamics.core.ft_sensor.contact import contact_wrench, sensor_mount,
 from irb140_dynamics.core.ft_sensor.load_estimation import estimate_ft_load
 from irb140_dynamics.core.ft_sensor.stream import FtSensorStream
 from irb140_dynamics.core.io.urdf.reader import load_urdf
-from irb140_dynamics.core.io.urdf.writer import export_urdf, exported_links
+from irb140_dynamics.core.io.urdf.writer import export_urdf, exported_carried
 from irb140_dynamics.core.kinematics import flange_jacobian, flange_motion, flange_pose
 from irb140_dynamics.core.payload.mass_com_estimation import EstimationError, RestSample
 
@@ -66,7 +66,7 @@ def test_flange_motion_is_the_derivative_of_the_jacobian_velocity():
 def test_a_tool_alone_reads_no_contact_and_a_push_is_given_back(link):
     rng = np.random.default_rng(1)
     for model in arms():
-        mount = sensor_mount(model, link, exported_links(model))
+        mount = sensor_mount(model, link, exported_carried(model))
         bare = model.with_payload(RigidBody())
         for _ in range(10):
             q, qd, qdd = rng.normal(size=6), rng.normal(size=6), rng.normal(size=(6)) * 3
@@ -92,13 +92,15 @@ def test_links_of_the_exported_and_the_read_urdf_place_the_sensor_alike():
     read = load_urdf(export_urdf(model))
     q = np.random.default_rng(2).normal(size=6)
     for link in ("flange", "link_6"):
-        ours = flange_pose(model, q) @ sensor_mount(model, link, exported_links(model))
-        theirs = flange_pose(read.model, q) @ sensor_mount(read.model, link, read.links)
+        ours = flange_pose(model, q) @ sensor_mount(model, link, exported_carried(model))
+        theirs = flange_pose(read.model, q) @ sensor_mount(read.model, link, read.carried)
         np.testing.assert_allclose(ours, theirs, atol=1e-12)
-    with pytest.raises(ValueError, match=r"^ft_sensor.link: 'link_5' is moved by 5 of the 6 joints"):
-        sensor_mount(model, "link_5", exported_links(model))
-    with pytest.raises(ValueError, match=r"^ft_sensor.link: no link 'tool0' on the arm's chain \(links: base_link, "):
-        sensor_mount(model, "tool0", read.links)
+    with pytest.raises(ValueError, match=r"^ft_sensor.link: 'link_5' is moved by joint joint_5, not by joint_6"):
+        sensor_mount(model, "link_5", exported_carried(model))
+    with pytest.raises(
+        ValueError, match=r"^ft_sensor.link: no link 'tool0' that the arm's joints move \(links: flange, "
+    ):
+        sensor_mount(model, "tool0", read.carried)
 
 
 def rest_samples(model, mount, poses, bias, rng, noise=(0.05, 0.005)):
@@ -116,7 +118,7 @@ def rest_samples(model, mount, poses, bias, rng, noise=(0.05, 0.005)):
 def test_bias_mass_and_com_come_back_from_noisy_rests():
     rng = np.random.default_rng(4)
     for model in arms():
-        mount = sensor_mount(model, "link_6", exported_links(model))
+        mount = sensor_mount(model, "link_6", exported_carried(model))
         bias = np.array([3.0, -2.0, 5.0, 0.3, -0.2, 0.1])
         poses = rng.uniform(-1.5, 1.5, size=(8, 6))
         estimate = estimate_ft_load(model, rest_samples(model, mount, poses, bias, rng), mount)
@@ -174,5 +176,8 @@ def test_the_stream_refuses_a_bad_frame_or_link_or_turns_off_when_told():
         stream.use(model, "flange", "tool", None, 20.0)
     assert stream.model is model and stream.frame == "sensor"  # nothing changed
     refused = stream.use(model, "link_2", "sensor", None, 20.0, strict=False)
-    assert refused.startswith("ft_sensor.link: 'link_2' is moved by 2 of the 6 joints") and stream.model is None
+    assert (
+        refused.startswith("ft_sensor.link: 'link_2' is moved by joint joint_2, not by joint_6")
+        and stream.model is None
+    )
     assert refused.endswith("; the force/torque sensor is off")

@@ -25,6 +25,7 @@ from irb140_dynamics.native import compiler, library
 
 from ..support.common import OFFSET_PAYLOAD
 from ..support.paths import URDF_DATA
+from .test_urdf_trees import TWO_ARMS
 
 pytestmark = pytest.mark.skipif(native.c_compiler() is None, reason="no C compiler on this machine")
 
@@ -47,6 +48,8 @@ def arms() -> dict:
         "ur5": lambda: urdf("ur5.urdf", tip_link="tool0"),
         "panda": lambda: urdf("panda.urdf", tip_link="panda_link8"),
         "prismatic arm": lambda: urdf("prismatic_arm.urdf"),
+        "panda tree, a mimic finger": lambda: urdf("panda.urdf"),
+        "two arms, mimic joints before their joint": lambda: load_urdf(TWO_ARMS).model,
         "no payload or gravity constants": no_constants,
     }
 

@@ -116,12 +116,16 @@ def test_ur5_transmission_joints_are_not_joints_and_base_link_may_be_below_the_r
     assert_close(gravity(from_base.model, q), gravity(from_root.model, q), 1e-15, 1e-15)
 
 
-@pytest.mark.parametrize(
-    "name, leaves", [("ur5", "ee_link, tool0, base"), ("panda", "panda_hand_tcp, panda_leftfinger, panda_rightfinger")]
-)
-def test_several_leaves_and_no_tip_link_names_them(name, leaves):
-    with pytest.raises(ValueError, match=f"3 leaf links below .*: {leaves}; name one"):
-        load_urdf(arm_text(name))
+def test_several_leaves_and_no_tip_link_give_every_moving_joint():
+    """The UR5's leaves hang from fixed joints: its tree is its chain, to the last moving
+    link; the Panda's fingers make a tree, the second finger a mimic joint of the first."""
+    ur5 = load_urdf(arm_text("ur5")).model
+    assert ur5.joint_names == load_urdf(arm_text("ur5"), tip_link="tool0").model.joint_names
+    assert ur5.parent == (-1, 0, 1, 2, 3, 4)
+    panda = load_urdf(arm_text("panda"))
+    assert panda.model.joint_names == tuple(f"panda_joint{i}" for i in range(1, 8)) + ("panda_finger_joint1",)
+    assert panda.model.parent == (-1, 0, 1, 2, 3, 4, 5, 6, 6)
+    assert panda.model.mimics[-1].joint == "panda_finger_joint1" and panda.tip_link == "panda_rightfinger"
 
 
 def test_continuous_joint_gets_the_wide_default_range():

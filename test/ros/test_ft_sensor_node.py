@@ -94,7 +94,9 @@ def test_the_load_is_estimated_from_rests_and_a_push_reads_as_it_was():
 
 
 def test_a_sensor_link_before_the_last_joint_stops_the_start():
-    refused = r"^ft_sensor.link: 'link_3' is moved by 3 of the 6 joints: the sensor must"
+    refused = (
+        r"^ft_sensor.link: 'link_3' is moved by joint joint_3, not by joint_6 that carries the flange: the sensor must"
+    )
     with (
         pytest.raises(ValueError, match=refused),
         running(IdNode, parameter_overrides=[Parameter("ft_sensor.link", value="link_3")]),

@@ -155,3 +155,24 @@ def test_bad_options_are_refused():
         mjcf(irb140(), integrator="leapfrog")
     with pytest.raises(ValueError, match="timestep"):
         mjcf(irb140(), timestep=0.0)
+
+
+def test_a_tree_nests_its_bodies_along_parent_and_mimic_joints_are_refused():
+    """Two arms on a torso (test_urdf_trees): MuJoCo's inverse dynamics, M and gravity are the
+    core's; mimic joints are not simulated yet, said in one line."""
+    from ..core.test_urdf_trees import TWO_ARMS, _without_mimics
+
+    model = load_urdf(_without_mimics(TWO_ARMS)).model
+    assert not model.is_chain
+    mm = mujoco_model(model, friction=False, limits=False)
+    data = mujoco.MjData(mm)
+    for q, qd, qdd in zip(*(np.random.default_rng(21).uniform(-1, 1, (5, model.n)) for _ in range(3))):
+        data.qpos[:], data.qvel[:], data.qacc[:] = q, qd, qdd
+        mujoco.mj_inverse(mm, data)
+        assert_close(data.qfrc_inverse, rnea(model, q, qd, qdd) - model.friction.torques(qd), 1e-9, 1e-9)
+        M = np.zeros((model.n, model.n))
+        mujoco.mj_forward(mm, data)
+        mujoco.mj_fullM(mm, data, M)
+        assert_close(M, mass_matrix(model, q), 1e-9, 1e-9)
+    with pytest.raises(ValueError, match="mimic joints is not simulated yet"):
+        mjcf(load_urdf(TWO_ARMS).model)

@@ -39,22 +39,24 @@ def spatial_inertia(body) -> pin.Inertia:
 
 
 def build(robot) -> pin.Model:
-    """The Pinocchio model of ``robot`` (a RobotModel): joint ids 1..n, gravity included."""
+    """The Pinocchio model of ``robot`` (a RobotModel, a chain or a tree without mimic
+    joints): joint ids 1..n in ``robot.joints``' order, parents as ``robot.parent``, gravity
+    included."""
     model = pin.Model()
     model.gravity.linear = np.array(robot.gravity, dtype=float)
-    parent, previous_body = 0, pin.SE3.Identity()
-    for i, joint in enumerate(robot.joints):
+    bodies = []  # each joint's link frame in its joint frame
+    for i, (joint, parent) in enumerate(zip(robot.joints, robot.parent)):
         axis = np.array(joint.turning_axis, dtype=float)
         offset = pin.SE3(pin.AngleAxis(joint.offset, axis).matrix(), np.zeros(3))
+        previous_body = bodies[parent] if parent >= 0 else pin.SE3.Identity()
         placement = previous_body * se3(joint.pre) * offset
         kind = pin.JointModelRZ() if tuple(axis) == (0.0, 0.0, 1.0) else pin.JointModelRevoluteUnaligned(axis)
-        joint_id = model.addJoint(parent, kind, placement, joint.name)
+        joint_id = model.addJoint(parent + 1, kind, placement, joint.name)
         model.armature[i] = joint.armature
-        previous_body = body_placement(joint)
-        model.appendBodyToJoint(joint_id, spatial_inertia(joint.link), previous_body)
-        if i == robot.n - 1:
-            model.appendBodyToJoint(joint_id, spatial_inertia(robot.payload), previous_body * se3(robot.flange))
-        parent = joint_id
+        bodies.append(body_placement(joint))
+        model.appendBodyToJoint(joint_id, spatial_inertia(joint.link), bodies[-1])
+        if i == robot.carrier:  # the payload on the flange's link
+            model.appendBodyToJoint(joint_id, spatial_inertia(robot.payload), bodies[-1] * se3(robot.flange))
     return model
 
 

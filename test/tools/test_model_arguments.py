@@ -75,7 +75,7 @@ def test_a_params_file_naming_a_urdf_gives_the_urdf_model(tmp_path):
     ("kwargs", "message"),
     [
         (dict(urdf_file="/no/such.urdf"), "URDF: /no/such.urdf: no such URDF file"),
-        (dict(urdf_file=UR5_URDF), "leaf links below"),
+        (dict(urdf_file=UR5_URDF, tip_link="nowhere"), "no link 'nowhere'"),
         (dict(urdf_file=UR5_URDF, base_link="nowhere"), "nowhere"),
         (dict(base_link=BASE), "--base and --tip choose a URDF's chain"),
         (dict(overrides={"model.source": "topic"}), "model.source: must be one of"),

@@ -34,24 +34,24 @@ def test_counts_take_the_singular_for_one(tmp_path, capsys):
 @pytest.mark.parametrize(
     "main, arguments",
     [
-        (load_diagram.main, ["--urdf", UR5, "--out", "o"]),
-        (excitation.main, ["--urdf", UR5, "--out", "o.yaml"]),
-        (export_urdf.main, ["export_urdf", "--urdf", UR5]),
-        (identify.main, ["run.csv", "--urdf", UR5, "--out", "o.yaml"]),
-        (retime.main, ["--params-file", str(CONFIG), "--urdf", UR5, "--check-only", "in.yaml"]),
-        (equations.main, ["--urdf", UR5, "--form", "c", "--out", "o"]),
+        (load_diagram.main, ["--urdf", UR5, "--tip", "nosuch", "--out", "o"]),
+        (excitation.main, ["--urdf", UR5, "--tip", "nosuch", "--out", "o.yaml"]),
+        (export_urdf.main, ["export_urdf", "--urdf", UR5, "--tip", "nosuch"]),
+        (identify.main, ["run.csv", "--urdf", UR5, "--tip", "nosuch", "--out", "o.yaml"]),
+        (retime.main, ["--params-file", str(CONFIG), "--urdf", UR5, "--tip", "nosuch", "--check-only", "in.yaml"]),
+        (equations.main, ["--urdf", UR5, "--tip", "nosuch", "--form", "c", "--out", "o"]),
     ],
     ids=lambda value: getattr(value, "__module__", "").rsplit(".", 1)[-1] or None,
 )
 def test_a_chain_end_is_named_by_the_tools_option(main, arguments, tmp_path, capsys, monkeypatch):
-    """No tip given on a URDF of several leaves: the line asks for --tip (the core's and the
-    nodes' name, tip_link, is no option of a tool); a tip the params file names is named as there."""
+    """A tip that is no link of the URDF: the line names --tip (the core's and the nodes'
+    name, tip_link, is no option of a tool); a tip the params file names is named as there."""
     monkeypatch.chdir(tmp_path)
     for name in ("run.csv", "in.yaml"):
         (tmp_path / name).write_text("")
     assert main(arguments) == 1
     err = capsys.readouterr().err.splitlines()
-    assert len(err) == 1 and f"{UR5}: --tip: 3 leaf links below 'world': ee_link, tool0, base; name one" in err[0], err
+    assert len(err) == 1 and f"{UR5}: --tip: no link 'nosuch' in the URDF" in err[0], err
     assert "tip_link" not in err[0]
 
 

@@ -8,7 +8,9 @@ from irb140_dynamics.core.algorithms.recursions import (
     add,
     cross,
     dot,
+    gather,
     inertia_times,
+    parents,
     scale,
     steps,
     to_child,
@@ -20,12 +22,14 @@ from irb140_dynamics.core.scalars.dual import dual_angles, partial
 
 def kinetic_energy(links, cs, qd):
     """T = sum over links of 1/2 m v.v + v.(w x h) + 1/2 w.(I w), v the velocity of o_i."""
-    w, v = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    parent, velocities = parents(links), []
     energy = 0.0
-    for link, (rot, p0), qd_i in zip(links, steps(links, cs), qd):
+    for i, (link, (rot, p0), qd_i) in enumerate(zip(links, steps(links, cs), qd)):
+        w, v = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)) if parent[i] < 0 else velocities[parent[i]]
         v = _joint_velocity(link, p0, w, v, qd_i)
         w = to_child(link, rot, w) if link.prismatic else add(to_child(link, rot, w), scale(qd_i, link.b))
         v = add(to_child(link, rot, v), cross(w, link.p))
+        velocities.append((w, v))
         energy = energy + 0.5 * (link.m * dot(v, v) + dot(w, inertia_times(link.I, w))) + dot(v, cross(w, link.h))
     return energy
 
@@ -46,7 +50,7 @@ def energy_gradient(links, cs, qd):
 def momentum_terms(links, cs, qd):
     """[p, dT/dq]: the generalized momentum M qd and C^T qd, O(n).
 
-    With h_i the spatial momentum of link i, H_k the sum over the subtree k..n and v_k the
+    With h_i the spatial momentum of link i, H_k the sum over the subtree of link k (k and its descendants) and v_k the
     spatial velocity of link k: turning joint k at fixed qd turns the subtree about S_k,
     dv_i/dq_k = S_k x (v_i - v_k) and dI_i/dq_k = S_k x* I_i - I_i S_k x, which leaves
     (Featherstone's notation, x* the force cross product)
@@ -59,9 +63,10 @@ def momentum_terms(links, cs, qd):
     S_k . (v_k x* H_k) = b . (w x L).
     """
     moves = steps(links, cs)
-    w, v = ZERO3, ZERO3
+    parent = parents(links)
     frames = []
-    for link, (rot, p0), qd_i in zip(links, moves, qd):  # velocities, as forward_motion's
+    for i, (link, (rot, p0), qd_i) in enumerate(zip(links, moves, qd)):  # velocities, as forward_motion's
+        w, _, v = (ZERO3, ZERO3, ZERO3) if parent[i] < 0 else frames[parent[i]]
         v = _joint_velocity(link, p0, w, v, qd_i)
         w = to_child(link, rot, w) if link.prismatic else add(to_child(link, rot, w), scale(qd_i, link.b))
         u = to_child(link, rot, v)  # the joint origin's velocity, in frame i
@@ -69,11 +74,10 @@ def momentum_terms(links, cs, qd):
         frames.append((w, u, v))
     n_links = len(links)
     p, gradient = [0.0] * n_links, [0.0] * n_links
-    L, A = ZERO3, ZERO3  # the subtree's momentum
+    carried = [None] * n_links  # the children's subtrees' momentum, about o_i in frame i
     for i in reversed(range(n_links)):
         link, (w, u, v) = links[i], frames[i]
-        if i + 1 < n_links:
-            L, A = to_parent_wrench(links[i + 1], moves[i + 1], L, A)
+        L, A = carried[i] or (ZERO3, ZERO3)
         L_i = add(scale(link.m, v), cross(w, link.h))
         L = add(L, L_i)
         A = add(A, inertia_times(link.I, w), cross(link.h, v), cross(link.p, L))  # about o'_i
@@ -83,4 +87,6 @@ def momentum_terms(links, cs, qd):
         else:
             p[i] = dot(link.b, A) + link.armature * qd[i]
             gradient[i] = -dot(link.b, add(cross(w, A), cross(u, L)))
+        if parent[i] >= 0:
+            gather(carried, parent[i], to_parent_wrench(link, moves[i], L, A))
     return p + gradient

@@ -17,6 +17,11 @@ A prismatic joint i slides by d_i = q_i along its axis, e = R0 u in frame i-1: i
 origin o'_i = o_{i-1} + p0 + d_i e moves with it (``steps``), with velocity qd_i e and
 acceleration qdd_i e relative to frame i-1; its rotation Rot is the identity.
 
+The links form a tree: link i's parent is ``Link.parent`` (-1 the base, None the link
+before: a chain), parents before children, as spatial_v2's ``model.parent``; "frame i-1"
+below is the parent's frame. A link's motion comes from its parent's; the backward passes
+gather each link's children's wrenches into it.
+
 Vectors are 3-tuples, rotations 3x3 tuples of rows. A scalar may be a float, a NumPy array
 (many states at once) or a symbol of ``codegen`` (which turns these functions into
 straight-line code). So only ``+ - *`` are used, the joint angles enter as (cos, sin) pairs
@@ -32,6 +37,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from irb140_dynamics.core.algorithms.topology import ancestors, children, parents  # noqa: F401 (part of this module's interface)
 from irb140_dynamics.core.model.joints import Z_AXIS, snap
 from irb140_dynamics.core.model.rigid_body import ZERO3, Inertia6, Vector3, shift_inertia
 from irb140_dynamics.core.scalars.dual import Dual, dual_angles, partial  # noqa: F401 (Dual: part of this module's interface)
@@ -56,13 +62,22 @@ class Link:
     armature: float = 0.0
     prismatic: bool = False
     e: Vector3 = ZERO3  # a prismatic joint's axis in frame i-1 (R0 u)
+    parent: int | None = None  # the parent link's index, -1 the base; None: the link before (a chain)
 
 
 def chain(model) -> tuple[Link, ...]:
-    """The per-link constants of a RobotModel (payload merged into the last link)."""
+    """The per-link constants of a RobotModel, one per moving joint, mimic joints included
+    (payload merged into the last link); each link's ``parent`` is the model's, None where
+    it is the link before (so that a chain's links, and slices of them, are a chain)."""
     return tuple(
-        Link(*_joint_constants(joint), *body.about_origin(), joint.armature, *_slide(joint))
-        for joint, body in zip(model.joints, model.bodies)
+        Link(
+            *_joint_constants(joint),
+            *body.about_origin(),
+            joint.armature,
+            *_slide(joint),
+            parent=None if parent == i - 1 else parent,
+        )
+        for i, (joint, body, parent) in enumerate(zip(model.joints, model.bodies, model.parent))
     )
 
 
@@ -204,36 +219,51 @@ def steps(links, cs):
 # -- algorithms ---------------------------------------------------------------------
 
 
-def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3):
+def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3, at: int = -1):
     """Joint torques tau(q, qd, qdd) by the recursive Newton-Euler algorithm.
 
     ``cs`` holds (cos, sin) of each joint angle theta_i = q_i + theta_offset_i.
-    (f_ext, n_ext) is the wrench the environment exerts on the last link, in its frame, the
-    moment taken about its origin (see ``flange_wrench``); tau balances it (a load pressing
+    (f_ext, n_ext) is the wrench the environment exerts on the last link (link ``at``), in
+    its frame, the moment taken about its origin (see ``flange_wrench``); tau balances it (a load pressing
     on the flange raises tau like a weight would). Friction is not included.
     """
     moves = steps(links, cs)
     motion = forward_motion(links, moves, qd, qdd, gravity)
+    parent = parents(links)
     tau = [0.0] * len(links)
-    f, n = scale(-1.0, f_ext), scale(-1.0, n_ext)
+    # the wrench each link's children (the environment, for the last one) exert on it, about
+    # its origin o_i in its frame; gathered as the backward pass reaches them
+    carried = [None] * len(links)
+    carried[at] = scale(-1.0, f_ext), scale(-1.0, n_ext)
     for i in reversed(range(len(links))):
         link, (w, dw, a) = links[i], motion[i]
-        if i + 1 < len(links):
-            f, n = to_parent_wrench(links[i + 1], moves[i + 1], f, n)
+        f, n = carried[i] or (ZERO3, ZERO3)
         force = add(scale(link.m, a), cross(dw, link.h), cross(w, cross(w, link.h)))
         moment = add(inertia_times(link.I, dw), cross(w, inertia_times(link.I, w)), cross(link.h, a))
         f = add(force, f)
         n = add(moment, n, cross(link.p, f))
         tau[i] = dot(link.b, f if link.prismatic else n) + link.armature * qdd[i]
+        if parent[i] >= 0:
+            gather(carried, parent[i], to_parent_wrench(link, moves[i], f, n))
     return tau
+
+
+def gather(carried, i, wrench) -> None:
+    """Add a child's wrench (or momentum) to what link i carries."""
+    if carried[i] is None:
+        carried[i] = wrench
+    else:
+        carried[i] = add(carried[i][0], wrench[0]), add(carried[i][1], wrench[1])
 
 
 def forward_motion(links, moves, qd, qdd, gravity, at_joints=False):
     """(w, dw, a) of each link, in its frame, a at its origin (``at_joints``: at its joint
     origin o'_i); gravity as a base acceleration. ``moves``: see ``steps``."""
-    w, dw, a = ZERO3, ZERO3, scale(-1.0, gravity)
-    motion = []
-    for link, (rot, p0), qd_i, qdd_i in zip(links, moves, qd, qdd):
+    base = ZERO3, ZERO3, scale(-1.0, gravity)
+    parent = parents(links)
+    at_origins, motion = [], []
+    for i, (link, (rot, p0), qd_i, qdd_i) in enumerate(zip(links, moves, qd, qdd)):
+        w, dw, a = base if parent[i] < 0 else at_origins[parent[i]]
         if p0 is not None:  # the joint origin's acceleration, in frame i-1
             a = add(a, cross(dw, p0), cross(w, cross(w, p0)))
         if link.prismatic:  # sliding: qdd e, and Coriolis 2 w x (qd e)
@@ -245,6 +275,7 @@ def forward_motion(links, moves, qd, qdd, gravity, at_joints=False):
             dw = add(to_child(link, rot, dw), scale(qdd_i, link.b), cross(w_parent, scale(qd_i, link.b)))
         a_joint = to_child(link, rot, a)
         a = add(a_joint, cross(dw, link.p), cross(w, cross(w, link.p)))
+        at_origins.append((w, dw, a))
         motion.append((w, dw, a_joint if at_joints else a))
     return motion
 
@@ -264,17 +295,19 @@ def crba(links, cs):
     diagonal).
 
     Column j is the torque that a unit qdd_j needs with no velocity and no gravity: the
-    composite body j..n turns about joint j's axis, links before j stand still.
+    composite body of link j and its descendants turns about joint j's axis, the other
+    links stand still; only joint j's ancestors feel it (M_ij = 0 off that path).
     """
     moves = steps(links, cs)
     n_links = len(links)
+    parent, below = parents(links), children(links)
     composite = [None] * n_links
     for i in reversed(range(n_links)):
         m, h, inertia = links[i].m, links[i].h, links[i].I
-        if i + 1 < n_links:
-            child, (rot, p0) = links[i + 1], moves[i + 1]
-            m_c, h_c, inertia_c = composite[i + 1]
-            r = to_parent(child, rot, child.p)  # o_i -> o_(i+1), in frame i
+        for c in below[i]:
+            child, (rot, p0) = links[c], moves[c]
+            m_c, h_c, inertia_c = composite[c]
+            r = to_parent(child, rot, child.p)  # o_i -> o_c, in frame i
             if p0 is not None:
                 r = add(r, p0)
             m_c, h_c, inertia_c = shift_inertia(
@@ -294,10 +327,13 @@ def crba(links, cs):
             f = add(scale(m, a), cross(link.b, h))
             n = add(inertia_times(inertia, link.b), cross(h, a), cross(link.p, f))
         M[j][j] = dot(link.b, f if link.prismatic else n) + link.armature
-        for i in reversed(range(j)):
-            f, n = to_parent_wrench(links[i + 1], moves[i + 1], f, n)
+        k = j  # up the ancestors: only they feel joint j's acceleration
+        while parent[k] >= 0:
+            i = parent[k]
+            f, n = to_parent_wrench(links[k], moves[k], f, n)
             n = add(n, cross(links[i].p, f))
             M[i][j] = M[j][i] = dot(links[i].b, f if links[i].prismatic else n)
+            k = i
     return M
 
 
@@ -337,8 +373,12 @@ def christoffel_coriolis(links, cs, qd):
     Coriolis/centrifugal torque and Mdot - 2C is skew-symmetric. The partial derivatives
     of M are exact: crba runs on dual numbers carrying d/dq of each scalar.
     """
-    n = len(links)
-    M = crba(links, dual_angles(cs))
+    return christoffel(crba(links, dual_angles(cs)), qd)
+
+
+def christoffel(M, qd):
+    """C(q, qd) of M(q) given on dual numbers carrying d/dq (see christoffel_coriolis)."""
+    n = len(M)
     dM = [[[partial(M[i][j], k) for k in range(n)] for j in range(n)] for i in range(n)]
     return [
         [sum(0.5 * (dM[i][j][k] + dM[i][k][j] - dM[j][k][i]) * qd[k] for k in range(n)) for j in range(n)]

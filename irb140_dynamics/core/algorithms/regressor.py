@@ -9,6 +9,7 @@ from __future__ import annotations
 from irb140_dynamics.core.algorithms.recursions import (
     Link,
     add,
+    ancestors,
     cross,
     dot,
     forward_motion,
@@ -33,10 +34,12 @@ def rigid_body_regressor(links, cs, qd, qdd, gravity):
     for k in range(n):
         w, dw, a = _in_joint_frame(links[k], *motion[k])
         for column, (f, moment) in enumerate(_unit_wrenches(w, dw, a)):
-            for i in reversed(range(k + 1)):
-                if i < k:
-                    f, moment = _to_parent_joint_frame(links[i + 1], moves[i + 1], links[i], f, moment)
+            Y[k][INERTIAL_PARAMETERS * k + column] = dot(links[k].u, f if links[k].prismatic else moment)
+            child = k
+            for i in ancestors(links, k):  # only they carry link k's wrench
+                f, moment = _to_parent_joint_frame(links[child], moves[child], links[i], f, moment)
                 Y[i][INERTIAL_PARAMETERS * k + column] = dot(links[i].u, f if links[i].prismatic else moment)
+                child = i
     return Y
 
 

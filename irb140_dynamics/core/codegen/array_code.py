@@ -25,7 +25,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from irb140_dynamics.core.codegen.program import ANGLES, Program
-from irb140_dynamics.core.codegen.python_code import BOUND, bound, constant, parameters, unpacked
+from irb140_dynamics.core.codegen.python_code import BOUND, angle_name, bound, constant, parameters, unpacked
 
 _UFUNCS = {"*": "mul", "+": "add", "-": "sub", "/": "div", "neg": "neg", "tanh": "tanh"}
 _NAMESPACE = {
@@ -97,7 +97,7 @@ def _emit_into(program: Program, scalar_vars: set[str]):
             continue
         if op in ANGLES:  # an array of its own, computed as the Python form does
             q = names[args[0]]
-            names[k] = f"{op[0]}{q[1:]}"
+            names[k] = angle_name(program, k)
             lines.append(f"    {names[k]} = {op}({q if args[1] == 0.0 else f'{q} + {args[1]!r}'})")
             continue
         operands = [names[a] if isinstance(a, int) else constant(a) for a in args]

@@ -14,8 +14,9 @@ from __future__ import annotations
 from irb140_dynamics.core.algorithms import analytical_derivatives as analytical
 from irb140_dynamics.core.algorithms import derivatives
 from irb140_dynamics.core.algorithms import recursions as algorithms
-from irb140_dynamics.core.algorithms.linear import inverse
+from irb140_dynamics.core.algorithms.linear import inverse, negated, times, times_vector
 from irb140_dynamics.core.codegen.trace import operands_first, tanh
+from irb140_dynamics.core.scalars.dual import Dual
 
 REFERENCES = 2  # frames tried for the analytical derivatives: links 0 and 1 (see _shortest)
 
@@ -35,9 +36,65 @@ def friction_terms(arm, k, qd, kind: str | None):
     return torques, [v + c * (1.0 - t * t) / s for v, c, t in zip(viscous, coulomb, shapes)]
 
 
+def _on_a_tree(arm) -> bool:
+    """Whether the arm is a tree (not a chain) or has mimic joints: its derivatives then
+    come from the definitions on dual numbers (``derivatives``, or ``_coordinate_partials``)."""
+    return arm.coupled is not None or any(link.parent is not None for link in arm.links)
+
+
+def _coordinate_partials(arm, links, cs, qd, qdd, gravity, slopes=None):
+    """(d tau / dq, d tau / dqd) of the coordinates of an arm with mimic joints: rnea on
+    dual numbers carrying d/dq_k and d/dqd_k, every link's from its coordinate's."""
+    n = arm.n
+    zeros = (0.0,) * (2 * n)
+    velocities = [Dual(v, zeros[: n + k] + (1.0,) + zeros[n + k + 1 :]) for k, v in enumerate(qd)]
+    angles, velocities, accelerations = arm.expanded(arm.dual_angles(cs, 2 * n), velocities, qdd)
+    tau = arm.projected(algorithms.rnea(links, angles, velocities, accelerations, gravity))
+    parts = [t.d if isinstance(t, Dual) else zeros for t in tau]
+    dq, dqd = [list(p[:n]) for p in parts], [list(p[n:]) for p in parts]
+    for i, slope in enumerate(slopes or ()):
+        dqd[i][i] = dqd[i][i] + slope
+    return dq, dqd
+
+
+def _coordinate_forward(arm, links, cs, qd, tau, gravity, friction_torques=None):
+    """(qdd, M, M^-1) of the coordinates of an arm with mimic joints."""
+    angles, velocities = arm.expanded(cs, qd)
+    M = arm.projected_matrix(algorithms.crba(links, angles))
+    bias = arm.projected(algorithms.rnea(links, angles, velocities, [0.0] * arm.n_links, gravity))
+    if friction_torques is not None:
+        bias = [b + f for b, f in zip(bias, friction_torques)]
+    Minv = inverse(M)
+    return times_vector(Minv, [t - b for t, b in zip(tau, bias)]), M, Minv
+
+
+def _partials(arm, links, cs, qd, qdd, gravity, slopes):
+    if arm.coupled is not None:
+        return _coordinate_partials(arm, links, cs, qd, qdd, gravity, slopes)
+    return derivatives.rnea_partials(links, cs, qd, qdd, gravity, slopes)
+
+
+def _forward(arm, links, cs, qd, tau, gravity, friction_torques):
+    if arm.coupled is not None:
+        return _coordinate_forward(arm, links, cs, qd, tau, gravity, friction_torques)
+    return derivatives.forward_dynamics(links, cs, qd, tau, gravity, friction_torques)
+
+
+def _mass_matrix(arm, links, cs):
+    (angles,) = arm.expanded(cs)
+    return arm.projected_matrix(algorithms.crba(links, angles))
+
+
+def _flat(*matrices) -> list:
+    return [x for matrix in matrices for row in matrix for x in row]
+
+
 def rnea_derivatives(arm, cs, qd, qdd, k, friction=None):
     """[d tau / dq, d tau / dqd, M]."""
     links, terms = arm.links_with(k), friction_terms(arm, k, qd, friction)
+    if _on_a_tree(arm):
+        dq, dqd = _partials(arm, links, cs, qd, qdd, arm.gravity_of(k), terms and terms[1])
+        return _flat(dq, dqd, _mass_matrix(arm, links, cs))
     return _shortest(
         lambda r: analytical.rnea_partials(links, cs, qd, qdd, arm.gravity_of(k), terms and terms[1], r), arm.n
     )
@@ -46,12 +103,18 @@ def rnea_derivatives(arm, cs, qd, qdd, k, friction=None):
 def forward_dynamics(arm, cs, qd, tau, k, friction=None):
     """qdd = M^-1 (tau - b(q, qd)), friction in b."""
     terms = friction_terms(arm, k, qd, friction)
-    return derivatives.forward_dynamics(arm.links_with(k), cs, qd, tau, arm.gravity_of(k), terms and terms[0])[0]
+    return _forward(arm, arm.links_with(k), cs, qd, tau, arm.gravity_of(k), terms and terms[0])[0]
 
 
 def forward_dynamics_derivatives(arm, cs, qd, tau, k, friction=None):
-    """[d qdd / dq, d qdd / dqd, M^-1]."""
+    """[d qdd / dq, d qdd / dqd, M^-1]: on a tree -M^-1 d tau / d(q, qd) at qdd = FD(q, qd, tau)."""
     links, terms = arm.links_with(k), friction_terms(arm, k, qd, friction)
+    if _on_a_tree(arm):
+        gravity = arm.gravity_of(k)
+        qdd, _, Minv = _forward(arm, links, cs, qd, tau, gravity, terms and terms[0])
+        dq, dqd = _partials(arm, links, cs, qd, qdd, gravity, terms and terms[1])
+        minus = negated(Minv)
+        return _flat(times(minus, dq), times(minus, dqd), Minv)
     return _shortest(
         lambda r: analytical.forward_dynamics_partials(links, cs, qd, tau, arm.gravity_of(k), terms, r), arm.n
     )
@@ -59,7 +122,7 @@ def forward_dynamics_derivatives(arm, cs, qd, tau, k, friction=None):
 
 def inverse_mass_matrix(arm, cs, k):
     """The upper triangle of M^-1, row by row."""
-    Minv = inverse(algorithms.crba(arm.links_with(k), cs))
+    Minv = inverse(_mass_matrix(arm, arm.links_with(k), cs))
     return [Minv[i][j] for i in range(arm.n) for j in range(i, arm.n)]
 
 

@@ -2,8 +2,8 @@
 the one the public verbs use (as Pinocchio keeps what a call needs in ``Data``, apart from
 its ``Model``).
 
-The payload (merged into the last link) and gravity are not folded into the code: their
-13 numbers (m, h, I about the origin of the last link; g) are the kernels' last argument
+The payload (merged into the last link, or the ``flange_joint``'s) and gravity are not folded
+into the code: their 13 numbers (m, h, I about the origin of that link; g) are the kernels' last argument
 ``k``, whose default is the model's own. Only the zero ones are folded (as the rest of the
 model is), so models that differ only in payload or gravity share their traced code
 (cached per arm and pattern of zeros, see ``_arm``): changing the payload mass, or moving
@@ -24,6 +24,7 @@ from functools import cached_property, lru_cache, partial
 
 from irb140_dynamics import native_hook
 from irb140_dynamics.core.algorithms import recursions as algorithms
+from irb140_dynamics.core.algorithms.mimic import Coordinates, coupling
 from irb140_dynamics.core.codegen.array_code import compile_into
 from irb140_dynamics.core.codegen.program import Program, traced, with_friction
 from irb140_dynamics.core.codegen.python_code import compile_python
@@ -153,13 +154,14 @@ class Kernels:
         self.shape = (model.n,)  # of a state array, compared on the hot paths
         self.links = links = algorithms.chain(model)  # the whole model's, for other number types
         self.gravity = model.gravity
-        last = links[-1]
-        constants = (last.m, *last.h, *last.I, *model.gravity)
+        at = model.carrier  # the payload's link: the last one's, or the flange_joint's
+        carrier = links[at]
+        constants = (carrier.m, *carrier.h, *carrier.I, *model.gravity)
         # plain floats: a NumPy scalar (a URDF inertial turned by NumPy) would make every
         # operation it enters several times slower
         self.constants = tuple(float(x) for x in constants if x != 0.0)
-        arm = links[:-1] + (replace(last, m=0.0, h=ZERO3, I=ZERO6),)
-        self._arm = _arm(arm, model.flange, tuple(x != 0.0 for x in constants))
+        arm = links[:at] + (replace(carrier, m=0.0, h=ZERO3, I=ZERO6),) + links[at + 1 :]
+        self._arm = _arm(arm, model.flange, tuple(x != 0.0 for x in constants), coupling(model), at)
         self._friction = model.friction
         self._made: dict[str, Kernel] = {}
         self._lock = threading.Lock()  # one kernel of a name, also when threads ask at once
@@ -259,8 +261,8 @@ def prepare(model, timeout: float | None = None, names: tuple[str, ...] = NATIVE
 
 
 @lru_cache(maxsize=ARMS_CACHED)
-def _arm(links, flange, nonzero: tuple[bool, ...]) -> ArmKernels:
-    return ArmKernels(links, flange, nonzero)
+def _arm(links, flange, nonzero: tuple[bool, ...], coupled=None, carrier: int = -1) -> ArmKernels:
+    return ArmKernels(links, flange, nonzero, coupled, carrier)
 
 
 @dataclass(frozen=True)
@@ -270,19 +272,19 @@ class _Flange:
     flange: object
 
 
-class ArmKernels:
+class ArmKernels(Coordinates):
     """The traces of an arm (its links, the last one's inertia left out), each made once on
     first use; the last link's inertia and gravity come from the argument ``k``, its
     nonzero ones of the 13 numbers (``nonzero``), the others are zero."""
 
-    def __init__(self, links, flange, nonzero: tuple[bool, ...]):
-        self.n = len(links)
+    def __init__(self, links, flange, nonzero: tuple[bool, ...], coupled=None, carrier: int = -1):
         self.links = links
+        self.carrier = carrier % len(links)  # the link the payload and a flange wrench are on
         self.flange = _Flange(flange)
         self.nonzero = nonzero
-        self.angles = [None if link.prismatic else link.theta_offset for link in links]
         self._traces: dict[str, Trace] = {}
         self._lock = threading.RLock()  # one trace of a kernel, also when threads ask at once
+        Coordinates.__init__(self, links, coupled)
 
     def has(self, name: str) -> bool:
         return name in self._traces
@@ -306,7 +308,7 @@ class ArmKernels:
                 inputs = {group: 6 if group == "wrench" else self.n for group in recipe.groups}
                 inputs["k"] = sum(self.nonzero) + {None: 0, "viscous": self.n, "coulomb": 2 * self.n + 1}[friction]
                 algorithm = partial(recipe.algorithm, friction=friction) if recipe.friction else recipe.algorithm
-                program = traced(name, lambda *args: algorithm(self, *args), inputs, self.angles)
+                program = traced(name, lambda *args: algorithm(self, *args), inputs, self.angles, self.mimic_angles)
                 if recipe.matrices:
                     program = replace(program, matrices=recipe.matrices)
                 trace = Trace(program, self.n if recipe.matrix else 0)
@@ -319,9 +321,10 @@ class ArmKernels:
         return tuple(next(given) if used else 0.0 for used in self.nonzero)
 
     def links_with(self, k):
-        """The links with the last one's inertia from k."""
+        """The links with the carrier's (the last one's) inertia from k."""
         x = self._spread(k)
-        return self.links[:-1] + (replace(self.links[-1], m=x[0], h=x[1:4], I=x[4:10]),)
+        at = self.carrier
+        return self.links[:at] + (replace(self.links[at], m=x[0], h=x[1:4], I=x[4:10]),) + self.links[at + 1 :]
 
     def gravity_of(self, k):
         return self._spread(k)[10:13]

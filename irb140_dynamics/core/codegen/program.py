@@ -12,7 +12,8 @@ An operation is ``(op, args)``:
 - ``("in", (name,))``: an input, ``name`` = group and index, e.g. ``qd2``;
 - ``("+" | "-" | "*" | "/", (a, b))``, ``("neg", (a,))``, ``("tanh", (a,))``;
 - ``("cos" | "sin", (a, offset))``: cos or sin of input ``a`` plus the float ``offset``
-  (a joint angle: theta_i = q_i + theta_offset_i; offset 0.0 adds nothing).
+  (a joint angle: theta_i = q_i + theta_offset_i; offset 0.0 adds nothing); for a mimic
+  joint ``a`` is the operation multiplier * q_k.
 
 An operand is an int (the index of an earlier operation) or a float (a constant).
 """
@@ -60,14 +61,19 @@ class Program:
 
 
 def traced(
-    name: str, algorithm: Callable[..., Sequence], inputs: dict[str, int], angles: Sequence[float] | None = None
+    name: str,
+    algorithm: Callable[..., Sequence],
+    inputs: dict[str, int],
+    angles: Sequence[float] | None = None,
+    mimic_angles: Sequence[tuple] = (),
 ) -> Program:
     """``algorithm`` traced (see ``trace.trace``) and lowered to a Program: each operation
-    once, the joint angles' cos and sin as operations on q."""
-    _, outputs = trace(algorithm, inputs, angles)
+    once, the joint angles' cos and sin as operations on q (a mimic joint's on
+    multiplier * q_k)."""
+    _, outputs = trace(algorithm, inputs, angles, mimic_angles)
     outputs = merged(outputs)
     groups = ((("q", len(angles)),) if angles is not None else ()) + tuple(inputs.items())
-    builder = _Builder()
+    builder = _Builder(mimic_angles)
     index: dict[int, int] = {}
     for x in operands_first(outputs):
         if x.op == "var":
@@ -80,9 +86,11 @@ def traced(
 
 
 class _Builder:
-    def __init__(self):
+    def __init__(self, mimic_angles=()):
         self.ops: list[tuple[str, tuple]] = []
         self.inputs: dict[str, int] = {}
+        self.mimic_angles = mimic_angles
+        self.scaled: dict[int, int] = {}  # mimic j -> the operation multiplier * q_k
 
     def add(self, op: str, args: tuple) -> int:
         self.ops.append((op, args))
@@ -98,6 +106,16 @@ class _Builder:
         if name[0] in "cs" and name[1:].isdigit():
             i = int(name[1:])
             return self.add("cos" if name[0] == "c" else "sin", (self.input(f"q{i}"), float(angles[i])))
+        if name[:2] in ("mc", "ms", "mq") and name[2:].isdigit():
+            j = int(name[2:])
+            k, multiplier, offset, _ = self.mimic_angles[j]
+            if j not in self.scaled:
+                q = self.input(f"q{k}")
+                self.scaled[j] = q if multiplier == 1.0 else self.add("*", (q, float(multiplier)))
+            x = self.scaled[j]
+            if name[1] == "q":  # a prismatic joint's slide, multiplier q_k + offset
+                return x if offset == 0.0 else self.add("+", (x, float(offset)))
+            return self.add("cos" if name[1] == "c" else "sin", (x, float(offset)))
         return self.input(name)
 
 

@@ -25,6 +25,18 @@ def constant(x: float) -> str:
     return f"({float(x)!r})" if x < 0 else repr(float(x))
 
 
+def angle_name(program: Program, k: int) -> str:
+    """The variable of the cos or sin operation k: c3 for cos(q3 + offset), as a joint's;
+    another one on the same q (a mimic joint's), or on an operation, gets its index too."""
+    op, (a, offset) = program.ops[k]
+    source_op, source_args = program.ops[a]
+    if source_op == "in":
+        first = next(j for j, (o, args) in enumerate(program.ops) if o == op and args[0] == a)
+        if first == k:
+            return f"{op[0]}{source_args[0][1:]}"
+    return f"{op[0]}_{k}"
+
+
 def statements(program: Program) -> tuple[list[tuple[str, str]], list[str]]:
     """(assignments (variable, expression) in order, the outputs' expressions)."""
     uses = program.uses()
@@ -46,7 +58,7 @@ def statements(program: Program) -> tuple[list[tuple[str, str]], list[str]]:
         if op in ANGLES:
             q = exprs[args[0]]
             theta = q if args[1] == 0.0 else f"{q} + {args[1]!r}"
-            name = f"{op[0]}{q[1:]}"
+            name = angle_name(program, k)
             lines.append((name, f"{op}({theta})"))
             exprs.append(name)
             depth.append(0)

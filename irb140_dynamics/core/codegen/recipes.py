@@ -28,50 +28,71 @@ class Recipe:
 
 
 def _rnea(arm, cs, qd, qdd, k):
-    return algorithms.rnea(arm.links_with(k), cs, qd, qdd, arm.gravity_of(k))
+    cs, qd, qdd = arm.expanded(cs, qd, qdd)
+    return arm.projected(algorithms.rnea(arm.links_with(k), cs, qd, qdd, arm.gravity_of(k)))
 
 
 def _rnea_wrench(arm, cs, qd, qdd, wrench, k):
+    cs, qd, qdd = arm.expanded(cs, qd, qdd)
     force, moment = algorithms.flange_wrench(arm.flange, wrench[:3], wrench[3:])
-    return algorithms.rnea(arm.links_with(k), cs, qd, qdd, arm.gravity_of(k), force, moment)
+    links, gravity = arm.links_with(k), arm.gravity_of(k)
+    return arm.projected(algorithms.rnea(links, cs, qd, qdd, gravity, force, moment, at=arm.carrier))
 
 
 def _gravity(arm, cs, k):
-    zeros = [0.0] * arm.n
-    return algorithms.rnea(arm.links_with(k), cs, zeros, zeros, arm.gravity_of(k))
+    zeros = [0.0] * arm.n_links
+    (cs,) = arm.expanded(cs)
+    return arm.projected(algorithms.rnea(arm.links_with(k), cs, zeros, zeros, arm.gravity_of(k)))
 
 
 def _coriolis(arm, cs, qd, k):
-    return algorithms.rnea(arm.links_with(k), cs, qd, [0.0] * arm.n, (0.0, 0.0, 0.0))
+    cs, qd = arm.expanded(cs, qd)
+    return arm.projected(algorithms.rnea(arm.links_with(k), cs, qd, [0.0] * arm.n_links, (0.0, 0.0, 0.0)))
 
 
 def _mass_matrix(arm, cs, k):
-    M = algorithms.crba(arm.links_with(k), cs)
+    (cs,) = arm.expanded(cs)
+    M = arm.projected_matrix(algorithms.crba(arm.links_with(k), cs))
     return [M[i][j] for i in range(arm.n) for j in range(i, arm.n)]
 
 
 def _coriolis_matrix(arm, cs, qd, k):
-    return [x for row in algorithms.christoffel_coriolis(arm.links_with(k), cs, qd) for x in row]
+    if arm.coupled is None:
+        return [x for row in algorithms.christoffel_coriolis(arm.links_with(k), cs, qd) for x in row]
+    (angles,) = arm.expanded(arm.dual_angles(cs, arm.n))  # M(q) of the coordinates, on dual numbers
+    M = arm.projected_matrix(algorithms.crba(arm.links_with(k), angles))
+    return [x for row in algorithms.christoffel(M, qd) for x in row]
 
 
 def _regressor(arm, cs, qd, qdd, k):
     # column by column, as the algorithm computes them: then the array form (see
     # array_code) keeps few intermediates alive (29 buffers for the IRB-140, not 138)
+    _only_without_mimic(arm, "the regressor")
     Y = rigid_body_regressor(arm.links_with(k), cs, qd, qdd, arm.gravity_of(k))
     return [x for column in zip(*Y) for x in column]
 
 
 def _momentum(arm, cs, qd, k):
-    return momentum_terms(arm.links_with(k), cs, qd)
+    cs, qd = arm.expanded(cs, qd)
+    terms = momentum_terms(arm.links_with(k), cs, qd)
+    return arm.projected(terms[: arm.n_links]) + arm.projected(terms[arm.n_links :])
 
 
 def _monitor(arm, cs, qd, qdd, k):
-    links, gravity, zeros = arm.links_with(k), arm.gravity_of(k), [0.0] * arm.n
+    cs, qd, qdd = arm.expanded(cs, qd, qdd)
+    links, gravity, zeros = arm.links_with(k), arm.gravity_of(k), [0.0] * arm.n_links
+    terms = momentum_terms(links, cs, qd)
     return [
-        *algorithms.rnea(links, cs, qd, qdd, gravity),
-        *algorithms.rnea(links, cs, zeros, zeros, gravity),
-        *momentum_terms(links, cs, qd),
+        *arm.projected(algorithms.rnea(links, cs, qd, qdd, gravity)),
+        *arm.projected(algorithms.rnea(links, cs, zeros, zeros, gravity)),
+        *arm.projected(terms[: arm.n_links]),
+        *arm.projected(terms[arm.n_links :]),
     ]
+
+
+def _only_without_mimic(arm, what: str) -> None:
+    if arm.coupled is not None:
+        raise ValueError(f"{what} is not available for a model with mimic joints")
 
 
 RECIPES = {  # every kernel, by name; q comes first in each

@@ -125,13 +125,21 @@ def _is_const(x) -> bool:
     return False
 
 
-def trace(algorithm: Callable[..., Sequence], inputs: dict[str, int], angles: Sequence[float] | None = None):
+def trace(
+    algorithm: Callable[..., Sequence],
+    inputs: dict[str, int],
+    angles: Sequence[float] | None = None,
+    mimic_angles: Sequence[tuple] = (),
+):
     """Run ``algorithm`` on symbols: (the parameters' names, the outputs: Syms and floats).
 
     ``inputs`` names the argument groups and their lengths, e.g. {"qd": 6, "qdd": 6}.
     With ``angles`` (the theta offsets), a first argument ``q`` is added and the algorithm
     receives the (cos, sin) pairs of q_i + offset_i (symbols c_i, s_i) as its first argument;
-    an offset None marks a prismatic joint, whose entry is (q_i,).
+    an offset None marks a prismatic joint, whose entry is (q_i,). ``mimic_angles``, each
+    (k, multiplier, offset, prismatic), append the entries of joints following q_k: the
+    (cos, sin) of multiplier q_k + offset (symbols mc_j, ms_j), or (multiplier q_k + offset,)
+    (symbol mq_j).
     """
     args = {}
     params = []
@@ -140,6 +148,9 @@ def trace(algorithm: Callable[..., Sequence], inputs: dict[str, int], angles: Se
         args["cs"] = [
             (Sym("var", name=f"q{i}"),) if offset is None else (Sym("var", name=f"c{i}"), Sym("var", name=f"s{i}"))
             for i, offset in enumerate(angles)
+        ] + [
+            (Sym("var", name=f"mq{j}"),) if prismatic else (Sym("var", name=f"mc{j}"), Sym("var", name=f"ms{j}"))
+            for j, (_, _, _, prismatic) in enumerate(mimic_angles)
         ]
     for group, length in inputs.items():
         params.append(group)

@@ -26,6 +26,7 @@ import sympy as sp
 from sympy.core.parameters import distribute
 
 from ..algorithms import recursions as algorithms
+from ..algorithms.mimic import Coordinates, coupling
 from ..algorithms.regressor import rigid_body_regressor
 from ..model.rigid_body import shift_inertia
 from ..regressor import JOINT_TERMS, LINK_PARAMETERS, PARAMETERS_PER_JOINT
@@ -87,6 +88,17 @@ def joint_input(q: sp.Symbol, link):
     return angle_pair(q, link.theta_offset)
 
 
+def _angles(coordinates, q) -> list:
+    """What the recursions take for each coordinate's joint, then for each mimic joint
+    (cos, sin) of multiplier q_k + offset, or (multiplier q_k + offset,) (see ``Coordinates``)."""
+    independent = [i for i, c in enumerate(coordinates.coupled or range(len(q))) if isinstance(c, int)]
+    cs = [joint_input(q_i, coordinates.links[i]) for q_i, i in zip(q, independent)]
+    for k, multiplier, offset, prismatic in coordinates.mimic_angles:
+        x = _exact(multiplier) * q[k]
+        cs.append((x + _exact(offset),) if prismatic else angle_pair(x, offset))
+    return cs
+
+
 def derive(model, what=DEFAULT_QUANTITIES, symbolic: bool = False, progress: Callable[[str], None] = None):
     """The Equations of ``model`` for the quantities ``what`` (names from QUANTITIES)."""
     unknown = [w for w in what if w not in QUANTITIES]
@@ -95,28 +107,35 @@ def derive(model, what=DEFAULT_QUANTITIES, symbolic: bool = False, progress: Cal
     progress = progress or (lambda stage: None)
     n = model.n
     q, qd, qdd = joint_symbols(n)
+    if model.mimics is not None and (symbolic or "regressor" in what):
+        raise ValueError("a model with mimic joints is written with its numbers, without the regressor")
+    if model.flange_joint is not None and symbolic:
+        raise ValueError("symbolic parameters take the payload on the last link (no flange_joint)")
     links, parameters, friction = links_of(model, symbolic)
-    cs = [joint_input(q_i, link) for q_i, link in zip(q, links)]
-    zeros = [0] * n
+    coordinates = Coordinates(links, coupling(model))
+    cs = coordinates.expanded(_angles(coordinates, q))[0]
+    zeros = [0] * len(links)
+    project = coordinates.projected
+    full_qd, full_qdd = coordinates.expanded(cs, qd, qdd)[1:]
     quantities, shapes, arguments = {}, {}, {}
     with distribute(False):
         if "tau" in what:
             progress("tau by Newton-Euler")
-            tau = algorithms.rnea(links, cs, qd, qdd, _exact(model.gravity))
+            tau = project(algorithms.rnea(links, cs, full_qd, full_qdd, _exact(model.gravity)))
             quantities["tau"] = [t + _friction(friction, i, qd[i]) for i, t in enumerate(tau)]
             shapes["tau"], arguments["tau"] = (n,), ("q", "qd", "qdd")
         if "M" in what:
             progress("M by composite rigid bodies")
-            M = algorithms.crba(links, cs)
+            M = coordinates.projected_matrix(algorithms.crba(links, cs))
             quantities["M"] = [M[i][j] for i in range(n) for j in range(n)]
             shapes["M"], arguments["M"] = (n, n), ("q",)
         if "C" in what:
             progress("C(q, qd) qd by Newton-Euler")
-            quantities["Cqd"] = list(algorithms.rnea(links, cs, qd, zeros, (0, 0, 0)))
+            quantities["Cqd"] = project(algorithms.rnea(links, cs, full_qd, zeros, (0, 0, 0)))
             shapes["Cqd"], arguments["Cqd"] = (n,), ("q", "qd")
         if "g" in what:
             progress("g by Newton-Euler")
-            quantities["g"] = list(algorithms.rnea(links, cs, zeros, zeros, _exact(model.gravity)))
+            quantities["g"] = project(algorithms.rnea(links, cs, zeros, zeros, _exact(model.gravity)))
             shapes["g"], arguments["g"] = (n,), ("q",)
         if "regressor" in what:
             progress("the regressor")
@@ -162,8 +181,9 @@ def links_of(model, symbolic: bool, scalar: Callable = None):
     links = exact_links(algorithms.chain(model))
     if not symbolic:
         friction = None
-        if model.friction is not None:
-            friction = [(j.friction.viscous, j.friction.coulomb, model.smoothing_velocity) for j in model.joints]
+        if model.friction is not None:  # per coordinate, a mimic joint's carried by its joint
+            f = model.friction
+            friction = [(v, c, model.smoothing_velocity) for v, c in zip(f.viscous.tolist(), f.coulomb.tolist())]
         return links, (), friction
     arm = exact_links(algorithms.chain(model.with_payload(type(model.payload)())))
     parameters: list[Parameter] = []

@@ -23,7 +23,7 @@ torque is about the sensor's origin in both.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -37,20 +37,25 @@ FRAMES = ("sensor", "base")
 NO_BIAS = np.zeros(6)
 
 
-def sensor_mount(model: RobotModel, link: str, links: Sequence[tuple[str, int, Placement]]) -> np.ndarray:
-    """The sensor frame in the flange frame (4x4) when the sensor is on ``link``; ``links``:
-    the arm's chain as (name, k, placement in link frame k) (``LoadedUrdf.links``, or
-    ``exported_links`` for a model of parameters). ValueError naming ft_sensor.link for a
-    link not on the chain, or one before the last moving joint (the tool would be links)."""
-    found = [(k, placement) for name, k, placement in links if name == link]
-    if not found:
-        names = ", ".join(name for name, _, _ in links)
-        raise ValueError(f"ft_sensor.link: no link {link[:80]!r} on the arm's chain (links: {names})")
-    k, placement = found[0]
-    if k != model.n:
+def sensor_mount(model: RobotModel, link: str, carried: Mapping[str, tuple[str, Placement]]) -> np.ndarray:
+    """The sensor frame in the flange frame (4x4) when the sensor is on ``link``; ``carried``:
+    the links the arm's joints move, link -> (joint, placement in its link frame)
+    (``LoadedUrdf.carried``, or ``exported_carried`` for a model of parameters). ValueError
+    naming ft_sensor.link for a link no joint moves, or one the flange's joint does not carry
+    (the tool would be links), or on a model that is no plain chain (``flange_motion``'s)."""
+    if not model.is_chain:
         raise ValueError(
-            f"ft_sensor.link: {link!r} is moved by {k} of the {model.n} joints: the sensor must be on the last "
-            "link (the tool beyond it is the payload)"
+            "ft_sensor.link: a force/torque sensor needs an arm that is one chain (no tree, no mimic joint)"
+        )
+    if link not in carried:
+        names = ", ".join(sorted(carried)[:12])
+        raise ValueError(f"ft_sensor.link: no link {link[:80]!r} that the arm's joints move (links: {names})")
+    joint, placement = carried[link]
+    last = model.joints[model.carrier].name
+    if joint != last:
+        raise ValueError(
+            f"ft_sensor.link: {link!r} is moved by joint {joint}, not by {last} that carries the flange: the "
+            "sensor must be on the flange's link (the tool beyond it is the payload)"
         )
     return _rigid_inverse(model.flange.matrix()) @ placement.matrix()
 

@@ -19,7 +19,7 @@ import numpy as np
 from irb140_dynamics.core.errors import check_choice
 from irb140_dynamics.core.ft_sensor.contact import FRAMES, NO_BIAS, contact_wrench, sensor_mount
 from irb140_dynamics.core.ft_sensor.load_estimation import FtLoadEstimate, estimate_ft_load
-from irb140_dynamics.core.io.urdf.writer import exported_links
+from irb140_dynamics.core.io.urdf.writer import exported_carried
 from irb140_dynamics.core.model.joint_order import BadMessage
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.monitoring.filters import VelocityDifferentiator
@@ -42,20 +42,20 @@ class FtSensorStream:
         self._states: deque = deque(maxlen=HISTORY)
         self._differentiator: VelocityDifferentiator | None = None
 
-    def use(self, model: RobotModel, link: str, frame: str, links, cutoff: float, strict: bool = True) -> str | None:
-        """The settings in force: the sensor on ``link`` ("" = off) of ``model``'s chain
-        ``links`` (``LoadedUrdf.links``; None: ``exported_links``, the model's of parameters;
-        see ``contact.sensor_mount``), the contact wrench in ``frame``'s axes, qdd through a
+    def use(self, model: RobotModel, link: str, frame: str, carried, cutoff: float, strict: bool = True) -> str | None:
+        """The settings in force: the sensor on ``link`` ("" = off) of ``model``, among the
+        links its joints move (``LoadedUrdf.carried``; None: ``exported_carried``, the model's
+        of parameters; see ``contact.sensor_mount``), the contact wrench in ``frame``'s axes, qdd through a
         low-pass of ``cutoff`` [Hz]. A link or frame refused: ValueError, nothing changed
         (``strict``), or the sensor off and the refusal returned. A model of other joints
         forgets the joint states and rests seen."""
         try:
             check_choice("ft_contact_wrench.frame", frame, FRAMES)
-            mount = sensor_mount(model, link, exported_links(model) if links is None else links) if link else None
+            mount = sensor_mount(model, link, exported_carried(model) if carried is None else carried) if link else None
         except ValueError as error:
             if strict:
                 raise
-            self.use(model, "", "sensor", links, cutoff)
+            self.use(model, "", "sensor", carried, cutoff)
             return f"{error}; the force/torque sensor is off"
         if not link or self.model is None or model.joint_names != self.model.joint_names:
             self._states.clear()

@@ -83,7 +83,11 @@ MODEL_PARAMETER_NAMES = (
     "model.urdf_file",
     "model.base_link",
     "model.tip_link",
+    "tree.joints",  # a tree's or a model with mimic joints (see model.robot_model)
+    "tree.parents",
+    "flange_joint",
 )
+MIMIC_FIELDS = ("mimic.joint", "mimic.multiplier", "mimic.offset")  # <joint>.<field> of a mimic joint
 
 
 def sibling_parameter_names(joint_names) -> set[str]:
@@ -94,9 +98,10 @@ def sibling_parameter_names(joint_names) -> set[str]:
 
 
 def model_parameter_names(joint_names, from_urdf: bool = False) -> set[str]:
-    """The model's parameters for these joints; of a URDF's joints, only those its model takes
-    from the parameters (limits, friction, armature: ``core.io.arm_source``)."""
-    fields = JOINT_DRIVE_FIELDS if from_urdf else JOINT_FIELDS
+    """The model's parameters for these joints (every joint of ``model.joints``, mimic joints
+    too); of a URDF's joints, only those its model takes from the parameters (limits,
+    friction, armature: ``core.io.arm_source``)."""
+    fields = JOINT_DRIVE_FIELDS if from_urdf else (*JOINT_FIELDS, *MIMIC_FIELDS)
     return set(MODEL_PARAMETER_NAMES) | {f"{param_prefix(joint)}.{field}" for joint in joint_names for field in fields}
 
 

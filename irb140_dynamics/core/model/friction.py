@@ -27,11 +27,14 @@ class JointFriction:
 
     @classmethod
     def of(cls, model) -> JointFriction:
-        return cls(
-            np.array([j.friction.viscous for j in model.joints]),
-            np.array([j.friction.coulomb for j in model.joints]),
-            model.smoothing_velocity,
-        )
+        """The friction of the model's independent joints, a mimic joint's carried by the
+        joint it follows (virtual work): m^2 v more viscous friction, c more Coulomb
+        friction (its multiplier m is +-1 when it has Coulomb friction, see ``model``)."""
+        viscous, coulomb = np.zeros(model.n), np.zeros(model.n)
+        for joint, (k, multiplier, _) in zip(model.joints, model.coordinates):
+            viscous[k] += multiplier * multiplier * joint.friction.viscous
+            coulomb[k] += joint.friction.coulomb
+        return cls(viscous, coulomb, model.smoothing_velocity)
 
     def coulomb_shape(self, qd) -> np.ndarray:
         """tanh(qd / v_s): the Coulomb torque per N m of level, (n,) or (N, n)."""

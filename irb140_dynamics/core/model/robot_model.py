@@ -15,6 +15,7 @@ parameter to fix:
     payload.mass / .com / .inertia
     friction.smoothing_velocity rad/s, of the Coulomb friction's tanh
     flange                      [x, y, z, roll, pitch, yaw] in the last link (identity if absent)
+    flange_joint                the joint whose link carries the flange instead (a tree's)
     <joint>.type                "revolute" (default) or "prismatic" (URDF form only)
     <joint>.dh                  [a, alpha, d, theta_offset], or in URDF form:
     <joint>.origin, .axis       [x, y, z, roll, pitch, yaw] in the parent link; [x, y, z]
@@ -27,6 +28,13 @@ parameter to fix:
     <joint>.friction.viscous    N m s/rad
     <joint>.friction.coulomb    N m
     <joint>.armature            kg m^2
+
+and for a tree or a model with mimic joints (absent for a chain):
+
+    tree.joints                 [name, ...] every moving joint, parents first
+    tree.parents                [parent joint's name or "" (the base), ...] per tree.joints
+    <joint>.mimic.joint         the joint it follows (a mimic joint only)
+    <joint>.mimic.multiplier, <joint>.mimic.offset
 
 (prismatic joints: m, N, N s/m, N, kg). ``<joint>`` is the joint's name when it is a
 parameter name ([A-Za-z][A-Za-z0-9_]*), else its ``param_prefix`` ("arm-left.1" ->
@@ -57,21 +65,35 @@ from irb140_dynamics.core.model.rigid_body import (
     finite_numbers,
     placed,
 )
+from irb140_dynamics.core.model.tree import Mimic, checked_mimics, checked_parents, tree_from_params, tree_params
 
 MAX_NAME = 200  # characters of a joint name
 DEFAULT_SMOOTHING_VELOCITY = 0.01  # rad/s: Coulomb friction reaches 76 % of its level at 0.01 rad/s
-__all__ = ["DH", "Friction", "Joint", "ModelError", "Placement", "RobotModel"]
+__all__ = ["DH", "Friction", "Joint", "Mimic", "ModelError", "Placement", "RobotModel"]
 
 
 @dataclass(frozen=True)
 class RobotModel:
-    """A validated serial-chain model; raises ModelError naming the bad field."""
+    """A validated model of a serial chain or a kinematic tree; raises ModelError naming
+    the bad field.
+
+    ``joints`` are every moving joint, parents before children; ``parent[i]`` is the index
+    in ``joints`` of joint i's parent joint (the joint moving the link joint i hangs from),
+    -1 for the base (spatial_v2's ``model.parent``); None: a chain, parent[i] = i - 1.
+    ``mimics``: per joint, None or the ``Mimic`` it follows (None: no mimic joint). The
+    model's coordinates are its independent joints (``joint_names``, ``n``, the states
+    q, qd, qdd, tau); the mimic joints follow them (``mimic_matrix``). The payload and the
+    flange are on the last joint's link.
+    """
 
     joints: tuple[Joint, ...]
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     payload: RigidBody = field(default_factory=RigidBody)
     flange: Placement = Placement()  # the payload's frame in the last link's frame
     smoothing_velocity: float = DEFAULT_SMOOTHING_VELOCITY  # rad/s, Coulomb friction's tanh
+    parent: tuple[int, ...] | None = None  # per joint: its parent joint's index, -1 the base
+    mimics: tuple[Mimic | None, ...] | None = None  # per joint: the joint it follows, or None
+    flange_joint: str | None = None  # the joint whose link carries the flange; None: the last one
 
     def __post_init__(self):
         object.__setattr__(self, "joints", tuple(validated_joint(j) for j in self.joints))
@@ -83,28 +105,94 @@ class RobotModel:
         if not smoothing > 0.0:
             raise ModelError("friction.smoothing_velocity", f"must be > 0, got {smoothing}")
         object.__setattr__(self, "smoothing_velocity", smoothing)
-        check_joint_names(self.joint_names)
+        check_joint_names([j.name for j in self.joints])
+        object.__setattr__(self, "parent", checked_parents(self.parent, len(self.joints)))
+        object.__setattr__(self, "mimics", checked_mimics(self.mimics, self.joints))
+        if self.flange_joint is not None:
+            if self.flange_joint not in [j.name for j in self.joints]:
+                raise ModelError("flange_joint", f"{str(self.flange_joint)[:80]!r} is not a joint of the model")
+            if self.flange_joint == self.joints[-1].name:
+                object.__setattr__(self, "flange_joint", None)  # the default, said once
 
     @property
     def n(self) -> int:
-        return len(self.joints)
+        """The number of independent joints: the length of a state."""
+        return len(self.independent)
+
+    @cached_property
+    def independent(self) -> tuple[int, ...]:
+        """The indices in ``joints`` of the independent joints (all but the mimic joints)."""
+        if self.mimics is None:
+            return tuple(range(len(self.joints)))
+        return tuple(i for i, mimic in enumerate(self.mimics) if mimic is None)
+
+    @property
+    def independent_joints(self) -> tuple[Joint, ...]:
+        """The independent joints (``joints`` but the mimic joints): one per coordinate, their
+        limits the state's (a mimic joint's friction is its joint's: ``friction``)."""
+        if self.mimics is None:
+            return self.joints
+        return tuple(self.joints[i] for i in self.independent)
 
     @property
     def joint_names(self) -> tuple[str, ...]:
-        return tuple(j.name for j in self.joints)
+        """The independent joints' names, the order of every state."""
+        return tuple(self.joints[i].name for i in self.independent)
+
+    @property
+    def is_chain(self) -> bool:
+        """A serial chain (each joint's parent the joint before), no mimic joint, the flange
+        on the last link."""
+        return self.mimics is None and self.flange_joint is None and all(p == i - 1 for i, p in enumerate(self.parent))
+
+    @cached_property
+    def carrier(self) -> int:
+        """The index in ``joints`` of the joint whose link carries the flange and payload."""
+        if self.flange_joint is None:
+            return len(self.joints) - 1
+        return [j.name for j in self.joints].index(self.flange_joint)
+
+    @cached_property
+    def coordinates(self) -> tuple[tuple[int, float, float], ...]:
+        """Per joint of ``joints``: (k, multiplier, offset), its position being
+        multiplier * q_k + offset of the state q; (k, 1.0, 0.0) for an independent joint."""
+        index = {self.joints[i].name: k for k, i in enumerate(self.independent)}
+        if self.mimics is None:
+            return tuple((k, 1.0, 0.0) for k in range(len(self.joints)))
+        return tuple(
+            (index[j.name], 1.0, 0.0) if m is None else (index[m.joint], m.multiplier, m.offset)
+            for j, m in zip(self.joints, self.mimics)
+        )
+
+    def mimic_matrix(self):
+        """G, (len(joints), n): every joint's velocity is G qd; its torque is carried by the
+        independent joints as G^T tau_all (virtual work), M = G^T M_all G."""
+        import numpy as np
+
+        G = np.zeros((len(self.joints), self.n))
+        for i, (k, multiplier, _) in enumerate(self.coordinates):
+            G[i, k] = multiplier
+        return G
+
+    def all_positions(self, q):
+        """Every joint's position, mimic joints included, from the state q (n numbers)."""
+        import numpy as np
+
+        q = np.asarray(q, dtype=float)
+        return np.array([multiplier * q[k] + offset for k, multiplier, offset in self.coordinates])
 
     @property
     def torque_limits(self) -> tuple[float, ...]:
-        return tuple(j.torque_limit for j in self.joints)
+        return tuple(self.joints[i].torque_limit for i in self.independent)
 
     @property
     def bodies(self) -> tuple[RigidBody, ...]:
-        """The moving bodies, the payload merged into the last link."""
+        """The moving bodies, the payload merged into the flange's link (the last one's)."""
         bodies = [j.link for j in self.joints]
         payload = self.payload
         if not self.flange.is_identity:
             payload = placed(payload, self.flange.rotation(), self.flange.xyz)
-        bodies[-1] = combine(bodies[-1], payload)
+        bodies[self.carrier] = combine(bodies[self.carrier], payload)
         return tuple(bodies)
 
     @cached_property
@@ -130,6 +218,10 @@ class RobotModel:
         }
         if not self.flange.is_identity:
             params["flange"] = self.flange.flat()
+        if not self.is_chain:
+            params.update(tree_params(self))
+        if self.flange_joint is not None:
+            params["flange_joint"] = self.flange_joint
         params.update(_body_params("payload", self.payload))
         for j in self.joints:
             key = param_prefix(j.name)
@@ -164,6 +256,12 @@ class RobotModel:
             raise ModelError(name, "missing")
 
         names = check_joint_names(get("joint_names"))
+        parent = mimics = None
+        if params.get("tree.joints") is not None:
+            names, independent = check_joint_names(get("tree.joints")), names
+            parent, mimics = tree_from_params(names, params, get)
+            if [name for name, mimic in zip(names, mimics) if mimic is None] != independent:
+                raise ModelError("joint_names", "must be tree.joints but the mimic joints, in that order")
         joints = tuple(_joint_from_params(name, params, get) for name in names)
         payload = _body_from_params("payload", get, optional=True)
         return cls(
@@ -172,6 +270,9 @@ class RobotModel:
             payload,
             Placement.validated("flange", get("flange", (0.0,) * 6)),
             get("friction.smoothing_velocity", DEFAULT_SMOOTHING_VELOCITY),
+            parent,
+            mimics,
+            params.get("flange_joint") or None,
         )
 
 

@@ -291,7 +291,7 @@ def check_payload(
     L = limit_values(limits, model.n)
     if workspace is None:
         workspace = workspace_load(model, payload, limits)
-    sliding = tuple(joint.prismatic for joint in model.joints)
+    sliding = tuple(joint.prismatic for joint in model.independent_joints)
     if q is None:
         return PayloadCheck(model.joint_names, payload, limits, workspace, sliding=sliding)
     tau0, dtau = payload_family(model, payload).torques(q, qd)

@@ -303,6 +303,10 @@ def payload_family(model: RobotModel, payload: RigidBody) -> PayloadFamily:
     compile their kernels then. Prismatic joints too: the proof takes their displacements
     as angles (see ``harmonic.slide``).
     """
+    if not model.is_chain:  # the proofs slice the chain (harmonic): a tree's would be wrong
+        raise ValueError(
+            "the payload analysis takes a serial chain without mimic joints: load the URDF with its tip_link"
+        )
     arm = tuple(getattr(model, f.name) for f in fields(model) if f.name != "payload")
     key = (arm, tuple(payload.com), tuple(payload.inertia))
     with _LOCK:

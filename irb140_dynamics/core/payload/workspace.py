@@ -77,8 +77,8 @@ class JointRanges:
     @classmethod
     def of(cls, model: RobotModel, count: int = 2048) -> JointRanges:
         """The model's joint ranges; samples: ``count`` quasi-random poses and the right angles."""
-        lower, upper = np.array([j.position_limits for j in model.joints]).T
-        sliding = np.array([j.prismatic for j in model.joints], dtype=bool)
+        lower, upper = np.array([j.position_limits for j in model.independent_joints]).T
+        sliding = np.array([j.prismatic for j in model.independent_joints], dtype=bool)
         spread = lower + quasi_random(count, model.n) * (upper - lower)
         return cls(lower, upper, np.vstack([right_angle_poses(lower, upper, sliding=sliding), spread]), sliding)
 

@@ -35,8 +35,8 @@ def trajectory_limits(model: RobotModel) -> Limits:
         torque, source = np.array(derived.values, dtype=float), derived.source
     return Limits(
         torque,
-        _or_inf([j.velocity_limit for j in model.joints]),
-        _or_inf([j.acceleration_limit for j in model.joints]),
+        _or_inf([j.velocity_limit for j in model.independent_joints]),
+        _or_inf([j.acceleration_limit for j in model.independent_joints]),
         tuple(source),
     )
 

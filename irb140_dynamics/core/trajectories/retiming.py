@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from irb140_dynamics.core.dynamics import gravity_batch, rnea_batch
+from irb140_dynamics.core.model.friction import JointFriction
 from irb140_dynamics.core.model.robot_model import RobotModel
 
 from .check import profiles
@@ -145,9 +146,14 @@ def _dynamics(model: RobotModel, pg: PathGrid) -> _Dynamics:
     return _Dynamics(a, tau if model.friction is None else tau - model.friction.torques(q1), c)
 
 
+def _friction(model) -> JointFriction:
+    """The friction of the coordinates (a mimic joint's carried by its joint), zero if none."""
+    return model.friction or JointFriction(np.zeros(model.n), np.zeros(model.n), model.smoothing_velocity)
+
+
 def _refuse_static(model, pg, dyn, limits, tr) -> None:
     """A pose on the path that cannot be held, or left (Coulomb), within a torque limit."""
-    coulomb = np.array([j.friction.coulomb for j in model.joints])
+    coulomb = _friction(model).coulomb
     moves = (np.abs(pg.q1) > 0).any(axis=0)
     need = np.abs(dyn.c) + coulomb * moves
     over = need - limits.torque
@@ -173,8 +179,8 @@ def _rows(model, pg, dyn, limits, factor, x0, X, floor):
     (a point's left side, where the path's q'' jumps, is left to the verification)."""
     L = limits.torque[None, :] * np.maximum(factor, floor)[:, None]  # torque: never below holding the pose
     A = limits.acceleration[None, :] * factor[:, None]
-    viscous = np.array([j.friction.viscous for j in model.joints])
-    coulomb = np.array([j.friction.coulomb for j in model.joints])
+    viscous = _friction(model).viscous
+    coulomb = _friction(model).coulomb
     q1, q2, a, b, c = pg.q1[1], pg.q2[1], dyn.a, dyn.b, dyn.c
     sign, d = np.sign(q1), viscous * np.abs(q1)
     root0 = np.sqrt(np.maximum(x0, 1e-12))[:, None]

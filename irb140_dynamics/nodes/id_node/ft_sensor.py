@@ -24,8 +24,8 @@ class FtSensor:
     def use(self, settings, started: bool) -> None:
         """The sensor on the settings' model; a link not on it: off, said (ValueError at startup)."""
         urdf = self.node.parameters.urdf
-        links, lag = None if urdf is None else urdf.links, settings.cutoff_frequency
-        refused = self.stream.use(settings.model, settings.ft_link, settings.ft_frame, links, lag, strict=not started)
+        carried, lag = None if urdf is None else urdf.carried, settings.cutoff_frequency
+        refused = self.stream.use(settings.model, settings.ft_link, settings.ft_frame, carried, lag, strict=not started)
         if refused:
             self.node.get_logger().error(refused)
 

@@ -8,8 +8,10 @@ import pytest
 
 from irb140_dynamics.core import Friction, coriolis, gravity, irb140, mass_matrix, rnea
 from irb140_dynamics.core.equations import generate
+from irb140_dynamics.core.urdf import load_urdf
 
 from ...support.common import OFFSET_PAYLOAD
+from ..test_urdf_trees import TWO_ARMS
 from .support import arms, c_function, compile_c, compiler, random_states
 
 pytestmark = pytest.mark.skipif(compiler() is None, reason="no C compiler (cc or gcc) on this machine")
@@ -33,6 +35,25 @@ def test_the_written_c_is_the_cores_arithmetic(tmp_path, arm):
     tau, M = c_function(library, "arm_tau", 3, n), c_function(library, "arm_M", 1, n * n)
     g, Cqd = c_function(library, "arm_g", 1, n), c_function(library, "arm_Cqd", 2, n)
     for q, qd, qdd in zip(*random_states(n, seed=3, count=200)):
+        assert tau(q, qd, qdd).tobytes() == rnea(model, q, qd, qdd).tobytes()
+        assert M(q).tobytes() == mass_matrix(model, q).tobytes()
+        assert g(q).tobytes() == gravity(model, q).tobytes()
+        assert Cqd(q, qd).tobytes() == coriolis(model, q, qd).tobytes()
+
+
+@pytest.mark.slow  # the symbolic derivation of a tree: seconds
+def test_the_written_c_of_a_tree_with_mimic_joints_is_the_cores_arithmetic(tmp_path):
+    """Two arms on a torso, mimic joints (one before its joint in the file, one prismatic
+    with an offset; damping on one) as in test_urdf_trees."""
+    model = load_urdf(TWO_ARMS).model
+    assert model.mimics is not None and model.friction is not None
+    for file, text in generate(model, ("c",), prefix="arm").items():
+        (tmp_path / file).write_text(text)
+    library = compile_c(tmp_path, "arm")
+    n = model.n
+    tau, M = c_function(library, "arm_tau", 3, n), c_function(library, "arm_M", 1, n * n)
+    g, Cqd = c_function(library, "arm_g", 1, n), c_function(library, "arm_Cqd", 2, n)
+    for q, qd, qdd in zip(*random_states(n, seed=4, count=50)):
         assert tau(q, qd, qdd).tobytes() == rnea(model, q, qd, qdd).tobytes()
         assert M(q).tobytes() == mass_matrix(model, q).tobytes()
         assert g(q).tobytes() == gravity(model, q).tobytes()

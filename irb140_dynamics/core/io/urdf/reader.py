@@ -21,8 +21,12 @@
   moments, as vendor files have them): taken as given, with a ``warning`` naming the link.
 - A joint that moves no mass (nothing after it has an inertial) is a ``warning``: M(q) is
   then singular, forward dynamics needs a payload.
-- Refused, with UrdfError naming the element: floating and planar joints and mimic joints
-  in the chain; a revolute or prismatic joint without <limit>; a chain of more than
+- Mimic joints (<mimic joint multiplier offset>) follow their joint (``model.Mimic``): the
+  model's ``joint_names`` are the others. One following a joint that is not in the model
+  is refused, as a mimic of a mimic.
+- With no tip_link and several leaves below base_link, the whole tree (``whole_tree``).
+- Refused, with UrdfError naming the element: floating and planar joints in the chain
+  (or the tree); a revolute or prismatic joint without <limit>; a chain of more than
   ``max_joints`` moving joints; besides everything ``tree`` refuses (size, binary input,
   loops).
 """
@@ -30,7 +34,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from functools import reduce
 
 import numpy as np
@@ -46,17 +50,16 @@ from irb140_dynamics.core.io.urdf.tree import (
     number,
     parse_tree,
 )
+from irb140_dynamics.core.io.urdf.whole_tree import MOVING, carried_links, compose, moving_joints
 from irb140_dynamics.core.model.joints import (
     MAX_TORQUE_LIMIT,
     Friction,
     Joint,
     Placement,
-    matrix_rpy,
 )
 from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, combine, placed
-from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.model.robot_model import Mimic, RobotModel
 
-MOVING = ("revolute", "continuous", "prismatic")
 CONTINUOUS_LIMITS = (-4 * math.pi, 4 * math.pi)  # rad: two turns either way, every angle within
 MAX_JOINTS = 100  # moving joints in a chain at most (the longest public arms and legs have 10)
 GRAVITY = 9.81  # m/s^2, along the root link's -z
@@ -74,7 +77,16 @@ class LoadedUrdf:
     notes: tuple[str, ...] = ()  # invalid inertials off the chain, ignored
     base_rotation: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))  # base_link's axes in the root's
     robot_name: str = ""  # <robot name="...">: the hardware_id of the nodes' /diagnostics
-    links: tuple[tuple[str, int, Placement], ...] = ()  # the chain's links: (name, k, placement in link frame k)
+    carried: dict = field(default_factory=dict, compare=False, hash=False, repr=False)  # see with_flange_at
+
+    def with_flange_at(self, link: str) -> RobotModel:
+        """The model with its flange (where the payload sits) at URDF link ``link``: on the
+        link of the joint that carries it (``model.flange_joint``), placed as the URDF does
+        (the joints off the chain at zero); UrdfError unless the model moves that link."""
+        if link not in self.carried:
+            raise UrdfError("link", f"{clipped(repr(link), 80)} is not moved by the model's joints")
+        joint, placement = self.carried[link]
+        return replace(self.model, flange_joint=joint, flange=placement)
 
     def in_base(self, vector) -> tuple[float, float, float]:
         """A vector given in the root link's frame (gravity) in base_link's frame."""
@@ -88,10 +100,16 @@ def load_urdf(
     max_chars: int | None = None,
     max_joints: int = MAX_JOINTS,
 ) -> LoadedUrdf:
-    """The chain from ``base_link`` (default: the root link) to ``tip_link`` (default: the
-    only leaf below base_link) as a RobotModel (gravity: the root's -z; payload: none).
-    ``max_chars``: the text's size limit (default: MAX_URDF_CHARS, or IRB140_MAX_FILE_BYTES)."""
+    """The chain from ``base_link`` (default: the root link) to ``tip_link`` as a RobotModel
+    (gravity: the root's -z; payload: none). With no ``tip_link``, every moving joint below
+    base_link: the chain to the only leaf, or the whole tree (see ``whole_tree``) when there
+    are several. Mimic joints follow their joint (``model.Mimic``). ``max_chars``: the text's
+    size limit (default: MAX_URDF_CHARS, or IRB140_MAX_FILE_BYTES)."""
     tree = parse_tree(text, max_chars)
+    if not tip_link:
+        tree._known("base_link", base_link or tree.root)
+        if len(tree.leaves(base_link or tree.root)) > 1:
+            return _load_tree(tree, base_link or tree.root, max_joints)
     base, tip, path = tree.chain(base_link, tip_link)
     span = f"from {clipped(repr(base), 60)} to {clipped(repr(tip), 60)}"
     for joint in path:
@@ -101,14 +119,8 @@ def load_urdf(
                 f"a {joint.kind} joint in the chain {span}: only revolute, continuous, "
                 "prismatic and fixed joints are supported there",
             )
-        mimic = joint.element.find("mimic")
-        if mimic is not None:
-            raise UrdfError(
-                f"{joint.label} <mimic>",
-                f"a mimic joint (following {clipped(repr(mimic.get('joint')), 60)}"
-                ") in the chain is not supported: end the chain before it (tip_link)",
-            )
     moving = [joint for joint in path if joint.kind in MOVING]
+    mimics = mimics_of(moving)
     if not moving:
         raise UrdfError("chain", f"no revolute, continuous or prismatic joint {span}")
     if len(moving) > max_joints:
@@ -140,7 +152,7 @@ def load_urdf(
         _joint(joint, placement, body, ok) for joint, placement, (body, _), ok in zip(moving, origins, bodies, physical)
     ]
     try:
-        model = RobotModel(tuple(joints), gravity=base_gravity(tree, base), flange=since_last)
+        model = RobotModel(tuple(joints), gravity=base_gravity(tree, base), flange=since_last, mimics=mimics)
     except ModelError as error:
         raise UrdfError("chain", str(error)) from None
     on_chain = {name for names in carried for name in names}
@@ -150,21 +162,32 @@ def load_urdf(
         if name not in on_chain and (problem := inertial_problem(name, body))
     ]
     rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
-    links = tuple(_chain_links(base, path))
-    return LoadedUrdf(model, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name, links)
+    carried = carried_links(tree, moving)
+    return LoadedUrdf(model, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name, carried)
 
 
-def _chain_links(base: str, path: list[UrdfJoint]):
-    """Each link of the chain as (name, k, its placement in link frame k), k the moving
-    joints before it (0: the base frame): a moving joint's child is link frame k itself."""
-    k, placement = 0, Placement()
-    yield base, k, placement
-    for joint in path:
-        if joint.kind == "fixed":
-            placement = compose(placement, joint.origin)
-        else:
-            k, placement = k + 1, Placement()
-        yield joint.child, k, placement
+def mimics_of(moving: list[UrdfJoint]) -> tuple | None:
+    """Per moving joint, the ``Mimic`` its <mimic joint= multiplier= offset=> gives (None:
+    not a mimic joint); UrdfError for one following a joint that is not among ``moving``."""
+    names = {joint.name for joint in moving}
+    mimics = []
+    for joint in moving:
+        element = joint.element.find("mimic")
+        if element is None:
+            mimics.append(None)
+            continue
+        where = f"{joint.label} <mimic>"
+        leader = element.get("joint")
+        if not leader:
+            raise UrdfError(where, "names no joint")
+        if leader not in names:
+            raise UrdfError(
+                where,
+                f"follows {clipped(repr(leader), 60)}, which is not a moving joint of the model "
+                "(name a base_link/tip_link taking it in, or one leaving the mimic joint out)",
+            )
+        mimics.append(Mimic(leader, number(element, "multiplier", where, 1.0), number(element, "offset", where, 0.0)))
+    return tuple(mimics) if any(m is not None for m in mimics) else None
 
 
 def _checked_inertials(tree: UrdfTree, carried: list[list[str]]) -> tuple[list[str], list[bool]]:
@@ -215,26 +238,12 @@ def read_urdf(path, max_chars: int | None = None) -> str:
         raise UrdfError("file", f"{clipped(str(path), 120)}: {error.reason}") from None
 
 
-def compose(a: Placement, b: Placement) -> Placement:
-    """The placement a * b; exact when either is a pure translation or the identity."""
-    if a.is_identity:
-        return b
-    if b.is_identity:
-        return a
-    xyz = tuple((np.array(a.xyz) + a.rotation() @ np.array(b.xyz)).tolist())
-    if b.rpy == (0.0, 0.0, 0.0):
-        return Placement(xyz, a.rpy)
-    if a.rpy == (0.0, 0.0, 0.0):
-        return Placement(xyz, b.rpy)
-    return Placement(xyz, matrix_rpy(a.rotation() @ b.rotation()))
-
-
-def lumped(
-    tree: UrdfTree, link: str, stop: str | None, held: list[str], carried: list[list[str]]
-) -> tuple[RigidBody, bool]:
+def lumped(tree: UrdfTree, link: str, stop, held: list[str], carried: list[list[str]]) -> tuple[RigidBody, bool]:
     """Everything rigidly attached to ``link`` (joints off the chain at zero), up to the
-    chain joint ``stop``, as one body in ``link``'s frame; and whether any had an inertial.
-    The names of the links with an inertial are appended to ``carried`` as a list."""
+    chain joint ``stop`` (a name, None, or a set of names), as one body in ``link``'s frame;
+    and whether any had an inertial. The names of the links with an inertial are appended
+    to ``carried`` as a list."""
+    stops = stop if isinstance(stop, (set, frozenset)) else {stop}
     bodies, stack, names = [], [(link, np.eye(4))], []
     carried.append(names)
     with np.errstate(all="ignore"):  # a non-finite inertial is refused by _checked_inertials
@@ -247,7 +256,7 @@ def lumped(
                     continue
                 bodies.append(placed(inertial, T[:3, :3], T[:3, 3]) if name != link else inertial)
             for joint in tree.child_joints[name]:
-                if joint.name == stop:
+                if joint.name in stops:
                     continue
                 if joint.kind != "fixed":
                     held.append(joint.name)
@@ -292,3 +301,48 @@ def _joint(joint: UrdfJoint, origin: Placement, body: RigidBody, physical: bool)
         kind="prismatic" if joint.kind == "prismatic" else "revolute",
         physical=physical,
     )
+
+
+def _load_tree(tree: UrdfTree, base: str, max_joints: int) -> LoadedUrdf:
+    """The whole tree below ``base`` as a LoadedUrdf (see ``whole_tree``)."""
+    moving, parents, origins = moving_joints(tree, base)
+    where = f"below {clipped(repr(base), 60)}"
+    if not moving:
+        raise UrdfError("tree", f"no revolute, continuous or prismatic joint {where}")
+    if len(moving) > max_joints:
+        raise UrdfError(
+            "tree", f"{len(moving)} moving joints {where}, more than the limit of {max_joints} (max_joints)"
+        )
+    stops = {joint.name for joint in moving}
+    held: list[str] = []
+    carried: list[list[str]] = []
+    bodies = [lumped(tree, joint.child, stops, held, carried) for joint in moving]
+    warnings, physical = _checked_inertials(tree, carried)
+    subtree_mass = [body.mass for body, _ in bodies]
+    for i in reversed(range(len(moving))):
+        if parents[i] >= 0:
+            subtree_mass[parents[i]] += subtree_mass[i]
+    for joint, mass in zip(moving, subtree_mass):
+        if mass == 0.0:
+            warnings.append(
+                f'URDF joint "{clipped(joint.name, 100)}": moves no mass (M(q) is singular: forward '
+                "dynamics needs a payload)"
+            )
+    joints = [
+        _joint(joint, placement, body, ok) for joint, placement, (body, _), ok in zip(moving, origins, bodies, physical)
+    ]
+    try:
+        model = RobotModel(
+            tuple(joints), gravity=base_gravity(tree, base), parent=tuple(parents), mimics=mimics_of(moving)
+        )
+    except ModelError as error:
+        raise UrdfError("tree", str(error)) from None
+    in_model = {name for names in carried for name in names}
+    notes = [
+        f"{problem[1]} (not moved by the tree: ignored)"
+        for name, body in tree.inertials.items()
+        if name not in in_model and (problem := inertial_problem(name, body))
+    ]
+    rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
+    carried = carried_links(tree, moving)
+    return LoadedUrdf(model, base, moving[-1].child, (), tuple(warnings), tuple(notes), rotation, tree.name, carried)

@@ -87,11 +87,12 @@ def export_urdf(model: RobotModel, name: str = "robot", shapes: Mapping[str, Box
     return '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n"
 
 
-def exported_links(model: RobotModel) -> tuple[tuple[str, int, Placement], ...]:
-    """The links ``export_urdf`` writes, as ``LoadedUrdf.links``: (name, k, its placement in
-    link frame k); link_i's frame is joint i's frame (before post_i)."""
-    links = [(f"link_{k}", k, _inverse(joint.post)) for k, joint in enumerate(model.joints, 1)]
-    return ((BASE, 0, Placement()), *links, (FLANGE, model.n, model.flange))
+def exported_carried(model: RobotModel) -> dict[str, tuple[str, Placement]]:
+    """The links ``export_urdf`` writes that the joints move, as ``LoadedUrdf.carried``: link ->
+    (the joint moving it, its placement in that joint's link frame); link_i's frame is joint
+    i's frame (before post_i)."""
+    carried = {f"link_{k}": (joint.name, _inverse(joint.post)) for k, joint in enumerate(model.joints, 1)}
+    return carried | {FLANGE: (model.joints[-1].name, model.flange)}
 
 
 def _inverse(placement: Placement) -> Placement:

@@ -174,7 +174,7 @@ class StaticForms:
         if model.n > most:
             return None
         kernels = kernels_of(model)
-        sliding = tuple(slide(j.position_limits) if j.prismatic else None for j in model.joints)
+        sliding = tuple(slide(j.position_limits) if j.prismatic else None for j in model.independent_joints)
         return _forms(kernels.links, tuple(kernels.gravity), sliding)
 
     def affine(self, other: StaticForms, k: float) -> StaticForms:

@@ -1,0 +1,84 @@
+"""A URDF's whole kinematic tree below base_link: its moving joints, as ``load_urdf`` reads
+them with no tip_link and several leaves (two arms on a torso, an arm with a head); and
+``compose``, of placements.
+
+- Every revolute, continuous and prismatic joint below base_link is a joint of the model,
+  depth first in the file's order (a joint, then everything below it, then the next joint
+  of the same link): ``model.joints``, their parents in ``model.parent``, the independent
+  ones' names ``model.joint_names``.
+- Fixed joints are merged as in a chain: a body fixed to a moving link is lumped into it,
+  the fixed joints between a moving joint and the next one below it make up that one's
+  origin; bodies fixed to base_link do not move and are left out. The model's flange is
+  the last joint's link frame, the ``tip_link`` reported (where a payload would sit).
+- Mimic joints follow their joint (see ``reader.mimics_of``).
+- A floating or planar joint below base_link is refused, naming it. A URDF whose root is
+  a floating base (a humanoid written with its free-flyer joint) is read from the link
+  under that joint: name it as base_link, and what is above it (the floating joint) is
+  left out, as everything above base_link is; gravity is the root's -z with it at zero.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from irb140_dynamics.core.io.urdf.tree import UrdfError, UrdfTree, clipped
+from irb140_dynamics.core.model.joints import Placement, matrix_rpy
+
+MOVING = ("revolute", "continuous", "prismatic")
+
+
+def moving_joints(tree: UrdfTree, base: str) -> tuple[list, list[int], list[Placement]]:
+    """(the moving joints below ``base``, depth first in the file's order; each one's parent
+    index, -1 for none; each one's origin in its parent's link frame, the fixed joints
+    between them composed). UrdfError for a floating or planar joint."""
+    moving, parents, origins = [], [], []
+    # (joint, index of the moving joint whose link its parent link is fixed to, the
+    # placement of its parent link in that link): a joint's subtree is pushed on top of its
+    # next siblings, so the walk is depth first in the file's order (preorder)
+    stack = [(joint, -1, Placement()) for joint in reversed(tree.child_joints[base])]
+    while stack:
+        joint, above, placement = stack.pop()
+        if joint.kind in MOVING:
+            moving.append(joint)
+            parents.append(above)
+            origins.append(compose(placement, joint.origin))
+            above, placement = len(moving) - 1, Placement()
+        elif joint.kind == "fixed":
+            placement = compose(placement, joint.origin)
+        else:
+            hint = " (a floating base: name the link under it as base_link)" if joint.kind == "floating" else ""
+            raise UrdfError(
+                joint.label,
+                f"a {joint.kind} joint below {clipped(repr(base), 60)}: only revolute, continuous, "
+                f"prismatic and fixed joints are supported{hint}",
+            )
+        stack += [(child, above, placement) for child in reversed(tree.child_joints[joint.child])]
+    return moving, parents, origins
+
+
+def carried_links(tree: UrdfTree, moving: list) -> dict[str, tuple[str, Placement]]:
+    """Every link a moving joint of the model carries, fixed to its link or behind joints
+    held at zero: link -> (that joint's name, the link's frame in the joint's link frame)."""
+    names = {joint.name for joint in moving}
+    found = {}
+    for joint in moving:
+        stack = [(joint.child, Placement())]
+        while stack:
+            link, placement = stack.pop()
+            found[link] = (joint.name, placement)
+            stack += [(j.child, compose(placement, j.origin)) for j in tree.child_joints[link] if j.name not in names]
+    return found
+
+
+def compose(a: Placement, b: Placement) -> Placement:
+    """The placement a * b; exact when either is a pure translation or the identity."""
+    if a.is_identity:
+        return b
+    if b.is_identity:
+        return a
+    xyz = tuple((np.array(a.xyz) + a.rotation() @ np.array(b.xyz)).tolist())
+    if b.rpy == (0.0, 0.0, 0.0):
+        return Placement(xyz, a.rpy)
+    if a.rpy == (0.0, 0.0, 0.0):
+        return Placement(xyz, b.rpy)
+    return Placement(xyz, matrix_rpy(a.rotation() @ b.rotation()))
