@@ -267,19 +267,22 @@ def crba(links, cs):
     composite body j..n turns about joint j's axis, links before j stand still.
     """
     moves = steps(links, cs)
+    turns = [_one_turn(link, rot) for link, (rot, _) in zip(links, moves)]
     n_links = len(links)
     composite = [None] * n_links
     for i in reversed(range(n_links)):
         m, h, inertia = links[i].m, links[i].h, links[i].I
         if i + 1 < n_links:
-            child, (rot, p0) = links[i + 1], moves[i + 1]
+            child, (rot, p0), R = links[i + 1], moves[i + 1], turns[i + 1]
             m_c, h_c, inertia_c = composite[i + 1]
-            r = to_parent(child, rot, child.p)  # o_i -> o_(i+1), in frame i
+            if R is None:
+                r, h_c = to_parent(child, rot, child.p), to_parent(child, rot, h_c)
+                inertia_c = _rotate_inertia(child, rot, inertia_c)
+            else:
+                r, h_c, inertia_c = rotate(R, child.p), rotate(R, h_c), turned(R, inertia_c)
             if p0 is not None:
-                r = add(r, p0)
-            m_c, h_c, inertia_c = shift_inertia(
-                m_c, to_parent(child, rot, h_c), _rotate_inertia(child, rot, inertia_c), r
-            )
+                r = add(r, p0)  # o_i -> o_(i+1), in frame i
+            m_c, h_c, inertia_c = shift_inertia(m_c, h_c, inertia_c, r)
             m, h, inertia = m + m_c, add(h, h_c), tuple(x + y for x, y in zip(inertia, inertia_c))
         composite[i] = (m, h, inertia)
 
@@ -295,10 +298,31 @@ def crba(links, cs):
             n = add(inertia_times(inertia, link.b), cross(h, a), cross(link.p, f))
         M[j][j] = dot(link.b, f if link.prismatic else n) + link.armature
         for i in reversed(range(j)):
-            f, n = to_parent_wrench(links[i + 1], moves[i + 1], f, n)
+            child, move, R = links[i + 1], moves[i + 1], turns[i + 1]
+            if R is None:
+                f, n = to_parent_wrench(child, move, f, n)
+            else:
+                f, n = rotate(R, f), rotate(R, n)
+                if move[1] is not None:
+                    n = add(n, cross(move[1], f))
             n = add(n, cross(links[i].p, f))
             M[i][j] = M[j][i] = dot(links[i].b, f if links[i].prismatic else n)
     return M
+
+
+def _one_turn(link: Link, rot):
+    """R_i = R0 Rot R1 as one matrix when the turn is about an axis other than z and a fixed
+    rotation goes with it (then every vector crba moves to the parent's frame turns once,
+    not two or three times: fewer operations); None otherwise (a DH row, a turn about z)."""
+    if rot is None or link.u == Z_AXIS or (link.R0 is None and link.R1 is None):
+        return None
+    R = rot if link.R1 is None else _product(rot, link.R1)
+    return R if link.R0 is None else _product(link.R0, R)
+
+
+def _product(A, B) -> Rotation:
+    """A B, the constants 0 and +-1 left out."""
+    return tuple(tuple(_combination((A[j][k], B[k][l]) for k in range(3)) for l in range(3)) for j in range(3))
 
 
 def _rotate_inertia(link, rot, inertia):
