@@ -299,20 +299,23 @@ def crba(links, cs):
     links stand still; only joint j's ancestors feel it (M_ij = 0 off that path).
     """
     moves = steps(links, cs)
+    turns = [_one_turn(link, rot) for link, (rot, _) in zip(links, moves)]
     n_links = len(links)
     parent, below = parents(links), children(links)
     composite = [None] * n_links
     for i in reversed(range(n_links)):
         m, h, inertia = links[i].m, links[i].h, links[i].I
         for c in below[i]:
-            child, (rot, p0) = links[c], moves[c]
+            child, (rot, p0), R = links[c], moves[c], turns[c]
             m_c, h_c, inertia_c = composite[c]
-            r = to_parent(child, rot, child.p)  # o_i -> o_c, in frame i
+            if R is None:
+                r, h_c = to_parent(child, rot, child.p), to_parent(child, rot, h_c)
+                inertia_c = _rotate_inertia(child, rot, inertia_c)
+            else:
+                r, h_c, inertia_c = rotate(R, child.p), rotate(R, h_c), turned(R, inertia_c)
             if p0 is not None:
-                r = add(r, p0)
-            m_c, h_c, inertia_c = shift_inertia(
-                m_c, to_parent(child, rot, h_c), _rotate_inertia(child, rot, inertia_c), r
-            )
+                r = add(r, p0)  # o_i -> o_c, in frame i
+            m_c, h_c, inertia_c = shift_inertia(m_c, h_c, inertia_c, r)
             m, h, inertia = m + m_c, add(h, h_c), tuple(x + y for x, y in zip(inertia, inertia_c))
         composite[i] = (m, h, inertia)
 
@@ -330,11 +333,32 @@ def crba(links, cs):
         k = j  # up the ancestors: only they feel joint j's acceleration
         while parent[k] >= 0:
             i = parent[k]
-            f, n = to_parent_wrench(links[k], moves[k], f, n)
+            child, move, R = links[k], moves[k], turns[k]
+            if R is None:
+                f, n = to_parent_wrench(child, move, f, n)
+            else:
+                f, n = rotate(R, f), rotate(R, n)
+                if move[1] is not None:
+                    n = add(n, cross(move[1], f))
             n = add(n, cross(links[i].p, f))
             M[i][j] = M[j][i] = dot(links[i].b, f if links[i].prismatic else n)
             k = i
     return M
+
+
+def _one_turn(link: Link, rot):
+    """R_i = R0 Rot R1 as one matrix when the turn is about an axis other than z and a fixed
+    rotation goes with it (then every vector crba moves to the parent's frame turns once,
+    not two or three times: fewer operations); None otherwise (a DH row, a turn about z)."""
+    if rot is None or link.u == Z_AXIS or (link.R0 is None and link.R1 is None):
+        return None
+    R = rot if link.R1 is None else _product(rot, link.R1)
+    return R if link.R0 is None else _product(link.R0, R)
+
+
+def _product(A, B) -> Rotation:
+    """A B, the constants 0 and +-1 left out."""
+    return tuple(tuple(_combination((A[j][k], B[k][l]) for k in range(3)) for l in range(3)) for j in range(3))
 
 
 def _rotate_inertia(link, rot, inertia):
