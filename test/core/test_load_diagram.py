@@ -172,10 +172,10 @@ CASES = {
 GRIDS = {
     "irb140": ([0.0, 0.12], [0.0, 0.08]),
     "ur5": ([0.0, 0.15], [0.0, 0.1]),
-    "panda": ([0.0, 0.15], [0.0, 0.1]),
-    "talos_arm": ([0.1], [0.0, 0.05]),
+    "panda": ([0.15], [0.0, 0.1]),  # an on-axis and an off-axis point each (the proof's two kinds)
+    "talos_arm": ([0.1], [0.05]),
     "xarm7": ([0.2], [0.15]),
-    "gantry_irb140": ([0.0, 0.1], [0.0, 0.1]),
+    "gantry_irb140": ([0.1], [0.0, 0.1]),
     "prismatic_arm": ([0.0, 0.2], [0.0, 0.1]),
 }
 
