@@ -13,8 +13,6 @@ file's loaded chains is compared with Pinocchio (every robot, one of its limbs),
 IRB140_SWEEP=full every chain (docs/development.md).
 """
 
-import importlib.metadata
-import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -26,20 +24,13 @@ from irb140_dynamics.core import ModelError, gravity, mass_matrix, rnea
 from irb140_dynamics.core.urdf import load_urdf
 
 from ..support.common import full_sweep
+from ..support.pinocchio_trees import corpus_files, pinocchio_state
 from ..support.pinocchio_trees import worst_error as mimic_worst_error
 
 MOVING = ("revolute", "continuous", "prismatic")
 MIN_JOINTS = 3
 RTOL = 1e-9
 STATES = 3
-
-
-def corpus_files() -> list[str]:
-    try:
-        distribution = importlib.metadata.distribution("example-robot-data")
-    except importlib.metadata.PackageNotFoundError:
-        return []
-    return sorted(str(distribution.locate_file(f)) for f in distribution.files or () if str(f).endswith(".urdf"))
 
 
 def chains(text: str) -> list[tuple[str, str]]:
@@ -112,19 +103,6 @@ def _moving_below(root, children) -> dict[str, int]:
     for link in reversed(order):
         below[link] = sum((kind in MOVING) + below[child] for kind, child in children.get(link, ()))
     return below
-
-
-def pinocchio_state(model: pin.Model, names, q, qd, qdd):
-    """Pinocchio's q, v, a: the chain's joints at q, qd, qdd, the others at zero."""
-    pq, v, a = pin.neutral(model), np.zeros(model.nv), np.zeros(model.nv)
-    for name, x, xd, xdd in zip(names, q, qd, qdd):
-        joint = model.joints[model.getJointId(name)]
-        if joint.nq == 2:  # continuous: (cos, sin)
-            pq[joint.idx_q : joint.idx_q + 2] = math.cos(x), math.sin(x)
-        else:
-            pq[joint.idx_q] = x
-        v[joint.idx_v], a[joint.idx_v] = xd, xdd
-    return pq, v, a
 
 
 def worst_error(text: str, base: str, tip: str, rng) -> float:

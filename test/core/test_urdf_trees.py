@@ -10,7 +10,6 @@ what Pinocchio cannot refuse to check: a mimic joint before its joint in the fil
 multiplier and an offset; and the other algorithms on a tree by their identities.
 """
 
-import importlib.metadata
 from pathlib import Path
 
 import numpy as np
@@ -34,7 +33,7 @@ from irb140_dynamics.core.urdf import load_urdf
 from irb140_dynamics.identification.base import find_base_parameters
 
 from ..support.common import full_sweep
-from ..support.pinocchio_trees import worst_error
+from ..support.pinocchio_trees import corpus_files, worst_error
 
 RTOL = 1e-9
 MAX_JOINTS = 128  # TIAGo++ with its hands has 101 moving joints, beyond load_urdf's default
@@ -42,14 +41,6 @@ QUICK_FILES = 6  # compared in the suite (seeded), besides the mimic ones
 # refusals a whole file may get, each one line: no moving joint at all, a mimic joint of a
 # joint the file does not have (alex_psyonic_hands), not a URDF (ur3.urdf is a xacro stub)
 REFUSALS = ("no revolute, continuous or prismatic joint", "which is not a moving joint of the model", "no <link>")
-
-
-def corpus_files() -> list[str]:
-    try:
-        distribution = importlib.metadata.distribution("example-robot-data")
-    except importlib.metadata.PackageNotFoundError:
-        return []
-    return sorted(str(distribution.locate_file(f)) for f in distribution.files or () if str(f).endswith(".urdf"))
 
 
 FILES = corpus_files()

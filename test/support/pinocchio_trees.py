@@ -8,6 +8,7 @@ tau = G^T tau_all(G qd, G qdd), M = G^T M_all G. A fresh Data per call (Pinocchi
 mass matrix is wrong with a Data reused).
 """
 
+import importlib.metadata
 import math
 
 import numpy as np
@@ -24,7 +25,17 @@ def pinocchio_of(text: str, mimic: bool) -> tuple[pin.Model, bool]:
     return pin.buildModelFromXML(text), False
 
 
-def _state(full: pin.Model, names, q, qd, qdd):
+def corpus_files() -> list[str]:
+    """The URDF files of example-robot-data (none when it is not installed)."""
+    try:
+        distribution = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError:
+        return []
+    return sorted(str(distribution.locate_file(f)) for f in distribution.files or () if str(f).endswith(".urdf"))
+
+
+def pinocchio_state(full: pin.Model, names, q, qd, qdd):
+    """Pinocchio's q, v, a: the named joints at q, qd, qdd, the others at zero."""
     pq, v, a = pin.neutral(full), np.zeros(full.nv), np.zeros(full.nv)
     for name, x, xd, xdd in zip(names, q, qd, qdd):
         joint = full.joints[full.getJointId(name)]
@@ -45,7 +56,7 @@ def reference(full: pin.Model, follows_mimics: bool, model, q, qd, qdd):
         names, G = [j.name for j in model.joints], model.mimic_matrix()
         state = model.all_positions(q), G @ qd, G @ qdd
     index = [full.joints[full.getJointId(name)].idx_v for name in names]
-    pq, v, a = _state(full, names, *state)
+    pq, v, a = pinocchio_state(full, names, *state)
     tau = pin.rnea(full, full.createData(), pq, v, a)[index]
     g = pin.computeGeneralizedGravity(full, full.createData(), pq)[index]
     M = pin.crba(full, full.createData(), pq)
