@@ -63,10 +63,24 @@ def flange_jacobian_in(model: RobotModel, q, frame: str = "base") -> np.ndarray:
     return J if frame == "base" else _turned(pose[:3, :3].T, J)
 
 
+TREE_REFUSAL = (
+    "no external wrench on a tree or with mimic joints: the external torques of every branch "
+    "would be read as one flange's wrench (external_wrench.links is not done); external_torques only"
+)
+
+
+def wrench_refusal(model: RobotModel) -> str | None:
+    """Why ``model`` has no flange wrench (a tree, mimic joints, the flange off the last link), or None."""
+    return None if model.is_chain else TREE_REFUSAL
+
+
 def flange_wrench(model: RobotModel, q, tau_ext, frame: str = "tip") -> FlangeWrench:
     """The wrench F on the flange with J(q)^T F = tau_ext [N m] (see the module), in the axes
-    of ``frame``. ValueError if q or tau_ext are not n finite numbers, or for another frame."""
+    of ``frame``. ValueError if q or tau_ext are not n finite numbers, for another frame, or
+    on a model that is no chain (``wrench_refusal``)."""
     _check_frame(frame)
+    if not model.is_chain:
+        raise ValueError(TREE_REFUSAL)
     tau_ext = state(tau_ext, model.n, "tau_ext")
     pose, J = flange_pose_and_jacobian(model, q)
     return wrench_of(pose, J, tau_ext, frame)
@@ -135,6 +149,8 @@ class WrenchStream:
         smallest singular values of J); starts a new period."""
         if self._sample is None:
             return False, "no efforts received: no wrench estimated", {}
+        if wrench_refusal(self._sample[0]):
+            return False, wrench_refusal(self._sample[0]), {}
         try:
             now = flange_wrench(*self._sample, "tip")
         except ValueError as error:

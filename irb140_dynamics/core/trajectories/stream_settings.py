@@ -79,11 +79,12 @@ def check_settings(values: dict) -> IdNodeSettings:
 
 def finish_settings(settings: IdNodeSettings, previous: IdNodeSettings | None) -> IdNodeSettings:
     """Make the kernels the messages use native (compiled as C, or loaded from the cache)
-    and derive the markers' torque limits (the payload check's: given, else derived from
-    the rated payload within LIMITS_TIME; inf: none), each unless ``previous`` has them for
-    the same arm. Run before the first message, and off the executor after a change while
-    the old settings answer; a compile longer than NATIVE_WAIT goes on in the background,
-    the Python form answering meanwhile."""
+        and derive the markers' torque limits (the payload check's: given, else derived from
+        the rated payload within LIMITS_TIME; on a tree or with mimic joints, the given ones
+    only; inf: none), each unless ``previous`` has them for
+        the same arm. Run before the first message, and off the executor after a change while
+        the old settings answer; a compile longer than NATIVE_WAIT goes on in the background,
+        the Python form answering meanwhile."""
     if previous is not None and previous.model == settings.model:
         kernels = previous.kernels
         settings = replace(settings, model=previous.model)
@@ -96,6 +97,8 @@ def finish_settings(settings: IdNodeSettings, previous: IdNodeSettings | None) -
         settings.rated_payload,
     ):  # the payload in use does not enter them
         limits = previous.torque_limits
+    elif not model.is_chain:  # the payload analysis is a chain's: a tree's markers use the given limits only
+        limits = tuple(limit if limit > 0 else float("inf") for limit in model.torque_limits)
     else:
         with stopping(seconds=LIMITS_TIME):
             limits = derive_torque_limits(model, settings.rated_payload).values

@@ -255,7 +255,7 @@ class IdNode(Node):
         model, frame = self.settings.model, self.settings.wrench_frame
         self.markers.note(sample.stamp, sample.q, sample.effort, r, [model.joint_names[j] for j in colliding])
         self.wrench.note(model, sample.q, r)
-        if not self._wrench_pub.subscribers:
+        if not self._wrench_pub.subscribers or not model.is_chain:  # a tree's: see wrench.report()
             return
         try:
             wrench = self.wrench.estimate(frame)

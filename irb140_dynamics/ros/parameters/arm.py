@@ -35,6 +35,7 @@ from irb140_dynamics.ros.parameters.spec import Spec, as_type
 from irb140_dynamics.ros.parameters.specs import (
     DESCRIPTION_PARAMETERS,
     MODEL_NAME,
+    PAYLOAD_LINK,
     RELIABILITIES,
     SOURCE,
     drive_specs,
@@ -75,7 +76,7 @@ class ArmParameters:
                 self.urdf = self.read(text or read_urdf_file(path, "model.urdf_file").text, origin)
             self.from_topic = self.urdf is None
             joint_names = None if self.urdf is None else self.urdf.model.joint_names
-            arm = model_specs([], {})
+            arm = [*model_specs([], {}), PAYLOAD_LINK]
         else:
             path = default_config_path()
             if not path.is_file():

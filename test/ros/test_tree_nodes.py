@@ -1,0 +1,150 @@
+"""id_node on a whole kinematic tree, in-process: example-robot-data's Baxter (two arms, a
+head pan, grippers whose second finger is a mimic joint), read with no tip_link. Its gravity
+and feed-forward torques of every independent joint, by name, against Pinocchio's of the same
+tree (test.support.pinocchio_trees), from one JointState naming the
+joints in any order, mimic joints among them (ignored)."""
+
+import importlib.metadata
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from builtin_interfaces.msg import Time
+from rclpy.parameter import Parameter
+from sensor_msgs.msg import JointState
+
+from irb140_dynamics.core import RigidBody, gravity
+from irb140_dynamics.core.io.arm_source import read_arm
+from irb140_dynamics.core.io.urdf import load_urdf
+from irb140_dynamics.core.monitoring.wrench import TREE_REFUSAL, WrenchStream
+from irb140_dynamics.nodes.id_node.markers import build_markers
+from irb140_dynamics.nodes.id_node.node import IdNode
+
+from ..support.pinocchio_model import spatial_inertia
+from ..support.pinocchio_trees import _state, pinocchio_of, reference
+from ..support.ros_harness import running
+
+PAYLOAD = RigidBody(2.0, (0.01, -0.02, 0.08), (0.01, 0.02, 0.015, 0.001, 0.0, -0.002))
+
+
+def example_robot_text(name: str) -> str | None:
+    try:
+        distribution = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError:
+        return None
+    paths = [distribution.locate_file(f) for f in distribution.files or () if f.name == name]
+    return paths[0].read_text() if paths else None
+
+
+BAXTER = example_robot_text("baxter.urdf")
+needs_baxter = pytest.mark.skipif(BAXTER is None, reason="example-robot-data is not installed")
+
+
+def from_description(**values):
+    overrides = [Parameter("model.source", value="robot_description"), Parameter("robot_description", value=BAXTER)]
+    return overrides + [Parameter(name.replace("__", "."), value=value) for name, value in values.items()]
+
+
+def answers(harness, names, q, qd):
+    for topic in ("gravity_torques", "feedforward_torques"):
+        harness.listen(JointState, topic)
+    publisher = harness.publisher(JointState, "joint_states")
+    publisher.publish(JointState(name=list(names), position=[float(x) for x in q], velocity=[float(x) for x in qd]))
+    inboxes = [harness.received[topic] for topic in ("gravity_torques", "feedforward_torques")]
+    assert harness.spin_until(lambda: all(inboxes)), "no torques"
+    return inboxes[0][-1], inboxes[1][-1]
+
+
+@needs_baxter
+def test_id_node_on_a_whole_tree_gives_every_independent_joint_as_pinocchio():
+    with running(IdNode, parameter_overrides=from_description()) as harness:
+        model = harness.node.settings.model
+        assert model.n == 17 and len(model.joints) == 19 and not model.is_chain
+        rng = np.random.default_rng(7)
+        q, qd = rng.uniform(-1.0, 1.0, model.n), rng.uniform(-1.0, 1.0, model.n)
+        every = [j.name for j in model.joints]
+        q_all, qd_all = model.all_positions(q), model.mimic_matrix() @ qd
+        shuffled = rng.permutation(len(every))  # every joint, mimic ones too, in any order
+        g_msg, tau_msg = answers(harness, [every[i] for i in shuffled], q_all[shuffled], qd_all[shuffled])
+        tau, g, _ = reference(*pinocchio_of(BAXTER, mimic=True), model, q, qd, np.zeros(model.n))
+        friction = 0.0 if model.friction is None else model.friction.torques(qd)
+    assert tuple(g_msg.name) == tuple(tau_msg.name) == model.joint_names
+    np.testing.assert_allclose(g_msg.effort, g, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(tau_msg.effort, tau + friction, rtol=1e-9, atol=1e-9)
+    assert np.abs(g).max() > 1.0  # the arms' weight is in it
+
+
+@needs_baxter
+def test_a_payload_on_a_named_link_of_the_tree_as_pinocchio_and_none_without_a_link():
+    link = "left_gripper"
+    values = dict(payload__link=link, payload__mass=PAYLOAD.mass, payload__com=list(PAYLOAD.com))
+    values["payload__inertia"] = list(PAYLOAD.inertia)
+    with running(IdNode, parameter_overrides=from_description(**values)) as harness:
+        model = harness.node.settings.model
+        q = np.random.default_rng(3).uniform(-1.0, 1.0, model.n)
+        g_msg, _ = answers(harness, model.joint_names, q, np.zeros(model.n))
+        [refused] = harness.set_parameters([Parameter("payload.link", value="")])
+        [unknown] = harness.set_parameters([Parameter("payload.link", value="no_such_link")])
+    full, follows = pinocchio_of(BAXTER, mimic=True)
+    frame = full.frames[full.getFrameId(link)]
+    full.appendBodyToJoint(frame.parentJoint, spatial_inertia(PAYLOAD), frame.placement)
+    _, g, _ = reference(full, follows, model, q, np.zeros(model.n), np.zeros(model.n))
+    np.testing.assert_allclose(g_msg.effort, g, rtol=1e-9, atol=1e-9)
+    without = np.asarray(reference(*pinocchio_of(BAXTER, mimic=True), model, q, q * 0, q * 0)[1])
+    assert np.abs(g - without).max() > 1.0  # the payload loads the left arm
+    assert not refused.successful and "payload.link" in refused.reason and "tree" in refused.reason
+    assert not unknown.successful and "payload.link" in unknown.reason and "no_such_link" in unknown.reason
+
+
+@needs_baxter
+def test_a_tree_payload_without_its_link_stops_a_tool_or_node_in_one_line():
+    with pytest.raises(ValueError, match=r"^[^\n]*payload\.link: the model is a tree \(17 joints"):
+        read_arm({"model.source": "robot_description", "robot_description": BAXTER, "payload.mass": 1.0})
+    with pytest.raises(ValueError, match="payload.link names a URDF link"):
+        read_arm({"payload.link": "tool0"})
+
+
+@needs_baxter
+def test_markers_show_every_independent_joint_of_the_tree_at_pinocchios_joint_origins():
+    model = load_urdf(BAXTER).model
+    q = np.random.default_rng(5).uniform(-1.0, 1.0, model.n)
+    tau = gravity(model, q)
+    markers = build_markers(model, [np.inf] * model.n, "base", Time(), q, tau, external=tau * 0.1)
+    spheres = {m.id: m for m in markers.markers if m.ns == "joint_load"}
+    labels = [m.text for m in markers.markers if m.ns == "joint_label"]
+    assert sorted(spheres) == list(range(model.n))
+    assert [label.split(" ")[0] for label in labels] == list(model.joint_names)
+    full, _ = pinocchio_of(BAXTER, mimic=False)
+    data = full.createData()
+    pin.forwardKinematics(full, data, _state(full, [j.name for j in model.joints], model.all_positions(q), q, q)[0])
+    for k, name in enumerate(model.joint_names):
+        p = spheres[k].pose.position
+        joint = full.getJointId(name)  # its origin: the parent's frame placed, before the joint's own motion
+        origin = (data.oMi[full.parents[joint]] * full.jointPlacements[joint]).translation
+        np.testing.assert_allclose([p.x, p.y, p.z], origin, atol=1e-12)
+    assert not [m for m in markers.markers if m.ns == "external_force" and m.action == m.ADD]  # no flange force
+
+
+@needs_baxter
+def test_external_torques_on_a_tree_and_no_wrench_said_in_one_line():
+    with running(IdNode, parameter_overrides=from_description()) as harness:
+        model = harness.node.settings.model
+        q = np.random.default_rng(9).uniform(-1.0, 1.0, model.n)
+        harness.listen(JointState, "external_torques")
+        publisher = harness.publisher(JointState, "joint_states")
+        g = gravity(model, q)
+        for k in range(3):  # at rest, efforts = gravity: no external torque
+            msg = JointState(name=list(model.joint_names), position=q.tolist(), velocity=[0.0] * model.n)
+            msg.effort = g.tolist()
+            msg.header.stamp.nanosec = 1000 * (k + 1)
+            publisher.publish(msg)
+        inbox = harness.received["external_torques"]
+        assert harness.spin_until(lambda: len(inbox) >= 3), "no external torques"
+        report = harness.node.wrench.report()
+    assert tuple(inbox[-1].name) == model.joint_names
+    np.testing.assert_allclose(inbox[-1].effort, 0.0, atol=1e-9)
+    assert report == (False, TREE_REFUSAL, {}) and "\n" not in TREE_REFUSAL
+    stream = WrenchStream()
+    stream.note(model, q, g)
+    with pytest.raises(ValueError, match="no external wrench on a tree"):
+        stream.estimate("tip")
