@@ -52,8 +52,8 @@ class SimulatedArm:
         limits = np.array(model.torque_limits, dtype=float)
         self.torque_limits = np.where(limits > 0.0, limits, np.inf)
         self.applied = np.zeros(model.n)
-        self._flange_body = mujoco.mj_name2id(self.mj_model, mujoco.mjtObj.mjOBJ_BODY, model.joints[-1].name)
-        self._flange = model.flange.matrix()  # the flange in the last link's frame
+        self._flange_body = mujoco.mj_name2id(self.mj_model, mujoco.mjtObj.mjOBJ_BODY, model.joints[model.carrier].name)
+        self._flange = model.flange.matrix()  # the flange in its link's frame (model.carrier's)
         self._reset_state = (np.zeros(model.n), np.zeros(model.n))
         self.reset(np.zeros(model.n))
 

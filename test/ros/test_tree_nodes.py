@@ -1,10 +1,9 @@
-"""id_node on a whole kinematic tree, in-process: example-robot-data's Baxter (two arms, a
-head pan, grippers whose second finger is a mimic joint), read with no tip_link. Its gravity
+"""id_node and sim_node on a whole kinematic tree, in-process: Baxter (test/data/urdf: two arms,
+a head pan, grippers whose second finger is a mimic joint), read with no tip_link. Its gravity
 and feed-forward torques of every independent joint, by name, against Pinocchio's of the same
-tree (test.support.pinocchio_trees), from one JointState naming the
-joints in any order, mimic joints among them (ignored)."""
-
-import importlib.metadata
+tree (test.support.pinocchio_trees), from one JointState naming the joints in any order, mimic
+joints among them (ignored); a payload on a named link; the markers; the external torques.
+sim_node on a tree without mimic joints (test_urdf_trees' TWO_ARMS); with them, refused."""
 
 import numpy as np
 import pinocchio as pin
@@ -12,6 +11,7 @@ import pytest
 from builtin_interfaces.msg import Time
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
 
 from irb140_dynamics.core import RigidBody, gravity
 from irb140_dynamics.core.io.arm_source import read_arm
@@ -19,25 +19,19 @@ from irb140_dynamics.core.io.urdf import load_urdf
 from irb140_dynamics.core.monitoring.wrench import TREE_REFUSAL, WrenchStream
 from irb140_dynamics.nodes.id_node.markers import build_markers
 from irb140_dynamics.nodes.id_node.node import IdNode
+from irb140_dynamics.nodes.sim_node.node import SimNode
 
+from ..core.test_urdf_trees import TWO_ARMS, _without_mimics
+from ..support.paths import URDF_DATA
 from ..support.pinocchio_model import spatial_inertia
 from ..support.pinocchio_trees import _state, pinocchio_of, reference
 from ..support.ros_harness import running
+from .test_sim_node import states_after_reset
 
 PAYLOAD = RigidBody(2.0, (0.01, -0.02, 0.08), (0.01, 0.02, 0.015, 0.001, 0.0, -0.002))
 
 
-def example_robot_text(name: str) -> str | None:
-    try:
-        distribution = importlib.metadata.distribution("example-robot-data")
-    except importlib.metadata.PackageNotFoundError:
-        return None
-    paths = [distribution.locate_file(f) for f in distribution.files or () if f.name == name]
-    return paths[0].read_text() if paths else None
-
-
-BAXTER = example_robot_text("baxter.urdf")
-needs_baxter = pytest.mark.skipif(BAXTER is None, reason="example-robot-data is not installed")
+BAXTER = (URDF_DATA / "baxter.urdf").read_text()  # example-robot-data 6.0.0's, unchanged
 
 
 def from_description(**values):
@@ -55,7 +49,6 @@ def answers(harness, names, q, qd):
     return inboxes[0][-1], inboxes[1][-1]
 
 
-@needs_baxter
 def test_id_node_on_a_whole_tree_gives_every_independent_joint_as_pinocchio():
     with running(IdNode, parameter_overrides=from_description()) as harness:
         model = harness.node.settings.model
@@ -74,7 +67,6 @@ def test_id_node_on_a_whole_tree_gives_every_independent_joint_as_pinocchio():
     assert np.abs(g).max() > 1.0  # the arms' weight is in it
 
 
-@needs_baxter
 def test_a_payload_on_a_named_link_of_the_tree_as_pinocchio_and_none_without_a_link():
     link = "left_gripper"
     values = dict(payload__link=link, payload__mass=PAYLOAD.mass, payload__com=list(PAYLOAD.com))
@@ -96,7 +88,6 @@ def test_a_payload_on_a_named_link_of_the_tree_as_pinocchio_and_none_without_a_l
     assert not unknown.successful and "payload.link" in unknown.reason and "no_such_link" in unknown.reason
 
 
-@needs_baxter
 def test_a_tree_payload_without_its_link_stops_a_tool_or_node_in_one_line():
     with pytest.raises(ValueError, match=r"^[^\n]*payload\.link: the model is a tree \(17 joints"):
         read_arm({"model.source": "robot_description", "robot_description": BAXTER, "payload.mass": 1.0})
@@ -104,7 +95,6 @@ def test_a_tree_payload_without_its_link_stops_a_tool_or_node_in_one_line():
         read_arm({"payload.link": "tool0"})
 
 
-@needs_baxter
 def test_markers_show_every_independent_joint_of_the_tree_at_pinocchios_joint_origins():
     model = load_urdf(BAXTER).model
     q = np.random.default_rng(5).uniform(-1.0, 1.0, model.n)
@@ -125,7 +115,6 @@ def test_markers_show_every_independent_joint_of_the_tree_at_pinocchios_joint_or
     assert not [m for m in markers.markers if m.ns == "external_force" and m.action == m.ADD]  # no flange force
 
 
-@needs_baxter
 def test_external_torques_on_a_tree_and_no_wrench_said_in_one_line():
     with running(IdNode, parameter_overrides=from_description()) as harness:
         model = harness.node.settings.model
@@ -148,3 +137,31 @@ def test_external_torques_on_a_tree_and_no_wrench_said_in_one_line():
     stream.note(model, q, g)
     with pytest.raises(ValueError, match="no external wrench on a tree"):
         stream.estimate("tip")
+
+
+def test_sim_node_simulates_a_tree_held_by_its_gravity_torques():
+    """A torso and two arms (test_urdf_trees' TWO_ARMS, its fingers' mimic joints taken out):
+    every joint published, and the tree held where it is by the core's gravity torques (MuJoCo's
+    bodies nested along model.parent)."""
+    text = _without_mimics(TWO_ARMS)
+    model = load_urdf(text).model
+    pose = [0.4, -0.7, 0.9, 0.5, 0.2, -0.6, 1.1]
+    assert not model.is_chain and model.n == len(pose)
+    overrides = [Parameter("model.source", value="robot_description"), Parameter("robot_description", value=text)]
+    overrides += [Parameter("initial_positions", value=pose), Parameter("command_timeout", value=0.0)]
+    with running(SimNode, parameter_overrides=overrides) as sim:
+        sim.states = sim.listen(JointState, "joint_states", 1000)
+        sim.commands = sim.publisher(Float64MultiArray, "effort_commands")
+        held = states_after_reset(sim, 300, gravity(model, pose))
+        fall = states_after_reset(sim, 300, np.zeros(model.n))
+    assert list(held[0].name) == list(model.joint_names)
+    assert np.abs(np.array([msg.position for msg in held]) - pose).max() < 1e-6
+    assert np.abs(np.array(fall[-1].position) - pose).max() > 1e-2  # without them it falls
+
+
+def test_sim_node_refuses_mimic_joints_in_one_line():
+    with (
+        pytest.raises(ValueError, match=r"^[^\n]*mimic joints is not simulated"),
+        running(SimNode, parameter_overrides=from_description()),
+    ):
+        pass
