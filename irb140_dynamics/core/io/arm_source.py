@@ -188,7 +188,12 @@ def _urdf_arm(values, urdf, base_link, tip_link, origin) -> Arm:
         named = origin or (text is not None and where)
         raise ValueError(f"{named}: {one_line(error)}" if named else one_line(error)) from None
     name = loaded.robot_name or URDF_ROBOT_NAME
-    return Arm(model, name, f"{where} ({loaded.base_link} -> {loaded.tip_link})", loaded, text)
+    ends = (
+        f"{loaded.base_link} -> {loaded.tip_link}"
+        if is_one_chain(loaded.model)
+        else f"the tree below {loaded.base_link}"
+    )
+    return Arm(model, name, f"{where} ({ends})", loaded, text)
 
 
 def _described_urdf(values, origin, relative_to) -> UrdfText:
