@@ -3,7 +3,7 @@ a head pan, grippers whose second finger is a mimic joint), read with no tip_lin
 and feed-forward torques of every independent joint, by name, against Pinocchio's of the same
 tree (test.support.pinocchio_trees), from one JointState naming the joints in any order, mimic
 joints among them (ignored); a payload on a named link; the markers; the external torques.
-sim_node on a tree without mimic joints (test_urdf_trees' TWO_ARMS); with them, refused."""
+sim_node on a tree (test_urdf_trees' TWO_ARMS without its mimic joints; Baxter with its)."""
 
 import numpy as np
 import pinocchio as pin
@@ -139,29 +139,32 @@ def test_external_torques_on_a_tree_and_no_wrench_said_in_one_line():
         stream.estimate("tip")
 
 
-def test_sim_node_simulates_a_tree_held_by_its_gravity_torques():
-    """A torso and two arms (test_urdf_trees' TWO_ARMS, its fingers' mimic joints taken out):
-    every joint published, and the tree held where it is by the core's gravity torques (MuJoCo's
-    bodies nested along model.parent)."""
-    text = _without_mimics(TWO_ARMS)
+def within_limits(model, share):
+    """A pose at ``share`` (0..1) of each independent joint's range."""
+    lower, upper = np.array([joint.position_limits for joint in model.independent_joints]).T
+    return (lower + share * (upper - lower)).tolist()
+
+
+@pytest.mark.parametrize("arm", ["two_arms", "baxter"])
+def test_sim_node_simulates_a_tree_held_by_its_gravity_torques(arm):
+    """A torso and two arms (test_urdf_trees' TWO_ARMS, its mimic joints taken out), and
+    Baxter (its mimic fingers held to their joints by MuJoCo equalities): every independent
+    joint published, and the tree held where it is by the core's gravity torques (MuJoCo's
+    bodies nested along model.parent); without them it falls."""
+    text = _without_mimics(TWO_ARMS) if arm == "two_arms" else BAXTER
     model = load_urdf(text).model
-    pose = [0.4, -0.7, 0.9, 0.5, 0.2, -0.6, 1.1]
-    assert not model.is_chain and model.n == len(pose)
+    pose = within_limits(model, np.random.default_rng(6).uniform(0.2, 0.8, model.n))
+    assert not model.is_chain and (model.mimics is None) == (arm == "two_arms")
     overrides = [Parameter("model.source", value="robot_description"), Parameter("robot_description", value=text)]
     overrides += [Parameter("initial_positions", value=pose), Parameter("command_timeout", value=0.0)]
     with running(SimNode, parameter_overrides=overrides) as sim:
         sim.states = sim.listen(JointState, "joint_states", 1000)
         sim.commands = sim.publisher(Float64MultiArray, "effort_commands")
         held = states_after_reset(sim, 300, gravity(model, pose))
+        engine = sim.node.simulation.arm
+        every_joint = engine.data.qpos.copy()  # MuJoCo's: the mimic joints too
         fall = states_after_reset(sim, 300, np.zeros(model.n))
     assert list(held[0].name) == list(model.joint_names)
     assert np.abs(np.array([msg.position for msg in held]) - pose).max() < 1e-6
+    assert np.abs(every_joint - model.all_positions(pose)).max() < 1e-6  # each mimic joint where it follows
     assert np.abs(np.array(fall[-1].position) - pose).max() > 1e-2  # without them it falls
-
-
-def test_sim_node_refuses_mimic_joints_in_one_line():
-    with (
-        pytest.raises(ValueError, match=r"^[^\n]*mimic joints is not simulated"),
-        running(SimNode, parameter_overrides=from_description()),
-    ):
-        pass
