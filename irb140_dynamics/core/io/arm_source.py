@@ -169,6 +169,13 @@ def is_one_chain(model: RobotModel) -> bool:
     return all(p == i - 1 for i, p in enumerate(model.parent))
 
 
+def urdf_span(loaded: LoadedUrdf) -> str:
+    """What of the URDF the model is, for messages: 'base_link -> tool0', or 'the tree below base'."""
+    if is_one_chain(loaded.model):
+        return f"{loaded.base_link} -> {loaded.tip_link}"
+    return f"the tree below {loaded.base_link}"
+
+
 def _urdf_arm(values, urdf, base_link, tip_link, origin) -> Arm:
     """A chain read already (a node's) names no file in its errors: the parameter is named."""
     text, where = None, origin or "robot_description"
@@ -188,12 +195,7 @@ def _urdf_arm(values, urdf, base_link, tip_link, origin) -> Arm:
         named = origin or (text is not None and where)
         raise ValueError(f"{named}: {one_line(error)}" if named else one_line(error)) from None
     name = loaded.robot_name or URDF_ROBOT_NAME
-    ends = (
-        f"{loaded.base_link} -> {loaded.tip_link}"
-        if is_one_chain(loaded.model)
-        else f"the tree below {loaded.base_link}"
-    )
-    return Arm(model, name, f"{where} ({ends})", loaded, text)
+    return Arm(model, name, f"{where} ({urdf_span(loaded)})", loaded, text)
 
 
 def _described_urdf(values, origin, relative_to) -> UrdfText:
