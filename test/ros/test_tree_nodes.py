@@ -9,6 +9,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from builtin_interfaces.msg import Time
+from geometry_msgs.msg import WrenchStamped
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
@@ -16,6 +17,7 @@ from std_msgs.msg import Float64MultiArray
 from irb140_dynamics.core import RigidBody, gravity
 from irb140_dynamics.core.io.arm_source import read_arm
 from irb140_dynamics.core.io.urdf import load_urdf
+from irb140_dynamics.core.monitoring.link_wrenches import SINGULAR_THRESHOLD, link_wrenches, wrench_places
 from irb140_dynamics.core.monitoring.wrench import TREE_REFUSAL, WrenchStream
 from irb140_dynamics.nodes.id_node.markers import build_markers
 from irb140_dynamics.nodes.id_node.node import IdNode
@@ -181,3 +183,81 @@ def test_sim_node_simulates_a_tree_held_by_its_gravity_torques(arm):
     assert np.abs(np.array([msg.position for msg in held]) - pose).max() < 1e-6
     assert np.abs(every_joint - model.all_positions(pose)).max() < 1e-6  # each mimic joint where it follows
     assert np.abs(np.array(fall[-1].position) - pose).max() > 1e-2  # without them it falls
+
+
+def pinocchio_link_torques(model, q, forces: dict) -> np.ndarray:
+    """tau_ext = sum_k J_k^T F_k of wrenches (force; torque about the link's origin, in its
+    axes) on Baxter's links, J_k Pinocchio's LOCAL frame Jacobian, projected on the
+    independent joints."""
+    full, follows = pinocchio_of(BAXTER, mimic=True)
+    names = model.joint_names if follows else [j.name for j in model.joints]
+    state = (q if follows else model.all_positions(q)), np.zeros(len(names)), np.zeros(len(names))
+    pq = _state(full, names, *state)[0]
+    data = full.createData()
+    index = [full.joints[full.getJointId(name)].idx_v for name in names]
+    tau = np.zeros(full.nv)
+    for link, F in forces.items():
+        J = pin.computeFrameJacobian(full, data, pq, full.getFrameId(link), pin.ReferenceFrame.LOCAL)
+        tau += J.T @ F
+    return tau[index] if follows else model.mimic_matrix().T @ tau[index]
+
+
+FORCES = {
+    "left_gripper": np.array([5.0, -3.0, 8.0, 0.4, -0.2, 0.3]),
+    "right_gripper": np.array([-2.0, 6.0, 1.0, 0.0, 0.5, -0.1]),
+}
+
+
+def test_link_wrenches_on_two_arms_are_the_wrenches_that_made_the_torques():
+    loaded = load_urdf(BAXTER)
+    model = loaded.model
+    places = wrench_places(list(FORCES), loaded.carried)
+    exact = 0
+    for q in np.random.default_rng(12).uniform(-1.0, 1.0, (6, model.n)):
+        tau_ext = pinocchio_link_torques(model, q, FORCES)
+        wrenches, sigma, damping = link_wrenches(model, q, tau_ext, places)
+        assert (damping == 0.0) == (sigma >= SINGULAR_THRESHOLD)
+        if damping:  # near a singularity: damped, not exact
+            continue
+        exact += 1
+        for wrench in wrenches:
+            np.testing.assert_allclose(np.concatenate([wrench.force, wrench.torque]), FORCES[wrench.link], atol=1e-9)
+    assert exact >= 3
+    with pytest.raises(ValueError, match=r"^external_wrench\.links: 'base' is not moved by the model's joints$"):
+        wrench_places(["base"], loaded.carried)
+
+
+def test_id_node_publishes_each_links_wrench_in_its_frame():
+    overrides = from_description() + [Parameter("external_wrench.links", value=list(FORCES))]
+    with running(IdNode, parameter_overrides=overrides) as harness:
+        model = harness.node.settings.model
+        q = np.random.default_rng(13).uniform(-1.0, 1.0, model.n)
+        harness.listen(JointState, "external_torques")
+        harness.listen(WrenchStamped, "external_wrench")
+        publisher = harness.publisher(JointState, "joint_states")
+        effort = gravity(model, q) + pinocchio_link_torques(model, q, FORCES)
+        for k in range(5):
+            msg = JointState(name=list(model.joint_names), position=q.tolist(), velocity=[0.0] * model.n)
+            msg.effort, msg.header.stamp.nanosec = effort.tolist(), 1_000_000 * (k + 1)
+            publisher.publish(msg)
+        torques, wrenches = harness.received["external_torques"], harness.received["external_wrench"]
+        assert harness.spin_until(lambda: len(torques) >= 5 and len(wrenches) >= 10), "no wrenches"
+        report = harness.node.wrench.report()
+    r = np.array(torques[-1].effort)  # the observer's, a lag of its gain: some of tau_ext by now
+    expected, _, _ = link_wrenches(model, q, r, wrench_places(list(FORCES), load_urdf(BAXTER).carried))
+    last = {msg.header.frame_id: msg.wrench for msg in wrenches[-2:]}
+    assert sorted(last) == sorted(FORCES)
+    for wrench in expected:
+        w = last[wrench.link]
+        np.testing.assert_allclose([w.force.x, w.force.y, w.force.z], wrench.force, rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose([w.torque.x, w.torque.y, w.torque.z], wrench.torque, rtol=1e-9, atol=1e-9)
+    assert np.abs(r).max() > 0.1 and not report[0]
+
+
+def test_external_wrench_links_that_the_model_does_not_move_stop_the_start_in_one_line():
+    overrides = from_description() + [Parameter("external_wrench.links", value=["left_gripper", "nowhere"])]
+    with (
+        pytest.raises(ValueError, match=r"^[^\n]*external_wrench\.links: 'nowhere' is not moved"),
+        running(IdNode, parameter_overrides=overrides),
+    ):
+        pass

@@ -39,6 +39,7 @@ NODE_PARAMETER_NAMES = frozenset(
         "estimation.rest_time",
         "estimation.rest_velocity",
         "external_wrench.frame",
+        "external_wrench.links",
         "ft_contact_wrench.frame",
         "ft_sensor.apply_load",
         "ft_sensor.link",

@@ -43,6 +43,7 @@ class IdNodeSettings:
     collision: CollisionSettings
     gains: Gains
     wrench_frame: str  # "tip" or "base"
+    wrench_links: tuple[str, ...] = ()  # URDF links whose wrenches are estimated (monitoring.link_wrenches)
     ft_link: str = ""  # the link of a wrist force/torque sensor, "" = none (core.ft_sensor)
     ft_frame: str = "sensor"  # the axes of its contact wrench: "sensor" or "base"
     rated_payload: RigidBody = RATED_PAYLOAD  # the torque limits are derived from it (joints without torque_limit)
@@ -56,6 +57,9 @@ def check_settings(values: dict) -> IdNodeSettings:
     check_choice("acceleration.mode", values["acceleration.mode"], ACCELERATION_MODES)
     check_choice("effort_commands.source", values["effort_commands.source"], EFFORT_SOURCES)
     check_choice("external_wrench.frame", values["external_wrench.frame"], FRAMES)
+    links = tuple(values.get("external_wrench.links") or ())
+    if links and values["external_wrench.frame"] != "tip":
+        raise ValueError("external_wrench.frame: with external_wrench.links each wrench is in its link's axes ('tip')")
     ft_link, ft_frame = values.get("ft_sensor.link", ""), values.get("ft_contact_wrench.frame", "sensor")
     check_choice("ft_contact_wrench.frame", ft_frame, FT_FRAMES)
 
@@ -71,6 +75,7 @@ def check_settings(values: dict) -> IdNodeSettings:
         CollisionSettings(values["collision.observer_gain"], per_joint("collision_threshold")),
         Gains(per_joint("kp"), per_joint("kd")),
         values["external_wrench.frame"],
+        links,
         ft_link,
         ft_frame,
         RigidBody.validated("rated_payload", values["rated_payload.mass"], values["rated_payload.com"]),
