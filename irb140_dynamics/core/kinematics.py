@@ -141,6 +141,15 @@ def link_jacobian(model: RobotModel, q, joint: str) -> np.ndarray:
     return _jacobian(model, frames, frames[index + 1][:3, 3], index)
 
 
+def placed_pose_and_jacobian(model: RobotModel, q, joint: str, placement) -> tuple[np.ndarray, np.ndarray]:
+    """The pose (4x4, base frame) of the frame ``placement`` (a ``Placement``) places in the
+    link ``joint`` moves, and the 6 x n Jacobian of its origin (rows v; w, base axes)."""
+    frames = link_frames(model, q)
+    index = _joint_index(model, joint)
+    pose = frames[index + 1] @ placement.matrix()
+    return pose, _jacobian(model, frames, pose[:3, 3], index)
+
+
 def _joint_index(model: RobotModel, joint: str) -> int:
     for i, j in enumerate(model.joints):
         if j.name == joint:

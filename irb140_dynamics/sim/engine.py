@@ -52,8 +52,10 @@ class SimulatedArm:
         limits = np.array(model.torque_limits, dtype=float)
         self.torque_limits = np.where(limits > 0.0, limits, np.inf)
         self.applied = np.zeros(model.n)
-        self._flange_body = mujoco.mj_name2id(self.mj_model, mujoco.mjtObj.mjOBJ_BODY, model.joints[-1].name)
-        self._flange = model.flange.matrix()  # the flange in the last link's frame
+        # the state's coordinates in MuJoCo's qpos/qvel: every joint, or the independent ones (mimic joints)
+        self._dofs = slice(None) if model.mimics is None else np.array(model.independent)
+        self._flange_body = mujoco.mj_name2id(self.mj_model, mujoco.mjtObj.mjOBJ_BODY, model.joints[model.carrier].name)
+        self._flange = model.flange.matrix()  # the flange in its link's frame (model.carrier's)
         self._reset_state = (np.zeros(model.n), np.zeros(model.n))
         self.reset(np.zeros(model.n))
 
@@ -63,13 +65,13 @@ class SimulatedArm:
 
     @property
     def q(self) -> np.ndarray:
-        """Joint positions [rad] (a copy)."""
-        return self.data.qpos.copy()
+        """Joint positions [rad] (a copy; the independent joints': the state's)."""
+        return self.data.qpos[self._dofs].copy()
 
     @property
     def qd(self) -> np.ndarray:
-        """Joint velocities [rad/s] (a copy)."""
-        return self.data.qvel.copy()
+        """Joint velocities [rad/s] (a copy; the independent joints')."""
+        return self.data.qvel[self._dofs].copy()
 
     @property
     def time(self) -> float:
@@ -86,7 +88,7 @@ class SimulatedArm:
 
     def take_state_of(self, other: SimulatedArm) -> None:
         """Continue from another arm's state (a model change while running)."""
-        self._set(other.data.qpos, other.data.qvel, other.data.time)
+        self._set(other.q, other.qd, other.data.time)
         self.applied = other.applied.copy()
         self._reset_state = other._reset_state
 
@@ -104,7 +106,7 @@ class SimulatedArm:
             if wrench.shape != (6,) or not np.isfinite(wrench).all() or frame not in ("base", "tip"):
                 raise ValueError(f"wrench: expected 6 finite numbers in 'base' or 'tip' axes, got {wrench}, {frame!r}")
         data = self.data
-        data.qfrc_applied[:] = self.applied
+        data.qfrc_applied[self._dofs] = self.applied  # a mimic joint's: none (its equality carries it)
         for _ in range(self.substeps):
             data.xfrc_applied[self._flange_body] = 0.0 if wrench is None else self._at_com(wrench, frame)
             mujoco.mj_step(self.mj_model, data)
@@ -130,12 +132,12 @@ class SimulatedArm:
         stiffness, damping = np.asarray(stiffness, dtype=float), np.asarray(damping, dtype=float)
         Q, QD, TAU = (np.empty_like(feed_forward) for _ in range(3))
         data, mj_model, low, high = self.data, self.mj_model, -self.torque_limits, self.torque_limits
-        qpos, qvel, applied = data.qpos, data.qvel, data.qfrc_applied
+        qpos, qvel, applied, dofs = data.qpos, data.qvel, data.qfrc_applied, self._dofs
         for k in range(len(feed_forward)):
-            Q[k], QD[k] = qpos, qvel
+            Q[k], QD[k] = qpos[dofs], qvel[dofs]
             tau = feed_forward[k] + stiffness * (Q_ref[k] - Q[k]) + damping * (QD_ref[k] - QD[k])
             np.clip(tau, low, high, out=TAU[k])
-            applied[:] = TAU[k]
+            applied[dofs] = TAU[k]
             for _ in range(self.substeps):
                 mujoco.mj_step(mj_model, data)
         if len(TAU):
@@ -167,8 +169,9 @@ class SimulatedArm:
         return data_warning(self.data, mujoco.mjtWarning.mjWARN_BADQACC) > 0
 
     def _set(self, q, qd, time: float) -> None:
-        self.data.qpos[:] = q
-        self.data.qvel[:] = qd
+        mimics = self.model.mimics is not None  # then every joint placed as the state's ones say
+        self.data.qpos[:] = self.model.all_positions(q) if mimics else q
+        self.data.qvel[:] = self.model.mimic_matrix() @ qd if mimics else qd
         self.data.time = time
         self.data.qfrc_applied[:] = 0.0
         self.applied = np.zeros(self.n)

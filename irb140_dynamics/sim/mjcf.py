@@ -15,7 +15,10 @@ about the CoM in the link frame); the payload is a body welded to the last link 
 level: realistic for a true arm, but not our tanh smoothing; made as stiff as MuJoCo allows,
 time constant 2 timesteps and impedance 0.999..0.9999, so that a joint held at 2/3 of its
 level creeps by about 0.5 mrad/s instead of the 0.5 rad/s of MuJoCo's defaults), position
-limits as ``range`` (soft constraints: stops, MuJoCo's default stiffness).
+limits as ``range`` (soft constraints: stops, MuJoCo's default stiffness). A mimic joint is
+a joint of its own held to its joint by an equality constraint (``<equality><joint
+polycoef>``, as stiff as the friction's): MuJoCo's qpos holds every joint of
+``model.joints``, the state's q its independent ones (``engine`` maps them).
 
 Massless links (the IRB-140's links 3 and 5): MuJoCo refuses a body with a joint and no mass
 or inertia. The compiler's ``boundmass`` and ``boundinertia`` raise every body's mass and
@@ -37,6 +40,8 @@ from irb140_dynamics.core.model.robot_model import RobotModel
 MINIMAL_INERTIA = 1e-12  # kg and kg m^2: lower bound of each body's mass and principal moments
 FRICTION_IMPEDANCE = (0.999, 0.9999, 0.001, 0.5, 2.0)  # solimpfriction: dry friction nearly hard
 INTEGRATORS = ("implicitfast", "RK4", "implicit", "Euler")
+MIMIC_STEPS = 2.0  # a mimic joint's equality: its time constant in timesteps (MuJoCo's stiffest stable)
+MIMIC_IMPEDANCE = (0.999, 0.9999, 0.001, 0.5, 2.0)  # solimp: the equality nearly hard
 
 
 def mjcf(
@@ -64,8 +69,6 @@ def mjcf(
         "  </option>",
         "  <worldbody>",
     ]
-    if model.mimics is not None:
-        raise ValueError("a model with mimic joints is not simulated yet (its joints would move freely)")
     below = [[] for _ in model.joints]
     for i, parent in enumerate(model.parent):
         if parent >= 0:
@@ -110,8 +113,31 @@ def mjcf(
             lines.append(f"{indent}</body>")
         stack.append(("close", i))
         stack += [("open", child) for child in reversed(below[i])]
-    lines += ["  </worldbody>", "</mujoco>", ""]
+    lines.append("  </worldbody>")
+    lines += _mimic_equalities(model, timestep)
+    lines += ["</mujoco>", ""]
     return "\n".join(lines)
+
+
+def _mimic_equalities(model: RobotModel, timestep: float) -> list[str]:
+    """Each mimic joint held at multiplier * q_joint + offset by a joint equality (MuJoCo's
+    polycoef: joint1 = c0 + c1 joint2), as stiff as MuJoCo steps stably: time constant
+    MIMIC_STEPS timesteps, critically damped, impedance MIMIC_IMPEDANCE."""
+    if model.mimics is None:
+        return []
+    solref = _numbers((MIMIC_STEPS * timestep, 1.0))
+    lines = ["  <equality>"]
+    for joint, mimic in zip(model.joints, model.mimics):
+        if mimic is not None:
+            attributes = {
+                "joint1": joint.name,
+                "joint2": mimic.joint,
+                "polycoef": _numbers((mimic.offset, mimic.multiplier, 0.0, 0.0, 0.0)),
+                "solref": solref,
+                "solimp": _numbers(MIMIC_IMPEDANCE),
+            }
+            lines.append(f"    <joint {' '.join(f'{k}={quoteattr(v)}' for k, v in attributes.items())}/>")
+    return [*lines, "  </equality>"]
 
 
 def mujoco_model(model: RobotModel, **options) -> mujoco.MjModel:

@@ -56,11 +56,12 @@ class Measured:
 
 
 def initial_positions(model: RobotModel, values) -> np.ndarray:
-    """The initial positions, or ValueError: one per joint (none: zeros), within the limits."""
+    """The initial positions, or ValueError: one per independent joint (none: zeros), every
+    joint within its limits (a mimic joint where it follows its joint)."""
     q = np.zeros(model.n) if values is None or not len(values) else np.array(values, dtype=float)
     if q.shape != (model.n,):
         raise ValueError(f"initial_positions: expected {model.n} values, got {len(q)}")
-    for joint, x in zip(model.joints, q):
+    for joint, x in zip(model.joints, q if model.mimics is None else model.all_positions(q)):
         lower, upper = joint.position_limits
         if not lower <= x <= upper:
             raise ValueError(f"initial_positions: {joint.name} at {x} rad is outside its limits [{lower}, {upper}]")

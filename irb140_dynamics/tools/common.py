@@ -55,10 +55,11 @@ def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model"
     )
 
 
-def arm_of(args: argparse.Namespace):
+def arm_of(args: argparse.Namespace, chain_for: str | None = None):
     """The arm (``core.io.arm_source.Arm``) of the arguments ``add_model_arguments`` declared:
     ToolError in one line for a bad file or value; BadArgument (exit status 2) for a name no
-    executable of the package knows, with the nearest known one."""
+    executable of the package knows, with the nearest known one. ``chain_for``: what needs a
+    serial chain (the payload analysis): ToolError naming --tip for a tree or mimic joints."""
     from irb140_dynamics.core.io.arm_source import given_values, read_arm, read_urdf_file
     from irb140_dynamics.core.io.parameter_names import known_parameter_names, unknown_names
     from irb140_dynamics.core.io.params_file import read_parameter_file
@@ -86,6 +87,11 @@ def arm_of(args: argparse.Namespace):
         raise BadArgument(_unknown_text(unknown, dict(overrides), params_file))
     if arm.urdf is None and not params_file:  # the package's own arm: named by its file
         arm = replace(arm, origin=str(default_config_path()))
+    if chain_for and not arm.model.is_chain:
+        raise ToolError(
+            f"{chain_for} takes one serial chain, but {shown(arm.origin)} gives {len(arm.model.joints)} joints "
+            "as a tree or with mimic joints: give --tip LINK, the end effector's URDF link"
+        )
     return replace(arm, given=values)
 
 

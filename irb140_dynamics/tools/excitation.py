@@ -203,7 +203,7 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
     from irb140_dynamics.identification.excitation import check_limits, optimise_excitation
     from irb140_dynamics.tools.outputs import Outputs
 
-    source = arm_of(args)
+    source = arm_of(args, chain_for="excitation --payload" if args.payload else None)
     model, path = source.model, source.origin
     expectation = []
     if args.payload:

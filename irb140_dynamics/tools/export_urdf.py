@@ -80,6 +80,11 @@ def limits(model) -> tuple[list[float], list[float], list[str]]:
             effort.append(joint.torque_limit)
             sources.append(source + ", effort: model")
             continue
+        if not model.is_chain:  # the rated payload's torques are a chain's (core.payload)
+            raise ToolError(
+                f"{joint.name}: no torque_limit in the model, and on a tree or with mimic joints none is "
+                f"derived; give one (-p {joint.name}.torque_limit:=N_M)"
+            )
         derived = derived or derive_torque_limits(model)
         if np.isfinite(derived.values[k]) and derived.values[k] > 0:
             effort.append(float(derived.values[k]))
@@ -113,6 +118,25 @@ def _dynamic_effort(model, k: int) -> float:
     return value
 
 
+def mimic_limits(model):
+    """The model with each mimic joint that has no torque or velocity limit of its own given
+    its joint's, as it moves it: velocity |multiplier| times, torque 1/|multiplier| times."""
+    if model.mimics is None:
+        return model
+    from dataclasses import replace
+
+    joints, index = list(model.joints), {joint.name: k for k, joint in enumerate(model.joints)}
+    for k, mimic in enumerate(model.mimics):
+        if mimic is None or not mimic.multiplier:
+            continue
+        followed, ratio, joint = model.joints[index[mimic.joint]], abs(mimic.multiplier), joints[k]
+        torque = joint.torque_limit or followed.torque_limit / ratio
+        joints[k] = replace(
+            joint, torque_limit=torque, velocity_limit=joint.velocity_limit or followed.velocity_limit * ratio
+        )
+    return replace(model, joints=tuple(joints))
+
+
 def urdf_of(model) -> str:
     """The model's URDF with positive limits; the IRB-140's named irb140 and drawn with its shapes."""
     from dataclasses import replace
@@ -121,6 +145,7 @@ def urdf_of(model) -> str:
     from irb140_dynamics.core.io.urdf import export_urdf
     from irb140_dynamics.core.model.irb140 import IRB140_SHAPES
 
+    model = mimic_limits(model)
     effort, velocity, _ = limits(model)
     joints = [replace(j, torque_limit=e, velocity_limit=v) for j, e, v in zip(model.joints, effort, velocity)]
     limited = replace(model, joints=tuple(joints))

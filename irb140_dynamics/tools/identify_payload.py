@@ -33,7 +33,7 @@ def identify_payload(args: argparse.Namespace, argv: list[str], interrupts) -> i
     from irb140_dynamics.tools.common import arm_of, reading_progress
     from irb140_dynamics.tools.outputs import Outputs
 
-    source = arm_of(args)
+    source = arm_of(args, chain_for="identify --payload-only")
     arm = source.model
     settings = IdentificationSettings(topic=args.topic, cutoff=args.cutoff, min_speed=args.min_speed)
     progress = None if args.quiet else reading_progress("identify")

@@ -133,7 +133,7 @@ def _diagram(argv: list[str], interrupts) -> int:
     from irb140_dynamics.tools.load_diagram_plot import diagram_csv, diagram_png
     from irb140_dynamics.tools.outputs import Outputs
 
-    source = arm_of(args)
+    source = arm_of(args, chain_for="load_diagram")
     try:
         given = source.given
         if not (args.params_file or args.urdf):  # the package's own arm: its file states its rated payload

@@ -13,6 +13,7 @@ import pytest
 
 from irb140_dynamics.core import Friction, forward_dynamics, gravity, irb140, mass_matrix, rnea
 from irb140_dynamics.core.io.urdf import load_urdf
+from irb140_dynamics.sim.engine import SimulatedArm
 from irb140_dynamics.sim.mjcf import MINIMAL_INERTIA, mjcf, mujoco_model
 
 from ..support.common import OFFSET_PAYLOAD, assert_close, loaded_irb140, random_model, random_states, random_urdf_model
@@ -157,9 +158,12 @@ def test_bad_options_are_refused():
         mjcf(irb140(), timestep=0.0)
 
 
-def test_a_tree_nests_its_bodies_along_parent_and_mimic_joints_are_refused():
+def test_a_tree_nests_its_bodies_along_parent_and_mimic_joints_are_equalities():
     """Two arms on a torso (test_urdf_trees): MuJoCo's inverse dynamics, M and gravity are the
-    core's; mimic joints are not simulated yet, said in one line."""
+    core's; with its mimic joints (each a joint held by an equality, soft as MuJoCo's are), the
+    accelerations of the independent joints from rest are the core's forward dynamics within
+    1e-3 of their largest (the equality's regularisation), and a SimulatedArm held by the
+    core's gravity torques stays put."""
     from ..core.test_urdf_trees import TWO_ARMS, _without_mimics
 
     model = load_urdf(_without_mimics(TWO_ARMS)).model
@@ -174,5 +178,19 @@ def test_a_tree_nests_its_bodies_along_parent_and_mimic_joints_are_refused():
         mujoco.mj_forward(mm, data)
         mujoco.mj_fullM(mm, data, M)
         assert_close(M, mass_matrix(model, q), 1e-9, 1e-9)
-    with pytest.raises(ValueError, match="mimic joints is not simulated yet"):
-        mjcf(load_urdf(TWO_ARMS).model)
+    model = load_urdf(TWO_ARMS).model
+    mm = mujoco_model(model, friction=False, limits=False)
+    assert (mm.nq, mm.neq) == (len(model.joints), 2)
+    data = mujoco.MjData(mm)
+    for q in np.random.default_rng(22).uniform(-0.8, 0.8, (3, model.n)):
+        data.qpos[:], data.qvel[:] = model.all_positions(q), 0.0
+        mujoco.mj_forward(mm, data)
+        expected = forward_dynamics(model, q, np.zeros(model.n), np.zeros(model.n))
+        assert np.abs(data.qacc[list(model.independent)] - expected).max() < 1e-3 * np.abs(expected).max()
+    arm = SimulatedArm(model, 0.001)
+    q = np.array([0.3, -0.4, 0.5, 0.2, 0.1])
+    arm.reset(q)
+    for _ in range(500):
+        arm.step(gravity(model, q))
+    assert np.abs(arm.q - q).max() < 1e-6 and arm.q.shape == (model.n,)
+    assert np.abs(arm.data.qpos - model.all_positions(q)).max() < 1e-6  # each mimic joint where it follows

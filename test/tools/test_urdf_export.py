@@ -15,9 +15,11 @@ from irb140_dynamics.core.model.irb140 import IRB140_SHAPES, Cylinder, box_inert
 from irb140_dynamics.core.model.joints import rpy_matrix
 from irb140_dynamics.tools.export_urdf import urdf_of
 
+from ..core.test_urdf_trees import TWO_ARMS
 from ..support.common import OFFSET_PAYLOAD, assert_close, random_body, random_model, random_states, random_urdf_model
 from ..support.node_process import run_to_exit
 from ..support.paths import CONFIG, ROOT
+from ..support.pinocchio_trees import worst_error
 from ..support.urdf_support import full_mass_matrix, pinocchio_of
 
 STATES = 200
@@ -33,6 +35,8 @@ MODELS = {
     "irb140": lambda: irb140(payload=OFFSET_PAYLOAD),
     "random_dh_n7": lambda: random_model(np.random.default_rng(70), 7),
     "random_urdf_form_n6": lambda: without_armature(random_urdf_model(np.random.default_rng(60), 6, friction=True)),
+    # a tree: a torso, two arms, mimic fingers (one before its joint, one prismatic), the flange on l2's link
+    "tree_with_mimic_joints": lambda: dataclasses.replace(load_urdf(TWO_ARMS).model, flange_joint="l2"),
 }
 
 
@@ -41,7 +45,8 @@ def exported(request):
     """(model, URDF text, the model read back with the same payload and gravity, states)."""
     model = MODELS[request.param]()
     text = export_urdf(model)
-    back = load_urdf(text).model
+    loaded = load_urdf(text)
+    back = loaded.model if model.is_chain else loaded.with_flange_at("flange")  # a tree's: the flange named
     assert back.payload.mass == 0.0  # the payload is a node parameter, not written
     back = back.with_payload(model.payload).with_gravity(model.gravity)
     return model, text, back, random_states(np.random.default_rng(1), model.n, STATES)
@@ -50,6 +55,7 @@ def exported(request):
 def test_round_trip_gives_the_same_torques(exported):
     model, _, back, (Q, QD, QDD) = exported
     assert back.joint_names == model.joint_names
+    assert (back.parent, back.mimics, back.carrier) == (model.parent, model.mimics, model.carrier)
     for q, qd, qdd in zip(Q, QD, QDD):
         assert_close(rnea(back, q, qd, qdd), rnea(model, q, qd, qdd), 1e-12, 1e-12, f"tau at q={q}")
         assert_close(gravity(back, q), gravity(model, q), 1e-12, 1e-12, f"g at q={q}")
@@ -66,6 +72,9 @@ def test_round_trip_keeps_limits_and_friction(exported):
 
 def test_pinocchio_parser_on_the_exported_text(exported):
     model, text, _, (Q, QD, QDD) = exported
+    if model.mimics is not None:  # Pinocchio's model of every joint, projected (test.support.pinocchio_trees)
+        assert worst_error(text, model, np.random.default_rng(2), states=5) <= 1e-12
+        return
     pm = pinocchio_of(text, tip="flange", payload=model.payload, gravity=model.gravity)
     data = pm.createData()
     smooth = model.smoothing_velocity

@@ -19,6 +19,10 @@ dotted names, as rcl gives them to a node: ``given_values``), over the default a
   ``friction.smoothing_velocity``, ``payload.*`` (in the tip link's frame), and for the
   chain's own joints ``position_limits``, ``torque_limit``, ``velocity_limit``,
   ``acceleration_limit``, ``friction.viscous``, ``friction.coulomb``, ``armature``.
+  With no ``model.tip_link`` and several leaves, the whole tree below base_link (every
+  independent joint; mimic joints follow theirs). ``payload.link`` names the URDF link the
+  payload hangs on (``LoadedUrdf.with_flange_at``; ``payload.com``/``.inertia`` in its
+  frame); empty: the chain's tip link. On a tree a payload (``payload.mass`` > 0) needs it.
 
 Names given that are no parameter of the package: ``core.io.parameter_names``.
 Errors: a ValueError in one line naming the file or the parameter. No ROS.
@@ -111,6 +115,8 @@ def read_arm(
     if urdf is not None:
         return _urdf_arm(values, urdf, base_link or values.get("model.base_link") or None,
                          tip_link or values.get("model.tip_link") or None, origin)  # fmt: skip
+    if values.get("payload.link"):
+        raise ValueError("payload.link names a URDF link: give --urdf, or model.source: robot_description")
     if base_link or tip_link:
         raise ValueError(
             "--base and --tip choose a URDF's chain: give --urdf, or a parameter file with "
@@ -137,6 +143,39 @@ def urdf_values(values: Mapping[str, Any], loaded: LoadedUrdf) -> dict[str, Any]
     return taken
 
 
+def payload_carrier(loaded: LoadedUrdf, values: Mapping[str, Any]) -> RobotModel:
+    """The URDF's model with its flange at ``payload.link`` (empty: as read, the chain's tip);
+    ValueError naming payload.link for a link the model does not move, or for a payload
+    (``payload.mass`` > 0) on a tree with no link named."""
+    link = values.get("payload.link") or ""
+    if not isinstance(link, str):
+        raise ValueError(f"payload.link: must be a URDF link's name, got {link!r}")
+    if link:
+        try:
+            return loaded.with_flange_at(link)
+        except UrdfError as error:
+            raise ValueError(f"payload.link: {error.reason}") from None
+    mass = values.get("payload.mass") or 0.0
+    if not is_one_chain(loaded.model) and isinstance(mass, (int, float)) and mass > 0.0:
+        raise ValueError(
+            f"payload.link: the model is a tree ({loaded.model.n} joints below {loaded.base_link!r}); "
+            "name the URDF link the payload hangs on"
+        )
+    return loaded.model
+
+
+def is_one_chain(model: RobotModel) -> bool:
+    """Each joint hangs from the one before (mimic joints allowed): one tip, the payload's default place."""
+    return all(p == i - 1 for i, p in enumerate(model.parent))
+
+
+def urdf_span(loaded: LoadedUrdf) -> str:
+    """What of the URDF the model is, for messages: 'base_link -> tool0', or 'the tree below base'."""
+    if is_one_chain(loaded.model):
+        return f"{loaded.base_link} -> {loaded.tip_link}"
+    return f"the tree below {loaded.base_link}"
+
+
 def _urdf_arm(values, urdf, base_link, tip_link, origin) -> Arm:
     """A chain read already (a node's) names no file in its errors: the parameter is named."""
     text, where = None, origin or "robot_description"
@@ -149,13 +188,14 @@ def _urdf_arm(values, urdf, base_link, tip_link, origin) -> Arm:
     else:
         loaded = urdf
     try:
+        carrying = payload_carrier(loaded, values)
         taken = urdf_values(values, loaded)
-        model = RobotModel.from_params({**loaded.model.to_params(), **taken}) if taken else loaded.model
+        model = RobotModel.from_params({**carrying.to_params(), **taken}) if taken else carrying
     except ValueError as error:
         named = origin or (text is not None and where)
         raise ValueError(f"{named}: {one_line(error)}" if named else one_line(error)) from None
     name = loaded.robot_name or URDF_ROBOT_NAME
-    return Arm(model, name, f"{where} ({loaded.base_link} -> {loaded.tip_link})", loaded, text)
+    return Arm(model, name, f"{where} ({urdf_span(loaded)})", loaded, text)
 
 
 def _described_urdf(values, origin, relative_to) -> UrdfText:

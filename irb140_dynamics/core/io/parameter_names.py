@@ -39,6 +39,7 @@ NODE_PARAMETER_NAMES = frozenset(
         "estimation.rest_time",
         "estimation.rest_velocity",
         "external_wrench.frame",
+        "external_wrench.links",
         "ft_contact_wrench.frame",
         "ft_sensor.apply_load",
         "ft_sensor.link",
@@ -83,6 +84,7 @@ MODEL_PARAMETER_NAMES = (
     "model.urdf_file",
     "model.base_link",
     "model.tip_link",
+    "payload.link",  # the URDF link the payload hangs on (core.io.arm_source)
     "tree.joints",  # a tree's or a model with mimic joints (see model.robot_model)
     "tree.parents",
     "flange_joint",

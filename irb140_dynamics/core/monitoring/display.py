@@ -8,7 +8,8 @@
   gives 0.162 m across; never less than MIN_PAYLOAD_DIAMETER, so that a light payload shows.
 - A force is an arrow of ARROW_PER_NEWTON (0.01 m/N: 20 N draws 0.2 m), at most
   MAX_ARROW long (the length saturates; the label keeps the number).
-- A joint is a sphere of JOINT_DIAMETER at its origin; one at the place of earlier joints
+- A joint of the state (every independent joint of a tree; a mimic joint is shown by the joint
+  it follows) is a sphere of JOINT_DIAMETER at its origin; one at the place of earlier joints
   (within SAME_PLACE, e.g. a wrist's) nests inside them, NESTED times as large each.
 
 Units: N m, kg, m, N. Colours are (red, green, blue) in 0..1.
@@ -117,7 +118,7 @@ class ArmPicture(NamedTuple):
     diameters: list[float]  # of the joints' spheres
     payload: list  # (x, y, z) of the payload's centre of mass
     flange: list  # (x, y, z) of the flange origin
-    force: np.ndarray | None  # N, base axes: the external force on the flange (None: not measured)
+    force: np.ndarray | None  # N, base axes: the external force on the flange (None: not measured, or a tree)
     arrow_end: list | None  # (x, y, z) where its arrow ends
     loads: list  # |tau_j| / limit_j (see joint_loads)
 
@@ -127,13 +128,14 @@ def arm_picture(model, q, tau, limits=None, external=None) -> ArmPicture:
     none known) and, if measured, the ``external`` joint torques; ValueError if a number
     is not finite. One pass of forward kinematics gives the places and the wrench."""
     origins, pose, J = joint_origins_and_flange(model, q)
+    origins = origins[list(model.independent)]  # one sphere per joint of the state (a mimic joint's is its joint's)
     flange = pose[:3, 3]
     near = np.linalg.norm(origins[:, None, :] - origins[None, :, :], axis=2) < SAME_PLACE
     earlier = np.tril(near, -1).sum(axis=1).tolist()
     payload = pose[:3, :3] @ np.asarray(model.payload.com, dtype=float) + flange
     force = end = None
     numbers = [origins, payload, flange]
-    if external is not None:
+    if external is not None and model.is_chain:  # a tree's external torques are no one flange's force
         force = wrench_of(pose, J, external, "base").force
         end = arrow_end(flange, force)
         numbers.append(end)

@@ -21,7 +21,6 @@ arm of the IRB-140's size.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,9 +28,18 @@ import numpy as np
 from irb140_dynamics.core.kinematics import flange_pose_and_jacobian
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.model.states import state
+from irb140_dynamics.core.monitoring.link_wrenches import (
+    MAX_DAMPING as MAX_DAMPING,  # the damping's rule is stated here (the module) and shared
+)
+from irb140_dynamics.core.monitoring.link_wrenches import (
+    SINGULAR_THRESHOLD,
+    LinkWrench,
+    damped_solution,
+    link_wrenches,
+    turned,
+    wrench_places,
+)
 
-SINGULAR_THRESHOLD = 0.05  # sigma_min of J below this: damped, and flagged as near a singularity
-MAX_DAMPING = 0.05  # lambda at sigma_min = 0
 FRAMES = ("tip", "base")
 
 
@@ -60,13 +68,27 @@ def flange_jacobian_in(model: RobotModel, q, frame: str = "base") -> np.ndarray:
     (``tip``): v the flange origin's velocity, w the flange's angular velocity."""
     _check_frame(frame)
     pose, J = flange_pose_and_jacobian(model, q)
-    return J if frame == "base" else _turned(pose[:3, :3].T, J)
+    return J if frame == "base" else turned(pose[:3, :3].T, J)
+
+
+TREE_REFUSAL = (
+    "no external wrench on a tree or with mimic joints without external_wrench.links: the external "
+    "torques of every branch would be read as one flange's wrench; external_torques only"
+)
+
+
+def wrench_refusal(model: RobotModel) -> str | None:
+    """Why ``model`` has no flange wrench (a tree, mimic joints, the flange off the last link), or None."""
+    return None if model.is_chain else TREE_REFUSAL
 
 
 def flange_wrench(model: RobotModel, q, tau_ext, frame: str = "tip") -> FlangeWrench:
     """The wrench F on the flange with J(q)^T F = tau_ext [N m] (see the module), in the axes
-    of ``frame``. ValueError if q or tau_ext are not n finite numbers, or for another frame."""
+    of ``frame``. ValueError if q or tau_ext are not n finite numbers, for another frame, or
+    on a model that is no chain (``wrench_refusal``)."""
     _check_frame(frame)
+    if not model.is_chain:
+        raise ValueError(TREE_REFUSAL)
     tau_ext = state(tau_ext, model.n, "tau_ext")
     pose, J = flange_pose_and_jacobian(model, q)
     return wrench_of(pose, J, tau_ext, frame)
@@ -79,14 +101,8 @@ def wrench_of(pose: np.ndarray, J: np.ndarray, tau_ext, frame: str = "tip") -> F
     _check_frame(frame)
     tau_ext = state(tau_ext, J.shape[1], "tau_ext")
     if frame == "tip":
-        J = _turned(pose[:3, :3].T, J)
-    U, s, Vt = np.linalg.svd(J.T, full_matrices=False)  # J^T = U diag(s) Vt, s descending
-    sigma_min = float(s[-1])
-    damping = 0.0
-    if sigma_min < SINGULAR_THRESHOLD:
-        damping = MAX_DAMPING * math.sqrt(1.0 - (sigma_min / SINGULAR_THRESHOLD) ** 2)
-    inverse = np.divide(s, s * s + damping * damping, out=np.zeros_like(s), where=s > 0.0)
-    F = Vt.T @ (inverse * (U.T @ tau_ext))
+        J = turned(pose[:3, :3].T, J)
+    F, sigma_min, damping = damped_solution(J.T, tau_ext)
     if not np.isfinite(F).all():
         raise ValueError(f"flange wrench not finite for tau_ext {tau_ext.tolist()}")
     return FlangeWrench(F[:3], F[3:], frame, sigma_min, damping)
@@ -99,25 +115,41 @@ def in_base_axes(pose: np.ndarray, wrench) -> np.ndarray:
     return np.concatenate([R @ w[:3], R @ w[3:]])
 
 
-def _turned(R: np.ndarray, J: np.ndarray) -> np.ndarray:
-    return np.vstack([R @ J[:3], R @ J[3:]])
-
-
 def _check_frame(frame: str) -> None:
     if frame not in FRAMES:
         raise ValueError(f"frame: must be 'tip' or 'base', got {frame!r}")
 
 
 class WrenchStream:
-    """The flange wrenches of a stream of observed samples (q, external torques), and how
-    near a singularity they came since the last report."""
+    """The flange wrenches (or, with ``use``, the wrenches on named links) of a stream of
+    observed samples (q, external torques), and how near a singularity they came since the
+    last report."""
 
     def __init__(self):
+        self.places: tuple = ()  # (link, joint, placement) of external_wrench.links (link_wrenches)
         self.forget()
 
     def forget(self) -> None:
         """A new model: the last sample belongs to the old one."""
         self._sample, self._smallest = None, None  # (model, q, r); the smallest sigma_min since the last report
+
+    def use(self, links, carried, strict: bool) -> str | None:
+        """Estimate the wrenches on ``links`` (URDF links; ``carried``: ``LoadedUrdf.carried``,
+        None: no URDF) from now on; empty: the flange's. A link the model does not move:
+        ValueError if ``strict`` (at startup), else the links off and the reason returned."""
+        try:
+            self.places = wrench_places(links, carried)
+        except ValueError as error:
+            self.places = ()
+            if strict:
+                raise
+            return f"{error}; no link wrenches"
+        return None
+
+    @property
+    def refusal(self) -> str | None:
+        """Why no wrench is estimated for the last sample's model, or None."""
+        return None if self._sample is None or self.places else wrench_refusal(self._sample[0])
 
     def note(self, model: RobotModel, q, tau_ext) -> None:
         """An observed sample, reported on even when no wrench is asked of it."""
@@ -126,20 +158,33 @@ class WrenchStream:
     def estimate(self, frame: str) -> FlangeWrench:
         """The wrench of the last sample noted, in the axes of ``frame`` (ValueError if not finite)."""
         wrench = flange_wrench(*self._sample, frame)
-        sigma = wrench.smallest_singular_value
-        self._smallest = sigma if self._smallest is None else min(self._smallest, sigma)
+        self._note_sigma(wrench.smallest_singular_value)
         return wrench
+
+    def estimate_links(self) -> tuple[LinkWrench, ...]:
+        """The wrenches on the links of ``use`` at the last sample noted, each in its link's
+        axes (``link_wrenches``; ValueError if not finite)."""
+        wrenches, sigma, _ = link_wrenches(*self._sample, self.places)
+        self._note_sigma(sigma)
+        return wrenches
+
+    def _note_sigma(self, sigma: float) -> None:
+        self._smallest = sigma if self._smallest is None else min(self._smallest, sigma)
 
     def report(self) -> tuple[bool, str, dict[str, str]]:
         """(near a singularity now or at a wrench since the last report, the message, the
         smallest singular values of J); starts a new period."""
         if self._sample is None:
             return False, "no efforts received: no wrench estimated", {}
+        if self.refusal:
+            return False, self.refusal, {}
         try:
-            now = flange_wrench(*self._sample, "tip")
+            if self.places:
+                sigma = link_wrenches(*self._sample, self.places)[1]
+            else:
+                sigma = flange_wrench(*self._sample, "tip").smallest_singular_value
         except ValueError as error:
             return True, f"no wrench at the last joint state ({error})", {}
-        sigma = now.smallest_singular_value
         smallest = sigma if self._smallest is None else min(self._smallest, sigma)
         self._smallest = None
         values = {
@@ -148,7 +193,7 @@ class WrenchStream:
         }
         if smallest >= SINGULAR_THRESHOLD:
             return False, f"smallest singular value of J {smallest:.4f}", values
-        where = "now" if now.near_singularity else "since the last report"
+        where = "now" if sigma < SINGULAR_THRESHOLD else "since the last report"
         message = (
             f"near a singularity {where}: smallest singular value of J {smallest:.4f} < {SINGULAR_THRESHOLD:g}; "
             "the wrench estimate is damped and poor along the direction the arm cannot push"

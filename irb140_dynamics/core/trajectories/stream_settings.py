@@ -43,6 +43,7 @@ class IdNodeSettings:
     collision: CollisionSettings
     gains: Gains
     wrench_frame: str  # "tip" or "base"
+    wrench_links: tuple[str, ...] = ()  # URDF links whose wrenches are estimated (monitoring.link_wrenches)
     ft_link: str = ""  # the link of a wrist force/torque sensor, "" = none (core.ft_sensor)
     ft_frame: str = "sensor"  # the axes of its contact wrench: "sensor" or "base"
     rated_payload: RigidBody = RATED_PAYLOAD  # the torque limits are derived from it (joints without torque_limit)
@@ -56,6 +57,9 @@ def check_settings(values: dict) -> IdNodeSettings:
     check_choice("acceleration.mode", values["acceleration.mode"], ACCELERATION_MODES)
     check_choice("effort_commands.source", values["effort_commands.source"], EFFORT_SOURCES)
     check_choice("external_wrench.frame", values["external_wrench.frame"], FRAMES)
+    links = tuple(values.get("external_wrench.links") or ())
+    if links and values["external_wrench.frame"] != "tip":
+        raise ValueError("external_wrench.frame: with external_wrench.links each wrench is in its link's axes ('tip')")
     ft_link, ft_frame = values.get("ft_sensor.link", ""), values.get("ft_contact_wrench.frame", "sensor")
     check_choice("ft_contact_wrench.frame", ft_frame, FT_FRAMES)
 
@@ -71,6 +75,7 @@ def check_settings(values: dict) -> IdNodeSettings:
         CollisionSettings(values["collision.observer_gain"], per_joint("collision_threshold")),
         Gains(per_joint("kp"), per_joint("kd")),
         values["external_wrench.frame"],
+        links,
         ft_link,
         ft_frame,
         RigidBody.validated("rated_payload", values["rated_payload.mass"], values["rated_payload.com"]),
@@ -79,11 +84,12 @@ def check_settings(values: dict) -> IdNodeSettings:
 
 def finish_settings(settings: IdNodeSettings, previous: IdNodeSettings | None) -> IdNodeSettings:
     """Make the kernels the messages use native (compiled as C, or loaded from the cache)
-    and derive the markers' torque limits (the payload check's: given, else derived from
-    the rated payload within LIMITS_TIME; inf: none), each unless ``previous`` has them for
-    the same arm. Run before the first message, and off the executor after a change while
-    the old settings answer; a compile longer than NATIVE_WAIT goes on in the background,
-    the Python form answering meanwhile."""
+        and derive the markers' torque limits (the payload check's: given, else derived from
+        the rated payload within LIMITS_TIME; on a tree or with mimic joints, the given ones
+    only; inf: none), each unless ``previous`` has them for
+        the same arm. Run before the first message, and off the executor after a change while
+        the old settings answer; a compile longer than NATIVE_WAIT goes on in the background,
+        the Python form answering meanwhile."""
     if previous is not None and previous.model == settings.model:
         kernels = previous.kernels
         settings = replace(settings, model=previous.model)
@@ -96,6 +102,8 @@ def finish_settings(settings: IdNodeSettings, previous: IdNodeSettings | None) -
         settings.rated_payload,
     ):  # the payload in use does not enter them
         limits = previous.torque_limits
+    elif not model.is_chain:  # the payload analysis is a chain's: a tree's markers use the given limits only
+        limits = tuple(limit if limit > 0 else float("inf") for limit in model.torque_limits)
     else:
         with stopping(seconds=LIMITS_TIME):
             limits = derive_torque_limits(model, settings.rated_payload).values

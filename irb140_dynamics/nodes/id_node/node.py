@@ -176,6 +176,10 @@ class IdNode(Node):
         if not self.stream.use(model, mode, cutoff, timeout, source, settings.gains):
             self.tally.drop("reference", BadMessage("non_finite_torques", "the new model gives none at the reference"))
         self.collision.use(model, settings.collision.gain, settings.collision.thresholds)
+        urdf = self.parameters.urdf
+        refused = self.wrench.use(settings.wrench_links, None if urdf is None else urdf.carried, not self._started)
+        if refused:
+            self.get_logger().error(refused)
         self.ft.use(settings, self._started)
         self.settings = settings
         if old is None and self._started:  # the model came after startup
@@ -255,17 +259,20 @@ class IdNode(Node):
         model, frame = self.settings.model, self.settings.wrench_frame
         self.markers.note(sample.stamp, sample.q, sample.effort, r, [model.joint_names[j] for j in colliding])
         self.wrench.note(model, sample.q, r)
-        if not self._wrench_pub.subscribers:
+        if not self._wrench_pub.subscribers or self.wrench.refusal:  # a tree's without links: see wrench.report()
             return
+        base, tip = self.parameters.chain_links
         try:
-            wrench = self.wrench.estimate(frame)
+            if self.wrench.places:  # each link's wrench in its own frame
+                wrenches = [(w.link, w) for w in self.wrench.estimate_links()]
+            else:
+                wrenches = [(tip if frame == "tip" else base, self.wrench.estimate(frame))]
         except ValueError as error:
             self.counts["external_wrench.not_finite"] += 1
             self.tally.warn("external_wrench", f"no wrench for a joint state ({error})")
             return
-        base, tip = self.parameters.chain_links
-        msg = fill_wrench(self._wrench_msg, sample.stamp, tip if frame == "tip" else base, wrench.force, wrench.torque)
-        self._wrench_pub.publish(msg)
+        for frame_id, wrench in wrenches:
+            self._wrench_pub.publish(fill_wrench(self._wrench_msg, sample.stamp, frame_id, wrench.force, wrench.torque))
 
     @guarded("reference")
     def _on_reference(self, msg: JointTrajectory) -> None:

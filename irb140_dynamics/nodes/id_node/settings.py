@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from rclpy.parameter import Parameter
+
 from irb140_dynamics.core.model.rigid_body import MAX_MASS
 from irb140_dynamics.core.monitoring import collision as observer
 from irb140_dynamics.ros.parameters.specs import MAX_TORQUE, QOS_PARAMETERS, Spec
@@ -65,6 +67,13 @@ NODE_PARAMETERS = [
         "tip",
         "axes of external_wrench: 'tip' (the tip link's, e.g. flange) or 'base' (the base link's); "
         "the torque is about the flange origin in both",
+    ),
+    Spec(
+        "external_wrench.links",
+        Parameter.Type.STRING_ARRAY,
+        "URDF links whose wrenches are estimated jointly, each on external_wrench in its link's frame "
+        "(a tree's); not given: the flange's",
+        read_only=True,
     ),
     Spec(
         "markers.rate",

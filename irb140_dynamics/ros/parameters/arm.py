@@ -23,7 +23,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from irb140_dynamics.core import Joint, RigidBody, RobotModel
 from irb140_dynamics.core.errors import check_choice, one_line
-from irb140_dynamics.core.io.arm_source import SOURCES, read_arm, read_urdf_file
+from irb140_dynamics.core.io.arm_source import SOURCES, read_arm, read_urdf_file, urdf_span
 from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.core.io.urdf import LoadedUrdf, load_urdf
 from irb140_dynamics.core.io.urdf.writer import BASE, FLANGE
@@ -35,6 +35,7 @@ from irb140_dynamics.ros.parameters.spec import Spec, as_type
 from irb140_dynamics.ros.parameters.specs import (
     DESCRIPTION_PARAMETERS,
     MODEL_NAME,
+    PAYLOAD_LINK,
     RELIABILITIES,
     SOURCE,
     drive_specs,
@@ -75,7 +76,7 @@ class ArmParameters:
                 self.urdf = self.read(text or read_urdf_file(path, "model.urdf_file").text, origin)
             self.from_topic = self.urdf is None
             joint_names = None if self.urdf is None else self.urdf.model.joint_names
-            arm = model_specs([], {})
+            arm = [*model_specs([], {}), PAYLOAD_LINK]
         else:
             path = default_config_path()
             if not path.is_file():
@@ -211,7 +212,7 @@ class ArmParameters:
         self.robot_name = urdf.robot_name or "robot"
         names, held = list(urdf.model.joint_names), urdf.held_joints
         held = f"; held at zero: {', '.join(held)}" if held else ""
-        logger.info(f"model from the {origin}: {urdf.base_link} -> {urdf.tip_link}, {len(names)} joints {names}{held}")
+        logger.info(f"model from the {origin}: {urdf_span(urdf)}, {len(names)} joints {names}{held}")
         for warning in urdf.warnings:
             logger.warning(warning)
         for note in urdf.notes:

@@ -71,6 +71,14 @@ DESCRIPTION_PARAMETERS = [  # model.source robot_description
 ]
 
 
+PAYLOAD_LINK = Spec(
+    "payload.link",
+    "",
+    "the URDF link the payload hangs on (payload.com and .inertia in its frame); empty: the tip link "
+    "(on a whole tree, a payload needs it)",
+)
+
+
 def joint_states_qos(node: Node) -> QoSProfile:
     """The joint_states subscription's QoS from the node's qos.* parameters."""
     reliability = RELIABILITIES[node.get_parameter("qos.reliability").value]

@@ -9,7 +9,9 @@ Rot(axis_i, q_i + offset_i)), so that
 (for a DH row: the previous row's Trans(a, 0, d) Rot_x(alpha), then Rot_z(theta_offset)),
 and link i's inertial is re-expressed from the model's link frame i = joint frame * post_i.
 The fixed joint ``flange_joint`` places the link ``flange`` at post_n * flange: the frame
-the payload parameters refer to. Numbers are written in full (Python's repr), so reading
+the payload parameters refer to. A tree is written as one: each joint hung from its parent
+joint's link (``model.parent``; post_(i-1) is then the parent's post), the flange on
+``model.carrier``'s link, each mimic joint with its ``<mimic joint multiplier offset>``. Numbers are written in full (Python's repr), so reading
 the text back gives the same model up to rounding in the composed rotations.
 
 Not written, having no place in URDF: gravity, the payload (a parameter of the nodes:
@@ -51,9 +53,9 @@ def export_urdf(model: RobotModel, name: str = "robot", shapes: Mapping[str, Box
     )
     ET.SubElement(ET.SubElement(robot, "material", name="body"), "color", rgba=COLOUR)
     ET.SubElement(robot, "link", name=BASE)
-    parent, previous_post = BASE, Placement()
     for i, joint in enumerate(model.joints):
-        link = f"link_{i + 1}"
+        link, above = f"link_{i + 1}", model.parent[i]  # hung from its parent joint's link (a tree's too)
+        parent, previous_post = (BASE, Placement()) if above < 0 else (f"link_{above + 1}", model.joints[above].post)
         turn = (
             Placement(rpy=matrix_rpy(axis_rotation(joint.turning_axis, joint.offset))) if joint.offset else Placement()
         )
@@ -69,6 +71,11 @@ def export_urdf(model: RobotModel, name: str = "robot", shapes: Mapping[str, Box
             effort=_text([joint.torque_limit]),
             velocity=_text([joint.velocity_limit]),
         )
+        mimic = None if model.mimics is None else model.mimics[i]
+        if mimic is not None:
+            ET.SubElement(
+                element, "mimic", joint=mimic.joint, multiplier=_text([mimic.multiplier]), offset=_text([mimic.offset])
+            )
         if joint.friction.viscous or joint.friction.coulomb:
             ET.SubElement(
                 element, "dynamics", damping=_text([joint.friction.viscous]), friction=_text([joint.friction.coulomb])
@@ -78,10 +85,11 @@ def export_urdf(model: RobotModel, name: str = "robot", shapes: Mapping[str, Box
         body = placed(joint.link, post.rotation(), post.xyz)
         _inertial(link_element, body)
         _visual(link_element, body, post, shapes.get(joint.name))
-        parent, previous_post = link, post
-    names = set(model.joint_names)
+    names = {joint.name for joint in model.joints}
     flange_joint = next(n for n in ("flange_joint", "flange_fixed_joint", "tool_flange_joint") if n not in names)
-    _joint(robot, flange_joint, "fixed", parent, FLANGE, compose(previous_post, model.flange))
+    carrier = model.carrier  # the flange on the link of the joint that carries it
+    placement = compose(model.joints[carrier].post, model.flange)
+    _joint(robot, flange_joint, "fixed", f"link_{carrier + 1}", FLANGE, placement)
     ET.SubElement(robot, "link", name=FLANGE)
     ET.indent(robot)
     return '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n"
@@ -92,7 +100,7 @@ def exported_carried(model: RobotModel) -> dict[str, tuple[str, Placement]]:
     (the joint moving it, its placement in that joint's link frame); link_i's frame is joint
     i's frame (before post_i)."""
     carried = {f"link_{k}": (joint.name, _inverse(joint.post)) for k, joint in enumerate(model.joints, 1)}
-    return carried | {FLANGE: (model.joints[-1].name, model.flange)}
+    return carried | {FLANGE: (model.joints[model.carrier].name, model.flange)}
 
 
 def _inverse(placement: Placement) -> Placement:
