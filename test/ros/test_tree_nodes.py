@@ -26,7 +26,7 @@ from irb140_dynamics.nodes.sim_node.node import SimNode
 from ..core.test_urdf_trees import TWO_ARMS, _without_mimics
 from ..support.paths import URDF_DATA
 from ..support.pinocchio_model import spatial_inertia
-from ..support.pinocchio_trees import _state, pinocchio_of, reference
+from ..support.pinocchio_trees import pinocchio_of, pinocchio_state, reference
 from ..support.ros_harness import running
 from .test_sim_node import states_after_reset
 
@@ -121,7 +121,9 @@ def test_markers_show_every_independent_joint_of_the_tree_at_pinocchios_joint_or
     assert [label.split(" ")[0] for label in labels] == list(model.joint_names)
     full, _ = pinocchio_of(BAXTER, mimic=False)
     data = full.createData()
-    pin.forwardKinematics(full, data, _state(full, [j.name for j in model.joints], model.all_positions(q), q, q)[0])
+    pin.forwardKinematics(
+        full, data, pinocchio_state(full, [j.name for j in model.joints], model.all_positions(q), q, q)[0]
+    )
     for k, name in enumerate(model.joint_names):
         p = spheres[k].pose.position
         joint = full.getJointId(name)  # its origin: the parent's frame placed, before the joint's own motion
@@ -192,7 +194,7 @@ def pinocchio_link_torques(model, q, forces: dict) -> np.ndarray:
     full, follows = pinocchio_of(BAXTER, mimic=True)
     names = model.joint_names if follows else [j.name for j in model.joints]
     state = (q if follows else model.all_positions(q)), np.zeros(len(names)), np.zeros(len(names))
-    pq = _state(full, names, *state)[0]
+    pq = pinocchio_state(full, names, *state)[0]
     data = full.createData()
     index = [full.joints[full.getJointId(name)].idx_v for name in names]
     tau = np.zeros(full.nv)

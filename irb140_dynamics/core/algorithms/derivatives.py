@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from irb140_dynamics.core.algorithms.linear import inverse, times_vector
 from irb140_dynamics.core.algorithms.recursions import crba, rnea
-from irb140_dynamics.core.scalars.dual import Dual
+from irb140_dynamics.core.scalars.dual import Dual, dual_angles, partial
 
 
 def seeded(cs, qd):
@@ -64,3 +64,23 @@ def forward_dynamics(links, cs, qd, tau, gravity, friction_torques=None):
         bias = [b + f for b, f in zip(bias, friction_torques)]
     Minv = inverse(M)
     return times_vector(Minv, [t - b for t, b in zip(tau, bias)]), M, Minv
+
+
+def christoffel_coriolis(links, cs, qd):
+    """The Coriolis matrix C(q, qd) from the Christoffel symbols of M(q).
+
+    C_ij = sum_k 1/2 (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) qd_k, so that C qd is the
+    Coriolis/centrifugal torque and Mdot - 2C is skew-symmetric. The partial derivatives
+    of M are exact: crba runs on dual numbers carrying d/dq of each scalar.
+    """
+    return christoffel(crba(links, dual_angles(cs)), qd)
+
+
+def christoffel(M, qd):
+    """C(q, qd) of M(q) given on dual numbers carrying d/dq (see christoffel_coriolis)."""
+    n = len(M)
+    dM = [[[partial(M[i][j], k) for k in range(n)] for j in range(n)] for i in range(n)]
+    return [
+        [sum(0.5 * (dM[i][j][k] + dM[i][k][j] - dM[j][k][i]) * qd[k] for k in range(n)) for j in range(n)]
+        for i in range(n)
+    ]

@@ -40,7 +40,7 @@ import numpy as np
 from irb140_dynamics.core.algorithms.topology import ancestors, children, parents  # noqa: F401 (part of this module's interface)
 from irb140_dynamics.core.model.joints import Z_AXIS, snap
 from irb140_dynamics.core.model.rigid_body import ZERO3, Inertia6, Vector3, shift_inertia
-from irb140_dynamics.core.scalars.dual import Dual, dual_angles, partial  # noqa: F401 (Dual: part of this module's interface)
+from irb140_dynamics.core.scalars.dual import Dual  # noqa: F401 (part of this module's interface)
 
 Rotation = tuple[tuple[float, float, float], ...]
 
@@ -388,23 +388,3 @@ def _turned_about_z(rot, inertia):
     mean, half = (xx + yy) * 0.5, (xx - yy) * 0.5
     x = half * C - xy * S
     return (mean + x, mean - x, zz, half * S + xy * C, c * xz - s * yz, s * xz + c * yz)
-
-
-def christoffel_coriolis(links, cs, qd):
-    """The Coriolis matrix C(q, qd) from the Christoffel symbols of M(q).
-
-    C_ij = sum_k 1/2 (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) qd_k, so that C qd is the
-    Coriolis/centrifugal torque and Mdot - 2C is skew-symmetric. The partial derivatives
-    of M are exact: crba runs on dual numbers carrying d/dq of each scalar.
-    """
-    return christoffel(crba(links, dual_angles(cs)), qd)
-
-
-def christoffel(M, qd):
-    """C(q, qd) of M(q) given on dual numbers carrying d/dq (see christoffel_coriolis)."""
-    n = len(M)
-    dM = [[[partial(M[i][j], k) for k in range(n)] for j in range(n)] for i in range(n)]
-    return [
-        [sum(0.5 * (dM[i][j][k] + dM[i][k][j] - dM[j][k][i]) * qd[k] for k in range(n)) for j in range(n)]
-        for i in range(n)
-    ]

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from irb140_dynamics.core.algorithms import recursions as algorithms
+from irb140_dynamics.core.algorithms.derivatives import christoffel, christoffel_coriolis
 from irb140_dynamics.core.algorithms.momentum import momentum_terms
 from irb140_dynamics.core.algorithms.regressor import rigid_body_regressor
 from irb140_dynamics.core.codegen import derivative_kernels as derivatives
@@ -58,10 +59,10 @@ def _mass_matrix(arm, cs, k):
 
 def _coriolis_matrix(arm, cs, qd, k):
     if arm.coupled is None:
-        return [x for row in algorithms.christoffel_coriolis(arm.links_with(k), cs, qd) for x in row]
+        return [x for row in christoffel_coriolis(arm.links_with(k), cs, qd) for x in row]
     (angles,) = arm.expanded(arm.dual_angles(cs, arm.n))  # M(q) of the coordinates, on dual numbers
     M = arm.projected_matrix(algorithms.crba(arm.links_with(k), angles))
-    return [x for row in algorithms.christoffel(M, qd) for x in row]
+    return [x for row in christoffel(M, qd) for x in row]
 
 
 def _regressor(arm, cs, qd, qdd, k):
