@@ -24,9 +24,26 @@ def with_friction():
     )
 
 
-@pytest.mark.parametrize("arm", ["irb140 with friction and an offset payload", "panda (URDF damping)"])
+ARMS = {
+    "irb140 with friction and an offset payload": with_friction,
+    "panda (URDF damping)": lambda: arms()["panda"],
+    # two arms on a torso, mimic joints (one before its joint in the file, one prismatic with
+    # an offset; damping on one) as in test_urdf_trees
+    "a tree with mimic joints": lambda: load_urdf(TWO_ARMS).model,
+}
+
+
+@pytest.mark.parametrize(
+    "arm",
+    [
+        pytest.param(arm, marks=pytest.mark.slow)
+        if arm.startswith("a tree")
+        else arm  # its symbolic derivation: seconds
+        for arm in ARMS
+    ],
+)
 def test_the_written_c_is_the_cores_arithmetic(tmp_path, arm):
-    model = with_friction() if arm.startswith("irb140") else arms()["panda"]
+    model = ARMS[arm]()
     assert model.friction is not None
     for file, text in generate(model, ("c",), prefix="arm").items():
         (tmp_path / file).write_text(text)
@@ -34,26 +51,7 @@ def test_the_written_c_is_the_cores_arithmetic(tmp_path, arm):
     n = model.n
     tau, M = c_function(library, "arm_tau", 3, n), c_function(library, "arm_M", 1, n * n)
     g, Cqd = c_function(library, "arm_g", 1, n), c_function(library, "arm_Cqd", 2, n)
-    for q, qd, qdd in zip(*random_states(n, seed=3, count=200)):
-        assert tau(q, qd, qdd).tobytes() == rnea(model, q, qd, qdd).tobytes()
-        assert M(q).tobytes() == mass_matrix(model, q).tobytes()
-        assert g(q).tobytes() == gravity(model, q).tobytes()
-        assert Cqd(q, qd).tobytes() == coriolis(model, q, qd).tobytes()
-
-
-@pytest.mark.slow  # the symbolic derivation of a tree: seconds
-def test_the_written_c_of_a_tree_with_mimic_joints_is_the_cores_arithmetic(tmp_path):
-    """Two arms on a torso, mimic joints (one before its joint in the file, one prismatic
-    with an offset; damping on one) as in test_urdf_trees."""
-    model = load_urdf(TWO_ARMS).model
-    assert model.mimics is not None and model.friction is not None
-    for file, text in generate(model, ("c",), prefix="arm").items():
-        (tmp_path / file).write_text(text)
-    library = compile_c(tmp_path, "arm")
-    n = model.n
-    tau, M = c_function(library, "arm_tau", 3, n), c_function(library, "arm_M", 1, n * n)
-    g, Cqd = c_function(library, "arm_g", 1, n), c_function(library, "arm_Cqd", 2, n)
-    for q, qd, qdd in zip(*random_states(n, seed=4, count=50)):
+    for q, qd, qdd in zip(*random_states(n, seed=3, count=100)):
         assert tau(q, qd, qdd).tobytes() == rnea(model, q, qd, qdd).tobytes()
         assert M(q).tobytes() == mass_matrix(model, q).tobytes()
         assert g(q).tobytes() == gravity(model, q).tobytes()
