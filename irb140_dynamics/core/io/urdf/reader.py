@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from functools import reduce
+from functools import partial, reduce
 
 import numpy as np
 
@@ -151,19 +151,26 @@ def load_urdf(
     joints = [
         _joint(joint, placement, body, ok) for joint, placement, (body, _), ok in zip(moving, origins, bodies, physical)
     ]
+    model = partial(RobotModel, tuple(joints), gravity=base_gravity(tree, base), flange=since_last, mimics=mimics)
+    return _loaded(tree, base, tip, moving, model, "chain", held, warnings, carried, "off the chain: ignored")
+
+
+def _loaded(tree, base, tip, moving, model, kind, held, warnings, carried, ignored) -> LoadedUrdf:
+    """The LoadedUrdf of ``model()`` (a ModelError as a UrdfError of ``kind``), with notes on
+    the invalid inertials of the links ``carried`` leaves out (``ignored``: why they do not matter)."""
     try:
-        model = RobotModel(tuple(joints), gravity=base_gravity(tree, base), flange=since_last, mimics=mimics)
+        made = model()
     except ModelError as error:
-        raise UrdfError("chain", str(error)) from None
-    on_chain = {name for names in carried for name in names}
+        raise UrdfError(kind, str(error)) from None
+    in_model = {name for names in carried for name in names}
     notes = [
-        f"{problem[1]} (off the chain: ignored)"
+        f"{problem[1]} ({ignored})"
         for name, body in tree.inertials.items()
-        if name not in on_chain and (problem := inertial_problem(name, body))
+        if name not in in_model and (problem := inertial_problem(name, body))
     ]
     rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
-    carried = carried_links(tree, moving)
-    return LoadedUrdf(model, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name, carried)
+    links = carried_links(tree, moving)
+    return LoadedUrdf(made, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name, links)
 
 
 def mimics_of(moving: list[UrdfJoint]) -> tuple | None:
@@ -331,18 +338,7 @@ def _load_tree(tree: UrdfTree, base: str, max_joints: int) -> LoadedUrdf:
     joints = [
         _joint(joint, placement, body, ok) for joint, placement, (body, _), ok in zip(moving, origins, bodies, physical)
     ]
-    try:
-        model = RobotModel(
-            tuple(joints), gravity=base_gravity(tree, base), parent=tuple(parents), mimics=mimics_of(moving)
-        )
-    except ModelError as error:
-        raise UrdfError("tree", str(error)) from None
-    in_model = {name for names in carried for name in names}
-    notes = [
-        f"{problem[1]} (not moved by the tree: ignored)"
-        for name, body in tree.inertials.items()
-        if name not in in_model and (problem := inertial_problem(name, body))
-    ]
-    rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
-    carried = carried_links(tree, moving)
-    return LoadedUrdf(model, base, moving[-1].child, (), tuple(warnings), tuple(notes), rotation, tree.name, carried)
+    mimics = mimics_of(moving)
+    model = partial(RobotModel, tuple(joints), gravity=base_gravity(tree, base), parent=tuple(parents), mimics=mimics)
+    tip = moving[-1].child
+    return _loaded(tree, base, tip, moving, model, "tree", (), warnings, carried, "not moved by the tree: ignored")
