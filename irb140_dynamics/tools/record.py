@@ -106,8 +106,13 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _record(argv: list[str], stop: Stop) -> int:
-    from irb140_dynamics.ros.recorder import CannotRecord, record, topic_error
-    from irb140_dynamics.ros.runtime.spin import tool_arguments
+    try:
+        from irb140_dynamics.ros.recorder import CannotRecord, record, topic_error
+        from irb140_dynamics.ros.runtime.spin import tool_arguments
+    except ImportError as error:  # record subscribes through ROS 2: rclpy and the messages
+        raise ToolError(
+            f"needs ROS 2 Jazzy's rclpy ({error.name} cannot be imported: see the README's set-up)"
+        ) from None
 
     try:
         args = parser().parse_args(tool_arguments(argv))

@@ -104,3 +104,26 @@ def test_help_prints_usage_and_exits_0(capsys, module, flag):
     assert main(argv) == 0
     out, err = capsys.readouterr()
     assert out.startswith(f"usage: {module}") and err == "", (out, err)
+
+
+def test_record_without_rclpy_says_what_it_needs_in_one_line(monkeypatch, capsys, tmp_path):
+    """record subscribes through ROS 2: where rclpy cannot be imported it says so (exit 1),
+    not an internal error, and writes nothing."""
+    import builtins
+
+    from irb140_dynamics.tools import record
+
+    real_import = builtins.__import__
+
+    def without_rclpy(name, *args, **kwargs):
+        if name == "rclpy" or name.startswith("rclpy."):
+            raise ModuleNotFoundError("No module named 'rclpy'", name="rclpy")
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", without_rclpy)
+    for module in [m for m in sys.modules if m.startswith(("rclpy", "irb140_dynamics.ros"))]:
+        monkeypatch.delitem(sys.modules, module)
+    assert record.main(["record", "--out", str(tmp_path / "run")]) == 1
+    err = capsys.readouterr().err
+    assert err == "record: error: needs ROS 2 Jazzy's rclpy (rclpy cannot be imported: see the README's set-up)\n"
+    assert list(tmp_path.iterdir()) == []
