@@ -151,3 +151,14 @@ def test_an_unknown_name_is_refused_by_every_tool_and_warned_about_by_every_node
         assert node_model(make_node, ["--params-file", path, *unknown]) == irb140()
         warnings = [line for line in capfd.readouterr().err.splitlines() if "unknown parameter" in line]
         assert all(any(text in line for line in warnings) for text in names + hints), (make_node.__name__, warnings)
+
+
+@pytest.mark.parametrize("make_node", NODES, ids=lambda make: make.__name__)
+def test_a_payload_link_on_an_arm_of_parameters_is_refused_not_ignored(make_node):
+    """payload.link names a URDF link: on the default arm (DH parameters) a node refuses it,
+    as the tools do, rather than leaving the payload on the flange without a word."""
+    with (
+        pytest.raises(ValueError, match=r"payload.link names a URDF link"),
+        running(make_node, cli_args=["--ros-args", "-p", "payload.link:=link_3"]),
+    ):
+        pass

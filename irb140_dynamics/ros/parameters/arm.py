@@ -86,7 +86,7 @@ class ArmParameters:
             node.get_logger().info(f"model: {over if given else f'the built-in IRB-140 model ({path})'}")
             joint_names = check_joint_names(overrides.declare(joint_names_spec(defaults["joint_names"])))
             self.robot_name = overrides.declare(MODEL_NAME)
-            arm = model_specs(joint_names, defaults)
+            arm = [*model_specs(joint_names, defaults), PAYLOAD_LINK]  # refused there unless empty (read_arm)
         self.declare([*arm, *specs, *([] if joint_names is None else self._joint_specs(joint_names))])
         overrides.warn_unknown(joint_names)
         if self.urdf is not None:
