@@ -28,8 +28,9 @@ def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model"
     group.add_argument(
         "--urdf",
         metavar="FILE",
-        help="the model from this URDF's chain (the parameter file, if "
-        "any, gives gravity in the root link's frame, payload.* and the chain's limits, friction, armature)",
+        help="the model from this URDF: its chain to --tip, else every moving joint below --base (a chain or a "
+        "whole tree; the parameter file, if any, gives gravity in the root link's frame, payload.* and the joints' "
+        "limits, friction, armature)",
     )
     group.add_argument(
         "--base",
@@ -43,7 +44,7 @@ def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model"
         "--tip-link",
         dest="tip",
         metavar="LINK",
-        help="the URDF link the chain ends at (default: the only leaf)",
+        help="the URDF link the chain ends at (default: none, the whole tree below --base)",
     )
     group.add_argument(
         "-p",
@@ -93,6 +94,18 @@ def arm_of(args: argparse.Namespace, chain_for: str | None = None):
             "as a tree or with mimic joints: give --tip LINK, the end effector's URDF link"
         )
     return replace(arm, given=values)
+
+
+def refuse_mimic_joints(arm, what: str) -> None:
+    """ToolError in one line naming the mimic joints of ``arm``'s model: ``what`` (the
+    identification of the whole arm) fits a regressor that takes independent joints only."""
+    mimic = [j.name for j, m in zip(arm.model.joints, arm.model.mimics or ()) if m is not None]
+    if mimic:
+        raise ToolError(
+            f"{what} takes no mimic joints (the regressor cannot), but {shown(arm.origin)} has {len(mimic)}: "
+            f"{', '.join(mimic)}; "
+            "make them fixed joints in the URDF, or give --tip LINK for a chain without them"
+        )
 
 
 def _unknown_text(unknown, overrides: dict, params_file) -> str:

@@ -42,7 +42,7 @@ from irb140_dynamics.tools.cli import (
     refuse_input_as_output,
     run,
 )
-from irb140_dynamics.tools.common import add_model_arguments, arm_of, model_inputs
+from irb140_dynamics.tools.common import add_model_arguments, arm_of, model_inputs, refuse_mimic_joints
 
 MAX_POINTS = 1_000_000  # points written: 100 MB of YAML
 POINTS_PER_CYCLE = 4  # of the highest harmonic: fewer points do not show the motion
@@ -204,6 +204,8 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
     from irb140_dynamics.tools.outputs import Outputs
 
     source = arm_of(args, chain_for="excitation --payload" if args.payload else None)
+    if not args.payload:
+        refuse_mimic_joints(source, "excitation")
     model, path = source.model, source.origin
     expectation = []
     if args.payload:

@@ -1,0 +1,198 @@
+"""identify and retime on whole trees.
+
+identify: `excitation --urdf` of a two-arm tree (test_urdf_trees' TWO_ARMS, its fingers
+independent joints) is played by MuJoCo's true tree (other link masses, friction,
+armature) under computed torque; the recording (columns in a shuffled order) is fitted
+by `identify --urdf` with the file's inertials as the prior, and the identified tree
+predicts the true tree's torques on another motion. A tree with mimic joints (Baxter's
+fingers) is refused in one line naming them, nothing written.
+
+retime: a JointTrajectory naming Baxter's joints in a shuffled order is checked: the peak
+torques reported are the core's rnea (mimic fingers included) along the controller's
+interpolation; a motion over a torque limit is reported as such, naming the joint."""
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from irb140_dynamics.core import Friction, RigidBody, gravity, mass_matrix, rnea_batch
+from irb140_dynamics.core.io.params_file import read_parameter_file
+from irb140_dynamics.core.io.trajectory_file import read_joint_trajectory
+from irb140_dynamics.core.io.urdf import load_urdf
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.trajectories.check import check_trajectory
+from irb140_dynamics.core.trajectories.interpolation import spline
+from irb140_dynamics.core.trajectories.message import Trajectory
+from irb140_dynamics.identification.excitation import Limits, shaped
+from irb140_dynamics.tools import excitation, identify, retime
+
+from ..core.test_urdf_trees import TWO_ARMS, _without_mimics
+from ..support.paths import URDF_DATA
+from ..support.simulated_ur5 import write_csv
+
+BAXTER = URDF_DATA / "baxter.urdf"
+RATE = 500.0  # Hz: the simulation and the recording
+PERIODS = 3
+
+
+def run(capsys, tool, *args):
+    status = tool.main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def true_tree(model: RobotModel) -> RobotModel:
+    """``model`` with each link's mass (and inertia) scaled within [0.7, 1.3], viscous and
+    Coulomb friction and armature on every joint: the arm the recording is made on."""
+    factors = np.random.default_rng(5).uniform(0.7, 1.3, len(model.joints))
+    joints = tuple(
+        replace(
+            j,
+            link=RigidBody(j.link.mass * f, j.link.com, tuple(f * x for x in j.link.inertia)),
+            friction=Friction(0.4, 0.2),
+            armature=0.03,
+        )
+        for j, f in zip(model.joints, factors)
+    )
+    return replace(model, joints=joints)
+
+
+def record(true: RobotModel, path: Path, order) -> Path:
+    """The true tree under computed torque along the excitation file (as the controller
+    interpolates it), ``PERIODS`` times; the CSV's columns in ``order``."""
+    from irb140_dynamics.sim.engine import SimulatedArm
+
+    sp = spline(Trajectory.from_message(read_joint_trajectory(path), true.joint_names))
+    period = float(sp.end)
+    t = np.arange(int(round(PERIODS * period * RATE))) / RATE
+    Q_ref, QD_ref, QDD_ref = sp.evaluate(np.mod(t, period))
+    feed_forward = rnea_batch(true, Q_ref, QD_ref, QDD_ref)
+    sim = SimulatedArm(true, period=1.0 / RATE, substeps=2)
+    sim.reset(Q_ref[0], QD_ref[0])
+    scale = np.diag(mass_matrix(true, Q_ref[0]))  # kg m^2: the feedback through each joint's inertia
+    Q, QD, TAU = (np.empty_like(Q_ref) for _ in range(3))
+    for k in range(len(t)):
+        q, qd = sim.q, sim.qd
+        sim.step(feed_forward[k] + scale * (400.0 * (Q_ref[k] - q) + 40.0 * (QD_ref[k] - qd)))
+        Q[k], QD[k], TAU[k] = q, qd, sim.applied
+    assert np.abs(Q - Q_ref).max() < 0.01  # it followed the excitation
+    names = [true.joint_names[i] for i in order]
+    return write_csv(path.with_suffix(".csv"), names, t, Q[:, order], QD[:, order], TAU[:, order])
+
+
+def other_motion(model: RobotModel):
+    """(Q, QD, QDD) of a random Fourier motion the recording did not contain."""
+    limits = Limits(np.full(model.n, -1.5), np.full(model.n, 1.5), np.full(model.n, 1.5), np.full(model.n, 4.0))
+    free = np.random.default_rng(11).normal(size=2 * model.n * 3)
+    return shaped(free, model.n, 4, 6.0, limits).evaluate(np.arange(0.0, 6.0, 0.01))
+
+
+def test_identify_fits_a_whole_tree_from_one_recording_of_its_excitation(tmp_path, capsys):
+    urdf = tmp_path / "two_arms.urdf"
+    urdf.write_text(_without_mimics(TWO_ARMS))
+    prior = load_urdf(urdf.read_text()).model
+    assert not prior.is_chain and prior.n == 7
+    excitation_file = tmp_path / "excitation.yaml"
+    status, _, err = run(
+        capsys, excitation, "--urdf", urdf, "--out", excitation_file, "--iterations", 2, "--period", 6, "--harmonics", 3
+    )
+    assert status == 0, err
+    true = true_tree(prior)
+    order = np.random.default_rng(2).permutation(prior.n)
+    recording = record(true, excitation_file, order)
+    out = tmp_path / "identified.yaml"
+    status, printed, err = run(capsys, identify, recording, "--urdf", urdf, "--out", out, "--quiet")
+    assert status == 0, err
+    assert "the tree below base" in printed
+    identified = RobotModel.from_params(read_parameter_file(out))
+    assert identified.joint_names == prior.joint_names and identified.parent == prior.parent
+    Q, QD, QDD = other_motion(prior)
+    truth = rnea_batch(true, Q, QD, QDD)
+    peak = np.abs(truth).max(axis=0)
+    error = np.sqrt(np.mean((rnea_batch(identified, Q, QD, QDD) - truth) ** 2, axis=0)) / peak
+    before = np.sqrt(np.mean((rnea_batch(prior, Q, QD, QDD) - truth) ** 2, axis=0)) / peak
+    print(f"RMS torque error / peak on another motion: prior {np.round(before, 3)}, identified {np.round(error, 3)}")
+    assert np.all(error <= 0.1), error
+    assert np.sqrt(np.mean(error**2)) * 3 <= np.sqrt(np.mean(before**2))
+    back = load_urdf((tmp_path / "identified.urdf").read_text()).model  # the identified tree as URDF:
+    assert back.parent == prior.parent  # its inertials (a URDF holds no armature nor Coulomb friction)
+    np.testing.assert_allclose(gravity_batch(back, Q), gravity_batch(identified, Q), rtol=1e-6, atol=1e-6)
+
+
+def gravity_batch(model: RobotModel, Q) -> np.ndarray:
+    return np.array([gravity(model, q) for q in Q[::10]])
+
+
+@pytest.mark.parametrize("tool", [identify, excitation])
+def test_identify_and_excitation_refuse_mimic_joints_naming_them(tool, tmp_path, capsys):
+    (tmp_path / "bag").mkdir()
+    args = [tmp_path / "bag"] if tool is identify else []
+    status, out, err = run(capsys, tool, *args, "--urdf", BAXTER, "--out", tmp_path / "out.yaml")
+    lines = err.strip().splitlines()
+    assert status == 1 and len(lines) == 1 and not out, err
+    assert "mimic joints" in lines[0]
+    assert "r_gripper_r_finger_joint" in lines[0] and "l_gripper_r_finger_joint" in lines[0]
+    assert [p.name for p in tmp_path.iterdir()] == ["bag"]
+
+
+def baxter_trajectory(path: Path, model: RobotModel, duration: float) -> tuple[Path, np.ndarray]:
+    """A rest-to-rest JointTrajectory of Baxter's joints in a shuffled order, arms from a
+    pose where their shoulders hold well within their limits."""
+    rng = np.random.default_rng(1)
+    order = rng.permutation(model.n)
+    start = np.zeros(model.n)
+    for name, value in (("right_s1", -0.8), ("left_s1", -0.8), ("right_e1", 1.5), ("left_e1", 1.5)):
+        start[model.joint_names.index(name)] = value
+    end = start + rng.uniform(-0.3, 0.3, model.n)
+    sec = int(duration)
+    points = [
+        {
+            "positions": [float(q[i]) for i in order],
+            "velocities": [0.0] * model.n,
+            "time_from_start": {"sec": s, "nanosec": ns},
+        }
+        for q, (s, ns) in ((start, (0, 0)), (end, (sec, int(round((duration - sec) * 1e9)))))
+    ]
+    path.write_text(yaml.safe_dump({"joint_names": [model.joint_names[i] for i in order], "points": points}))
+    return path, order
+
+
+def test_retime_checks_the_torques_of_a_tree_as_the_cores_rnea(tmp_path, capsys):
+    model = load_urdf(BAXTER.read_text()).model
+    assert model.mimics is not None and not model.is_chain
+    path, _ = baxter_trajectory(tmp_path / "slow.yaml", model, 3.0)
+    status, printed, err = run(capsys, retime, "--urdf", BAXTER, "--check-only", path)
+    assert status == 0, err + printed
+    assert "input: 3.0000 s, within every limit" in printed
+    tr = Trajectory.from_message(read_joint_trajectory(path), model.joint_names)
+    sp = spline(tr)
+    report = check_trajectory(model, tr)
+    t = np.linspace(0.0, sp.end, 301)
+    tau = rnea_batch(model, *sp.evaluate(t))  # the core's torques along the interpolation
+    for j, name in enumerate(model.joint_names):
+        peak = next(p for p in report.peaks if p.joint == name and p.quantity == "torque")
+        at = rnea_batch(model, *sp.evaluate(np.array([peak.time])))[0, j]
+        assert peak.value == pytest.approx(at, rel=1e-12, abs=1e-12)
+        assert abs(peak.value) >= np.abs(tau[:, j]).max() - 1e-9
+        assert f"{name} torque: {peak.value:+.4g} N m" in printed  # the tool printed the core's number
+    right_s1 = model.joint_names.index("right_s1")
+    assert np.abs(tau[:, right_s1]).max() > 10.0  # the shoulder holds the arm: the numbers are not trivial
+
+
+def test_retime_reports_a_tree_trajectory_over_a_torque_limit(tmp_path, capsys):
+    model = load_urdf(BAXTER.read_text()).model
+    path, _ = baxter_trajectory(tmp_path / "fast.yaml", model, 0.15)
+    status, printed, err = run(capsys, retime, "--urdf", BAXTER, "--check-only", path)
+    assert status == retime.OVER_LIMIT, err + printed
+    report = check_trajectory(model, Trajectory.from_message(read_joint_trajectory(path), model.joint_names))
+    worst = report.worst
+    assert worst.quantity == "torque" and worst.ratio > 1.0
+    assert f"OVER A LIMIT (worst: {worst.line()})" in printed
+    status, printed, err = run(capsys, retime, "--urdf", BAXTER, path, tmp_path / "out.yaml")
+    assert status == 0, err
+    out = Trajectory.from_message(read_joint_trajectory(tmp_path / "out.yaml"), model.joint_names)
+    after = check_trajectory(model, out)
+    assert after.ok and after.duration > 0.15
