@@ -66,7 +66,10 @@ DESCRIPTION_PARAMETERS = [  # model.source robot_description
         ),
         ("model.urdf_file", "a URDF file, when robot_description is empty; empty: the robot_description topic"),
         ("model.base_link", "the URDF link the chain starts from (fixed); empty: the root link"),
-        ("model.tip_link", "the URDF link where the chain ends, the payload's frame; empty: the only leaf"),
+        (
+            "model.tip_link",
+            "the URDF link where the chain ends, the payload's frame; empty: the only leaf, or with several the whole tree",
+        ),
     )
 ]
 
