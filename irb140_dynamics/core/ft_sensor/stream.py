@@ -121,6 +121,16 @@ class FtSensorStream:
         return estimate
 
 
+def sensor_refusal(model: RobotModel, link: str, carried) -> str | None:
+    """Why the sensor cannot be on ``link`` of ``model`` (one line; ``use``'s arguments), or None."""
+    try:
+        if link:
+            sensor_mount(model, link, exported_carried(model) if carried is None else carried)
+    except ValueError as error:
+        return str(error)
+    return None
+
+
 def _lag(cutoff: float) -> float:
     """The time constant [s] of a first-order low-pass of ``cutoff`` [Hz] (as VelocityDifferentiator's)."""
     return 1.0 / (2.0 * math.pi * cutoff)
