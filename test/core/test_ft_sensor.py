@@ -140,6 +140,21 @@ def test_too_few_orientations_are_refused():
             estimate_ft_load(model, rest_samples(model, mount, poses, np.zeros(6), rng), mount)
 
 
+def test_readings_of_the_opposite_sign_are_refused_and_an_empty_tool_is_none():
+    """A sensor reporting the wrench on the tool (each reading negated) gives -2 kg with a
+    small deviation: refused, saying the convention; no tool gives ~0 kg, too light for a CoM."""
+    model = irb140().with_payload(TOOL)
+    rng, poses = np.random.default_rng(8), np.random.default_rng(9).uniform(-1.5, 1.5, size=(6, 6))
+    negated = [replace(s, effort=-s.effort) for s in rest_samples(model, np.eye(4), poses, np.zeros(6), rng)]
+    with pytest.raises(
+        EstimationError,
+        match=r"^the tool's mass came out negative \(-(1\.99|2\.00)\d \+- 0\.0\d\d kg\): the readings must",
+    ):
+        estimate_ft_load(model, negated, np.eye(4))
+    empty = estimate_ft_load(irb140(), rest_samples(irb140(), np.eye(4), poses, np.zeros(6), rng, (0.0, 0.0)))
+    assert abs(empty.mass) < 1e-9 and empty.com is None
+
+
 def test_the_stream_matches_readings_to_the_nearest_joint_state_and_estimates_from_its_rests():
     model = irb140().with_payload(TOOL)
     stream = FtSensorStream()
