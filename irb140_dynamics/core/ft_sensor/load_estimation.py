@@ -13,7 +13,7 @@ the condition number of the regressor with its columns scaled to unit norm. A tu
 gravity leaves g_s as it was: the poses must hold the sensor in at least MIN_ORIENTATIONS
 orientations relative to gravity (three distinct directions of g_s always determine x).
 
-Refusals (EstimationError, one line saying what to do): fewer orientations, poses too
+Refusals (EstimationError, one line saying what to do): no gravity, fewer orientations, poses too
 similar (condition above MAX_CONDITION), a mass below zero by more than 3 standard
 deviations and NEGATIVE_MASS (readings of the opposite sign, the wrench on the tool rather
 than the tool's on the sensor, or of other axes than the sensor link's). A tool too light to tell from the noise (mass
@@ -81,6 +81,8 @@ def estimate_ft_load(model: RobotModel, samples: list[RestSample], mount: np.nda
     """Bias, mass and CoM from rest samples (``effort``: the mean reading, 6 numbers), or
     EstimationError (see the module)."""
     mount = np.eye(4) if mount is None else mount
+    if not np.any(model.gravity):
+        raise EstimationError("the model's gravity is zero: a tool's load shows at rest only under gravity")
     gravities = [gravity_in_sensor(model, s.q, mount) for s in samples]
     if _orientations(gravities) < MIN_ORIENTATIONS:
         raise EstimationError(
