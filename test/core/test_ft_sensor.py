@@ -186,6 +186,9 @@ def test_the_stream_matches_readings_to_the_nearest_joint_state_and_estimates_fr
             stream.contact(t, bad)
     with pytest.raises(ValueError, match=r"^no_joint_state: the nearest joint state is 1 s from the reading"):
         stream.contact(t + 0.5, sample.effort)
+    stream.note(t + 1.0, np.array(q), np.full(6, 1e160))  # finite, but its w x (w x r) is not
+    with np.errstate(all="raise"), pytest.raises(ValueError, match=r"^not_finite_contact: no finite contact wrench"):
+        stream.contact(t + 1.0, sample.effort)
 
 
 def test_the_stream_refuses_a_bad_frame_or_link_or_turns_off_when_told():
