@@ -193,6 +193,8 @@ def test_the_stream_matches_readings_to_the_nearest_joint_state_and_estimates_fr
 
 def test_the_stream_refuses_a_bad_frame_or_link_or_turns_off_when_told():
     model, stream = irb140().with_payload(TOOL), FtSensorStream()
+    with pytest.raises(EstimationError, match="^the force/torque sensor is off: no model yet, or ft_sensor.link empty"):
+        stream.estimate()  # a node waiting for its URDF
     stream.use(model, "flange", "sensor", None, 20.0)
     with pytest.raises(ValueError, match=r"^ft_contact_wrench.frame: must be one of sensor, base; got 'tool'$"):
         stream.use(model, "flange", "tool", None, 20.0)

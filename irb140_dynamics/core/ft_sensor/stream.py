@@ -117,7 +117,7 @@ class FtSensorStream:
         """The bias and the tool's load from the rests since the start or the last estimate,
         the bias used at once; EstimationError (nothing changed) when they cannot tell."""
         if self.model is None:
-            raise EstimationError("the force/torque sensor is off (ft_sensor.link is empty or refused)")
+            raise EstimationError("the force/torque sensor is off: no model yet, or ft_sensor.link empty or refused")
         self.rests.flush()
         estimate = estimate_ft_load(self.model, self.rests.samples, self.mount)
         self.bias = estimate.bias
