@@ -172,10 +172,11 @@ def test_a_pose_the_rest_velocity_cannot_reach_ends_the_rest():
         np.testing.assert_allclose(sample.q, q, rtol=0.0, atol=1e-15)
         np.testing.assert_allclose(sample.effort, np.full(6, effort), rtol=0.0, atol=1e-15)
     detector.clear()
-    for j in range(60):  # creeping at 0.019 rad/s for 0.6 s: one rest
+    for j in range(60):  # creeping at 0.019 rad/s for 0.6 s, a second publisher's older stamps between: one rest
         detector.update(0.01 * j, np.full(6, 0.019 * 0.01 * j), np.full(6, 0.019), np.ones(6))
+        detector.update(0.01 * j - 0.005, np.full(6, 0.019 * 0.01 * j), np.full(6, 0.019), np.ones(6))
     detector.flush()
-    assert [s.count for s in detector.samples] == [60]
+    assert [s.count for s in detector.samples] == [120]
 
 
 def test_rest_detector_refuses_an_effort_too_large_to_average_and_keeps_its_rest():

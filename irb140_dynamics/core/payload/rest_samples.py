@@ -102,8 +102,8 @@ class RestDetector:
     of at least ``rest_time`` [s] becomes a sample, one per distinct pose (a pose within
     ``same_pose`` [rad] of an earlier one replaces it). A joint state the rest velocity cannot
     reach from the one before (farther than ``same_pose`` plus ``rest_velocity`` times the
-    time between them, or older) ends the rest and starts another: a driver reporting zero
-    velocities, or a gap in the stream, never averages two poses into one.
+    time since, none for an older stamp) ends the rest and starts another: a driver reporting
+    zero velocities, or a gap in the stream, never averages two poses into one.
 
     ``friction`` (the model's JointFriction, or None): its torque at each joint state's
     measured velocity is taken off that state's efforts before averaging. Inside the rest band
@@ -163,13 +163,13 @@ class RestDetector:
             self._sum_effort += effort
             self._sum_squares += effort**2
         self._count += 1
-        self._last, self._q_last = t, q
+        self._last, self._q_last = max(t, self._last if self._last is not None else t), q
         return added
 
     def _jumped(self, t: float, q: np.ndarray) -> bool:
         """Whether q at t is beyond the rest velocity's reach from the rest's last joint state."""
-        dt = t - self._last
-        return dt < 0.0 or float(np.max(np.abs(q - self._q_last))) > self.same_pose + self.rest_velocity * dt
+        reach = self.same_pose + self.rest_velocity * max(t - self._last, 0.0)
+        return float(np.max(np.abs(q - self._q_last))) > reach
 
     def _close(self) -> bool:
         if self._start is None or self._last - self._start < self.rest_time:
