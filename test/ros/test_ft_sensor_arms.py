@@ -2,11 +2,14 @@
 robot_description, the sensor on tool0): a 3 kg tool's load estimated from rests in three
 poses streamed with zero velocities and no motion between them (a driver's), applied to
 payload.mass and .com; a payload.link that would take the flange off the sensor's link is
-refused in one line, the sensor staying on."""
+refused in one line, the sensor staying on. Readings come from a best-effort publisher
+(sensor-data QoS, as force/torque drivers publish): a reliable-only subscription would hear
+nothing."""
 
 import numpy as np
 from geometry_msgs.msg import WrenchStamped
 from rclpy.parameter import Parameter
+from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
@@ -36,7 +39,7 @@ def test_ur5_tool_estimated_from_rests_without_motion_between_them_and_a_flange_
     with running(IdNode, parameter_overrides=OVERRIDES) as harness:
         harness.contacts = harness.listen(WrenchStamped, "ft_contact_wrench", 100)
         harness.joint_states = harness.publisher(JointState, "joint_states")
-        harness.readings = harness.publisher(WrenchStamped, "ft_wrench")
+        harness.readings = harness.publisher(WrenchStamped, "ft_wrench", qos_profile_sensor_data)
         true_arm = harness.node.model.with_payload(TOOL)
         mount = sensor_mount(true_arm, "tool0", loaded.carried)
         zero = np.zeros(6)

@@ -11,13 +11,14 @@ from irb140_dynamics.core.io.stamps import seconds
 from irb140_dynamics.core.model.joint_order import BadMessage
 from irb140_dynamics.core.payload.mass_com_estimation import EstimationError
 from irb140_dynamics.ros.messages.wrench import fill_wrench
+from irb140_dynamics.ros.parameters.specs import joint_states_qos
 from irb140_dynamics.ros.runtime.guard import guarded
 
 
 class FtSensor:
     def __init__(self, node, depth: int):
         self.node, self.tally, self.stream, self._msg = node, node.tally, FtSensorStream(), WrenchStamped()
-        node.create_subscription(WrenchStamped, "ft_wrench", self._on_reading, depth)
+        node.create_subscription(WrenchStamped, "ft_wrench", self._on_reading, joint_states_qos(node))
         self._pub = node.create_publisher(WrenchStamped, "ft_contact_wrench", depth)
         node.create_service(Trigger, "~/estimate_ft_load", self._on_estimate)
 
