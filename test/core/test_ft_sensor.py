@@ -140,6 +140,25 @@ def test_too_few_orientations_are_refused():
             estimate_ft_load(model, rest_samples(model, mount, poses, np.zeros(6), rng), mount)
 
 
+def test_readings_of_the_opposite_sign_or_no_gravity_are_refused_and_an_empty_tool_is_none():
+    """A sensor reporting the wrench on the tool (each reading negated) gives -2 kg with a
+    small deviation: refused, saying the convention; no tool gives ~0 kg, too light for a CoM;
+    a model without gravity is refused saying so (not "more orientations needed")."""
+    model = irb140().with_payload(TOOL)
+    rng, poses = np.random.default_rng(8), np.random.default_rng(9).uniform(-1.5, 1.5, size=(6, 6))
+    negated = [replace(s, effort=-s.effort) for s in rest_samples(model, np.eye(4), poses, np.zeros(6), rng)]
+    with pytest.raises(
+        EstimationError,
+        match=r"^the tool's mass came out negative \(-(1\.99|2\.00)\d \+- 0\.0\d\d kg\): the readings must",
+    ):
+        estimate_ft_load(model, negated, np.eye(4))
+    empty = estimate_ft_load(irb140(), rest_samples(irb140(), np.eye(4), poses, np.zeros(6), rng, (0.0, 0.0)))
+    assert abs(empty.mass) < 1e-9 and empty.com is None
+    weightless = replace(model, gravity=(0.0, 0.0, 0.0))
+    with pytest.raises(EstimationError, match=r"^the model's gravity is zero: a tool's load shows at rest only"):
+        estimate_ft_load(weightless, rest_samples(weightless, np.eye(4), poses, np.zeros(6), rng))
+
+
 def test_the_stream_matches_readings_to_the_nearest_joint_state_and_estimates_from_its_rests():
     model = irb140().with_payload(TOOL)
     stream = FtSensorStream()
@@ -167,10 +186,15 @@ def test_the_stream_matches_readings_to_the_nearest_joint_state_and_estimates_fr
             stream.contact(t, bad)
     with pytest.raises(ValueError, match=r"^no_joint_state: the nearest joint state is 1 s from the reading"):
         stream.contact(t + 0.5, sample.effort)
+    stream.note(t + 1.0, np.array(q), np.full(6, 1e160))  # finite, but its w x (w x r) is not
+    with np.errstate(all="raise"), pytest.raises(ValueError, match=r"^not_finite_contact: no finite contact wrench"):
+        stream.contact(t + 1.0, sample.effort)
 
 
 def test_the_stream_refuses_a_bad_frame_or_link_or_turns_off_when_told():
     model, stream = irb140().with_payload(TOOL), FtSensorStream()
+    with pytest.raises(EstimationError, match="^the force/torque sensor is off: no model yet, or ft_sensor.link empty"):
+        stream.estimate()  # a node waiting for its URDF
     stream.use(model, "flange", "sensor", None, 20.0)
     with pytest.raises(ValueError, match=r"^ft_contact_wrench.frame: must be one of sensor, base; got 'tool'$"):
         stream.use(model, "flange", "tool", None, 20.0)

@@ -152,6 +152,33 @@ def test_rest_detector_needs_rest_time_and_merges_the_same_pose():
     assert detector.samples == []
 
 
+def test_a_pose_the_rest_velocity_cannot_reach_ends_the_rest():
+    """A driver reporting zero velocities jumps between poses, a stream goes back in time: each
+    pose its own sample of its own efforts, never one average of two poses; a slow creep inside
+    the rest velocity stays one rest."""
+    detector = RestDetector(rest_velocity=0.02, rest_time=0.5)
+    poses = [np.zeros(6), np.full(6, 0.3), np.full(6, -0.2)]
+    t = 0.0
+    for k, q in enumerate(poses):  # 0.7 s at each pose, qd = 0 throughout, no motion between
+        for _ in range(8):
+            detector.update(t, q, np.zeros(6), np.full(6, float(k)))
+            t += 0.1
+    for q in poses[:1]:  # back in time: a new rest of its own
+        for j in range(8):
+            detector.update(0.1 * j, q + 0.5, np.zeros(6), np.full(6, 9.0))
+    detector.flush()
+    assert [s.count for s in detector.samples] == [8, 8, 8, 8]
+    for sample, q, effort in zip(detector.samples, [*poses, poses[0] + 0.5], [0.0, 1.0, 2.0, 9.0]):
+        np.testing.assert_allclose(sample.q, q, rtol=0.0, atol=1e-15)
+        np.testing.assert_allclose(sample.effort, np.full(6, effort), rtol=0.0, atol=1e-15)
+    detector.clear()
+    for j in range(60):  # creeping at 0.019 rad/s for 0.6 s, a second publisher's older stamps between: one rest
+        detector.update(0.01 * j, np.full(6, 0.019 * 0.01 * j), np.full(6, 0.019), np.ones(6))
+        detector.update(0.01 * j - 0.005, np.full(6, 0.019 * 0.01 * j), np.full(6, 0.019), np.ones(6))
+    detector.flush()
+    assert [s.count for s in detector.samples] == [120]
+
+
 def test_rest_detector_refuses_an_effort_too_large_to_average_and_keeps_its_rest():
     detector = RestDetector(rest_velocity=0.01, rest_time=0.5)
     q, effort = np.zeros(6), np.ones(6)

@@ -227,6 +227,10 @@ def test_link_wrenches_on_two_arms_are_the_wrenches_that_made_the_torques():
     assert exact >= 3
     with pytest.raises(ValueError, match=r"^external_wrench\.links: 'base' is not moved by the model's joints$"):
         wrench_places(["base"], loaded.carried)
+    with pytest.raises(
+        ValueError, match=r"^external_wrench\.links: 'left_gripper' is named twice; name each link once$"
+    ):
+        wrench_places(["left_gripper", "right_gripper", "left_gripper"], loaded.carried)
 
 
 def test_id_node_publishes_each_links_wrench_in_its_frame():

@@ -42,8 +42,9 @@ def sensor_mount(model: RobotModel, link: str, carried: Mapping[str, tuple[str, 
     the links the arm's joints move, link -> (joint, placement in its link frame)
     (``LoadedUrdf.carried``, or ``exported_carried`` for a model of parameters). ValueError
     naming ft_sensor.link for a link no joint moves, or one the flange's joint does not carry
-    (the tool would be links), or on a model that is no plain chain (``flange_motion``'s)."""
-    if not model.is_chain:
+    (the tool would be links), or on a model that is no plain chain (``flange_motion``'s: a
+    tree, mimic joints, or the flange moved before the last joint by payload.link)."""
+    if model.mimics is not None or any(p != i - 1 for i, p in enumerate(model.parent)):
         raise ValueError(
             "ft_sensor.link: a force/torque sensor needs an arm that is one chain (no tree, no mimic joint)"
         )
@@ -57,6 +58,8 @@ def sensor_mount(model: RobotModel, link: str, carried: Mapping[str, tuple[str, 
             f"ft_sensor.link: {link!r} is moved by joint {joint}, not by {last} that carries the flange: the "
             "sensor must be on the flange's link (the tool beyond it is the payload)"
         )
+    if not model.is_chain:  # payload.link put the flange before the last joint
+        raise ValueError(f"ft_sensor.link: {link!r} is before the last joint; the sensor must be on the last link")
     return _rigid_inverse(model.flange.matrix()) @ placement.matrix()
 
 

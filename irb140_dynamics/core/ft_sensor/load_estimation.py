@@ -13,8 +13,10 @@ the condition number of the regressor with its columns scaled to unit norm. A tu
 gravity leaves g_s as it was: the poses must hold the sensor in at least MIN_ORIENTATIONS
 orientations relative to gravity (three distinct directions of g_s always determine x).
 
-Refusals (EstimationError, one line saying what to do): fewer orientations, poses too
-similar (condition above MAX_CONDITION). A tool too light to tell from the noise (mass
+Refusals (EstimationError, one line saying what to do): no gravity, fewer orientations, poses too
+similar (condition above MAX_CONDITION), a mass below zero by more than 3 standard
+deviations and NEGATIVE_MASS (readings of the opposite sign, the wrench on the tool rather
+than the tool's on the sensor, or of other axes than the sensor link's). A tool too light to tell from the noise (mass
 not above 3 standard deviations) gives the bias and no CoM (``com`` None).
 """
 
@@ -32,6 +34,7 @@ from irb140_dynamics.core.payload.mass_com_estimation import EstimationError, Re
 MIN_ORIENTATIONS = 3
 DISTINCT_ANGLE = 0.05  # rad between two directions of gravity in the sensor's axes
 MAX_CONDITION = 1e3
+NEGATIVE_MASS = 0.01  # kg: a mass further below zero (and below 3 standard deviations) is refused
 
 
 @dataclass(frozen=True)
@@ -78,6 +81,8 @@ def estimate_ft_load(model: RobotModel, samples: list[RestSample], mount: np.nda
     """Bias, mass and CoM from rest samples (``effort``: the mean reading, 6 numbers), or
     EstimationError (see the module)."""
     mount = np.eye(4) if mount is None else mount
+    if not np.any(model.gravity):
+        raise EstimationError("the model's gravity is zero: a tool's load shows at rest only under gravity")
     gravities = [gravity_in_sensor(model, s.q, mount) for s in samples]
     if _orientations(gravities) < MIN_ORIENTATIONS:
         raise EstimationError(
@@ -94,6 +99,11 @@ def estimate_ft_load(model: RobotModel, samples: list[RestSample], mount: np.nda
         weights = np.tile(np.repeat([1.0 / (rms[0] or 1.0), 1.0 / (rms[1] or 1.0)], 3), len(samples))
     std = np.sqrt(np.maximum(np.diag(covariance), 0.0))
     mass, h = float(x[6]), x[7:]
+    if mass < -max(3.0 * std[6], NEGATIVE_MASS):
+        raise EstimationError(
+            f"the tool's mass came out negative ({mass:.3f} +- {std[6]:.3f} kg): the readings must be the wrench "
+            "on the sensor from the tool (a hanging tool reads its weight), in ft_sensor.link's axes"
+        )
     com = com_std = None
     if mass > 3.0 * std[6]:
         com = tuple(float(v) for v in h / mass)

@@ -82,7 +82,7 @@ class FtSensorStream:
     def contact(self, t: float, reading) -> np.ndarray:
         """The contact wrench of a reading at t [s] (see ``contact``), in ``frame``'s axes; the
         reading kept if the arm rests. BadMessage: a reading not finite or absurd, no joint
-        state near it."""
+        state near it, a joint state too fast for a finite contact wrench."""
         reading = np.asarray(reading, dtype=float)
         if reading.shape != (6,) or not np.isfinite(reading).all():
             raise BadMessage("not_finite", f"reading not 6 finite numbers: {reading.tolist()}")
@@ -94,8 +94,12 @@ class FtSensorStream:
         gap, (_, q, qd, qdd) = self._nearest(t)
         if gap > MAX_GAP:
             raise BadMessage("no_joint_state", f"the nearest joint state is {gap:.3g} s from the reading")
+        with np.errstate(all="ignore"):
+            contact = contact_wrench(self.model, q, qd, qdd, reading, self.mount, self.bias, self.frame)
+        if not np.isfinite(contact).all():  # a joint state too fast for the model's numbers
+            raise BadMessage("not_finite_contact", f"no finite contact wrench at qd = {qd.tolist()} rad/s")
         self.rests.update(t, q, qd, reading)
-        return contact_wrench(self.model, q, qd, qdd, reading, self.mount, self.bias, self.frame)
+        return contact
 
     def _nearest(self, t: float) -> tuple[float, tuple]:
         """(|gap| [s], the joint state nearest t): searched from the newest back, until the
@@ -113,12 +117,22 @@ class FtSensorStream:
         """The bias and the tool's load from the rests since the start or the last estimate,
         the bias used at once; EstimationError (nothing changed) when they cannot tell."""
         if self.model is None:
-            raise EstimationError("the force/torque sensor is off (ft_sensor.link is empty or refused)")
+            raise EstimationError("the force/torque sensor is off: no model yet, or ft_sensor.link empty or refused")
         self.rests.flush()
         estimate = estimate_ft_load(self.model, self.rests.samples, self.mount)
         self.bias = estimate.bias
         self.rests.clear()
         return estimate
+
+
+def sensor_refusal(model: RobotModel, link: str, carried) -> str | None:
+    """Why the sensor cannot be on ``link`` of ``model`` (one line; ``use``'s arguments), or None."""
+    try:
+        if link:
+            sensor_mount(model, link, exported_carried(model) if carried is None else carried)
+    except ValueError as error:
+        return str(error)
+    return None
 
 
 def _lag(cutoff: float) -> float:

@@ -65,8 +65,11 @@ def wrench_places(links: Sequence[str], carried: Mapping | None) -> tuple[tuple[
         return ()
     if carried is None:
         raise ValueError("external_wrench.links: names URDF links; the model is no URDF's (model.source)")
-    if len(links) > MAX_LINKS or len(set(links)) != len(links):
-        raise ValueError(f"external_wrench.links: at most {MAX_LINKS} links, each once; got {len(links)}")
+    if len(links) > MAX_LINKS:
+        raise ValueError(f"external_wrench.links: at most {MAX_LINKS} links; got {len(links)}")
+    repeated = next((link for k, link in enumerate(links) if link in links[:k]), None)
+    if repeated is not None:
+        raise ValueError(f"external_wrench.links: {str(repeated)[:80]!r} is named twice; name each link once")
     for link in links:
         if link not in carried:
             raise ValueError(f"external_wrench.links: {str(link)[:80]!r} is not moved by the model's joints")

@@ -100,7 +100,10 @@ class PayloadEstimator:
 class RestDetector:
     """Averages joint states while every joint is slower than ``rest_velocity`` [rad/s]; a rest
     of at least ``rest_time`` [s] becomes a sample, one per distinct pose (a pose within
-    ``same_pose`` [rad] of an earlier one replaces it).
+    ``same_pose`` [rad] of an earlier one replaces it). A joint state the rest velocity cannot
+    reach from the one before (farther than ``same_pose`` plus ``rest_velocity`` times the
+    time since, none for an older stamp) ends the rest and starts another: a driver reporting
+    zero velocities, or a gap in the stream, never averages two poses into one.
 
     ``friction`` (the model's JointFriction, or None): its torque at each joint state's
     measured velocity is taken off that state's efforts before averaging. Inside the rest band
@@ -129,6 +132,7 @@ class RestDetector:
 
     def _restart(self) -> None:
         self._start = self._last = None  # times of the current rest's first and last joint states
+        self._q_last = None  # the current rest's last pose
         self._sum_q = self._sum_effort = self._sum_squares = None
         self._count = 0
         self._has_effort = True  # of the current rest's joint states (a change ends the rest)
@@ -144,7 +148,7 @@ class RestDetector:
                     raise ValueError(f"effort {effort.tolist()} N m: too large to average")
         moving = np.max(np.abs(qd)) >= self.rest_velocity
         added = False
-        if moving or (self._start is not None and self._has_effort != (effort is not None)):
+        if moving or (self._start is not None and (self._has_effort != (effort is not None) or self._jumped(t, q))):
             added = self._close()
             self._restart()
         if moving:
@@ -159,8 +163,13 @@ class RestDetector:
             self._sum_effort += effort
             self._sum_squares += effort**2
         self._count += 1
-        self._last = t
+        self._last, self._q_last = max(t, self._last if self._last is not None else t), q
         return added
+
+    def _jumped(self, t: float, q: np.ndarray) -> bool:
+        """Whether q at t is beyond the rest velocity's reach from the rest's last joint state."""
+        reach = self.same_pose + self.rest_velocity * max(t - self._last, 0.0)
+        return float(np.max(np.abs(q - self._q_last))) > reach
 
     def _close(self) -> bool:
         if self._start is None or self._last - self._start < self.rest_time:

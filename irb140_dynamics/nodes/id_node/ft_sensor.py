@@ -6,18 +6,19 @@ from geometry_msgs.msg import WrenchStamped
 from rclpy.parameter import Parameter
 from std_srvs.srv import Trigger
 
-from irb140_dynamics.core.ft_sensor.stream import FtSensorStream
+from irb140_dynamics.core.ft_sensor.stream import FtSensorStream, sensor_refusal
 from irb140_dynamics.core.io.stamps import seconds
 from irb140_dynamics.core.model.joint_order import BadMessage
 from irb140_dynamics.core.payload.mass_com_estimation import EstimationError
 from irb140_dynamics.ros.messages.wrench import fill_wrench
+from irb140_dynamics.ros.parameters.specs import joint_states_qos
 from irb140_dynamics.ros.runtime.guard import guarded
 
 
 class FtSensor:
     def __init__(self, node, depth: int):
         self.node, self.tally, self.stream, self._msg = node, node.tally, FtSensorStream(), WrenchStamped()
-        node.create_subscription(WrenchStamped, "ft_wrench", self._on_reading, depth)
+        node.create_subscription(WrenchStamped, "ft_wrench", self._on_reading, joint_states_qos(node))
         self._pub = node.create_publisher(WrenchStamped, "ft_contact_wrench", depth)
         node.create_service(Trigger, "~/estimate_ft_load", self._on_estimate)
 
@@ -28,6 +29,13 @@ class FtSensor:
         refused = self.stream.use(settings.model, settings.ft_link, settings.ft_frame, carried, lag, strict=not started)
         if refused:
             self.node.get_logger().error(refused)
+
+    def refusal(self, settings) -> str | None:
+        """Why a parameter change would turn the sensor on now off (the change is refused), or None."""
+        urdf = self.node.parameters.urdf
+        if self.stream.model is None:
+            return None
+        return sensor_refusal(settings.model, settings.ft_link, None if urdf is None else urdf.carried)
 
     @guarded("ft_wrench")
     def _on_reading(self, msg: WrenchStamped) -> None:

@@ -140,6 +140,9 @@ class IdNode(Node):
     def _on_set(self, parameters) -> SetParametersResult:
         """A change is accepted only if the whole new configuration checks."""
         result, self._draft = self.parameters.check_change(parameters, check_settings)
+        refused = self._draft is not None and self.ft.refusal(self._draft)
+        if refused:
+            result, self._draft = SetParametersResult(successful=False, reason=refused), None
         return result
 
     def _on_set_done(self, parameters) -> None:

@@ -24,8 +24,8 @@ QOS_PARAMETERS = [
     Spec(
         "qos.reliability",
         "best_effort",
-        "joint_states subscription reliability: 'best_effort' (takes reliable and best-effort publishers) "
-        "or 'reliable'",
+        "joint_states (and ft_wrench) subscription reliability: 'best_effort' (takes reliable and "
+        "best-effort publishers) or 'reliable'",
         read_only=True,
     ),
     Spec(
