@@ -4,17 +4,14 @@ command, simulated time), a 20 N push shows on id_node's external_wrench within 
 
 import numpy as np
 import pytest
-import rclpy
 from geometry_msgs.msg import WrenchStamped
-from rclpy.context import Context
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 
-from irb140_dynamics.nodes.id_node.node import IdNode
 from irb140_dynamics.nodes.sim_node.node import SimNode
 
-from ..support.ros_harness import Harness, running
-from .test_sim_node import POSE, make, stamp
+from ..support.ros_harness import running
+from .test_sim_node import POSE, make, sim_with_controller, stamp
 
 PUSH = np.array([0.0, 0.0, 20.0])  # N, along the flange's z (through the wrist centre: the light wrist stays put)
 SETTLED = 0.1  # s of simulated time: 10/K, the observer's lag long gone
@@ -74,23 +71,16 @@ def test_a_push_is_held_in_the_frame_it_names(sim):
 
 
 def test_a_20_newton_push_shows_on_external_wrench_in_lockstep():
-    context = Context()
-    rclpy.init(context=context)
-    harness = id_node = None
-    try:
-        sim = SimNode(context=context, parameter_overrides=make(lockstep=True, rate=1000.0, **{"qos.depth": 1000}))
-        harness = Harness(context, sim)
-        id_node = IdNode(
-            context=context,
-            parameter_overrides=[
+    with sim_with_controller(lockstep=True, rate=1000.0, **{"qos.depth": 1000}) as (harness, add_controller):
+        add_controller(
+            [
                 Parameter("use_sim_time", value=True),
                 Parameter("effort_commands.enabled", value=True),
                 Parameter("effort_commands.source", value="gravity"),
                 Parameter("external_wrench.frame", value="tip"),
                 Parameter("collision.observer_gain", value=100.0),
-            ],
+            ]
         )
-        harness.executor.add_node(id_node)
         estimates = harness.listen(WrenchStamped, "external_wrench", 10000)
         pushes = harness.publisher(WrenchStamped, "/sim_node/external_wrench")
         pushes.publish(wrench("flange", PUSH))
@@ -105,12 +95,5 @@ def test_a_20_newton_push_shows_on_external_wrench_in_lockstep():
             force_error = np.linalg.norm(np.array([f.x, f.y, f.z]) - PUSH)
             torque_error = np.linalg.norm([m.x, m.y, m.z])  # N m: none pushed
             assert force_error <= 0.05 * 20.0 and torque_error <= 0.05 * 20.0 * 0.1, (stamp(msg), f, m)
-        moved = np.abs(sim.simulation.arm.q - POSE).max()
+        moved = np.abs(harness.node.simulation.arm.q - POSE).max()
         assert 1e-3 < moved < 0.3, moved  # the arm gave way, far from its limits
-    finally:
-        if id_node is not None:
-            harness.executor.remove_node(id_node)
-            id_node.destroy_node()
-        if harness is not None:
-            harness.close()
-        rclpy.try_shutdown(context=context)

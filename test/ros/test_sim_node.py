@@ -2,20 +2,24 @@
 reset, noise, bad commands, parameters."""
 
 import time
+from contextlib import contextmanager
 
 import numpy as np
 import pytest
+import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from rclpy.context import Context
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 
 from irb140_dynamics.core import RigidBody, gravity, irb140
+from irb140_dynamics.nodes.id_node.node import IdNode
 from irb140_dynamics.nodes.sim_node import node as sim_node
 from irb140_dynamics.nodes.sim_node.node import SimNode
 
-from ..support.ros_harness import TIMEOUT, running
+from ..support.ros_harness import TIMEOUT, Harness, running
 
 NAMES = [f"joint_{i}" for i in range(1, 7)]
 POSE = [0.0, -0.5, 0.5, 0.0, 0.5, 0.0]  # rad: without torques the arm falls from here
@@ -33,6 +37,32 @@ def sim(request):
         harness.states = harness.listen(JointState, "joint_states", 1000)
         harness.commands = harness.publisher(Float64MultiArray, "effort_commands")
         yield harness
+
+
+@contextmanager
+def sim_with_controller(**parameters):
+    """(harness, add_controller): a SimNode (``make(**parameters)``) in a context of its own,
+    spun by a Harness; ``add_controller(overrides)`` adds an id_node beside it. Both are
+    destroyed after, whatever happens."""
+    context = Context()
+    rclpy.init(context=context)
+    harness, controllers = None, []
+
+    def add_controller(overrides) -> IdNode:
+        controllers.append(IdNode(context=context, parameter_overrides=overrides))
+        harness.executor.add_node(controllers[-1])
+        return controllers[-1]
+
+    try:
+        harness = Harness(context, SimNode(context=context, parameter_overrides=make(**parameters)))
+        yield harness, add_controller
+    finally:
+        for controller in controllers:
+            harness.executor.remove_node(controller)
+            controller.destroy_node()
+        if harness is not None:
+            harness.close()
+        rclpy.try_shutdown(context=context)
 
 
 def command(sim, tau):
