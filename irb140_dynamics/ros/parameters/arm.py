@@ -76,7 +76,7 @@ class ArmParameters:
                 self.urdf = self.read(text or read_urdf_file(path, "model.urdf_file").text, origin)
             self.from_topic = self.urdf is None
             joint_names = None if self.urdf is None else self.urdf.model.joint_names
-            arm = [*model_specs([], {}), PAYLOAD_LINK]
+            arm = model_specs([], {})
         else:
             path = default_config_path()
             if not path.is_file():
@@ -86,8 +86,9 @@ class ArmParameters:
             node.get_logger().info(f"model: {over if given else f'the built-in IRB-140 model ({path})'}")
             joint_names = check_joint_names(overrides.declare(joint_names_spec(defaults["joint_names"])))
             self.robot_name = overrides.declare(MODEL_NAME)
-            arm = [*model_specs(joint_names, defaults), PAYLOAD_LINK]  # refused there unless empty (read_arm)
-        self.declare([*arm, *specs, *([] if joint_names is None else self._joint_specs(joint_names))])
+            arm = model_specs(joint_names, defaults)
+        # payload.link on an arm of parameters: refused unless empty (read_arm)
+        self.declare([*arm, PAYLOAD_LINK, *specs, *([] if joint_names is None else self._joint_specs(joint_names))])
         overrides.warn_unknown(joint_names)
         if self.urdf is not None:
             self._announce(origin)
