@@ -21,7 +21,7 @@ from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS
 
 from ..core.test_urdf_refusals import ARM, REFUSED
 from ..support.paths import URDF_DATA
-from ..support.ros_harness import Harness, running
+from ..support.ros_harness import Harness, built, running
 from ..support.urdf_support import ARMS, arm_text, expected_gravity
 
 PAYLOAD = RigidBody(2.5, (0.01, 0.02, 0.05), (0.01, 0.01, 0.01, 0.0, 0.0, 0.0))
@@ -85,7 +85,7 @@ def node_and_description_publisher(make_node, overrides, text_before=None):
     try:
         if text_before is not None:
             publisher.publish(String(data=text_before))
-        harness = Harness(context, make_node(context=context, parameter_overrides=overrides))
+        harness = Harness(context, built(make_node, context=context, parameter_overrides=overrides))
         harness.executor.add_node(publisher_node)
         harness.description = publisher
         yield harness

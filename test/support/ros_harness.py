@@ -5,7 +5,9 @@ Every wait has a timeout; contexts are shut down and nodes destroyed on exit.
 
 from __future__ import annotations
 
+import gc
 import time
+import traceback
 from collections.abc import Callable
 from contextlib import contextmanager
 
@@ -100,9 +102,24 @@ def running(make_node: Callable[..., Node], **node_kwargs):
     rclpy.init(context=context)
     harness = None
     try:
-        harness = Harness(context, make_node(context=context, **node_kwargs))
+        harness = Harness(context, built(make_node, context=context, **node_kwargs))
         yield harness
     finally:
         if harness is not None:
             harness.close()
         rclpy.try_shutdown(context=context)
+
+
+def built(make_node: Callable[..., Node], **node_kwargs) -> Node:
+    """``make_node(**node_kwargs)``; when it raises, the half-made node (its DDS participant)
+    is destroyed here, not by a garbage collection in some later test: FastDDS can deadlock
+    when a participant is torn down while another of the process is busy with discovery."""
+    try:
+        return make_node(**node_kwargs)
+    except Exception as error:
+        cause = error
+        while cause is not None:  # the failed __init__'s frames hold the node
+            traceback.clear_frames(cause.__traceback__)
+            cause = cause.__cause__ or cause.__context__
+        gc.collect()
+        raise
