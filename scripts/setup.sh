@@ -14,3 +14,5 @@ source scripts/env.sh run
 echo "building the package with colcon into install/ ..." >&2
 colcon --log-base build/log build --paths . --build-base build --install-base install >build.log 2>&1 \
     || { cat build.log >&2; echo "setup.sh: the build failed (build.log above)" >&2; exit 1; }
+# (the copy colcon installs, compiled as env.sh compiles the clone's)
+python -m compileall -q -j 0 install/irb140_dynamics/lib >/dev/null || true
