@@ -127,7 +127,7 @@ def payload_path(model: RobotModel) -> PayloadPath:
     if model.is_chain:
         n = model.n
         return PayloadPath(model, model, np.arange(n), np.zeros(n), np.ones(n, dtype=bool))
-    return _tree_path(model)
+    return _tree_path(model.with_payload(RigidBody()))  # one path for every payload (each its family)
 
 
 @lru_cache(maxsize=16)
