@@ -129,7 +129,7 @@ def test_the_state_and_the_largest_payload_on_the_tree_are_the_trees_torques():
 
 def test_a_bound_not_met_is_said_and_baxters_other_arm_adds_nothing():
     """TWO_ARMS' other arm cannot stretch along g x z of its torso: the gap is the rest of
-    the tree's, said so. On a tree whose other branches hang off the base, the path is the
+    the tree's, said so; the torques found (its fingers mimic r2) above every sampled one. On a tree whose other branches hang off the base, the path is the
     chain itself: nothing added, the same proofs."""
     model = load_urdf(TWO_ARMS).with_flange_at("la2")
     result = check_payload(model, RigidBody(1.0, (0.05, 0.0, 0.0)))
@@ -137,6 +137,7 @@ def test_a_bound_not_met_is_said_and_baxters_other_arm_adds_nothing():
         model, RigidBody(1.0, (0.05, 0.0, 0.0)), dense_poses(model, 20000, np.random.default_rng(4))
     )
     assert np.all(sampled <= result.workspace.bound * (1 + 1e-9))
+    assert np.all(np.abs(result.workspace.torque) >= sampled)  # its mimic fingers' coordinate searched on a grid
     assert result.workspace.gap[0] > 0.05 and "the rest of the tree's worst pose is bounded" in result.gap_note(0)
     off_base = PITCH_TORSO.replace(
         '<parent link="torso"/><child link="ra1"/>', '<parent link="base"/><child link="ra1"/>'

@@ -118,7 +118,9 @@ class PayloadPath:
         lower, upper = np.where(self.moving, lower, self._rest), np.where(self.moving, upper, self._rest)
         sliding = np.array([j.prismatic for j in self.tree.independent_joints], dtype=bool)
         samples = lower + quasi_random(SAMPLES, self.tree.n) * (upper - lower)
-        return JointRanges(lower, upper, samples, sliding)
+        followed = [k for (k, _, _), mimic in zip(self.tree.coordinates, self.tree.mimics or ()) if mimic is not None]
+        gridded = np.isin(np.arange(self.tree.n), followed) & (lower < upper)
+        return JointRanges(lower, upper, samples, sliding, gridded)
 
 
 def payload_path(model: RobotModel) -> PayloadPath:
