@@ -136,7 +136,7 @@ class JointRanges:
         step = np.zeros_like(X)
         for _ in range(max_sweeps):
             before, X_before = F, X.copy()
-            for k in range(X.shape[-1]):
+            for k in np.flatnonzero(self.lower < self.upper):  # (a coordinate held has no step)
                 if out_of_time():
                     return X, self._values(torque, W, X)
                 X, F = self._coordinate_step(torque, W, X, k, tol)
