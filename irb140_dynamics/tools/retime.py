@@ -9,8 +9,9 @@ joint_names, points with positions, velocities, accelerations, effort, time_from
 {sec, nanosec}); joints in any order, matched to the model's by name. The model, read as
 every tool and node reads it (``core.io.arm_source``): the package's IRB-140, the params
 file's ``/**`` section over it, then -p; or the URDF's chain with the params file's limits,
-friction and armature for its joints; --payload-mass puts that mass at the flange origin. Torque limits
-of 0 are derived as the payload check derives them (said in the report).
+friction and armature for its joints; --payload-mass puts that mass at the flange origin (on a whole
+tree, at payload.link's: -p payload.link:=LINK). Torque limits of 0 are derived as the payload check
+derives them (said in the report; on a tree, give them).
 
 Re-timing writes OUT.yaml (the same path, a point per grid point, timed time-optimally, as
 ``ros2 topic pub`` takes it) and prints the check of the input and of the output.
@@ -38,6 +39,7 @@ from pathlib import Path
 
 from ..core import RigidBody, RobotModel
 from ..core.errors import counted
+from ..core.io.arm_source import is_one_chain
 from ..core.io.atomic import write_files
 from ..core.io.trajectory_file import joint_trajectory_yaml, read_joint_trajectory
 from ..core.trajectories import (
@@ -81,6 +83,11 @@ def arm_of(args: argparse.Namespace):
         return arm
     if not (math.isfinite(args.payload_mass) and args.payload_mass >= 0):
         raise ToolError(f"--payload-mass: must be a mass >= 0 kg, got {args.payload_mass}")
+    if not is_one_chain(arm.model) and not arm.given.get("payload.link"):  # else on the last joint's link, any
+        raise ToolError(
+            f"--payload-mass: the model is a tree ({arm.model.n} joints); name the URDF link the payload "
+            "hangs on: -p payload.link:=LINK"
+        )
     try:
         return replace(arm, model=arm.model.with_payload(RigidBody(args.payload_mass)))
     except ValueError as error:

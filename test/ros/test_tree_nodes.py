@@ -267,3 +267,39 @@ def test_external_wrench_links_that_the_model_does_not_move_stop_the_start_in_on
         running(IdNode, parameter_overrides=overrides),
     ):
         pass
+
+
+def test_payload_check_node_checks_the_payload_on_its_link_with_the_other_arm_in_its_worst_pose():
+    """test_payload_tree's PITCH_TORSO: the torso's limit between the payload's worst torque
+    with the other arm at zero and in its worst pose: OVER-LIMIT, at the tree's worst torque;
+    its torque now the tree's gravity at the joint state (the other arm's pose in it)."""
+    from std_srvs.srv import Trigger
+
+    from irb140_dynamics.core.payload import workspace_load
+    from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
+
+    from ..core.test_payload_tree import PAYLOAD as LOAD
+    from ..core.test_payload_tree import PITCH_TORSO, tree
+
+    worst = abs(workspace_load(tree(), LOAD, [np.inf] * 3).torque[0])
+    values = dict(
+        payload__link="la2", payload__mass=LOAD.mass, payload__com=list(LOAD.com), torso__torque_limit=worst - 1
+    )
+    overrides = from_description(diagnostics__period=0.0, **values)
+    overrides[1] = Parameter("robot_description", value=PITCH_TORSO)
+    with running(PayloadCheckNode, parameter_overrides=overrides) as harness:
+        client = harness.probe.create_client(Trigger, "/payload_check_node/check")
+        assert client.wait_for_service(timeout_sec=10)
+        q = [0.3, -0.4, 0.7, 1.2, -0.9]
+        harness.publisher(JointState, "joint_states").publish(
+            JointState(name=["r2", "r1", "l2", "l1", "torso"], position=q[::-1])
+        )
+        assert harness.spin_until(lambda: harness.node.state is not None)
+        reply = harness.call(lambda: client.call_async(Trigger.Request()))
+        model = harness.node.model
+    assert not reply.success and reply.message.startswith(
+        f"OVER-LIMIT: 1.500 kg does not fit: torso needs {worst:.3f} N m at ("
+    )
+    now = gravity(model.with_payload(LOAD), q)[:3]
+    rows = {line.split()[0]: float(line.split()[1]) for line in reply.message.splitlines()[3:6]}
+    np.testing.assert_allclose([rows[name] for name in ("torso", "l1", "l2")], now, atol=5e-4)

@@ -196,3 +196,41 @@ def test_retime_reports_a_tree_trajectory_over_a_torque_limit(tmp_path, capsys):
     out = Trajectory.from_message(read_joint_trajectory(tmp_path / "out.yaml"), model.joint_names)
     after = check_trajectory(model, out)
     assert after.ok and after.duration > 0.15
+
+
+def test_retime_payload_mass_on_a_tree_loads_the_named_link_as_the_cores_rnea(tmp_path, capsys):
+    """--payload-mass with -p payload.link:=la2 on TWO_ARMS (mimic fingers and all): the
+    peaks reported are the core's rnea of the tree carrying the mass at la2's origin, and
+    differ from the bare tree's; with no link named, refused in one line."""
+    urdf = tmp_path / "two_arms.urdf"
+    urdf.write_text(TWO_ARMS)
+    loaded = load_urdf(TWO_ARMS)
+    bare = loaded.model
+    start, end = np.full(bare.n, 0.2), np.full(bare.n, 0.6)
+    points = [
+        {"positions": start.tolist(), "velocities": [0.0] * bare.n, "time_from_start": {"sec": 0, "nanosec": 0}},
+        {"positions": end.tolist(), "velocities": [0.0] * bare.n, "time_from_start": {"sec": 2, "nanosec": 0}},
+    ]
+    path = tmp_path / "motion.yaml"
+    path.write_text(yaml.safe_dump({"joint_names": list(bare.joint_names), "points": points}))
+    args = ("--urdf", urdf, "--check-only", "--payload-mass", 0.8, path)
+    status, printed, err = run(capsys, retime, *args[:-1], "-p", "payload.link:=la2", path)
+    assert status == 0, err + printed
+    loaded_model = loaded.with_flange_at("la2").with_payload(RigidBody(0.8))
+    tr = Trajectory.from_message(read_joint_trajectory(path), bare.joint_names)
+    report, without = check_trajectory(loaded_model, tr), check_trajectory(bare, tr)
+    for j, name in enumerate(bare.joint_names):
+        peak = next(p for p in report.peaks if p.joint == name and p.quantity == "torque")
+        at = rnea_batch(loaded_model, *spline(tr).evaluate(np.array([peak.time])))[0, j]
+        assert peak.value == pytest.approx(at, rel=1e-12, abs=1e-12)
+        assert f"{name} torque: {peak.value:+.4g} N m" in printed
+    peak_of = {p.joint: p.value for p in without.peaks if p.quantity == "torque"}
+    l1 = next(p.value for p in report.peaks if p.joint == "l1" and p.quantity == "torque")
+    assert abs(l1 - peak_of["l1"]) > 0.5  # the payload loads the left arm
+    status, printed, err = run(capsys, retime, *args)
+    assert status == 1 and not printed
+    assert err.count("\n") == 1 and "--payload-mass: the model is a tree" in err and "payload.link" in err
+    status, printed, err = run(
+        capsys, retime, *args[:-1], "-p", "payload.link:=la2", "-p", "torso.torque_limit:=0", path
+    )
+    assert status == 1 and err.count("\n") == 1 and "torso: no torque_limit, and on a tree none is derived" in err

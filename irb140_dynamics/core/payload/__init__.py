@@ -5,6 +5,8 @@
 - ``check``: a payload against those limits, now and in its proven worst pose;
 - ``family``: a payload's torques as affine in its mass, and their proven extremes;
 - ``workspace``: the joint ranges and the sampled search for the worst pose;
+- ``path``: a payload on a link of a tree: the joints it loads, and the rest of the tree's
+  proven share of their static torques;
 - ``analysis``: what a check runs on (the limits and the workspace's worst loads), reused
   where a new arm or payload leaves them as they were;
 - ``mass_com_estimation``: the payload's mass and centre of mass from efforts at rest;

@@ -31,9 +31,9 @@ from irb140_dynamics.core.payload.limits import (
     limit_values,
     loads,
     max_payload_here,
-    payload_family,
     workspace_load,
 )
+from irb140_dynamics.core.payload.path import payload_path
 from irb140_dynamics.core.payload.proof.harmonic import MAX_JOINTS
 
 VISIBLE = 5e-4  # N m or kg: a gap the report's 3 decimals would show is worth a note
@@ -104,11 +104,13 @@ class PayloadCheck:
         """The names of the joints neither proven within nor over their limit."""
         return [self.joint_names[j] for j in np.flatnonzero(~self.within & ~self.beyond)]
 
-    @property
-    def unfinished(self) -> str:
-        """Why a proof left a gap, in words."""
+    def unfinished(self, j: int) -> str:
+        """Why the proof left a gap at joint j, in words."""
         if self.workspace.out_of_time or self.limits.out_of_time:
             return "the analysis ran out of time"
+        rest = float(np.broadcast_to(self.workspace.rest, self.workspace.bound.shape)[j])
+        if rest > 0 and self.workspace.gap[j] <= rest * (1 + RTOL) + VISIBLE:
+            return "the rest of the tree's worst pose is bounded, not found"
         if len(self.joint_names) > MAX_JOINTS:
             return f"the proof's budget ran out (plain interval bounds: more than {MAX_JOINTS} joints)"
         return "the proof's budget ran out"
@@ -165,7 +167,7 @@ class PayloadCheck:
             )
         others = len(self.unproven) - 1
         more = f"; {others} more joint{'s' * (others > 1)} unproven" if others else ""
-        return f"{text}: {self.unfinished}{more}"
+        return f"{text}: {self.unfinished(j)}{more}"
 
     @property
     def loaded_without_limit(self) -> list[int]:
@@ -191,7 +193,7 @@ class PayloadCheck:
         load = self.workspace
         return (
             f"{self.joint_names[j]}: worst static torque proven only up to {load.bound[j]:.3f} N m "
-            f"(gap {load.gap[j]:.3g} N m: {self.unfinished})"
+            f"(gap {load.gap[j]:.3g} N m: {self.unfinished(j)})"
         )
 
     # -- the figures, formatted once for the report and /diagnostics --------------------
@@ -225,7 +227,7 @@ class PayloadCheck:
         if self.beyond[j]:
             return "ERROR", of_limit if finite else figures["limit source"]
         if not self.within[j]:
-            return "WARN", f"unproven: {of_limit} by its bound: {self.unfinished}"
+            return "WARN", f"unproven: {of_limit} by its bound: {self.unfinished(j)}"
         if finite:
             return ("WARN" if uses[most] >= warn_use else "OK"), of_limit
         if j in self.loaded_without_limit:
@@ -282,22 +284,26 @@ def check_payload(
 ) -> PayloadCheck:
     """Check ``payload`` against the torque limits (default: derive_torque_limits(model,
     rated_payload)) at the state (q, qd) with qdd = 0, if q is given, and over the joint
-    ranges (``workspace``: a cached workspace_load(model, payload, limits) may be passed)."""
+    ranges (``workspace``: a cached workspace_load(model, payload, limits) may be passed).
+    On a tree: the joints up to the payload's link (model.carrier), with the rest of the
+    tree in its worst pose (see ``path``); q and qd are the tree's."""
     payload, rated_payload, q, qd = checked_payload_arguments(model, payload, rated_payload, q, qd)
     if limits is None:
         limits = derive_torque_limits(model, rated_payload)
     elif not isinstance(limits, TorqueLimits):
         raise ValueError(f"limits: expected TorqueLimits (see derive_torque_limits), got {limits!r}")
-    L = limit_values(limits, model.n)
+    path = payload_path(model)  # on a tree: the joints up to the payload's link, the rest in its worst pose
+    L = limit_values(limits, path.chain.n)
     if workspace is None:
         workspace = workspace_load(model, payload, limits)
-    sliding = tuple(joint.prismatic for joint in model.independent_joints)
+    names, sliding = path.chain.joint_names, tuple(joint.prismatic for joint in path.chain.joints)
     if q is None:
-        return PayloadCheck(model.joint_names, payload, limits, workspace, sliding=sliding)
-    tau0, dtau = payload_family(model, payload).torques(q, qd)
+        return PayloadCheck(names, payload, limits, workspace, sliding=sliding)
+    tau0, dtau = path.torques(payload, q, qd)
+    q, qd = q[path.columns], qd[path.columns]
     here = max_payload_here(tau0, dtau, L, q)
     torque = tau0 + payload.mass * dtau
-    return PayloadCheck(model.joint_names, payload, limits, workspace, q, qd, torque, here, sliding)
+    return PayloadCheck(names, payload, limits, workspace, q, qd, torque, here, sliding)
 
 
 # -- text ------------------------------------------------------------------------------------------

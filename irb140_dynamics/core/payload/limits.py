@@ -38,6 +38,7 @@ from irb140_dynamics.core.model.rigid_body import MAX_MASS, ModelError, RigidBod
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.model.states import real_numbers, state
 from irb140_dynamics.core.payload.family import RTOL, Extremes, PayloadFamily, at_most, loads, max_mass, payload_family
+from irb140_dynamics.core.payload.path import payload_path
 from irb140_dynamics.core.payload.stop import out_of_time, ran_out
 from irb140_dynamics.core.payload.workspace import JointRanges
 
@@ -119,6 +120,7 @@ class WorkspaceLoad:
     max_payload: MaxPayload
     bound: np.ndarray  # (n,) N m: |tau_j| <= bound_j in every pose
     out_of_time: bool = False  # the analysis' deadline cut the search and proofs short
+    rest: np.ndarray | float = 0.0  # (n,) N m of the bound: the rest of a tree's poses, bounded (path.slack)
 
     @property
     def gap(self) -> np.ndarray:
@@ -133,12 +135,16 @@ def derive_torque_limits(model: RobotModel, rated_payload: RigidBody = RATED_PAY
     """Each joint's limit: its given torque_limit if > 0, else the worst static torque of
     the rated payload over the joint ranges (the torque found, at a real pose); none (inf)
     for a joint it cannot load (proven). The rated payload's torques are searched for every
-    joint, proven for those without a given limit."""
+    joint, proven for those without a given limit. On a tree, the joints up to the
+    payload's link, with the rest of the tree in its worst pose (see ``path``)."""
     rated_payload = checked_body("rated_payload", rated_payload)
+    path = payload_path(model)
+    model = path.chain
     family = payload_family(model, rated_payload)
     given = np.array(model.torque_limits) > 0
     rows = np.flatnonzero(~np.tile(given, 2))  # a given limit needs no proof
-    torque, pose, bound = family.extremes(rated_payload.mass, JointRanges.of(model), rows=rows).largest()
+    load = family.extremes(rated_payload.mass, JointRanges.of(model), rows=rows)
+    torque, pose, bound = path.widened(rated_payload, load).largest()
     loaded = loads(np.where(given, 0.0, bound))
     source = np.where(given, "given", np.where(loaded, "derived", "none"))
     limits = np.where(given, model.torque_limits, np.where(loaded, np.abs(torque), np.inf))
@@ -158,11 +164,12 @@ def limit_values(limits: TorqueLimits | Sequence[float], n: int) -> np.ndarray:
 
 def max_payload_at(model: RobotModel, payload: RigidBody, limits, q, qd=None) -> MaxPayload:
     """The largest mass of ``payload``'s shape that the state (q, qd), qdd = 0, can hold."""
-    payload, L = checked_body("payload", payload), limit_values(limits, model.n)
+    path = payload_path(model)
+    payload, L = checked_body("payload", payload), limit_values(limits, path.chain.n)
     q = state(q, model.n, "q")
     qd = [0.0] * model.n if qd is None else state(qd, model.n, "qd")
-    tau0, dtau = payload_family(model, payload).torques(q, qd)
-    return max_payload_here(tau0, dtau, L, q)
+    tau0, dtau = path.torques(payload, q, qd)
+    return max_payload_here(tau0, dtau, L, np.asarray(q, dtype=float)[path.columns])
 
 
 def max_payload_here(tau0, dtau, L, q) -> MaxPayload:
@@ -190,15 +197,19 @@ def workspace_load(
 ) -> WorkspaceLoad:
     """The payload's worst static torques over the joint ranges (found and proven), and the
     largest payload of its shape that holds still within the limits in every pose.
-    Depends only on its arguments: cache it."""
+    Depends only on its arguments: cache it. On a tree, the joints up to the payload's link
+    (see ``path``; ``ranges`` theirs), with the rest of the tree in its worst pose: the
+    largest payload is proven within each limit less the ``slack`` of the rest's poses."""
+    path = payload_path(model)
+    model = path.chain
     payload, L = checked_body("payload", payload), limit_values(limits, model.n)
     ranges = JointRanges.of(model) if ranges is None else ranges
     family = payload_family(model, payload)
     G0, dG = family.static_torques(ranges.samples)
     load = family.extremes(payload.mass, ranges, G0 + payload.mass * dG)
-    torque, pose, bound = load.largest()
-    best = _workspace_max_payload(family, ranges, L, G0, dG, payload.mass, load)
-    return WorkspaceLoad(payload, torque, pose, best, bound, ran_out())
+    torque, pose, bound = path.widened(payload, load).largest()
+    best = _workspace_max_payload(family, ranges, np.maximum(L - path.slack, 0.0), G0, dG, payload.mass, load)
+    return WorkspaceLoad(payload, torque, pose, best, bound, ran_out(), path.slack)
 
 
 def _workspace_max_payload(family, ranges, L, G0, dG, own_mass: float, load: Extremes) -> MaxPayload:

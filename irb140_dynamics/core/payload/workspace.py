@@ -30,6 +30,7 @@ from irb140_dynamics.core.payload.stop import out_of_time
 StaticTorque = Callable[[np.ndarray], np.ndarray]  # Q (N, n) -> tau (N, n)
 
 _THIRDS = np.array([0.0, 2 * math.pi / 3, 4 * math.pi / 3])
+GRID = 65  # points of a gridded coordinate's step (a mimic joint's torques are no single harmonic of it)
 
 
 def quasi_random(count: int, dim: int) -> np.ndarray:
@@ -73,6 +74,7 @@ class JointRanges:
     upper: np.ndarray
     samples: np.ndarray  # (S, n)
     sliding: np.ndarray | None = None  # (n,) the prismatic joints (their torques are affine in them)
+    gridded: np.ndarray | None = None  # (n,) coordinates that mimic joints follow too: searched on a grid
 
     @classmethod
     def of(cls, model: RobotModel, count: int = 2048) -> JointRanges:
@@ -134,7 +136,7 @@ class JointRanges:
         step = np.zeros_like(X)
         for _ in range(max_sweeps):
             before, X_before = F, X.copy()
-            for k in range(X.shape[-1]):
+            for k in np.flatnonzero(self.lower < self.upper):  # (a coordinate held has no step)
                 if out_of_time():
                     return X, self._values(torque, W, X)
                 X, F = self._coordinate_step(torque, W, X, k, tol)
@@ -152,15 +154,13 @@ class JointRanges:
     def _coordinate_step(self, torque, W, X, k, tol):
         """Each X[s, k] moved to the exact maximum along angle k (a prismatic joint: the
         better end of its range, static torques being affine in it): (X, values)."""
+        if self.gridded is not None and self.gridded[k]:  # a grid, then a finer one about its best
+            step = (self.upper[k] - self.lower[k]) / (GRID - 1)
+            X, F = self._best_of(torque, W, X, k, tol, np.linspace(self.lower[k], self.upper[k], GRID))
+            finer = X[..., k][None] + np.linspace(-step, step, GRID).reshape((-1,) + (1,) * (X.ndim - 1))
+            return self._best_of(torque, W, X, k, tol, np.clip(finer, self.lower[k], self.upper[k]))
         if self.sliding is not None and self.sliding[k]:
-            trial = np.repeat(X[None], 3, axis=0)
-            trial[1, ..., k], trial[2, ..., k] = self.lower[k], self.upper[k]
-            f = self._values(torque, W, trial)
-            best = np.argmax(f, axis=0)
-            better = np.take_along_axis(f, best[None], axis=0)[0] > f[0] + 0.01 * tol
-            X = X.copy()
-            X[..., k] = np.where(better, np.take_along_axis(trial[..., k], best[None], axis=0)[0], X[..., k])
-            return X, np.where(better, np.take_along_axis(f, best[None], axis=0)[0], f[0])
+            return self._best_of(torque, W, X, k, tol, np.array([self.lower[k], self.upper[k]]))
         trial = np.repeat(X[None], 3, axis=0)
         trial[..., k] += _THIRDS.reshape(3, 1, 1)
         f = self._values(torque, W, trial)  # (3, S, K), f[0] at X
@@ -172,6 +172,18 @@ class JointRanges:
         better = top > f[0] + 0.01 * tol  # not for rounding noise
         X = X.copy()
         X[..., k] = np.where(better, x, X[..., k])
+        return X, np.where(better, top, f[0])
+
+    def _best_of(self, torque, W, X, k, tol, values):
+        """Each X[s, k] moved to the best of ``values`` (G,) or (G, ...) if better: (X, values)."""
+        trial = np.repeat(X[None], 1 + len(values), axis=0)
+        trial[1:, ..., k] = values.reshape((len(values),) + (1,) * (X.ndim - 1)) if values.ndim == 1 else values
+        f = self._values(torque, W, trial)
+        best = np.argmax(f, axis=0)
+        top = np.take_along_axis(f, best[None], axis=0)[0]
+        better = top > f[0] + 0.01 * tol
+        X = X.copy()
+        X[..., k] = np.where(better, np.take_along_axis(trial[..., k], best[None], axis=0)[0], X[..., k])
         return X, np.where(better, top, f[0])
 
     def _canonical(self, torque, W, poses, tol):

@@ -30,6 +30,9 @@ def trajectory_limits(model: RobotModel) -> Limits:
     given = np.array(model.torque_limits, dtype=float)
     if (given > 0).all():
         torque, source = given, ("given",) * model.n
+    elif not model.is_chain:  # derived only for the joints up to the payload's link
+        missing = ", ".join(name for name, limit in zip(model.joint_names, given) if limit <= 0)
+        raise ValueError(f"{missing}: no torque_limit, and on a tree none is derived; give one (NAME.torque_limit)")
     else:
         derived = derive_torque_limits(model)
         torque, source = np.array(derived.values, dtype=float), derived.source

@@ -2,10 +2,10 @@
 
 Serves       ~/check        std_srvs/Trigger: the configured payload (payload.* parameters)
                             against the joint torque limits, at the current joint state (if
-                            joint_states was received) and in each joint's worst static pose
-                            over the joint ranges; success: it fits (proven); the reply's
-                            message: a one-line verdict (OK, OVER-LIMIT or UNPROVEN), then
-                            the report
+                            joint_states was received) and in each joint's worst static pose over the
+                            joint ranges (a tree: the joints up to payload.link, the rest of the tree
+                            in its worst pose); success: it fits (proven); the reply's message: a
+                            one-line verdict (OK, OVER-LIMIT or UNPROVEN), then the report
              ~/estimate_payload   std_srvs/Trigger: the payload's mass and centre of mass from
                             the efforts at rest (see core.payload.rest_samples); with
                             estimation.apply, set as payload.mass and payload.com
