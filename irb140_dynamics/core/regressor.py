@@ -51,6 +51,20 @@ def parameter_count(model: RobotModel) -> int:
     return PARAMETERS_PER_JOINT * len(model.joints)
 
 
+def zero_parameters(model: RobotModel) -> np.ndarray:
+    """The indices of pi that every model of this structure holds at zero: the Coulomb
+    friction of a mimic joint whose multiplier is not +-1 (its column is zero)."""
+    links = len(model.joints)
+    return np.array(
+        [
+            INERTIAL_PARAMETERS * links + JOINT_TERMS * i + 1
+            for i, (_, m, _) in enumerate(model.coordinates)
+            if abs(m) != 1.0
+        ],
+        dtype=int,
+    )
+
+
 def regressor(model: RobotModel, q, qd, qdd) -> np.ndarray:
     """Y(q, qd, qdd), n x 13 n_all: rnea(model, q, qd, qdd) == Y @ inertial_parameters(model)."""
     return regressor_batch(model, [q], [qd], [qdd])[0]

@@ -1,0 +1,162 @@
+"""excitation and identify on arms with mimic joints, and excitation within torque limits.
+
+identify: `excitation --urdf` of a chain with mimic joints (test_regressor_mimic's: one
+before its joint in the file, a gripper's finger of multiplier -1, a prismatic one) moves
+its independent joints within the limits of the mimic joints too; a recording of the true
+arm (other masses, friction and armature on every joint, mimic joints included) is made of
+rnea's torques with noise, its columns shuffled and the mimic joints' columns in it; the
+arm `identify --urdf` fits predicts the true arm's torques on another motion.
+
+excitation within torque limits: a torque limit between what holding the middle of the
+ranges needs and what the full motion needs scales the motion down (the joints sharing
+that torque), the file's torques within the limit; one below the holding torque is refused
+in one line naming the joint, the torque needed and the limit, nothing written."""
+
+from dataclasses import replace
+
+import numpy as np
+
+from irb140_dynamics.core import Friction, RigidBody, rnea_batch
+from irb140_dynamics.core.io.params_file import read_parameter_file
+from irb140_dynamics.core.io.trajectory_file import read_joint_trajectory
+from irb140_dynamics.core.io.urdf import load_urdf
+from irb140_dynamics.core.model.robot_model import RobotModel
+from irb140_dynamics.core.trajectories.message import Trajectory
+from irb140_dynamics.identification.excitation import Limits, torque_sharers
+from irb140_dynamics.tools import excitation, identify
+
+from ..core.test_regressor_mimic import MIMIC_CHAIN
+from ..core.test_urdf_trees import TWO_ARMS
+from ..support.simulated_ur5 import write_csv
+from .test_tree_identify_retime import other_motion, run
+
+RATE = 200.0  # Hz: the recording
+
+
+def true_arm(model: RobotModel) -> RobotModel:
+    """``model`` with each link's mass and inertia scaled within [0.7, 1.3], viscous friction
+    and armature on every joint, Coulomb friction where the model takes it."""
+    factors = np.random.default_rng(5).uniform(0.7, 1.3, len(model.joints))
+    joints = tuple(
+        replace(
+            j,
+            link=RigidBody(j.link.mass * f, j.link.com, tuple(f * x for x in j.link.inertia)),
+            friction=Friction(0.3, 0.2 if mimic is None or abs(mimic.multiplier) == 1.0 else 0.0),
+            armature=0.02,
+        )
+        for j, f, mimic in zip(model.joints, factors, model.mimics)
+    )
+    return replace(model, joints=joints)
+
+
+def points(path, model: RobotModel) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(t, Q, QD, QDD) of an excitation file's points, in the model's joint order."""
+    tr = Trajectory.from_message(read_joint_trajectory(path), model.joint_names)
+    return tr.t, tr.q, tr.qd, tr.qdd
+
+
+def test_identify_fits_an_arm_with_mimic_joints_from_its_excitation(tmp_path, capsys):
+    urdf = tmp_path / "mimic_chain.urdf"
+    urdf.write_text(MIMIC_CHAIN)
+    prior = load_urdf(MIMIC_CHAIN).model
+    assert prior.joint_names == ("j1", "j2", "j3") and len(prior.joints) == 6
+    excitation_file = tmp_path / "excitation.yaml"
+    status, printed, err = run(
+        capsys,
+        excitation,
+        "--urdf",
+        urdf,
+        "--out",
+        excitation_file,
+        "--iterations",
+        3,
+        "--period",
+        4,
+        "--harmonics",
+        3,
+        "--rate",
+        RATE,
+        "--periods",
+        3,
+    )
+    assert status == 0, err
+    t, Q, QD, QDD = points(excitation_file, prior)
+    assert Q.shape[1] == 3  # the independent joints only
+    positions = Q @ prior.mimic_matrix().T + [o for _, _, o in prior.coordinates]  # every joint's, mimic ones too
+    for i, joint in enumerate(prior.joints):
+        low, high = joint.position_limits
+        assert low - 1e-9 <= positions[:, i].min() and positions[:, i].max() <= high + 1e-9, joint.name
+    true = true_arm(prior)
+    tau = rnea_batch(true, Q, QD, QDD)
+    tau += np.random.default_rng(3).normal(0.0, 0.01 * np.abs(tau).max(axis=0), tau.shape)
+    mimic = [i for i, m in enumerate(prior.mimics) if m is not None]
+    names = [*prior.joint_names, *(prior.joints[i].name for i in mimic)]  # the mimic joints recorded too
+    all_Q = np.hstack([Q, positions[:, mimic]])
+    all_QD = np.hstack([QD, QD @ prior.mimic_matrix()[mimic].T])
+    order = np.random.default_rng(2).permutation(len(names))
+    recording = write_csv(
+        tmp_path / "recording.csv",
+        [names[i] for i in order],
+        t,
+        all_Q[:, order],
+        all_QD[:, order],
+        np.hstack([tau, np.zeros((len(t), len(mimic)))])[:, order],
+    )
+    out = tmp_path / "identified.yaml"
+    status, printed, err = run(capsys, identify, recording, "--urdf", urdf, "--out", out, "--quiet")
+    assert status == 0, err
+    identified = RobotModel.from_params(read_parameter_file(out))
+    assert identified.joint_names == prior.joint_names and identified.mimics == prior.mimics
+    Qo, QDo, QDDo = other_motion(prior)
+    truth = rnea_batch(true, Qo, QDo, QDDo)
+    peak = np.abs(truth).max(axis=0)
+    error = np.sqrt(np.mean((rnea_batch(identified, Qo, QDo, QDDo) - truth) ** 2, axis=0)) / peak
+    before = np.sqrt(np.mean((rnea_batch(prior, Qo, QDo, QDDo) - truth) ** 2, axis=0)) / peak
+    print(f"RMS torque error / peak on another motion: prior {np.round(before, 3)}, identified {np.round(error, 3)}")
+    assert np.all(error <= 0.05), error
+    assert np.sqrt(np.mean(error**2)) * 3 <= np.sqrt(np.mean(before**2))
+
+
+def test_excitation_scales_its_motion_down_within_a_torque_limit(tmp_path, capsys):
+    urdf = tmp_path / "mimic_chain.urdf"
+    urdf.write_text(MIMIC_CHAIN)
+    out = tmp_path / "excitation.yaml"
+    args = ["--urdf", urdf, "--out", out, "--iterations", 0, "--period", 2, "--harmonics", 2, "--rate", 200]
+    status, printed, err = run(capsys, excitation, *args, "-p", "j3.torque_limit:=4.5")
+    assert status == 0, err
+    model = load_urdf(MIMIC_CHAIN).model
+    line = next(line for line in printed.splitlines() if line.startswith("scaled down for the torque limits"))
+    needed = float(line.split("needed j3 ")[1].split(" N m")[0])
+    assert needed > 4.5 and "(limit 4.5)" in line  # the full motion needs more than the limit
+    _, Q, QD, QDD = points(out, model)
+    peak = np.abs(rnea_batch(model, Q, QD, QDD)).max(axis=0)
+    assert 0.9 * 4.5 < peak[2] <= 4.5, peak  # scaled to the limit, not far below it
+    assert line in out.read_text()  # the file's header says so too
+
+
+def test_excitation_refuses_a_torque_limit_the_arm_cannot_hold(tmp_path, capsys):
+    urdf = tmp_path / "mimic_chain.urdf"
+    urdf.write_text(MIMIC_CHAIN)
+    status, printed, err = run(
+        capsys, excitation, "--urdf", urdf, "--out", tmp_path / "out.yaml", "-p", "j3.torque_limit:=3"
+    )
+    lines = err.strip().splitlines()
+    assert status == 1 and len(lines) == 1, err
+    model = load_urdf(MIMIC_CHAIN).model
+    limits = Limits.of(model)
+    middle = (limits.lower + limits.upper) / 2.0
+    held = abs(rnea_batch(model, [middle], [np.zeros(3)], [np.zeros(3)])[0, 2])
+    assert held > 0.98 * 3.0
+    assert f"j3: holding the middle of the position ranges needs {held:.4g} N m" in lines[0]
+    assert "torque limit 3 N m" in lines[0]
+    assert [p.name for p in tmp_path.iterdir()] == ["mimic_chain.urdf"]
+
+
+def test_the_joints_sharing_a_torque_are_its_branch():
+    """On a tree, the coordinates whose motion enters l2's torque are those above and below
+    it (torso, l1, l2), not the other arm's; r2's include its mimic fingers' joint (r1 carries
+    finger_b) and the torso."""
+    model = load_urdf(TWO_ARMS).model
+    names = model.joint_names
+    assert [names[k] for k in torque_sharers(model, names.index("l2"))] == ["torso", "l1", "l2"]
+    assert [names[k] for k in torque_sharers(model, names.index("r2"))] == ["torso", "r1", "r2"]
