@@ -15,8 +15,8 @@ allow (within ``margin`` of the position range, 98 % of the velocity and acceler
 limits), and q0 centres it in the range. The cost is log cond(Y_b): the condition number
 of the base regressor stacked over ``samples`` states of one period (Y_b's columns as they
 are, in SI units), minimised by SciPy's L-BFGS-B from a seeded random start. The optimum
-is then scaled down, every joint alike, until its torques (rnea, the payload included) are
-within 98 % of the torque limits.
+is then scaled down where its torques (rnea, the payload included) exceed 98 % of a
+joint's torque limit (see ``torque_limits``).
 
 The joints are the model's independent ones (``joint_names``): a mimic joint moves with the
 joint it follows, and its limits bound that joint's motion (``Limits.of``).
@@ -35,6 +35,7 @@ from irb140_dynamics.core.dynamics import rnea_batch
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.regressor import regressor_batch
 from irb140_dynamics.identification.base import BaseParameters, find_base_parameters
+from irb140_dynamics.identification.torque_limits import TorqueScaling, holding_pose, within_torque_limits
 
 DEFAULT_PERIOD = 10.0  # s
 DEFAULT_HARMONICS = 5
@@ -43,7 +44,6 @@ DEFAULT_SPEED = 1.0  # rad/s where a joint gives no velocity limit
 DEFAULT_ACCELERATION = 5.0  # rad/s^2 where a joint gives no acceleration limit
 CHECK_POINTS_PER_HARMONIC = 100  # limit checks: points per period of the highest harmonic
 HEADROOM = 0.98  # of the velocity, acceleration and torque limits: peaks between check points stay within
-BISECTIONS = 20  # of the amplitude that keeps the torques within their limits: to 1e-6
 
 
 @dataclass(frozen=True, eq=False)
@@ -106,11 +106,9 @@ class Limits:
         return cls(lower + room, upper - room, speed, acceleration)
 
 
-def shaped(
-    free: np.ndarray, n: int, harmonics: int, period: float, limits: Limits, amplitude: float = 1.0
-) -> FourierTrajectory:
+def shaped(free: np.ndarray, n: int, harmonics: int, period: float, limits: Limits) -> FourierTrajectory:
     """The trajectory of free coefficients (harmonics 2..K), at rest at t = 0, scaled to
-    the limits (times ``amplitude``, at most 1) and centred in the position ranges."""
+    the limits and centred in the position ranges."""
     free = free.reshape(2, n, harmonics - 1)
     l = np.arange(2, harmonics + 1)
     a = np.hstack([-free[0].sum(axis=1, keepdims=True), free[0]])
@@ -127,7 +125,7 @@ def shaped(
             ],
             axis=0,
         )
-    scale = amplitude * np.where(np.isfinite(scale), scale, 0.0)
+    scale = np.where(np.isfinite(scale), scale, 0.0)
     q0 = (limits.upper + limits.lower) / 2.0 - scale * (Q.max(axis=0) + Q.min(axis=0)) / 2.0
     return FourierTrajectory(period, q0, a * scale[:, None], b * scale[:, None])
 
@@ -147,90 +145,6 @@ class Excitation:
     start_condition_number: float  # of the random start, before optimisation
     evaluations: int
     torque: TorqueScaling | None = None  # how the torque limits scaled it down (None: not at all)
-
-
-@dataclass(frozen=True)
-class TorqueScaling:
-    """The motion scaled down so that every joint's torque stays within HEADROOM of its
-    torque limit: ``amplitudes`` (n,) of what the other limits allow, per joint; the joints
-    that needed it, with their peak torque at the full motion and their limit, N m."""
-
-    amplitudes: np.ndarray
-    needed: tuple[tuple[str, float, float], ...]  # (joint, peak, limit)
-
-
-def peak_torques(model: RobotModel, trajectory: FourierTrajectory, samples: int) -> np.ndarray:
-    """max |tau| per joint [N m] over ``samples`` states of one period (rnea: the model's
-    payload, friction and armature included)."""
-    t = np.linspace(0.0, trajectory.period, samples, endpoint=False)
-    return np.abs(rnea_batch(model, *trajectory.evaluate(t))).max(axis=0)
-
-
-def torque_sharers(model: RobotModel, j: int) -> np.ndarray:
-    """The coordinates whose motion enters coordinate j's torque: those of every joint at,
-    above or below joint j or a mimic joint following it (a branch beside them adds nothing)."""
-    parent = model.parent
-    count = len(parent)
-    chain = []  # per joint, itself and its ancestors
-    for i in range(count):
-        chain.append({i} | (chain[parent[i]] if parent[i] >= 0 else set()))
-    carriers = [i for i, (k, _, _) in enumerate(model.coordinates) if k == j]
-    related = {d for d in range(count) for i in carriers if i in chain[d] or d in chain[i]}
-    return np.array(sorted({model.coordinates[d][0] for d in related}))
-
-
-def within_torque_limits(
-    model: RobotModel, free: np.ndarray, harmonics: int, period: float, limits: Limits
-) -> tuple[FourierTrajectory, TorqueScaling | None]:
-    """``shaped(free, ...)`` scaled down until every joint's torque is within HEADROOM of its
-    limit (0: none): while a joint is beyond, the joints sharing its torque (see
-    ``torque_sharers``) are scaled alike, by bisection, until it is within; if that does not
-    settle, every joint alike. ValueError naming a joint whose torque holding the middle of
-    the ranges (where a zero amplitude rests) is already beyond."""
-    n = model.n
-    limit = np.array(model.torque_limits)
-    limited = limit > 0.0
-    samples = CHECK_POINTS_PER_HARMONIC * harmonics
-
-    def ratios(amplitudes):
-        peaks = peak_torques(model, shaped(free, n, harmonics, period, limits, amplitudes), samples)
-        return np.where(limited, peaks / np.where(limited, limit, 1.0), 0.0), peaks
-
-    amplitudes = np.ones(n)
-    over, peaks = ratios(amplitudes)
-    if over.max() <= HEADROOM:
-        return shaped(free, n, harmonics, period, limits), None
-    held, torques = ratios(np.zeros(n))
-    if held.max() > HEADROOM:
-        raise ValueError(_unholdable(model, int(np.argmax(held)), torques[int(np.argmax(held))]))
-    needed = {}
-    for _ in range(2 * n):
-        over, _ = ratios(amplitudes)
-        j = int(np.argmax(over))
-        if over[j] <= HEADROOM:
-            break
-        needed.setdefault(j, (model.joint_names[j], float(peaks[j]), float(limit[j])))
-        amplitudes = _bisected(amplitudes, torque_sharers(model, j), lambda a, j=j: ratios(a)[0][j] <= HEADROOM)
-    else:  # not settled: every joint alike (zero is within: the holding pose)
-        amplitudes = _bisected(amplitudes, np.arange(n), lambda a: ratios(a)[0].max() <= HEADROOM)
-    scaling = TorqueScaling(amplitudes, tuple(needed[j] for j in sorted(needed)))
-    return shaped(free, n, harmonics, period, limits, amplitudes), scaling
-
-
-def _bisected(amplitudes: np.ndarray, which: np.ndarray, within) -> np.ndarray:
-    """``amplitudes`` with those of ``which`` times the largest factor in [0, 1] found by
-    bisection for which ``within(amplitudes)`` holds (it holds at 0)."""
-    low, high = 0.0, 1.0
-
-    def scaled(factor):
-        out = amplitudes.copy()
-        out[which] *= factor
-        return out
-
-    for _ in range(BISECTIONS):
-        middle = (low + high) / 2.0
-        low, high = (middle, high) if within(scaled(middle)) else (low, middle)
-    return scaled(low)
 
 
 def optimise_excitation(
@@ -256,7 +170,7 @@ def optimise_excitation(
     locked = [name for name, low, high in zip(model.joint_names, limits.lower, limits.upper) if not high > low]
     if locked:  # its friction (and what only it moves) would not be excited: condition number inf
         raise ValueError(f"{', '.join(locked)}: no position range to move in (position_limits less --margin)")
-    check_holding_torques(model, limits)
+    pose = holding_pose(model, limits.lower, limits.upper, HEADROOM)  # refused at once if not held
     samples = samples or max(4 * harmonics * 2 + 1, 2 * base.count // model.n + 20, 100)
     n = model.n
     evaluations = 0
@@ -281,7 +195,15 @@ def optimise_excitation(
         if progress is not None:
             progress(iterations, iterations)  # (the optimiser may stop before its last iteration)
         best = result.x if result.fun < start_cost else start
-    trajectory, torque = within_torque_limits(model, best, harmonics, period, limits)
+    checked = np.linspace(0.0, period, CHECK_POINTS_PER_HARMONIC * harmonics, endpoint=False)
+    trajectory, torque = within_torque_limits(
+        model,
+        lambda within: shaped(best, n, harmonics, period, within),
+        limits,
+        pose,
+        lambda trajectory: trajectory.evaluate(checked),
+        HEADROOM,
+    )
     return Excitation(
         trajectory, condition_number(model, base, trajectory, samples), math.exp(start_cost), evaluations, torque
     )
@@ -301,25 +223,6 @@ def iterations_to(progress: Callable[[int, int], None] | None, iterations: int):
         progress(min(done, iterations), iterations)
 
     return iterated
-
-
-def check_holding_torques(model: RobotModel, limits: Limits) -> None:
-    """ValueError naming the first joint whose torque holding the middle of the position
-    ranges is beyond HEADROOM of its torque limit: no excitation is within the limits."""
-    middle = (limits.lower + limits.upper) / 2.0
-    zeros = np.zeros(model.n)
-    held = np.abs(rnea_batch(model, [middle], [zeros], [zeros])[0])
-    for j, limit in enumerate(model.torque_limits):
-        if limit and held[j] > HEADROOM * limit:
-            raise ValueError(_unholdable(model, j, held[j]))
-
-
-def _unholdable(model: RobotModel, j: int, torque: float) -> str:
-    limit = model.torque_limits[j]
-    return (
-        f"{model.joint_names[j]}: holding the middle of the position ranges needs {torque:.4g} N m, beyond "
-        f"{100 * HEADROOM:g} % of its torque limit {limit:g} N m: no excitation is within it"
-    )
 
 
 def check_limits(model: RobotModel, trajectory: FourierTrajectory, rate: float, tolerance: float = 1e-9) -> list[str]:

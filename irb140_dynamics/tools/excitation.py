@@ -10,8 +10,9 @@ Writes FILE, a trajectory_msgs/JointTrajectory in YAML (the form `ros2 topic pub
 and prints the condition number of the base regressor it reached (also a comment in FILE).
 The trajectory stays within the model's position (less a margin), velocity and
 acceleration limits, and its torques (rnea, with the model's payload) within the torque
-limits (the motion scaled down, every joint alike, when they need it; refused when holding
-the middle of the ranges already needs more), starts and ends at rest at its first point,
+limits (the motion of the joints sharing a torque scaled down toward the pose that needs the
+least torque at rest, when they need it; refused when no pose within the ranges can be
+held), starts and ends at rest at its first point,
 and repeats seamlessly. On a model with mimic joints it moves the independent joints (the
 mimic joints follow them, within their own limits).
 Every argument and FILE's folder are checked before the work; FILE is written whole or
@@ -285,10 +286,14 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
 
 
 def torque_scaling_line(model, torque) -> str:
-    """What the torque limits did to the motion (``identification.excitation.TorqueScaling``)."""
+    """What the torque limits did to the motion (``identification.torque_limits.TorqueScaling``)."""
     needed = ", ".join(f"{name} {peak:.4g} N m (limit {limit:g})" for name, peak, limit in torque.needed)
-    scaled = ", ".join(f"{name} {100 * a:.0f} %" for name, a in zip(model.joint_names, torque.amplitudes) if a < 1.0)
-    return f"scaled down for the torque limits (the full motion needed {needed}): {scaled}"
+    scaled = ", ".join(
+        f"{name} {100 * a:.0f} % toward {q:.3f}"
+        for name, a, q in zip(model.joint_names, torque.amplitudes, torque.pose)
+        if a < 1.0
+    )
+    return f"scaled down for the torque limits (the full motion needed {needed}): {scaled} rad"
 
 
 def _payload_excitation(model, path: str, args: argparse.Namespace):

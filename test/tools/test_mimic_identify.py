@@ -8,10 +8,10 @@ rnea's torques with noise, its columns shuffled and the mimic joints' columns in
 arm `identify --urdf` fits predicts the true arm's torques on another motion, and its URDF
 keeps the mimic joints.
 
-excitation within torque limits: a torque limit between what holding the middle of the
-ranges needs and what the full motion needs scales the motion down (the joints sharing
-that torque), the file's torques within the limit; one below the holding torque is refused
-in one line naming the joint, the torque needed and the limit, nothing written."""
+excitation within torque limits: a torque limit below what the full motion needs scales the
+motion down (the joints sharing that torque), the file's torques within the limit; one
+below what any pose within the ranges needs at rest is refused in one line naming the
+joint, the torque needed and the limit, nothing written."""
 
 from dataclasses import replace
 
@@ -23,7 +23,7 @@ from irb140_dynamics.core.io.trajectory_file import read_joint_trajectory
 from irb140_dynamics.core.io.urdf import load_urdf
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.trajectories.message import Trajectory
-from irb140_dynamics.identification.excitation import Limits, torque_sharers
+from irb140_dynamics.identification.torque_limits import torque_sharers
 from irb140_dynamics.tools import excitation, identify
 
 from ..core.test_regressor_mimic import MIMIC_CHAIN
@@ -139,20 +139,26 @@ def test_excitation_scales_its_motion_down_within_a_torque_limit(tmp_path, capsy
 
 
 def test_excitation_refuses_a_torque_limit_the_arm_cannot_hold(tmp_path, capsys):
+    """Every joint kept within 0.05 rad of a bent pose: j3's torque at rest in the poses the
+    ranges allow is within those of the box's corners; a limit of half the least of them
+    cannot be kept."""
     urdf = tmp_path / "mimic_chain.urdf"
     urdf.write_text(MIMIC_CHAIN)
-    status, printed, err = run(
-        capsys, excitation, "--urdf", urdf, "--out", tmp_path / "out.yaml", "-p", "j3.torque_limit:=3"
+    narrow = [f"-p j{j}.position_limits:=[{low},{low + 0.05}]" for j, low in ((1, 0.0), (2, 0.5), (3, 0.8))]
+    model = load_urdf(MIMIC_CHAIN).model
+    corners = np.array([[q1, q2, q3] for q1 in (0.0, 0.05) for q2 in (0.5, 0.55) for q3 in (0.8, 0.85)])
+    at_rest = np.abs(rnea_batch(model, corners, 0 * corners, 0 * corners)[:, 2])
+    limit = round(float(at_rest.min()) / 2, 3)
+    out = tmp_path / "out.yaml"
+    status, _, err = run(
+        capsys, excitation, "--urdf", urdf, "--out", out, *" ".join(narrow).split(), "-p", f"j3.torque_limit:={limit}"
     )
     lines = err.strip().splitlines()
     assert status == 1 and len(lines) == 1, err
-    model = load_urdf(MIMIC_CHAIN).model
-    limits = Limits.of(model)
-    middle = (limits.lower + limits.upper) / 2.0
-    held = abs(rnea_batch(model, [middle], [np.zeros(3)], [np.zeros(3)])[0, 2])
-    assert held > 0.98 * 3.0
-    assert f"j3: holding the middle of the position ranges needs {held:.4g} N m" in lines[0]
-    assert "torque limit 3 N m" in lines[0]
+    needed = float(lines[0].split("it needs ")[1].split(" N m")[0])
+    assert 0.99 * at_rest.min() <= needed <= 1.01 * at_rest.max()
+    assert lines[0].startswith("excitation: error: j3: at rest within the position ranges")
+    assert f"its torque limit {limit:g} N m" in lines[0]
     assert [p.name for p in tmp_path.iterdir()] == ["mimic_chain.urdf"]
 
 
