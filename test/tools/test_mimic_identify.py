@@ -135,6 +135,9 @@ def test_excitation_scales_its_motion_down_within_a_torque_limit(tmp_path, capsy
     _, Q, QD, QDD = points(out, model)
     peak = np.abs(rnea_batch(model, Q, QD, QDD)).max(axis=0)
     assert 0.9 * 4.5 < peak[2] <= 4.5, peak  # scaled to the limit, not far below it
+    positions = Q @ model.mimic_matrix().T + [o for _, _, o in model.coordinates]  # toward the holding pose:
+    for i, joint in enumerate(model.joints):  # still within every joint's range, mimic joints' too
+        assert joint.position_limits[0] <= positions[:, i].min() <= positions[:, i].max() <= joint.position_limits[1]
     assert line in out.read_text()  # the file's header says so too
 
 
