@@ -169,7 +169,8 @@ def optimise_excitation(
     limits = Limits.of(model, margin)
     locked = [name for name, low, high in zip(model.joint_names, limits.lower, limits.upper) if not high > low]
     if locked:  # its friction (and what only it moves) would not be excited: condition number inf
-        raise ValueError(f"{', '.join(locked)}: no position range to move in (position_limits less --margin)")
+        within = " and those of the mimic joints following it" if model.mimics else ""
+        raise ValueError(f"{', '.join(locked)}: no position range to move in (position_limits{within} less --margin)")
     pose = holding_pose(model, limits.lower, limits.upper, HEADROOM)  # refused at once if not held
     samples = samples or max(4 * harmonics * 2 + 1, 2 * base.count // model.n + 20, 100)
     n = model.n

@@ -23,6 +23,7 @@ from irb140_dynamics.core.io.trajectory_file import read_joint_trajectory
 from irb140_dynamics.core.io.urdf import load_urdf
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.trajectories.message import Trajectory
+from irb140_dynamics.identification.excitation import Limits
 from irb140_dynamics.identification.torque_limits import torque_sharers
 from irb140_dynamics.tools import excitation, identify
 
@@ -173,3 +174,20 @@ def test_the_joints_sharing_a_torque_are_its_branch():
     names = model.joint_names
     assert [names[k] for k in torque_sharers(model, names.index("l2"))] == ["torso", "l1", "l2"]
     assert [names[k] for k in torque_sharers(model, names.index("r2"))] == ["torso", "r1", "r2"]
+
+
+def test_a_coordinates_limits_are_its_joints_and_its_mimic_joints():
+    """j3's range is its own within the image of finger's (q = -q3 + 0.05 in [-2, 2]: q3 in
+    [-1.95, 2.05]); its speed and acceleration those of parallel (multiplier -0.6) over 0.6
+    when they bind; j2's speed its own (slide follows it with 0.5: 2 rad/s would bind less)."""
+    model = load_urdf(MIMIC_CHAIN).model
+    names = [j.name for j in model.joints]
+    joints = list(model.joints)
+    joints[names.index("parallel")] = replace(
+        joints[names.index("parallel")], velocity_limit=0.3, acceleration_limit=1.2
+    )
+    limits = Limits.of(replace(model, joints=tuple(joints)), 0.0)
+    np.testing.assert_allclose(limits.lower, [-2.0, -2.0, -1.95], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(limits.upper, [2.0, 2.0, 2.0], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(limits.speed, [1.0, 1.0, 0.5], rtol=1e-15)
+    np.testing.assert_allclose(limits.acceleration, [5.0, 5.0, 2.0], rtol=1e-15)
