@@ -12,6 +12,13 @@ pi holds 13 numbers per joint, in two blocks:
 so Y[:, :10 n] is ``pinocchio.computeJointTorqueRegressor``. The friction columns are qd_i
 and tanh(qd_i / v_s) (the smoothed Coulomb shape, see ``friction``), the armature's qdd_i.
 The rigid-body part is generated code (see ``codegen``), like the other kernels.
+
+With mimic joints, i runs over every joint of ``model.joints`` (n_all of them, mimic joints
+included: each moves a link of its own) and Y's n rows are the independent joints': Y =
+G^T Y_all(q_all, qd_all, qdd_all), as ``rnea`` carries a mimic joint's torque (virtual work,
+``RobotModel.mimic_matrix``). A mimic joint of multiplier m following q_k gives row k
+m^2 qd_k, tanh(qd_k / v_s) and m^2 qdd_k; its Coulomb column is zero unless |m| = 1 (the
+only multipliers the model takes Coulomb friction with, see ``model.tree``).
 """
 
 from __future__ import annotations
@@ -26,7 +33,7 @@ from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.model.joints import Friction
 from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, inertia_matrix
 from irb140_dynamics.core.model.robot_model import RobotModel
-from irb140_dynamics.core.model.states import state, states
+from irb140_dynamics.core.model.states import states
 
 _CHUNK = 4096  # states per pass of the kernel (its buffers then stay in the CPU caches)
 
@@ -39,20 +46,33 @@ PARAMETERS_PER_JOINT = INERTIAL_PARAMETERS + JOINT_TERMS
 # -- public functions ---------------------------------------------------------------------
 
 
+def parameter_count(model: RobotModel) -> int:
+    """The length of pi: 13 per joint of ``model.joints`` (mimic joints included)."""
+    return PARAMETERS_PER_JOINT * len(model.joints)
+
+
+def zero_parameters(model: RobotModel) -> np.ndarray:
+    """The indices of pi that every model of this structure holds at zero: the Coulomb
+    friction of a mimic joint whose multiplier is not +-1 (its column is zero)."""
+    links = len(model.joints)
+    return np.array(
+        [
+            INERTIAL_PARAMETERS * links + JOINT_TERMS * i + 1
+            for i, (_, m, _) in enumerate(model.coordinates)
+            if abs(m) != 1.0
+        ],
+        dtype=int,
+    )
+
+
 def regressor(model: RobotModel, q, qd, qdd) -> np.ndarray:
-    """Y(q, qd, qdd), n x 13n: rnea(model, q, qd, qdd) == Y @ inertial_parameters(model)."""
-    n = model.n
-    q, qd, qdd = state(q, n, "q"), state(qd, n, "qd"), state(qdd, n, "qdd")
-    Y = np.zeros((n, PARAMETERS_PER_JOINT * n))
-    rigid = kernels_of(model).regressor.scalar(q, qd, qdd)
-    Y[:, : INERTIAL_PARAMETERS * n] = np.reshape(rigid, (INERTIAL_PARAMETERS * n, n)).T
-    _joint_columns(model, Y, np.array(qd), np.array(qdd))
-    return Y
+    """Y(q, qd, qdd), n x 13 n_all: rnea(model, q, qd, qdd) == Y @ inertial_parameters(model)."""
+    return regressor_batch(model, [q], [qd], [qdd])[0]
 
 
 def regressor_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
-    """regressor for N states: (N, n) arrays -> Y shaped (N, n, 13n)."""
-    n = model.n
+    """regressor for N states: (N, n) arrays -> Y shaped (N, n, 13 n_all)."""
+    n, links = model.n, len(model.joints)
     q, qd, qdd = states(n, Q=Q, QD=QD, QDD=QDD)
     N = q.shape[1]
     # Y is a view of rows[entry, state]: the kernel writes each of its outputs (a row of N
@@ -60,31 +80,23 @@ def regressor_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
     # written with a stride of 13 n^2 numbers, four times slower). Output c * n + i is
     # Y[:, i, c]; the constant zeros (about half: link k moves no joint after k) are left
     # as they are, their pages never touched.
-    width = PARAMETERS_PER_JOINT * n
+    width = parameter_count(model)
     rows = np.zeros((n * width, N))
     kernel = kernels_of(model).regressor
     where = [(j, (j % n) * width + j // n) for j in kernel.written]
-    out = [None] * (INERTIAL_PARAMETERS * n * n)
+    out = [None] * (INERTIAL_PARAMETERS * links * n)
     for start in range(0, N, _CHUNK):
         chunk = slice(start, start + _CHUNK)
         for j, row in where:
             out[j] = rows[row, chunk]
         kernel.into(out, q[:, chunk], qd[:, chunk], qdd[:, chunk])
-    joints = np.arange(n) * width + INERTIAL_PARAMETERS * n + JOINT_TERMS * np.arange(n)
-    rows[joints] = qd
-    rows[joints + 1] = np.tanh(qd / model.smoothing_velocity)
-    rows[joints + 2] = qdd
+    coulomb_shape = np.tanh(qd / model.smoothing_velocity)
+    for i, (k, m, _) in enumerate(model.coordinates):  # joint i's terms, carried by coordinate k
+        column = k * width + INERTIAL_PARAMETERS * links + JOINT_TERMS * i
+        rows[column] = m * m * qd[k]
+        rows[column + 1] = coulomb_shape[k] if abs(m) == 1.0 else 0.0
+        rows[column + 2] = m * m * qdd[k]
     return rows.T.reshape(N, n, width)
-
-
-def _joint_columns(model: RobotModel, Y: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> None:
-    """Fill the friction and armature columns of one state's Y (n, 13n)."""
-    n = model.n
-    rows = np.arange(n)
-    columns = INERTIAL_PARAMETERS * n + JOINT_TERMS * rows
-    Y[rows, columns] = qd
-    Y[rows, columns + 1] = np.tanh(qd / model.smoothing_velocity)
-    Y[rows, columns + 2] = qdd
 
 
 def parameter_names(model: RobotModel) -> list[str]:
@@ -94,7 +106,7 @@ def parameter_names(model: RobotModel) -> list[str]:
 
 
 def inertial_parameters(model: RobotModel) -> np.ndarray:
-    """pi of the model (13n,), the payload merged into the last link."""
+    """pi of the model (13 n_all,), the payload merged into the flange's link."""
     links = [body_parameters(body, joint.post) for joint, body in zip(model.joints, model.bodies)]
     joints = [(j.friction.viscous, j.friction.coulomb, j.armature) for j in model.joints]
     return np.concatenate([np.ravel(links), np.ravel(joints)])
@@ -105,10 +117,10 @@ def with_inertial_parameters(model: RobotModel, pi) -> RobotModel:
     link carries it). ModelError naming the joint if pi is not physically consistent."""
     from dataclasses import replace
 
-    n = model.n
+    n = len(model.joints)
     pi = np.asarray(pi, dtype=float)
-    if pi.shape != (PARAMETERS_PER_JOINT * n,):
-        raise ValueError(f"pi: expected {PARAMETERS_PER_JOINT * n} parameters, got shape {pi.shape}")
+    if pi.shape != (parameter_count(model),):
+        raise ValueError(f"pi: expected {parameter_count(model)} parameters, got shape {pi.shape}")
     links = np.reshape(pi[: INERTIAL_PARAMETERS * n], (n, INERTIAL_PARAMETERS))
     terms = np.reshape(pi[INERTIAL_PARAMETERS * n :], (n, JOINT_TERMS))
     joints = []

@@ -40,6 +40,7 @@ from irb140_dynamics.core.regressor import (
     PARAMETERS_PER_JOINT,
     inertial_parameters,
     with_inertial_parameters,
+    zero_parameters,
 )
 from irb140_dynamics.identification.base import BaseParameters
 from irb140_dynamics.identification.least_squares import Estimate
@@ -124,8 +125,8 @@ def _link(i: int) -> slice:
 
 
 def prior_spread(model: RobotModel, pi_prior: np.ndarray) -> np.ndarray:
-    """s of the module's docstring, (13 n,)."""
-    n = model.n
+    """s of the module's docstring, (13 n_all,): per joint of ``model.joints``."""
+    n = len(model.joints)
     masses = pi_prior[0 : INERTIAL_PARAMETERS * n : INERTIAL_PARAMETERS]
     reference = np.maximum(masses, 0.1 * max(masses.mean(), 1e-3))
     distances = [np.linalg.norm(np.add(j.pre.xyz, j.post.xyz)) for j in model.joints]
@@ -152,8 +153,13 @@ def consistent_parameters(
     max_evaluations: int = MAX_EVALUATIONS,
     start: np.ndarray | None = None,
 ) -> ConsistentFit:
-    """The physically consistent parameters of the module's docstring, as a model."""
-    n = prior.n
+    """The physically consistent parameters of the module's docstring, as a model (a
+    mimic joint's link is a link: n counts every joint of ``prior.joints``)."""
+    n = len(prior.joints)
+    size, joints = PARAMETERS_PER_JOINT * n, INERTIAL_PARAMETERS * n
+    # the solver's unknowns: every entry but those no model of the structure holds (zero,
+    # see core.regressor: a mimic joint's Coulomb friction of multiplier other than +-1)
+    free = np.setdiff1d(np.arange(size), zero_parameters(prior))
     pi_prior = inertial_parameters(prior)
     spread = prior_spread(prior, pi_prior)
     K = base.matrix()
@@ -162,16 +168,18 @@ def consistent_parameters(
     data_target = root.T @ estimate.beta
     regularisation = np.sqrt(prior_weight) / spread
 
-    def evaluate(x):
-        """pi(x) and d pi / d x (block diagonal: links, then the identity for friction)."""
-        size, joints = PARAMETERS_PER_JOINT * n, INERTIAL_PARAMETERS * n
+    def evaluate(unknowns):
+        """pi(x) and d pi / d x (block diagonal: links, then the identity for friction), x
+        every entry (the unknowns, zeros elsewhere); the derivatives by the unknowns."""
+        x = np.zeros(size)
+        x[free] = unknowns
         pi, jacobian = np.empty(size), np.zeros((size, size))
         for i in range(n):
             block = _link(i)
             pi[block], jacobian[block, block] = parameters_and_jacobian(x[block])
         pi[joints:] = x[joints:]
         jacobian[joints:, joints:] = np.eye(JOINT_TERMS * n)
-        return pi, jacobian
+        return pi, jacobian[:, free]
 
     def residuals(x):
         pi, _ = evaluate(x)
@@ -195,19 +203,19 @@ def consistent_parameters(
     x0 = np.concatenate([*start, np.maximum(unconstrained[INERTIAL_PARAMETERS * n :], 0.0)])
     lower = np.concatenate([np.tile(THETA_LOWER, n), np.zeros(JOINT_TERMS * n)])
     upper = np.concatenate([np.tile(THETA_UPPER, n), np.full(JOINT_TERMS * n, np.inf)])
-    x0 = np.clip(x0, lower, upper)
+    x0 = np.clip(x0, lower, upper)[free]
     result = least_squares(
         residuals,
         x0,
         jac=jacobian,
-        bounds=(lower, upper),
+        bounds=(lower[free], upper[free]),
         method="trf",
         x_scale="jac",
         max_nfev=max_evaluations,
         ftol=1e-4,
     )
     pi, _ = evaluate(result.x)
-    pi[INERTIAL_PARAMETERS * n :] = np.maximum(pi[INERTIAL_PARAMETERS * n :], 0.0)
+    pi[joints:] = np.maximum(pi[joints:], 0.0)
     deviation = (K @ pi - estimate.beta) / estimate.std
     misfit = float(np.sum((data_map @ pi - data_target) ** 2))
     model = with_inertial_parameters(prior, pi)

@@ -12,10 +12,14 @@ rest: sum_l a_jl = 0 and sum_l l b_jl = 0, so a controller can start it from q(0
 still. The optimiser picks the coefficients of harmonics 2..K freely; those of harmonic 1
 follow from the rest conditions. Each joint's motion is then scaled as large as its limits
 allow (within ``margin`` of the position range, 98 % of the velocity and acceleration
-limits),
-and q0 centres it in the range. The cost is log cond(Y_b): the condition number of the
-base regressor stacked over ``samples`` states of one period (Y_b's columns as they are,
-in SI units), minimised by SciPy's L-BFGS-B from a seeded random start.
+limits), and q0 centres it in the range. The cost is log cond(Y_b): the condition number
+of the base regressor stacked over ``samples`` states of one period (Y_b's columns as they
+are, in SI units), minimised by SciPy's L-BFGS-B from a seeded random start. The optimum
+is then scaled down where its torques (rnea, the payload included) exceed 98 % of a
+joint's torque limit (see ``torque_limits``).
+
+The joints are the model's independent ones (``joint_names``): a mimic joint moves with the
+joint it follows, and its limits bound that joint's motion (``Limits.of``).
 """
 
 from __future__ import annotations
@@ -27,9 +31,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize
 
+from irb140_dynamics.core.dynamics import rnea_batch
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.regressor import regressor_batch
 from irb140_dynamics.identification.base import BaseParameters, find_base_parameters
+from irb140_dynamics.identification.torque_limits import TorqueScaling, holding_pose, within_torque_limits
 
 DEFAULT_PERIOD = 10.0  # s
 DEFAULT_HARMONICS = 5
@@ -37,7 +43,7 @@ DEFAULT_MARGIN = 0.05  # of each joint's position range, kept free at both ends
 DEFAULT_SPEED = 1.0  # rad/s where a joint gives no velocity limit
 DEFAULT_ACCELERATION = 5.0  # rad/s^2 where a joint gives no acceleration limit
 CHECK_POINTS_PER_HARMONIC = 100  # limit checks: points per period of the highest harmonic
-HEADROOM = 0.98  # of the velocity and acceleration limits: peaks between check points stay within
+HEADROOM = 0.98  # of the velocity, acceleration and torque limits: peaks between check points stay within
 
 
 @dataclass(frozen=True, eq=False)
@@ -80,10 +86,23 @@ class Limits:
 
     @classmethod
     def of(cls, model: RobotModel, margin: float = DEFAULT_MARGIN) -> Limits:
-        lower, upper = np.array([j.position_limits for j in model.joints]).T
-        room = margin * (upper - lower)
-        speed = np.array([j.velocity_limit or DEFAULT_SPEED for j in model.joints])
-        acceleration = np.array([j.acceleration_limit or DEFAULT_ACCELERATION for j in model.joints])
+        """The limits of the model's coordinates (its independent joints): each one's own and
+        those of the mimic joints following it (q = m q_k + o within theirs, |m qd_k| and
+        |m qdd_k| within theirs), ``margin`` of the range kept free at both ends."""
+        n = model.n
+        lower, upper = np.full(n, -np.inf), np.full(n, np.inf)
+        speed, acceleration = np.full(n, np.inf), np.full(n, np.inf)
+        for joint, (k, m, o), mimic in zip(model.joints, model.coordinates, model.mimics or (None,) * n):
+            if m == 0.0:  # held at its offset: no limit on q_k
+                continue
+            ends = sorted((np.array(joint.position_limits) - o) / m)
+            lower[k], upper[k] = max(lower[k], ends[0]), min(upper[k], ends[1])
+            own = mimic is None  # a coordinate's own joint: the defaults where it gives none
+            if joint.velocity_limit or own:
+                speed[k] = min(speed[k], (joint.velocity_limit or DEFAULT_SPEED) / abs(m))
+            if joint.acceleration_limit or own:
+                acceleration[k] = min(acceleration[k], (joint.acceleration_limit or DEFAULT_ACCELERATION) / abs(m))
+        room = margin * np.maximum(upper - lower, 0.0)
         return cls(lower + room, upper - room, speed, acceleration)
 
 
@@ -125,6 +144,7 @@ class Excitation:
     condition_number: float
     start_condition_number: float  # of the random start, before optimisation
     evaluations: int
+    torque: TorqueScaling | None = None  # how the torque limits scaled it down (None: not at all)
 
 
 def optimise_excitation(
@@ -147,9 +167,11 @@ def optimise_excitation(
         raise ValueError(f"harmonics: at least 2 are needed to start at rest, got {harmonics}")
     base = base or find_base_parameters(model)
     limits = Limits.of(model, margin)
-    locked = [joint.name for joint, low, high in zip(model.joints, limits.lower, limits.upper) if not high > low]
+    locked = [name for name, low, high in zip(model.joint_names, limits.lower, limits.upper) if not high > low]
     if locked:  # its friction (and what only it moves) would not be excited: condition number inf
-        raise ValueError(f"{', '.join(locked)}: no position range to move in (position_limits less --margin)")
+        within = " and those of the mimic joints following it" if model.mimics else ""
+        raise ValueError(f"{', '.join(locked)}: no position range to move in (position_limits{within} less --margin)")
+    pose = holding_pose(model, limits.lower, limits.upper, HEADROOM)  # refused at once if not held
     samples = samples or max(4 * harmonics * 2 + 1, 2 * base.count // model.n + 20, 100)
     n = model.n
     evaluations = 0
@@ -174,8 +196,18 @@ def optimise_excitation(
         if progress is not None:
             progress(iterations, iterations)  # (the optimiser may stop before its last iteration)
         best = result.x if result.fun < start_cost else start
-    trajectory = shaped(best, n, harmonics, period, limits)
-    return Excitation(trajectory, condition_number(model, base, trajectory, samples), math.exp(start_cost), evaluations)
+    checked = np.linspace(0.0, period, CHECK_POINTS_PER_HARMONIC * harmonics, endpoint=False)
+    trajectory, torque = within_torque_limits(
+        model,
+        lambda within: shaped(best, n, harmonics, period, within),
+        limits,
+        pose,
+        lambda trajectory: trajectory.evaluate(checked),
+        HEADROOM,
+    )
+    return Excitation(
+        trajectory, condition_number(model, base, trajectory, samples), math.exp(start_cost), evaluations, torque
+    )
 
 
 def iterations_to(progress: Callable[[int, int], None] | None, iterations: int):
@@ -195,15 +227,19 @@ def iterations_to(progress: Callable[[int, int], None] | None, iterations: int):
 
 
 def check_limits(model: RobotModel, trajectory: FourierTrajectory, rate: float, tolerance: float = 1e-9) -> list[str]:
-    """Where the trajectory sampled at ``rate`` leaves the model's limits (empty: nowhere)."""
+    """Where the trajectory sampled at ``rate`` leaves the model's limits (of its
+    coordinates, see ``Limits.of``; torques by rnea, the payload included): empty, nowhere."""
     Q, QD, QDD = trajectory.evaluate(trajectory.times(rate))
     limits = Limits.of(model, 0.0)
+    peaks = np.abs(rnea_batch(model, Q, QD, QDD)).max(axis=0)
     problems = []
-    for j, joint in enumerate(model.joints):
+    for j, (name, torque_limit) in enumerate(zip(model.joint_names, model.torque_limits)):
         if Q[:, j].min() < limits.lower[j] - tolerance or Q[:, j].max() > limits.upper[j] + tolerance:
-            problems.append(f"{joint.name}: position outside [{limits.lower[j]:.4f}, {limits.upper[j]:.4f}] rad")
+            problems.append(f"{name}: position outside [{limits.lower[j]:.4f}, {limits.upper[j]:.4f}] rad")
         if np.abs(QD[:, j]).max() > limits.speed[j] * (1 + tolerance):
-            problems.append(f"{joint.name}: speed above {limits.speed[j]:.4f} rad/s")
+            problems.append(f"{name}: speed above {limits.speed[j]:.4f} rad/s")
         if np.abs(QDD[:, j]).max() > limits.acceleration[j] * (1 + tolerance):
-            problems.append(f"{joint.name}: acceleration above {limits.acceleration[j]:.4f} rad/s^2")
+            problems.append(f"{name}: acceleration above {limits.acceleration[j]:.4f} rad/s^2")
+        if torque_limit and peaks[j] > torque_limit * (1 + tolerance):
+            problems.append(f"{name}: torque {peaks[j]:.4g} N m, above its limit {torque_limit:g} N m")
     return problems

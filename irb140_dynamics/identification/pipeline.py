@@ -28,7 +28,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from irb140_dynamics.core.model.robot_model import RobotModel
-from irb140_dynamics.core.regressor import PARAMETERS_PER_JOINT, inertial_parameters, regressor_batch
+from irb140_dynamics.core.regressor import inertial_parameters, parameter_count, regressor_batch
 from irb140_dynamics.identification.base import BaseParameters, find_base_parameters
 from irb140_dynamics.identification.consistent import (
     ConsistentFit,
@@ -125,7 +125,7 @@ def identify(
         raise ValueError(
             f"prior_weight must be > 0 and min_speed >= 0, got {settings.prior_weight}, {settings.min_speed}"
         )
-    P = PARAMETERS_PER_JOINT * prior.n
+    P = parameter_count(prior)
     train, held_out = NormalEquations(prior.n, P), NormalEquations(prior.n, P)
     min_speed = settings.min_speed if settings.min_speed is not None else SLOW_SPEEDS * prior.smoothing_velocity
     recordings = [Recording(path, prior.joint_names, settings.topic, settings.chunk_size)]

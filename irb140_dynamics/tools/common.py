@@ -96,18 +96,6 @@ def arm_of(args: argparse.Namespace, chain_for: str | None = None):
     return replace(arm, given=values)
 
 
-def refuse_mimic_joints(arm, what: str) -> None:
-    """ToolError in one line naming the mimic joints of ``arm``'s model: ``what`` (the
-    identification of the whole arm) fits a regressor that takes independent joints only."""
-    mimic = [j.name for j, m in zip(arm.model.joints, arm.model.mimics or ()) if m is not None]
-    if mimic:
-        raise ToolError(
-            f"{what} takes no mimic joints (the regressor cannot), but {shown(arm.origin)} has {len(mimic)}: "
-            f"{', '.join(mimic)}; "
-            "make them fixed joints in the URDF, or give --tip LINK for a chain without them"
-        )
-
-
 def _unknown_text(unknown, overrides: dict, params_file) -> str:
     """'unknown parameters in arm.yaml: payload.masss (did you mean payload.mass?); -p:
     joint_6.torque_limt (did you mean joint_6.torque_limit?)'."""

@@ -9,7 +9,12 @@
 Writes FILE, a trajectory_msgs/JointTrajectory in YAML (the form `ros2 topic pub` takes),
 and prints the condition number of the base regressor it reached (also a comment in FILE).
 The trajectory stays within the model's position (less a margin), velocity and
-acceleration limits, starts and ends at rest at its first point, and repeats seamlessly.
+acceleration limits, and its torques (rnea, with the model's payload) within the torque
+limits (the motion of the joints sharing a torque scaled down toward the pose that needs the
+least torque at rest, when they need it; refused when no pose within the ranges can be
+held), starts and ends at rest at its first point,
+and repeats seamlessly. On a model with mimic joints it moves the independent joints (the
+mimic joints follow them, within their own limits).
 Every argument and FILE's folder are checked before the work; FILE is written whole or
 not at all. The optimisation's progress goes to stderr (a bar with the time left on a
 terminal, else a line per 10 %). Exit status 0; 1 with one line; 2 for a bad argument; 130 after Ctrl-C.
@@ -42,7 +47,7 @@ from irb140_dynamics.tools.cli import (
     refuse_input_as_output,
     run,
 )
-from irb140_dynamics.tools.common import add_model_arguments, arm_of, model_inputs, refuse_mimic_joints
+from irb140_dynamics.tools.common import add_model_arguments, arm_of, model_inputs
 
 MAX_POINTS = 1_000_000  # points written: 100 MB of YAML
 POINTS_PER_CYCLE = 4  # of the highest harmonic: fewer points do not show the motion
@@ -204,8 +209,6 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
     from irb140_dynamics.tools.outputs import Outputs
 
     source = arm_of(args, chain_for="excitation --payload" if args.payload else None)
-    if not args.payload:
-        refuse_mimic_joints(source, "excitation")
     model, path = source.model, source.origin
     expectation = []
     if args.payload:
@@ -235,9 +238,12 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
             progress=_progress(),
         )
         regressor = "the base regressor"
+        if result.torque is not None:
+            expectation = [torque_scaling_line(model, result.torque)]
+            print(expectation[0], flush=True)
     trajectory = result.trajectory
     problems = check_limits(model, trajectory, args.rate)
-    if problems:  # cannot happen by construction; refuse rather than write a bad file
+    if problems:  # by construction only a --payload motion's torques: refuse rather than write a bad file
         raise ToolError("the trajectory leaves the limits: " + "; ".join(problems))
     times = trajectory.times(args.rate, args.periods)
     Q, QD, QDD = trajectory.evaluate(times)
@@ -277,6 +283,17 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
             "publish it with --yaml-file, or lower --rate"
         )
     return 0
+
+
+def torque_scaling_line(model, torque) -> str:
+    """What the torque limits did to the motion (``identification.torque_limits.TorqueScaling``)."""
+    needed = ", ".join(f"{name} {peak:.4g} N m (limit {limit:g})" for name, peak, limit in torque.needed)
+    scaled = ", ".join(
+        f"{name} {100 * a:.0f} % toward {q:.3f}"
+        for name, a, q in zip(model.joint_names, torque.amplitudes, torque.pose)
+        if a < 1.0
+    )
+    return f"scaled down for the torque limits (the full motion needed {needed}): {scaled} rad"
 
 
 def _payload_excitation(model, path: str, args: argparse.Namespace):

@@ -51,7 +51,7 @@ from irb140_dynamics.tools.cli import (
     refuse_input_as_output,
     run,
 )
-from irb140_dynamics.tools.common import add_model_arguments, arm_of, model_inputs, refuse_mimic_joints
+from irb140_dynamics.tools.common import add_model_arguments, arm_of, model_inputs
 
 DEFAULT_HELD_OUT = 0.2
 DEFAULT_PRIOR_WEIGHT = 1.0
@@ -157,7 +157,6 @@ def _identify(argv: list[str], interrupts) -> int:
     from irb140_dynamics.tools.outputs import Outputs
 
     source = arm_of(args)
-    refuse_mimic_joints(source, "identify")
     prior, prior_path = source.model, source.origin
     if urdf_out is None and source.urdf is not None:
         args.urdf_out = str(Path(args.out).with_suffix(".urdf"))

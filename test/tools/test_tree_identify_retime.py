@@ -4,8 +4,7 @@ identify: `excitation --urdf` of a two-arm tree (test_urdf_trees' TWO_ARMS, its 
 independent joints) is played by MuJoCo's true tree (other link masses, friction,
 armature) under computed torque; the recording (columns in a shuffled order) is fitted
 by `identify --urdf` with the file's inertials as the prior, and the identified tree
-predicts the true tree's torques on another motion. A tree with mimic joints (Baxter's
-fingers) is refused in one line naming them, nothing written.
+predicts the true tree's torques on another motion (mimic joints: test_mimic_identify).
 
 retime: a JointTrajectory naming Baxter's joints in a shuffled order is checked: the peak
 torques reported are the core's rnea (mimic fingers included) along the controller's
@@ -124,18 +123,6 @@ def test_identify_fits_a_whole_tree_from_one_recording_of_its_excitation(tmp_pat
 
 def gravity_batch(model: RobotModel, Q) -> np.ndarray:
     return np.array([gravity(model, q) for q in Q[::10]])
-
-
-@pytest.mark.parametrize("tool", [identify, excitation])
-def test_identify_and_excitation_refuse_mimic_joints_naming_them(tool, tmp_path, capsys):
-    (tmp_path / "bag").mkdir()
-    args = [tmp_path / "bag"] if tool is identify else []
-    status, out, err = run(capsys, tool, *args, "--urdf", BAXTER, "--out", tmp_path / "out.yaml")
-    lines = err.strip().splitlines()
-    assert status == 1 and len(lines) == 1 and not out, err
-    assert "mimic joints" in lines[0]
-    assert "r_gripper_r_finger_joint" in lines[0] and "l_gripper_r_finger_joint" in lines[0]
-    assert [p.name for p in tmp_path.iterdir()] == ["bag"]
 
 
 def baxter_trajectory(path: Path, model: RobotModel, duration: float) -> tuple[Path, np.ndarray]:

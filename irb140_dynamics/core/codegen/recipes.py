@@ -67,10 +67,11 @@ def _coriolis_matrix(arm, cs, qd, k):
 
 def _regressor(arm, cs, qd, qdd, k):
     # column by column, as the algorithm computes them: then the array form (see
-    # array_code) keeps few intermediates alive (29 buffers for the IRB-140, not 138)
-    _only_without_mimic(arm, "the regressor")
+    # array_code) keeps few intermediates alive (29 buffers for the IRB-140, not 138); with
+    # mimic joints each link's column is carried by the coordinates, G^T Y_all (virtual work)
+    cs, qd, qdd = arm.expanded(cs, qd, qdd)
     Y = rigid_body_regressor(arm.links_with(k), cs, qd, qdd, arm.gravity_of(k))
-    return [x for column in zip(*Y) for x in column]
+    return [x for column in zip(*Y) for x in arm.projected(column)]
 
 
 def _momentum(arm, cs, qd, k):
@@ -89,11 +90,6 @@ def _monitor(arm, cs, qd, qdd, k):
         *arm.projected(terms[: arm.n_links]),
         *arm.projected(terms[arm.n_links :]),
     ]
-
-
-def _only_without_mimic(arm, what: str) -> None:
-    if arm.coupled is not None:
-        raise ValueError(f"{what} is not available for a model with mimic joints")
 
 
 RECIPES = {  # every kernel, by name; q comes first in each
