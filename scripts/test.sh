@@ -8,6 +8,10 @@ cd "$(dirname "$0")/.."
 source scripts/env.sh test
 ruff check --quiet . || { echo "ruff check found problems (ruff check --fix . mends most)" >&2; exit 1; }
 ruff format --check --quiet . || { echo "files not formatted: run ruff format ." >&2; exit 1; }
+# Bytecode kept, as Python and pytest keep it by default (a machine may set
+# PYTHONDONTWRITEBYTECODE): each worker would otherwise rewrite and compile every test
+# module again, and each process the tests start compile what env.sh did not.
+unset PYTHONDONTWRITEBYTECODE
 # Two workers (pytest-xdist), a test file each at a time: the suite's processes and nodes
 # wait on each other as much as they compute, so two keep both cores busy. `-n 0` after
 # the script's name runs it in one process.
