@@ -101,7 +101,10 @@ def parser() -> Parser:
         help="random start of the optimisation (default 0)",
     )
     p.add_argument(
-        "--iterations", type=number(0, 10_000, integer=True), default=40, help="optimiser iterations (default 40)"
+        "--iterations",
+        type=number(0, 10_000, integer=True),
+        default=40,
+        help="optimiser iterations (default 40; --payload: for each of the 2 best periods, a quarter for every period)",
     )
     p.add_argument(
         "--payload",
@@ -146,7 +149,7 @@ def _pose(text: str) -> list[float]:
 
 
 def _effort_noise(text: str):
-    from irb140_dynamics.identification.payload_excitation import EffortNoise
+    from irb140_dynamics.identification.effort_noise import EffortNoise
 
     try:
         return EffortNoise.parse(text)

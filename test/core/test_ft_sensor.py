@@ -205,3 +205,18 @@ def test_the_stream_refuses_a_bad_frame_or_link_or_turns_off_when_told():
         and stream.model is None
     )
     assert refused.endswith("; the force/torque sensor is off")
+
+
+def test_a_reading_in_another_links_frame_is_refused_and_the_sensors_own_or_none_accepted():
+    model, stream = irb140().with_payload(TOOL), FtSensorStream()
+    stream.use(model, "flange", "sensor", None, 20.0)
+    q = np.array([0.0, -0.3, 0.4, 0.0, 0.5, 0.0])
+    stream.note(0.0, q, np.zeros(6))
+    reading = tool_wrench(model, q, np.zeros(6), np.zeros(6))[0] + np.array([5.0, 0.0, -2.0, 0.0, 0.3, 0.0])
+    for frame_id in ("", "flange", "/flange"):
+        np.testing.assert_allclose(stream.contact(0.0, reading, frame_id), [5.0, 0.0, -2.0, 0.0, 0.3, 0.0], atol=1e-9)
+    for frame_id in ("link_6", "base_link", "flange_sensor"):
+        with pytest.raises(
+            ValueError, match=rf"^wrong_frame: reading in frame '{frame_id}', the sensor is on 'flange'$"
+        ):
+            stream.contact(0.0, reading, frame_id)

@@ -53,22 +53,24 @@ def tool(mass, com, moments, angles) -> RigidBody:
 
 
 ARMS = {
-    # arm, payload, feedback gains of the simulated controller (per joint, kg m^2)
+    # arm, payload, feedback gains of the simulated controller (per joint, kg m^2), period [s]
+    # (given: the design's choice of it is test_load_any_arm's)
     "irb140": (
         lambda: load_model(ROOT / "config" / "true_arm.yaml"),
         tool(3.5, (0.06, -0.04, 0.09), (0.012, 0.02, 0.03), (0.4, -0.3, 0.7)),
         (8.0, 8.0, 3.0, 0.3, 0.3, 0.1),
+        7.5,
     ),
-    "ur5": (true_ur5, tool(2.0, (0.04, -0.03, 0.06), (0.006, 0.009, 0.0125), (-0.5, 0.2, 0.9)), None),
+    "ur5": (true_ur5, tool(2.0, (0.04, -0.03, 0.06), (0.006, 0.009, 0.0125), (-0.5, 0.2, 0.9)), None, 3.0),
 }
 
 
 @pytest.fixture(scope="module", params=sorted(ARMS))
 def recorded(request, tmp_path_factory):
     """(arm without payload, true payload, excitation, (t, Q, QD, TAU), CSV path)."""
-    make, payload, gains = ARMS[request.param]
+    make, payload, gains, period = ARMS[request.param]
     arm = make()
-    excitation = optimise_payload_excitation(arm, iterations=10)
+    excitation = optimise_payload_excitation(arm, period=period, iterations=10)
     duration = PERIODS * excitation.trajectory.period
     recording = simulate(arm.with_payload(payload), excitation.trajectory, duration, noise=NOISE, gains=gains)
     path = write_csv(tmp_path_factory.mktemp(request.param) / "payload.csv", arm.joint_names, *recording)

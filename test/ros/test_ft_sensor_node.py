@@ -2,8 +2,9 @@
 (with a bias, the node told 0.5 kg) at rest in three poses; ~/estimate_ft_load gives the
 bias, 2 kg and the CoM, uses the bias and sets payload.mass and .com (ft_sensor.apply_load);
 then a known push reads as it was on ft_contact_wrench, in the sensor's axes and the base's,
-stamped like the reading; a reading not finite is dropped and counted; a sensor link not on
-the last link stops the start with one line."""
+stamped like the reading; a reading not finite, or in another link's frame (header.frame_id),
+is dropped and counted, one in the sensor link's frame taken; a sensor link not on the last link
+stops the start with one line."""
 
 import numpy as np
 import pytest
@@ -34,13 +35,14 @@ def stamped(msg, t: float):
     return msg
 
 
-def send(harness, t: float, q, qd, wrench) -> None:
-    """A joint state, taken, then a reading at the same stamp."""
+def send(harness, t: float, q, qd, wrench, frame_id: str = "") -> None:
+    """A joint state, taken, then a reading at the same stamp in ``frame_id``."""
     names, counts = harness.node.settings.model.joint_names, harness.node.counts
     received = counts["joint_states.received"]
     harness.joint_states.publish(stamped(JointState(name=list(names), position=list(q), velocity=list(qd)), t))
     assert harness.spin_until(lambda: counts["joint_states.received"] > received), "joint state not taken"
     reading, count = stamped(WrenchStamped(), t), len(harness.contacts) + len(harness.node.counts)
+    reading.header.frame_id = frame_id
     f, m = reading.wrench.force, reading.wrench.torque
     f.x, f.y, f.z, m.x, m.y, m.z = (float(x) for x in wrench)
     harness.readings.publish(reading)
@@ -68,6 +70,8 @@ def test_the_load_is_estimated_from_rests_and_a_push_reads_as_it_was():
             t += 2.0
         send(harness, t, q, zero, [np.nan] * 6)
         assert harness.node.counts["ft_wrench.dropped_not_finite"] == 1
+        send(harness, t, q, zero, reading, frame_id="link_6")  # the sensor's link is the flange
+        assert harness.node.counts["ft_wrench.dropped_wrong_frame"] == 1
         client = harness.probe.create_client(Trigger, "/id_node/estimate_ft_load")
         assert client.wait_for_service(timeout_sec=10.0)
         reply = harness.call(lambda: client.call_async(Trigger.Request()))
@@ -80,7 +84,7 @@ def test_the_load_is_estimated_from_rests_and_a_push_reads_as_it_was():
         assert abs(payload.mass - 2.0) < 1e-6 and np.allclose(payload.com, TOOL.com, atol=1e-6)
         push = np.array([5.0, -20.0, 3.0, 0.5, 0.2, -0.1])  # on the tool, sensor axes, about its origin
         q, t = POSES[1], t + 1.0
-        send(harness, t, q, zero, tool_wrench(TRUE_ARM, q, zero, zero)[0] + BIAS + push)
+        send(harness, t, q, zero, tool_wrench(TRUE_ARM, q, zero, zero)[0] + BIAS + push, frame_id="flange")
         last = harness.contacts[-1]
         assert last.header.frame_id == "flange" and (last.header.stamp.sec, last.header.stamp.nanosec) == (17, 0)
         np.testing.assert_allclose(read(last), push, atol=1e-6)

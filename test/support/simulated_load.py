@@ -16,7 +16,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from irb140_dynamics.core import Friction, RigidBody, RobotModel, mass_matrix, rnea_batch
-from irb140_dynamics.identification.payload_excitation import EffortNoise
+from irb140_dynamics.identification.effort_noise import EffortNoise
 
 from .simulated_ur5 import write_csv  # noqa: F401  (the loads' recordings as the UR5's: one writer)
 

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from irb140_dynamics.core import RobotModel
+from irb140_dynamics.identification.effort_noise import EffortNoise
 from irb140_dynamics.identification.excitation import Limits, shaped
-from irb140_dynamics.identification.payload_excitation import EffortNoise
 
 from . import simulated_load
 

@@ -3,7 +3,9 @@
 Joint states (t [s], q, qd) are kept for a short while (HISTORY of them), each with qdd
 from the velocities (core.monitoring.filters: a finite difference through a first-order
 low-pass). A reading (t, 6 numbers as ``contact``'s) is matched to the joint state nearest
-in time (at most MAX_GAP away) and gives the contact wrench. Readings at rest (every joint
+in time (at most MAX_GAP away) and gives the contact wrench; a reading stamped in a frame
+other than the sensor's link (its header.frame_id; "" and a leading "/" accepted) is
+refused, as its numbers are in other axes or about another point. Readings at rest (every joint
 slower than REST_VELOCITY for REST_TIME, as payload_check_node's defaults) are averaged,
 one sample per pose, for ``estimate``: the bias is used at once; the samples are forgotten
 after an estimate (the next one uses the poses since).
@@ -79,10 +81,13 @@ class FtSensorStream:
             return
         self._states.append((t, q, qd, qdd))
 
-    def contact(self, t: float, reading) -> np.ndarray:
-        """The contact wrench of a reading at t [s] (see ``contact``), in ``frame``'s axes; the
-        reading kept if the arm rests. BadMessage: a reading not finite or absurd, no joint
-        state near it, a joint state too fast for a finite contact wrench."""
+    def contact(self, t: float, reading, frame_id: str = "") -> np.ndarray:
+        """The contact wrench of a reading at t [s] (see ``contact``) given in ``frame_id``
+        ("": the sensor's link), in ``frame``'s axes; the reading kept if the arm rests.
+        BadMessage: a reading in another link's frame, not finite or absurd, no joint state
+        near it, a joint state too fast for a finite contact wrench."""
+        if frame_id and frame_id.removeprefix("/") != self.link:
+            raise BadMessage("wrong_frame", f"reading in frame {frame_id!r}, the sensor is on {self.link!r}")
         reading = np.asarray(reading, dtype=float)
         if reading.shape != (6,) or not np.isfinite(reading).all():
             raise BadMessage("not_finite", f"reading not 6 finite numbers: {reading.tolist()}")

@@ -44,7 +44,7 @@ class FtSensor:
         f, m, stamp = msg.wrench.force, msg.wrench.torque, msg.header.stamp
         t = seconds(stamp.sec, stamp.nanosec) or self.node._now()  # unstamped: its arrival
         try:
-            w = self.stream.contact(t, [f.x, f.y, f.z, m.x, m.y, m.z])
+            w = self.stream.contact(t, [f.x, f.y, f.z, m.x, m.y, m.z], msg.header.frame_id)
         except BadMessage as error:
             return self.tally.drop("ft_wrench", error)
         frame_id = self.stream.link if self.stream.frame == "sensor" else self.node.parameters.chain_links[0]
