@@ -53,16 +53,19 @@ CONSTANTS = {
 }
 
 # One text of the arithmetic, valid Python and C: theta -> k (rounded: its low bits k mod 4),
-# r, s = sin r, c = cos r.
+# r, s = sin r, c = cos r. The polynomials in z = r^2 by Estrin's scheme (pairs, then z^2 and
+# z^4): a dependent path of 3 products and 3 sums where Horner's has 6 of each.
 _STEPS = """\
 rounded = theta * TWO_OVER_PI + ROUNDER
 k = rounded - ROUNDER
 r = ((theta - k * PIO2_1) - k * PIO2_2) - k * PIO2_3
 z = r * r
-s = r + (z * r) * (S1 + z * (S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)))))
+z2 = z * z
+z4 = z2 * z2
+s = r + (z * r) * (((S1 + z * S2) + z2 * (S3 + z * S4)) + z4 * (S5 + z * S6))
 half = 0.5 * z
 w = 1.0 - half
-c = w + (((1.0 - w) - half) + z * (z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))))))"""
+c = w + (((1.0 - w) - half) + z2 * (((C1 + z * C2) + z2 * (C3 + z * C4)) + z4 * (C5 + z * C6)))"""
 
 
 def _python(steps: str, indent: str) -> str:
