@@ -3,20 +3,23 @@
 A kernel takes ``sine(theta)`` and ``cosine(theta)`` of each joint angle. Left to libm
 (sin, cos, or gcc's sincos), those are n calls one after the other, each a branchy routine
 the processor does not overlap with the next: on a 6-joint arm they took about half the
-time of the generated C. Here they are plain arithmetic that a C compiler inlines, so the
-n evaluations run side by side:
+time of the generated C. Here the C computes all the angles of a program first (``batched``:
+one call of ``sin_cos_angles``, a loop without a branch that gcc -O2 vectorizes, two angles
+per SSE2 register), and the Python forms likewise (``hoisted``: one ``sin_cos_rows``):
 
 - Cody-Waite range reduction: k, the integer nearest theta * 2 / pi (rounded by adding and
   subtracting 1.5 * 2^52), and r = theta - k pi / 2 with pi / 2 split in three parts of 33
   bits (each k * part exact while |k| < 2^20), so |r| <= pi / 4;
 - fdlibm's minimax polynomials of sin and cos on [-pi / 4, pi / 4] (degrees 13 and 14,
-  errors below 2^-58), the quadrant k mod 4 choosing which one and its sign.
+  errors below 2^-58) by Estrin's scheme, the quadrant k mod 4 choosing which one and its
+  sign (in C on the bits, without a branch).
 
 For |theta| <= LIBM_BEYOND the result is within 2 ulp of the true value (an error below
 2.3e-16; near a multiple of pi / 2, where the result is near 0, below 1e-24; test_sincos
 measures both); beyond, and for a theta not finite, libm's sin and cos compute it. The C
-(``C_SOURCE``), the Python on floats (``sine``, ``cosine``) and on NumPy arrays
-(``sine_array``, ``cosine_array``; ``ARRAY_SOURCE``, their text for a module written out)
+(``C_SOURCE``), the Python on floats (``sine``, ``cosine``, ``scalar_sin_cos_rows``) and on
+NumPy arrays (``sine_array``, ``cosine_array``, ``sin_cos_rows``; ``ARRAY_SOURCE``, their
+text for a module written out)
 do the same IEEE operations in the same order, without fused multiply-add: their results
 are identical, bit for bit, so a kernel's native form equals its Python form.
 """
@@ -136,12 +139,12 @@ def cosine_array(theta):
 
 _namespace: dict = {"np": np, "math": math}
 exec(_SCALAR_SOURCE, _namespace)
-# float -> float (sin_cos: both), as the C's
-sin_cos, sine, cosine = _namespace["sin_cos"], _namespace["sine"], _namespace["cosine"]
+# on floats, as the C computes them (sin_cos_rows: the sines of a sequence, then its cosines)
+sine, cosine = _namespace["sine"], _namespace["cosine"]
 scalar_sin_cos_rows = _namespace["sin_cos_rows"]
 exec(ARRAY_SOURCE, _namespace)
 # the same on arrays, entry by entry
-sin_cos_array, sin_cos_rows = _namespace["sin_cos_array"], _namespace["sin_cos_rows"]
+sin_cos_rows = _namespace["sin_cos_rows"]
 sine_array, cosine_array = _namespace["sine_array"], _namespace["cosine_array"]
 
 
