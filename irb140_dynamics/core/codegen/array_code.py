@@ -67,9 +67,9 @@ def compile_into(program: Program, scalars: Sequence[str] = ()) -> tuple[str, Ca
 
 def into_source(program: Program, scalars: Sequence[str] = (), default: str | None = None) -> tuple[str, list[int]]:
     """(the source of ``<name>_into``, see compile_into; the outputs it writes). Its names:
-    cosine, sine, sin_cos_rows (``sincos``'s, on arrays), tanh, mul, add, sub, div, neg (NumPy's ufuncs)
-    and empty (np.empty). With
-    ``default``, the last group defaults to the variable of that name."""
+    cosine, sine, sin_cos_rows (``sincos``'s, on arrays), tanh, mul, add, sub, div, neg
+    (NumPy's ufuncs) and empty (np.empty). With ``default``, the last group defaults to the
+    variable of that name."""
     scalar_vars = {f"{group}{i}" for group in scalars for i in range(program.group(group))}
     body, first_array, registers = _emit_into(program, scalar_vars)
     written = [j for j, out in enumerate(program.outputs) if isinstance(out, int)]
