@@ -149,10 +149,7 @@ def inertia_times(inertia, v):
 
 
 def gyroscopic(link: Link, w):
-    """w x (I w). For an inertia that is numbers with no product of inertia, ((Izz - Iyy)
-    w_y w_z, ...): two products a component where the cross product takes three and a
-    difference. Not on the payload's link, whose inertia the kernels take as constants (so
-    that they do on it what the recursion on numbers does)."""
+    """w x (I w), as ((Izz - Iyy) w_y w_z, ...) for numbers without products of inertia (not the payload's)."""
     xx, yy, zz, xy, xz, yz = link.I
     if not link.carrier and all(type(x) is float for x in link.I) and xy == xz == yz == 0.0:
         return ((zz - yy) * (w[1] * w[2]), (xx - zz) * (w[2] * w[0]), (yy - xx) * (w[0] * w[1]))
