@@ -63,6 +63,7 @@ class Link:
     prismatic: bool = False
     e: Vector3 = ZERO3  # a prismatic joint's axis in frame i-1 (R0 u)
     parent: int | None = None  # the parent link's index, -1 the base; None: the link before (a chain)
+    carrier: bool = False  # the payload is merged into it (the kernels take its inertia as constants)
 
 
 def chain(model) -> tuple[Link, ...]:
@@ -76,6 +77,7 @@ def chain(model) -> tuple[Link, ...]:
             joint.armature,
             *_slide(joint),
             parent=None if parent == i - 1 else parent,
+            carrier=i == model.carrier,
         )
         for i, (joint, body, parent) in enumerate(zip(model.joints, model.bodies, model.parent))
     )
@@ -144,6 +146,14 @@ def inertia_times(inertia, v):
         xy * v[0] + yy * v[1] + yz * v[2],
         xz * v[0] + yz * v[1] + zz * v[2],
     )
+
+
+def gyroscopic(link: Link, w):
+    """w x (I w), as ((Izz - Iyy) w_y w_z, ...) for numbers without products of inertia (not the payload's)."""
+    xx, yy, zz, xy, xz, yz = link.I
+    if not link.carrier and all(type(x) is float for x in link.I) and xy == xz == yz == 0.0:
+        return ((zz - yy) * (w[1] * w[2]), (xx - zz) * (w[2] * w[0]), (yy - xx) * (w[0] * w[1]))
+    return cross(w, inertia_times(link.I, w))
 
 
 def _combination(terms):
@@ -239,7 +249,7 @@ def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3, at: int = -1):
         link, (w, dw, a) = links[i], motion[i]
         f, n = carried[i] or (ZERO3, ZERO3)
         force = add(scale(link.m, a), cross(dw, link.h), cross(w, cross(w, link.h)))
-        moment = add(inertia_times(link.I, dw), cross(w, inertia_times(link.I, w)), cross(link.h, a))
+        moment = add(inertia_times(link.I, dw), gyroscopic(link, w), cross(link.h, a))
         f = add(force, f)
         n = add(moment, n, cross(link.p, f))
         tau[i] = dot(link.b, f if link.prismatic else n) + link.armature * qdd[i]

@@ -24,13 +24,23 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from irb140_dynamics.core.codegen import sincos
 from irb140_dynamics.core.codegen.program import ANGLES, Program
-from irb140_dynamics.core.codegen.python_code import BOUND, angle_name, bound, constant, parameters, unpacked
+from irb140_dynamics.core.codegen.python_code import (
+    ANGLE_FUNCTIONS,
+    BOUND,
+    angle_name,
+    bound,
+    constant,
+    parameters,
+    unpacked,
+)
 
 _UFUNCS = {"*": "mul", "+": "add", "-": "sub", "/": "div", "neg": "neg", "tanh": "tanh"}
 _NAMESPACE = {
-    "cos": np.cos,
-    "sin": np.sin,
+    "cosine": sincos.cosine_array,
+    "sine": sincos.sine_array,
+    "sin_cos_rows": sincos.sin_cos_rows,
     "mul": np.multiply,
     "add": np.add,
     "sub": np.subtract,
@@ -57,8 +67,9 @@ def compile_into(program: Program, scalars: Sequence[str] = ()) -> tuple[str, Ca
 
 def into_source(program: Program, scalars: Sequence[str] = (), default: str | None = None) -> tuple[str, list[int]]:
     """(the source of ``<name>_into``, see compile_into; the outputs it writes). Its names:
-    cos, sin, tanh, mul, add, sub, div, neg (NumPy's ufuncs) and empty (np.empty). With
-    ``default``, the last group defaults to the variable of that name."""
+    cosine, sine, sin_cos_rows (``sincos``'s, on arrays), tanh, mul, add, sub, div, neg
+    (NumPy's ufuncs) and empty (np.empty). With ``default``, the last group defaults to the
+    variable of that name."""
     scalar_vars = {f"{group}{i}" for group in scalars for i in range(program.group(group))}
     body, first_array, registers = _emit_into(program, scalar_vars)
     written = [j for j, out in enumerate(program.outputs) if isinstance(out, int)]
@@ -89,6 +100,17 @@ def _emit_into(program: Program, scalar_vars: set[str]):
 
     names: dict[int, str] = {}
     lines: list[str] = []
+    # the joint angles (those of an input) at once: one sin_cos_rows call on all their thetas
+    angles = [
+        (k, op, _theta(ops[args[0]][1][0], args[1]))
+        for k, (op, args) in enumerate(ops)
+        if op in ANGLES and ops[args[0]][0] == "in"
+    ]
+    thetas = {theta: i for i, theta in enumerate(dict.fromkeys(theta for k, op, theta in angles))}
+    for k, op, theta in angles:
+        names[k] = f"angle_rows[{thetas[theta] + (len(thetas) if op == 'cos' else 0)}]"
+    if thetas:
+        lines.append(f"    angle_rows = sin_cos_rows(({', '.join(thetas)},))")
     buffers: set[str] = set()
     free: list[str] = []  # buffers whose values are dead, the most recently freed last
     for k, (op, args) in enumerate(ops):
@@ -96,9 +118,9 @@ def _emit_into(program: Program, scalar_vars: set[str]):
             names[k] = args[0]
             continue
         if op in ANGLES:  # an array of its own, computed as the Python form does
-            q = names[args[0]]
-            names[k] = angle_name(program, k)
-            lines.append(f"    {names[k]} = {op}({q if args[1] == 0.0 else f'{q} + {args[1]!r}'})")
+            if k not in names:  # a mimic joint's, of a multiple of an input
+                names[k] = angle_name(program, k)
+                lines.append(f"    {names[k]} = {ANGLE_FUNCTIONS[op]}({_theta(names[args[0]], args[1])})")
             continue
         operands = [names[a] if isinstance(a, int) else constant(a) for a in args]
         if k in scalar:
@@ -130,3 +152,7 @@ def _emit_into(program: Program, scalar_vars: set[str]):
             lines.append(f"    o{j}[...] = {names[out]}")
     first_array = next((args[0] for op, args in ops if op == "in" and args[0] not in scalar_vars), None)
     return lines, first_array, len(buffers)
+
+
+def _theta(q: str, offset: float) -> str:
+    return q if offset == 0.0 else f"{q} + {offset!r}"

@@ -2,8 +2,9 @@
 
 The body is the infix text of ``python_code.statements``, the very operations of the
 Python form in the same order. Compiled without contraction or fast-math (no fused
-multiply-add) and with cos, sin and tanh left to libm, its results are the Python form's,
-bit for bit (the ``native`` room checks that before use).
+multiply-add), with the joint angles' sine and cosine inline (``sincos``, the Python form's
+arithmetic) and tanh left to libm, its results are the Python form's, bit for bit (the
+``native`` room checks that before use).
 
 ``kernel_source`` is ``int kernel(const double *x, const double *k, double *out)``;
 ``extension_source`` adds a module ``<name>`` whose ``bind(k: bytes)`` returns the kernel
@@ -16,6 +17,7 @@ then takes the Python form, which says why). A program whose outputs are ``matri
 
 from __future__ import annotations
 
+from irb140_dynamics.core.codegen import sincos
 from irb140_dynamics.core.codegen.layout import whole_matrix
 from irb140_dynamics.core.codegen.program import Program
 from irb140_dynamics.core.codegen.python_code import statements
@@ -39,9 +41,10 @@ def kernel_source(program: Program, full_matrix: int = 0) -> tuple[str, int, int
     then of the outputs: finite values whose sum overflows are sent to the Python form too,
     which tells them apart."""
     body, results = statements(program)
+    angles, body = sincos.batched(body)
     if full_matrix:
         results = whole_matrix(results, full_matrix)
-    lines = ["#include <math.h>", ""]
+    lines = ["#include <math.h>", "", sincos.C_SOURCE]
     if len(program.ops) >= COMPACT_FROM:
         lines += ["#if defined(__GNUC__) && !defined(__clang__)", '__attribute__((optimize("Os")))', "#endif"]
     lines.append("int kernel(const double *x, const double *k, double *out) {")
@@ -56,6 +59,7 @@ def kernel_source(program: Program, full_matrix: int = 0) -> tuple[str, int, int
     lines.append("    double check = 0.0;")
     lines.append(f"    for (int i = 0; i < {count}; ++i) check += x[i];")
     lines.append(f"    if (!isfinite(check)) return {INPUT_NOT_FINITE};")
+    lines += angles
     if len(program.ops) >= COMPACT_FROM:
         stores: dict[str, list[int]] = {}
         for j, expression in enumerate(results):

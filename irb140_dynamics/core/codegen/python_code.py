@@ -3,8 +3,8 @@
 ``statements`` writes each operation as an infix expression: a value used once is written
 inline into its user (up to a nesting depth), any other into a variable (``t<k>``, the
 joint angles' ``c<i>``, ``s<i>``). That text is valid Python and valid C: ``python_source``
-wraps it into a function of floats (compiled with math's cos and sin, or NumPy's to
-evaluate many states at once), ``c_code`` into a C function.
+wraps it into a function of floats (with ``sincos``'s sine and cosine on floats, or on
+NumPy arrays to evaluate many states at once), ``c_code`` into a C function.
 """
 
 from __future__ import annotations
@@ -15,8 +15,10 @@ from collections.abc import Callable
 
 import numpy as np
 
+from irb140_dynamics.core.codegen import sincos
 from irb140_dynamics.core.codegen.program import ANGLES, Program
 
+ANGLE_FUNCTIONS = {"cos": "cosine", "sin": "sine"}  # an angle operation's function (see sincos)
 MAX_INLINE_DEPTH = 12  # of an expression written inline: deeper ones get a variable
 
 
@@ -59,7 +61,7 @@ def statements(program: Program) -> tuple[list[tuple[str, str]], list[str]]:
             q = exprs[args[0]]
             theta = q if args[1] == 0.0 else f"{q} + {args[1]!r}"
             name = angle_name(program, k)
-            lines.append((name, f"{op}({theta})"))
+            lines.append((name, f"{ANGLE_FUNCTIONS[op]}({theta})"))
             exprs.append(name)
             depth.append(0)
             continue
@@ -91,6 +93,7 @@ def python_source(program: Program, default: str | None = None) -> str:
     """``def <name>(q, qd, ...): return (outputs,)``: the program on floats. With
     ``default``, the last group (``k``) defaults to the variable of that name (see bound)."""
     lines, results = statements(program)
+    lines = sincos.hoisted(lines)
     text = [f"def {program.name}({parameters(program, default)}):", *unpacked(program)]
     text += [f"    {var} = {expr}" for var, expr in lines]
     text.append(f"    return ({', '.join(results)},)")
@@ -128,8 +131,18 @@ def compile_python(program: Program) -> tuple[str, Callable, Callable]:
     ``bind(constants)`` giving the function of the groups but ``k``, which defaults to the
     constants given (see bound)."""
     source = python_source(program, default=BOUND)
-    scalar_ns = {"cos": math.cos, "sin": math.sin, "tanh": math.tanh}
-    array_ns = {"cos": np.cos, "sin": np.sin, "tanh": np.tanh}
+    scalar_ns = {
+        "cosine": sincos.cosine,
+        "sine": sincos.sine,
+        "sin_cos_rows": sincos.scalar_sin_cos_rows,
+        "tanh": math.tanh,
+    }
+    array_ns = {
+        "cosine": sincos.cosine_array,
+        "sine": sincos.sine_array,
+        "sin_cos_rows": sincos.sin_cos_rows,
+        "tanh": np.tanh,
+    }
     return source, *bound(source, program.name, scalar_ns, array_ns)
 
 

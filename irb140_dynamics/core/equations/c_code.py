@@ -7,6 +7,7 @@ qdd, Y)``; with symbolic parameters each takes ``p`` (the parameters) last.
 
 from __future__ import annotations
 
+from ..codegen import sincos
 from ..regressor import PARAMETERS_PER_JOINT
 from .printing import DESCRIPTIONS, CPrinter, header_lines, used_names
 from .symbolic import Equations
@@ -29,6 +30,8 @@ def render(
         h.append(f"#define {prefix.upper()}_PARAMETERS {{{values}}}")
     h += ["", "#ifdef __cplusplus", 'extern "C" {', "#endif", ""]
     c = [comment, f'#include "{prefix}_eom.h"', "", "#include <math.h>", ""]
+    if bodies or functions:  # the programs' joint angles (see codegen.sincos)
+        c.append(sincos.C_SOURCE)
     for name, (replacements, outputs) in reduced.items():
         signature = _signature(eq, name, prefix)
         h += [f"/* {DESCRIPTIONS[name]} */", f"{signature};", ""]
@@ -80,6 +83,8 @@ def _traced_body(eq: Equations, name: str, body) -> list[str]:
     for arg in eq.arguments[name]:
         taken = [f"    const double {var} = {arg}[{i}];" for i, var in body.inputs.get(arg, [])]
         lines += taken or [f"    (void){arg};"]
-    lines += [f"    const double {var} = {expr};" for var, expr in body.assignments]
+    angles, assignments = sincos.batched(body.assignments)
+    lines += angles
+    lines += [f"    const double {var} = {expr};" for var, expr in assignments]
     out = name if name != "regressor" else "Y"
     return lines + [f"    {out}[{k}] = {expr};" for k, expr in enumerate(body.outputs)]

@@ -12,6 +12,7 @@ output i by input j.
 
 from __future__ import annotations
 
+from ..codegen import sincos
 from ..codegen.kernels import kernels_of
 from ..codegen.layout import whole_matrix
 from ..codegen.program import selected, with_constants
@@ -61,6 +62,8 @@ def c_functions(model, what, prefix: str) -> list[tuple[str, str, list[str]]]:
         for group, length in program.groups:
             taken = [f"    const double {group}{i} = {group}[{i}];" for i in range(length) if f"{group}{i}" in used]
             lines += taken or [f"    (void){group};"]
+        angles, assignments = sincos.batched(assignments)
+        lines += angles
         lines += [f"    const double {var} = {expr};" for var, expr in assignments]
         start = 0
         for (array, _), size in zip(arrays, sizes):

@@ -7,6 +7,7 @@ states, chunk by chunk so that its intermediates stay in the CPU caches.
 
 from __future__ import annotations
 
+from ..codegen import sincos
 from ..regressor import PARAMETERS_PER_JOINT
 from .printing import DESCRIPTIONS, PythonPrinter, header_lines, used_names
 from .symbolic import Equations
@@ -15,7 +16,7 @@ _PRELUDE = '''
 import numpy as np
 from numpy import add, cos, empty, sin, tanh  # noqa: F401 (used by the generated code)
 from numpy import divide as div, multiply as mul, negative as neg, subtract as sub  # noqa: F401
-
+{sincos}
 CHUNK = 4096  # states per pass
 
 
@@ -33,6 +34,12 @@ def _run(kernel, shape, *arrays):
             flat[part, k] = entry
     return out[0] if single else out
 '''
+# the joint angles' sine and cosine of the programs, the package's arithmetic (codegen.sincos)
+_SINCOS = (
+    "\n# sine and cosine of the joint angles: Cody-Waite reduction, fdlibm's polynomials"
+    + sincos.ARRAY_SOURCE
+    + "\n\nsine, cosine = sine_array, cosine_array\n"
+)
 
 
 def render(eq: Equations, reduced: dict, prefix: str, source: str, bodies: dict | None = None) -> dict[str, str]:
@@ -40,7 +47,8 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str, bodies: dict 
     its program, the others from ``reduced``."""
     bodies = bodies or {}
     doc = "\n".join(header_lines(eq, source, traced=bool(bodies)))
-    lines = [f'"""{doc}\n\nFunctions of one state (arrays (n,)) or N states ((N, n)).\n"""', _PRELUDE]
+    prelude = _PRELUDE.replace("{sincos}", _SINCOS if bodies else "")
+    lines = [f'"""{doc}\n\nFunctions of one state (arrays (n,)) or N states ((N, n)).\n"""', prelude]
     lines.append(f"N_JOINTS = {eq.n}")
     lines.append(f"JOINT_NAMES = {tuple(eq.joint_names)!r}")
     if eq.parameters:
