@@ -67,10 +67,16 @@ def pseudo_inertia(pi10) -> np.ndarray:
 
 
 def parameters_of(J: np.ndarray) -> np.ndarray:
-    """The ten parameters of a pseudo-inertia."""
-    S = J[:3, :3]
-    I = np.trace(S) * np.eye(3) - S
-    return np.array([J[3, 3], *J[:3, 3], I[0, 0], I[0, 1], I[1, 1], I[0, 2], I[1, 2], I[2, 2]])
+    """The ten parameters of a pseudo-inertia (or of each of a stack of them, (..., 4, 4) ->
+    (..., 10))."""
+    S = J[..., :3, :3]
+    I = np.trace(S, axis1=-2, axis2=-1)[..., None, None] * np.eye(3) - S
+    return np.stack(
+        [J[..., 3, 3], J[..., 0, 3], J[..., 1, 3], J[..., 2, 3], *(I[..., r, c] for r, c in _UPPER_INERTIA)], axis=-1
+    )
+
+
+_UPPER_INERTIA = ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2))  # Ixx, Ixy, Iyy, Ixz, Iyz, Izz
 
 
 def log_cholesky(theta) -> np.ndarray:
@@ -87,18 +93,18 @@ def _upper(theta) -> np.ndarray:
 
 
 _ENTRIES = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))  # of d1..d3, s12, s23, s13, t1..t3
+_ROWS, _COLUMNS = np.array(_ENTRIES).T
 
 
 def parameters_and_jacobian(theta) -> tuple[np.ndarray, np.ndarray]:
     """The ten parameters of log_cholesky(theta) and their derivatives (10 x 10) by theta."""
     U = _upper(theta)
-    derivatives = [U]  # d U / d alpha
-    for k, (row, column) in enumerate(_ENTRIES):
-        dU = np.zeros((4, 4))
-        dU[row, column] = U[row, column] if k < 3 else np.exp(theta[0])  # d e^(alpha + d) / dd; d (e^alpha s) / ds
-        derivatives.append(dU)
-    jacobian = np.column_stack([parameters_of(dU @ U.T + U @ dU.T) for dU in derivatives])
-    return parameters_of(U @ U.T), jacobian
+    dU = np.zeros((10, 4, 4))  # d U / d theta_k
+    dU[0] = U  # d U / d alpha
+    # d e^(alpha + d) / dd on the diagonal; d (e^alpha s) / ds off it
+    dU[np.arange(1, 10), _ROWS, _COLUMNS] = np.where(np.arange(9) < 3, U[_ROWS, _COLUMNS], np.exp(theta[0]))
+    dU_Ut = dU @ U.T
+    return parameters_of(U @ U.T), parameters_of(dU_Ut + dU_Ut.transpose(0, 2, 1)).T  # d(U U^T) = dU U^T + U dU^T
 
 
 def log_cholesky_of(J: np.ndarray) -> np.ndarray:
