@@ -67,10 +67,16 @@ def pseudo_inertia(pi10) -> np.ndarray:
 
 
 def parameters_of(J: np.ndarray) -> np.ndarray:
-    """The ten parameters of a pseudo-inertia."""
-    S = J[:3, :3]
-    I = np.trace(S) * np.eye(3) - S
-    return np.array([J[3, 3], *J[:3, 3], I[0, 0], I[0, 1], I[1, 1], I[0, 2], I[1, 2], I[2, 2]])
+    """The ten parameters of a pseudo-inertia (or of each of a stack of them, (..., 4, 4) ->
+    (..., 10))."""
+    S = J[..., :3, :3]
+    I = np.trace(S, axis1=-2, axis2=-1)[..., None, None] * np.eye(3) - S
+    return np.stack(
+        [J[..., 3, 3], J[..., 0, 3], J[..., 1, 3], J[..., 2, 3], *(I[..., r, c] for r, c in _UPPER_INERTIA)], axis=-1
+    )
+
+
+_UPPER_INERTIA = ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2))  # Ixx, Ixy, Iyy, Ixz, Iyz, Izz
 
 
 def log_cholesky(theta) -> np.ndarray:
@@ -80,25 +86,34 @@ def log_cholesky(theta) -> np.ndarray:
 
 
 def _upper(theta) -> np.ndarray:
-    alpha, d1, d2, d3, s12, s23, s13, t1, t2, t3 = theta
-    return np.exp(alpha) * np.array(
-        [[np.exp(d1), s12, s13, t1], [0.0, np.exp(d2), s23, t2], [0.0, 0.0, np.exp(d3), t3], [0.0, 0.0, 0.0, 1.0]]
-    )
+    """U (4 x 4) of ten log-Cholesky numbers (or of each row of a stack, (..., 10) -> (..., 4, 4))."""
+    theta = np.asarray(theta, dtype=float)
+    alpha, d1, d2, d3, s12, s23, s13, t1, t2, t3 = np.moveaxis(theta, -1, 0)
+    U = np.zeros((*theta.shape[:-1], 4, 4))
+    U[..., 0, :] = np.stack([np.exp(d1), s12, s13, t1], axis=-1)
+    U[..., 1, 1:] = np.stack([np.exp(d2), s23, t2], axis=-1)
+    U[..., 2, 2:] = np.stack([np.exp(d3), t3], axis=-1)
+    U[..., 3, 3] = 1.0
+    return np.exp(alpha)[..., None, None] * U
 
 
 _ENTRIES = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))  # of d1..d3, s12, s23, s13, t1..t3
+_ROWS, _COLUMNS = np.array(_ENTRIES).T
 
 
 def parameters_and_jacobian(theta) -> tuple[np.ndarray, np.ndarray]:
-    """The ten parameters of log_cholesky(theta) and their derivatives (10 x 10) by theta."""
+    """The ten parameters of log_cholesky(theta) and their derivatives (10 x 10) by theta
+    (or those of each row of a stack of them: (..., 10) -> (..., 10), (..., 10, 10))."""
+    theta = np.asarray(theta, dtype=float)
     U = _upper(theta)
-    derivatives = [U]  # d U / d alpha
-    for k, (row, column) in enumerate(_ENTRIES):
-        dU = np.zeros((4, 4))
-        dU[row, column] = U[row, column] if k < 3 else np.exp(theta[0])  # d e^(alpha + d) / dd; d (e^alpha s) / ds
-        derivatives.append(dU)
-    jacobian = np.column_stack([parameters_of(dU @ U.T + U @ dU.T) for dU in derivatives])
-    return parameters_of(U @ U.T), jacobian
+    dU = np.zeros((*theta.shape[:-1], 10, 4, 4))  # d U / d theta_k
+    dU[..., 0, :, :] = U  # d U / d alpha
+    # d e^(alpha + d) / dd on the diagonal; d (e^alpha s) / ds off it
+    scale = np.exp(theta[..., 0])[..., None]
+    dU[..., np.arange(1, 10), _ROWS, _COLUMNS] = np.where(np.arange(9) < 3, U[..., _ROWS, _COLUMNS], scale)
+    dU_Ut = dU @ np.swapaxes(U, -1, -2)[..., None, :, :]
+    jacobian = np.swapaxes(parameters_of(dU_Ut + np.swapaxes(dU_Ut, -1, -2)), -1, -2)  # d(U U^T) = dU U^T + U dU^T
+    return parameters_of(U @ np.swapaxes(U, -1, -2)), jacobian
 
 
 def log_cholesky_of(J: np.ndarray) -> np.ndarray:
@@ -174,9 +189,10 @@ def consistent_parameters(
         x = np.zeros(size)
         x[free] = unknowns
         pi, jacobian = np.empty(size), np.zeros((size, size))
+        links, link_jacobians = parameters_and_jacobian(x[:joints].reshape(n, INERTIAL_PARAMETERS))
+        pi[:joints] = links.ravel()
         for i in range(n):
-            block = _link(i)
-            pi[block], jacobian[block, block] = parameters_and_jacobian(x[block])
+            jacobian[_link(i), _link(i)] = link_jacobians[i]
         pi[joints:] = x[joints:]
         jacobian[joints:, joints:] = np.eye(JOINT_TERMS * n)
         return pi, jacobian[:, free]

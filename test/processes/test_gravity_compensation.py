@@ -56,7 +56,7 @@ def stamp(msg) -> int:
 def test_gravity_compensation_holds_the_arm(probe, process):  # noqa: F811
     states = {}  # by stamp: sim_node publishes a state again, same stamp, while no command answers it
     probe.create_subscription(JointState, "joint_states", lambda msg: states.__setitem__(stamp(msg), msg), 10000)
-    process(
+    sim = process(
         "irb140_dynamics.nodes.sim_node.node",
         *MODEL_ARGS,
         *("-p", f"initial_positions:={POSE}", "-p", f"reset_hold:={HOLD}"),
@@ -65,7 +65,7 @@ def test_gravity_compensation_holds_the_arm(probe, process):  # noqa: F811
     # Nothing steps before id_node answers: sim_node publishes its first state again every
     # lockstep_timeout. Once the probe has one, it is matched and will miss none of the loop.
     probe.spin_until(lambda: states, timeout=READY)
-    process(
+    controller = process(
         "irb140_dynamics.nodes.id_node.node",
         *MODEL_ARGS,
         *("-p", "effort_commands.enabled:=true", "-p", "effort_commands.source:=gravity"),
@@ -74,6 +74,8 @@ def test_gravity_compensation_holds_the_arm(probe, process):  # noqa: F811
     released = round(HOLD * 1e9)  # [ns] simulated: the startup hold ends, the commands apply
     end = released + round(DURATION * 1e9)
     probe.spin_until(lambda: states and max(states) >= end, timeout=READY + LOOP)
+    for node in (controller, sim):  # every state is in: the loop would go on at full speed during the checks
+        node.kill()
 
     held = [msg for s, msg in sorted(states.items()) if s <= released]
     assert all(msg.position.tolist() == POSE and not np.any(msg.effort) for msg in held)  # still at first

@@ -42,6 +42,13 @@ def install(tmp_path_factory) -> Path:
         timeout=300,
     )
     assert result.returncode == 0, result.stdout + result.stderr
+    # compiled once, as scripts/setup.sh compiles its install/: under PYTHONDONTWRITEBYTECODE
+    # each executable below would compile the modules it imports from source again
+    subprocess.run(
+        [sys.executable, "-m", "compileall", "-q", "-j", "0", str(work / "install" / "irb140_dynamics" / "lib")],
+        capture_output=True,
+        timeout=300,
+    )
     return work / "install"
 
 

@@ -116,7 +116,7 @@ def test_the_demo_stops_on_ctrl_c_and_writes_its_plot_where_it_says(tmp_path):
 def test_the_demo_with_a_duration_ends_by_itself_with_its_plot(tmp_path):
     """--duration S: S seconds of tracking figures, the first from a held arm, then the plot,
     every node stopped, exit 0."""
-    seconds = 3
+    seconds = 1
     process = run_script("--demo", "--duration", str(seconds), cwd=tmp_path)
     try:
         output, _ = communicate(process, BUILD_AND_START + 120)

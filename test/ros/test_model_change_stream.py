@@ -3,8 +3,8 @@ executor while the model before answers every joint state, then swapped in at on
 
 id_node runs on its own executor thread, as under ``ros2 run``; joint states come at up to
 1 kHz (never in bursts: a late publisher goes on from where it is) with a unique stamp each.
-Meanwhile a 100,000-link URDF is published (refused: far over the joint limit, after a
-parse that takes seconds), then a Panda replacing the UR5 in use, then parameter changes
+Meanwhile a 50,000-link URDF is published (refused: far over the joint limit, after a
+parse of about a second: twice the queue), then a Panda replacing the UR5 in use, then parameter changes
 (payload, gravity). Every stamp sent gets
 its gravity_torques, whatever the latency: a stall of the executor longer than the queue
 (qos.depth) would lose some.
@@ -34,8 +34,8 @@ from ..support.urdf_support import arm_text
 
 RATE = 1000.0  # Hz at most
 DEPTH = 500  # joint_states queue of the node: half a second at 1 kHz
-LINKS = 100_000
-SLOW = 600.0  # s: waits for the refusal (the parse of 20 MB of URDF on a busy machine)
+LINKS = 50_000  # 10 MB of URDF: its parse takes about a second, twice the queue (DEPTH)
+SLOW = 600.0  # s: waits for the refusal (the parse of 10 MB of URDF on a busy machine)
 TIMEOUT = 60.0  # s
 UR5_JOINTS = [
     "shoulder_pan_joint",
