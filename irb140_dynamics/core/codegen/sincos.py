@@ -247,7 +247,11 @@ def hoisted(assignments: list[tuple[str, str]]) -> list[tuple[str, str]]:
     thetas, angles, rest = _input_angles(assignments)
     if not thetas:
         return rest
-    names = ["_"] * (2 * len(thetas))
+    names, aliases = ["_"] * (2 * len(thetas)), []
     for var, function, i in angles:
-        names[i + (len(thetas) if function == "cosine" else 0)] = var
-    return [(", ".join(names), f"sin_cos_rows(({', '.join(thetas)},))"), *rest]
+        slot = i + (len(thetas) if function == "cosine" else 0)
+        if names[slot] == "_":
+            names[slot] = var
+        else:  # the same angle again (a mimic joint that follows at 1x): the value already named
+            aliases.append((var, names[slot]))
+    return [(", ".join(names), f"sin_cos_rows(({', '.join(thetas)},))"), *aliases, *rest]
