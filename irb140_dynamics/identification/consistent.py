@@ -89,16 +89,28 @@ def _upper(theta) -> np.ndarray:
 _ENTRIES = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))  # of d1..d3, s12, s23, s13, t1..t3
 
 
+_ROWS, _COLUMNS = np.array(_ENTRIES).T
+
+
 def parameters_and_jacobian(theta) -> tuple[np.ndarray, np.ndarray]:
     """The ten parameters of log_cholesky(theta) and their derivatives (10 x 10) by theta."""
     U = _upper(theta)
-    derivatives = [U]  # d U / d alpha
-    for k, (row, column) in enumerate(_ENTRIES):
-        dU = np.zeros((4, 4))
-        dU[row, column] = U[row, column] if k < 3 else np.exp(theta[0])  # d e^(alpha + d) / dd; d (e^alpha s) / ds
-        derivatives.append(dU)
-    jacobian = np.column_stack([parameters_of(dU @ U.T + U @ dU.T) for dU in derivatives])
+    derivatives = np.zeros((10, 4, 4))
+    derivatives[0] = U  # d U / d alpha
+    k = np.arange(9)
+    # d e^(alpha + d) / dd; d (e^alpha s) / ds
+    derivatives[1 + k, _ROWS, _COLUMNS] = np.where(k < 3, U[_ROWS, _COLUMNS], np.exp(theta[0]))
+    products = derivatives @ U.T
+    jacobian = _parameters_of_many(products + products.transpose(0, 2, 1)).T
     return parameters_of(U @ U.T), jacobian
+
+
+def _parameters_of_many(J: np.ndarray) -> np.ndarray:
+    """``parameters_of`` of each pseudo-inertia of J (K, 4, 4): (K, 10)."""
+    S = J[:, :3, :3]
+    trace = np.trace(S, axis1=1, axis2=2)
+    I = trace[:, None, None] * np.eye(3) - S
+    return np.column_stack([J[:, 3, 3], J[:, :3, 3], I[:, (0, 0, 1, 0, 1, 2), (0, 1, 1, 2, 2, 2)]])  # Ixx ... Izz
 
 
 def log_cholesky_of(J: np.ndarray) -> np.ndarray:
