@@ -94,15 +94,26 @@ _ROWS, _COLUMNS = np.array(_ENTRIES).T
 
 def parameters_and_jacobian(theta) -> tuple[np.ndarray, np.ndarray]:
     """The ten parameters of log_cholesky(theta) and their derivatives (10 x 10) by theta."""
-    U = _upper(theta)
-    derivatives = np.zeros((10, 4, 4))
-    derivatives[0] = U  # d U / d alpha
+    pi10, jacobian = parameters_and_jacobians(np.asarray(theta, dtype=float)[None])
+    return pi10[0], jacobian[0]
+
+
+def parameters_and_jacobians(thetas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``parameters_and_jacobian`` of each row of thetas (L, 10): (L, 10), (L, 10, 10)."""
+    L = len(thetas)
+    alpha, d, s, t = thetas[:, 0], thetas[:, 1:4], thetas[:, 4:7], thetas[:, 7:]
+    U = np.zeros((L, 4, 4))
+    U[:, [0, 1, 2], [0, 1, 2]], U[:, [0, 1, 0], [1, 2, 2]], U[:, :3, 3], U[:, 3, 3] = np.exp(d), s, t, 1.0
+    U *= np.exp(alpha)[:, None, None]
+    derivatives = np.zeros((L, 10, 4, 4))
+    derivatives[:, 0] = U  # d U / d alpha
     k = np.arange(9)
     # d e^(alpha + d) / dd; d (e^alpha s) / ds
-    derivatives[1 + k, _ROWS, _COLUMNS] = np.where(k < 3, U[_ROWS, _COLUMNS], np.exp(theta[0]))
-    products = derivatives @ U.T
-    jacobian = _parameters_of_many(products + products.transpose(0, 2, 1)).T
-    return parameters_of(U @ U.T), jacobian
+    derivatives[:, 1 + k, _ROWS, _COLUMNS] = np.where(k < 3, U[:, _ROWS, _COLUMNS], np.exp(alpha)[:, None])
+    Ut = U.transpose(0, 2, 1)
+    products = derivatives @ Ut[:, None]
+    jacobian = _parameters_of_many((products + products.transpose(0, 1, 3, 2)).reshape(-1, 4, 4))
+    return _parameters_of_many(U @ Ut), jacobian.reshape(L, 10, 10).transpose(0, 2, 1)
 
 
 def _parameters_of_many(J: np.ndarray) -> np.ndarray:
@@ -186,9 +197,10 @@ def consistent_parameters(
         x = np.zeros(size)
         x[free] = unknowns
         pi, jacobian = np.empty(size), np.zeros((size, size))
+        links, derivatives = parameters_and_jacobians(x[:joints].reshape(n, INERTIAL_PARAMETERS))
+        pi[:joints] = links.ravel()
         for i in range(n):
-            block = _link(i)
-            pi[block], jacobian[block, block] = parameters_and_jacobian(x[block])
+            jacobian[_link(i), _link(i)] = derivatives[i]
         pi[joints:] = x[joints:]
         jacobian[joints:, joints:] = np.eye(JOINT_TERMS * n)
         return pi, jacobian[:, free]
