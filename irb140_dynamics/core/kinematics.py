@@ -120,6 +120,51 @@ def flange_jacobian(model: RobotModel, q) -> np.ndarray:
     return _flange_jacobian(model, link_frames(model, q))
 
 
+def flange_jacobians(model: RobotModel, Q) -> np.ndarray:
+    """``flange_jacobian`` at each pose of Q (N, n): (N, 6, n), the same numbers; on a chain
+    without mimic joints one pass of forward kinematics per joint over all the poses."""
+    Q = np.asarray(Q, dtype=float)
+    if Q.ndim != 2 or Q.shape[1] != model.n:
+        raise ValueError(f"Q: expected poses shaped (N, {model.n}), got {Q.shape}")
+    if model.mimics is not None or not model.is_chain:
+        return np.array([flange_jacobian(model, q) for q in Q]).reshape(len(Q), 6, model.n)
+    N = len(Q)
+    frames = [np.broadcast_to(np.eye(4), (N, 4, 4))]
+    for i, (pre, post, axis, offset, prismatic) in enumerate(_placements(model)):
+        move = np.broadcast_to(np.eye(4), (N, 4, 4)).copy()
+        if prismatic:
+            move[:, :3, 3] = axis * Q[:, i, None]
+        else:
+            move[:] = _turns(axis, Q[:, i] + offset)
+        frames.append(frames[-1] @ (pre @ move @ post))
+    flange = (frames[model.carrier + 1] @ _flange_matrix(model))[:, :3, 3]
+    J = np.empty((N, 6, model.n))
+    for i, (frame, (pre, _, turning_axis, _, prismatic)) in enumerate(zip(frames[:-1], _placements(model))):
+        joint_frame = frame @ pre
+        axis, origin = joint_frame[:, :3, :3] @ turning_axis, joint_frame[:, :3, 3]
+        if prismatic:
+            J[:, :3, i], J[:, 3:, i] = axis, 0.0
+            continue
+        (ax, ay, az), (rx, ry, rz) = axis.T, (flange - origin).T
+        J[:, :3, i] = np.stack([ay * rz - az * ry, az * rx - ax * rz, ax * ry - ay * rx], axis=1)
+        J[:, 3:, i] = axis
+    return J
+
+
+def _turns(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """``_turn`` of each angle (N,): (N, 4, 4), cos and sin by the math module as there."""
+    x, y, z = axis.tolist()
+    c = np.array([math.cos(a) for a in angles.tolist()])
+    s = np.array([math.sin(a) for a in angles.tolist()])
+    v = 1.0 - c
+    M = np.zeros((len(angles), 4, 4))
+    M[:, 0, 0], M[:, 0, 1], M[:, 0, 2] = c + v * x * x, v * x * y - s * z, v * x * z + s * y
+    M[:, 1, 0], M[:, 1, 1], M[:, 1, 2] = v * x * y + s * z, c + v * y * y, v * y * z - s * x
+    M[:, 2, 0], M[:, 2, 1], M[:, 2, 2] = v * x * z - s * y, v * y * z + s * x, c + v * z * z
+    M[:, 3, 3] = 1.0
+    return M
+
+
 def flange_pose_and_jacobian(model: RobotModel, q) -> tuple[np.ndarray, np.ndarray]:
     """``flange_pose`` and ``flange_jacobian`` from one pass of forward kinematics."""
     frames = link_frames(model, q)

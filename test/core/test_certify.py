@@ -74,6 +74,26 @@ def test_interval_arithmetic_encloses_the_exact_results():
                     assert Fraction(float(lo)) <= exact <= Fraction(float(hi))
 
 
+def test_interval_arrays_round_as_their_elements_do_bit_for_bit():
+    """On arrays (wide intervals, points, mixed; zeros, subnormals, huge and infinite
+    values) + and * give each element's interval exactly as on that element alone."""
+    rng = np.random.default_rng(2)
+    special = np.array([0.0, -0.0, 5e-324, -5e-324, 2.2250738585072014e-308, 1.7976931348623157e308, np.inf, -np.inf])
+    values = np.concatenate([rng.normal(size=200) * 10.0 ** rng.integers(-300, 300, 200), special])
+    width = np.abs(rng.normal(size=values.size)) * np.where(rng.random(values.size) < 0.5, 0.0, 1.0)
+    point, wide = Interval(values), Interval(values - width, values + width)
+    other = Interval(rng.permutation(values))
+    with np.errstate(all="ignore"):
+        for x, y in ((wide, other), (point, other), (other, wide), (wide, wide), (point, 3.0)):
+            for result, element in ((x * y, lambda a, b: a * b), (x + y, lambda a, b: a + b)):
+                for i in range(values.size):
+                    a = Interval(float(x.lo[i]), float(x.hi[i]))
+                    b = Interval(float(y.lo[i]), float(y.hi[i])) if isinstance(y, Interval) else y
+                    alone = element(a, b)
+                    for got, expected in ((result.lo[i], alone.lo), (result.hi[i], alone.hi)):
+                        assert np.array_equal(got, expected, equal_nan=True), (i, got, expected)
+
+
 @pytest.mark.parametrize("fn", ["cos", "sin"])
 def test_interval_cos_and_sin_enclose_their_range(fn):
     rng = np.random.default_rng(2)

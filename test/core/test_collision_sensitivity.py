@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from irb140_dynamics.core import flange_pose, irb140, rnea, rnea_batch
+from irb140_dynamics.core.kinematics import flange_jacobian, flange_jacobians
 from irb140_dynamics.core.monitoring.sensitivity import (
     AXES,
     CalibrationError,
@@ -38,6 +39,19 @@ def prismatic_arm():
 
 
 ARMS = {"irb140": irb140, "ur5": ur5, "prismatic": prismatic_arm}
+
+
+@pytest.mark.parametrize("name", sorted(ARMS))
+def test_the_poses_jacobians_at_once_are_each_pose_s_bit_for_bit(name):
+    """``flange_jacobians`` (what DetectableForces.add uses) is ``flange_jacobian`` at each pose,
+    the same numbers; a shape that is not (N, n) poses is refused."""
+    model = ARMS[name]()
+    lower, upper = np.array([j.position_limits for j in model.joints]).T
+    Q = lower + np.random.default_rng(3).random((40, model.n)) * (upper - lower)
+    assert np.array_equal(flange_jacobians(model, Q), np.array([flange_jacobian(model, q) for q in Q]))
+    assert flange_jacobians(model, Q[:0]).shape == (0, 6, model.n)
+    with pytest.raises(ValueError, match="poses shaped"):
+        flange_jacobians(model, Q[:, :-1])
 
 
 def external_torques(model, q, force):

@@ -20,10 +20,17 @@ from ..support.common import random_model
 PHI = np.linspace(-math.pi, math.pi, 361)
 
 
-def largest_over_phi(a, X, Y):
-    """max over phi of |a + X cos(phi) + Y sin(phi)| per row, (P, 3) each: (P,)."""
-    c, s = np.cos(PHI)[:, None, None], np.sin(PHI)[:, None, None]
-    return np.linalg.norm(a + c * X + s * Y, axis=2).max(axis=0)
+def largest_over_phi(a, X, Y, rows=1000):
+    """max over phi of |a + X cos(phi) + Y sin(phi)| per row, (P, 3) each: (P,). The square
+    is a quadratic form in (1, cos, sin) of the rows' dot products; ``rows`` at a time."""
+    c, s = np.cos(PHI)[:, None], np.sin(PHI)[:, None]
+    largest = []
+    for first in range(0, len(a), rows):
+        u, v, w = a[first : first + rows], X[first : first + rows], Y[first : first + rows]
+        dot = [np.einsum("pk,pk->p", p, q) for p, q in ((u, u), (u, v), (u, w), (v, v), (v, w), (w, w))]
+        squared = dot[0] + 2 * c * dot[1] + 2 * s * dot[2] + c * c * dot[3] + 2 * c * s * dot[4] + s * s * dot[5]
+        largest.append(np.sqrt(np.maximum(squared.max(axis=0), 0.0)))
+    return np.concatenate(largest)
 
 
 @pytest.mark.parametrize("z, l", [(0.0, 0.1), (0.2, 0.15)])

@@ -21,6 +21,7 @@ from irb140_dynamics.core.urdf import load_urdf
 from irb140_dynamics.tools import excitation as excitation_tool
 from irb140_dynamics.tools import identify as identify_tool
 
+from ..support.common import load_yaml
 from ..support.paths import CONFIG, ROOT
 from ..support.simulated_ur5 import BASE, TIP, UR5_URDF, excitation, true_ur5, write_csv
 
@@ -115,7 +116,7 @@ def test_excitation_for_a_urdf_arm(tmp_path):
     arguments = ["--out", str(out), "--urdf", str(UR5_URDF), "--base", BASE, "--tip", TIP, "--iterations", "0"]
     with contextlib.redirect_stdout(io.StringIO()):
         assert excitation_tool.main(arguments) == 0
-    document = yaml.safe_load(out.read_text())
+    document = load_yaml(out.read_text())
     assert document["joint_names"] == list(true_ur5().joint_names)
 
 

@@ -10,7 +10,6 @@ import re
 
 import numpy as np
 import pytest
-import yaml
 
 from irb140_dynamics.core import RigidBody, rnea_batch
 from irb140_dynamics.core.io.params_file import load_model, read_parameter_file
@@ -19,6 +18,7 @@ from irb140_dynamics.tools import excitation as excitation_tool
 from irb140_dynamics.tools import identify as identify_tool
 from irb140_dynamics.tools import retime as retime_tool
 
+from ..support.common import load_yaml
 from ..support.paths import CONFIG, ROOT
 from ..support.simulated_ur5 import write_csv
 
@@ -28,7 +28,7 @@ PAYLOAD = RigidBody(3.0, (0.05, 0.03, 0.08), (0.02, 0.03, 0.015, 0.004, -0.002, 
 
 
 def points_of(path):
-    document = yaml.safe_load(path.read_text())
+    document = load_yaml(path.read_text())
     t = np.array([p["time_from_start"]["sec"] + 1e-9 * p["time_from_start"]["nanosec"] for p in document["points"]])
     fields = ("positions", "velocities", "accelerations")
     return document, t, *(np.array([p[f] for p in document["points"]]) for f in fields)
@@ -93,7 +93,7 @@ def test_retime_and_the_trajectory_check_use_the_identified_inertia(workflow, id
     from irb140_dynamics.nodes.trajectory_check_node.node import draft
 
     _, motion, _, _, load = workflow
-    trajectory = Trajectory.from_message(yaml.safe_load(motion.read_text()), identified.joint_names)
+    trajectory = Trajectory.from_message(load_yaml(motion.read_text()), identified.joint_names)
     point_mass = identified.with_payload(RigidBody(identified.payload.mass, identified.payload.com))
     torques = [p for p in check_trajectory(identified, trajectory).peaks if p.quantity == "torque"]
     without = [p for p in check_trajectory(point_mass, trajectory).peaks if p.quantity == "torque"]
@@ -366,7 +366,7 @@ def test_a_wrist_without_an_acceleration_limit_is_taken_to_reach_its_speed_in_a_
             )
             == 0
         )
-        document = yaml.safe_load(out.read_text())
+        document = load_yaml(out.read_text())
         QDD = np.array([p["accelerations"] for p in document["points"]])
         return np.abs(QDD).max(axis=0)[3:], capsys.readouterr().out, out.read_text()
 

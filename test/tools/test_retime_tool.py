@@ -7,13 +7,13 @@ import sys
 
 import numpy as np
 import pytest
-import yaml
 
 from irb140_dynamics.core import irb140
 from irb140_dynamics.core.io.trajectory_file import joint_trajectory_yaml
 from irb140_dynamics.core.trajectories import Trajectory
 from irb140_dynamics.tools.retime import OVER_LIMIT, main
 
+from ..support.common import load_yaml
 from ..support.paths import CONFIG, ROOT
 from ..support.trajectories import smooth_trajectory
 
@@ -45,7 +45,7 @@ def test_retime_writes_the_retimed_trajectory_and_the_plot(tmp_path, capsys):
     assert main(["--params-file", str(CONFIG), "--payload-mass", "6", source, str(out), "--plot", str(plot)]) == 0
     printed = capsys.readouterr().out
     assert "derived" in printed and "re-timed:" in printed and "within every limit" in printed
-    result = Trajectory.from_message(yaml.safe_load(out.read_text()), irb140().joint_names)
+    result = Trajectory.from_message(load_yaml(out.read_text()), irb140().joint_names)
     knots = [np.flatnonzero((result.q == q).all(axis=1))[0] for q in tr.q]
     assert knots == sorted(knots) and knots[0] == 0 and knots[-1] == len(result.t) - 1  # same points, in order
     assert result.duration < tr.duration and result.has_qd.all()
@@ -138,7 +138,7 @@ def test_a_urdf_arm_with_the_params_files_globals(tmp_path, capsys):
     assert main([*args, source, str(out)]) == 0
     printed = capsys.readouterr().out
     assert "re-timed:" in printed and "within every limit" in printed and "derived" not in printed  # URDF efforts
-    result = Trajectory.from_message(yaml.safe_load(out.read_text()), model.joint_names)
+    result = Trajectory.from_message(load_yaml(out.read_text()), model.joint_names)
     assert result.duration < tr.duration
 
 

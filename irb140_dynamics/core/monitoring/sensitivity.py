@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from irb140_dynamics.core.kinematics import flange_jacobian
+from irb140_dynamics.core.kinematics import flange_jacobian, flange_jacobians
 from irb140_dynamics.core.model.joints import MAX_TORQUE_LIMIT
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.monitoring.collision import DEFAULT_GAIN, MAX_GAIN, MIN_GAIN, OBSERVER_GAP
@@ -39,6 +39,7 @@ from irb140_dynamics.core.monitoring.observer import MomentumObserver
 
 DEFAULT_MARGIN = 1.5  # threshold = margin x the largest |r_j| recorded
 AXES = ("+x", "-x", "+y", "-y", "+z", "-z")  # the base frame's directions, in print order
+_POSES = 4096  # poses' Jacobians made at once
 UNFELT = 1e-12  # a joint loaded by less than this per N (m) does not feel the force
 
 
@@ -160,8 +161,13 @@ class DetectableForces:
 
     def add(self, time, q) -> None:
         """Poses (time (N,) [s], q (N, n)), each with finite values."""
-        for t, pose in zip(np.asarray(time, dtype=float), np.asarray(q, dtype=float)):
-            load = np.abs(flange_jacobian(self.model, pose)[:3])  # (3, n): N m (N) per N along x, y, z
+        time, q = np.asarray(time, dtype=float), np.asarray(q, dtype=float)
+        for first in range(0, len(time), _POSES):
+            self._add(time[first : first + _POSES], flange_jacobians(self.model, q[first : first + _POSES]))
+
+    def _add(self, time, jacobians) -> None:
+        for t, jacobian in zip(time, jacobians):
+            load = np.abs(jacobian[:3])  # (3, n): N m (N) per N along x, y, z
             felt = np.where(load > UNFELT, load, 0.0) / self.thresholds  # 1/N
             joint = felt.argmax(axis=1)
             sensitivity = felt[np.arange(3), joint]

@@ -56,7 +56,7 @@ class Interval:
             return self
         else:
             lo, hi = self.lo + other, self.hi + other
-        return Interval(np.nextafter(lo, _DOWN), np.nextafter(hi, _UP))
+        return _outward(lo, hi)
 
     __radd__ = __add__
 
@@ -68,9 +68,25 @@ class Interval:
 
     def __mul__(self, other):
         if isinstance(other, Interval):
-            products = (self.lo * other.lo, self.lo * other.hi, self.hi * other.lo, self.hi * other.hi)
-            lo = np.minimum(np.minimum(products[0], products[1]), np.minimum(products[2], products[3]))
-            hi = np.maximum(np.maximum(products[0], products[1]), np.maximum(products[2], products[3]))
+            if self.lo is self.hi and other.lo is other.hi:  # two points: one product
+                product = self.lo * other.lo
+                return _outward(product, product)
+            if other.lo is other.hi or self.lo is self.hi:  # a point: two products
+                point, wide = (other, self) if other.lo is other.hi else (self, other)
+                a, b = wide.lo * point.lo, wide.hi * point.lo
+                if _fresh(a, b):
+                    lo = np.minimum(a, b)
+                    return _outward(lo, np.maximum(a, b, out=a))
+                return _outward(np.minimum(a, b), np.maximum(a, b))
+            p0, p1, p2, p3 = self.lo * other.lo, self.lo * other.hi, self.hi * other.lo, self.hi * other.hi
+            if _fresh(p0, p1, p2, p3):  # (the same values, fewer arrays made)
+                lo = np.minimum(p0, p1)
+                hi = np.maximum(p0, p1, out=p0)
+                np.minimum(lo, np.minimum(p2, p3, out=p1), out=lo)
+                np.maximum(hi, np.maximum(p2, p3, out=p2), out=hi)
+                return _outward(lo, hi)
+            lo = np.minimum(np.minimum(p0, p1), np.minimum(p2, p3))
+            hi = np.maximum(np.maximum(p0, p1), np.maximum(p2, p3))
         elif np.ndim(other) == 0:
             if other == 0:
                 return 0.0
@@ -82,7 +98,7 @@ class Interval:
         else:
             a, b = self.lo * other, self.hi * other
             lo, hi = np.minimum(a, b), np.maximum(a, b)
-        return Interval(np.nextafter(lo, _DOWN), np.nextafter(hi, _UP))
+        return _outward(lo, hi)
 
     __rmul__ = __mul__
 
@@ -93,6 +109,41 @@ class Interval:
     def sin(self) -> Interval:
         """An enclosure of sin over [lo, hi] (cos shifted by pi/2)."""
         return _trig(np.sin, self.lo, self.hi, math.pi / 2)
+
+
+def _outward(lo, hi) -> Interval:
+    """[lo, hi] widened by an ulp each way; lo and hi are the caller's own (changed in place
+    where float arrays; the same array for both is taken as a point)."""
+    if isinstance(lo, np.ndarray) and isinstance(hi, np.ndarray) and lo.dtype == hi.dtype == np.float64:
+        if lo is hi:
+            hi = lo.copy()
+        return Interval(_step(lo, -1), _step(hi, 1))
+    return Interval(np.nextafter(lo, _DOWN), np.nextafter(hi, _UP))
+
+
+_EXPONENT = 0x7FF0000000000000  # a double's exponent bits: all set for inf and nan
+
+
+def _step(x: np.ndarray, direction: int) -> np.ndarray:
+    """x (float64, changed in place) one ulp up (direction 1) or down (-1): np.nextafter
+    toward +-inf, bit for bit, at a fraction of its cost. A finite nonzero double's
+    neighbour is its bit pattern as an integer plus or minus one (by its sign); zeros,
+    infinities and nans are left to np.nextafter."""
+    bits = x.view(np.int64)
+    special = ((bits & _EXPONENT) == _EXPONENT) | ((bits << 1) == 0)
+    held = x[special]
+    bits += direction * ((bits >> 63) | 1)
+    if held.size:
+        x[special] = np.nextafter(held, direction * np.inf)
+    return x
+
+
+def _fresh(*arrays) -> bool:
+    """Are these arrays of one shape and type (results of products: the caller's own)?"""
+    first = arrays[0]
+    return isinstance(first, np.ndarray) and all(
+        isinstance(a, np.ndarray) and a.shape == first.shape and a.dtype == np.float64 for a in arrays
+    )
 
 
 def _is_zero(x) -> bool:

@@ -29,6 +29,7 @@ import numpy as np
 
 U = np.finfo(float).eps / 2  # unit roundoff
 _WIDE = 3.0  # rad: a half-width past which 1 - cos t is bounded by its size alone
+_CELLS = 1 << 16  # coefficients expanded at once (512 kB)
 
 
 def rounding(d: int) -> float:
@@ -44,10 +45,16 @@ def expand(coefficients, centre):
     M[:, :, 0, 0] = 1.0
     M[:, :, 1, 0], M[:, :, 1, 1], M[:, :, 1, 2] = c, -c, -s
     M[:, :, 2, 0], M[:, :, 2, 1], M[:, :, 2, 2] = s, -s, c
-    D = coefficients
-    for k in range(d - 1, -1, -1):  # the last joint first; each pass turns the axes once
-        D = np.matmul(D.reshape(B, -1, 3), M[:, k]).transpose(0, 2, 1).reshape(B, -1)
-    return D
+    coefficients = np.asarray(coefficients, dtype=float)
+    result = np.empty((B, 3**d))
+    step = max(1, _CELLS // 3**d)
+    for first in range(0, B, step):  # a few boxes at a time: each pass's copy stays in the caches
+        rows = slice(first, first + step)
+        D = coefficients[rows]
+        for k in range(d - 1, -1, -1):  # the last joint first; each pass turns the axes once
+            D = np.matmul(D.reshape(D.shape[0], -1, 3), M[rows, k]).transpose(0, 2, 1).reshape(D.shape[0], -1)
+        result[rows] = D
+    return result
 
 
 def sizes(radius):
