@@ -110,7 +110,11 @@ def test_no_joint_state_goes_unanswered_while_the_payload_changes_every_100_ms(p
         streaming.clear()
         streamer.join(TIMEOUT)
     total = before + sent[0]
-    probe.spin_until(lambda: counts.get("joint_states.received", 0) >= total, TIMEOUT)  # the node's next reports
+    try:  # the node's next reports
+        probe.spin_until(lambda: counts.get("joint_states.received", 0) >= total, TIMEOUT)
+    except AssertionError:
+        lost = total - counts.get("joint_states.received", 0)
+        pytest.fail(f"{lost} of {sent[0]} joint states never reached id_node (its counts: {dict(counts)})")
     reports = counts["reports"]
     probe.spin_until(lambda: counts["reports"] >= reports + 1, TIMEOUT)  # and one more: nothing still coming
     assert sent[0] >= CHANGES * RATE * CHANGE_PERIOD
