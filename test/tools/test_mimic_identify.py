@@ -30,7 +30,7 @@ from irb140_dynamics.tools import excitation, identify
 from ..core.test_regressor_mimic import MIMIC_CHAIN
 from ..core.test_urdf_trees import TWO_ARMS
 from ..support.simulated_ur5 import write_csv
-from .test_tree_identify_retime import gravity_batch, other_motion, run
+from .test_tree_identify_retime import errors_on_another_motion, gravity_batch, run
 
 RATE = 200.0  # Hz: the recording
 
@@ -109,12 +109,7 @@ def test_identify_fits_an_arm_with_mimic_joints_from_its_excitation(tmp_path, ca
     assert status == 0, err
     identified = RobotModel.from_params(read_parameter_file(out))
     assert identified.joint_names == prior.joint_names and identified.mimics == prior.mimics
-    Qo, QDo, QDDo = other_motion(prior)
-    truth = rnea_batch(true, Qo, QDo, QDDo)
-    peak = np.abs(truth).max(axis=0)
-    error = np.sqrt(np.mean((rnea_batch(identified, Qo, QDo, QDDo) - truth) ** 2, axis=0)) / peak
-    before = np.sqrt(np.mean((rnea_batch(prior, Qo, QDo, QDDo) - truth) ** 2, axis=0)) / peak
-    print(f"RMS torque error / peak on another motion: prior {np.round(before, 3)}, identified {np.round(error, 3)}")
+    error, before, Qo = errors_on_another_motion(true, prior, identified)
     assert np.all(error <= 0.05), error
     assert np.sqrt(np.mean(error**2)) * 3 <= np.sqrt(np.mean(before**2))
     back = load_urdf((tmp_path / "identified.urdf").read_text()).model  # the identified arm as URDF:

@@ -89,6 +89,19 @@ def other_motion(model: RobotModel):
     return shaped(free, model.n, 4, 6.0, limits).evaluate(np.arange(0.0, 6.0, 0.01))
 
 
+def errors_on_another_motion(true: RobotModel, prior: RobotModel, identified: RobotModel):
+    """(identified, prior): each joint's RMS torque error against the true arm's on
+    ``other_motion``, over that joint's peak torque; and the motion's positions."""
+    Q, QD, QDD = other_motion(prior)
+    truth = rnea_batch(true, Q, QD, QDD)
+    peak = np.abs(truth).max(axis=0)
+    error, before = (
+        np.sqrt(np.mean((rnea_batch(m, Q, QD, QDD) - truth) ** 2, axis=0)) / peak for m in (identified, prior)
+    )
+    print(f"RMS torque error / peak on another motion: prior {np.round(before, 3)}, identified {np.round(error, 3)}")
+    return error, before, Q
+
+
 def test_identify_fits_a_whole_tree_from_one_recording_of_its_excitation(tmp_path, capsys):
     urdf = tmp_path / "two_arms.urdf"
     urdf.write_text(_without_mimics(TWO_ARMS))
@@ -108,12 +121,7 @@ def test_identify_fits_a_whole_tree_from_one_recording_of_its_excitation(tmp_pat
     assert "the tree below base" in printed
     identified = RobotModel.from_params(read_parameter_file(out))
     assert identified.joint_names == prior.joint_names and identified.parent == prior.parent
-    Q, QD, QDD = other_motion(prior)
-    truth = rnea_batch(true, Q, QD, QDD)
-    peak = np.abs(truth).max(axis=0)
-    error = np.sqrt(np.mean((rnea_batch(identified, Q, QD, QDD) - truth) ** 2, axis=0)) / peak
-    before = np.sqrt(np.mean((rnea_batch(prior, Q, QD, QDD) - truth) ** 2, axis=0)) / peak
-    print(f"RMS torque error / peak on another motion: prior {np.round(before, 3)}, identified {np.round(error, 3)}")
+    error, before, Q = errors_on_another_motion(true, prior, identified)
     assert np.all(error <= 0.1), error
     assert np.sqrt(np.mean(error**2)) * 3 <= np.sqrt(np.mean(before**2))
     back = load_urdf((tmp_path / "identified.urdf").read_text()).model  # the identified tree as URDF:
