@@ -1,10 +1,10 @@
 """Test session setup: DDS isolated to this machine and to this session's own domain, a
-cache of native kernels of its own, Ctrl-C as from a terminal, and the markers of the test
+cache of native kernels of the run's own, Ctrl-C as from a terminal, and the markers of the test
 folders: test/ros/ spins nodes (``ros``), test/processes/ starts executables (``process``).
 
 Under pytest-xdist (``-n 2``) each worker is a session of its own: a domain of its own (the
 run's first domain plus the worker's number, the run's drawn once by the process that starts
-the workers, which they inherit) and a kernel cache of its own."""
+the workers, which they inherit); the run's kernel cache is one, shared by its workers."""
 
 import os
 import random
@@ -22,10 +22,13 @@ assert WORKER < WORKERS_AT_MOST, f"at most {WORKERS_AT_MOST} pytest-xdist worker
 os.environ["ROS_DOMAIN_ID"] = str(FIRST_DOMAIN + WORKER)
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ.pop("ROS_STATIC_PEERS", None)
-# Native kernels (irb140_dynamics.native) compiled by this session into a folder of its own,
-# not into the user's cache: a test sees its own compiles, and leaves nothing behind.
-_CACHE = tempfile.TemporaryDirectory(prefix="irb140_kernels_")
-os.environ["IRB140_CACHE"] = _CACHE.name
+# Native kernels (irb140_dynamics.native) compiled by this run into a folder of its own (the
+# root conftest.py's, shared by the run's workers), not into the user's cache: nothing is
+# left behind.
+if "IRB140_TEST_CACHE" not in os.environ:
+    _CACHE = tempfile.TemporaryDirectory(prefix="irb140_kernels_")
+    os.environ["IRB140_TEST_CACHE"] = _CACHE.name
+os.environ["IRB140_CACHE"] = os.environ["IRB140_TEST_CACHE"]
 # A run started with SIGINT ignored (a background job of a script, nohup, some CI runners)
 # passes the ignoring on to every process it starts: run.sh could not trap the tests'
 # Ctrl-C, nor Python turn it into KeyboardInterrupt. A handler here is reset to the default
