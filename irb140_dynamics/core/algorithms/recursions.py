@@ -37,12 +37,11 @@ from functools import lru_cache
 
 import numpy as np
 
+from irb140_dynamics.core.algorithms.rotations import Rotation, _combination, fused, rotate, rotate_back, turn  # noqa: F401 (part of this module's interface)
 from irb140_dynamics.core.algorithms.topology import ancestors, children, parents  # noqa: F401 (part of this module's interface)
 from irb140_dynamics.core.model.joints import Z_AXIS, snap
 from irb140_dynamics.core.model.rigid_body import ZERO3, Inertia6, Vector3, shift_inertia
 from irb140_dynamics.core.scalars.dual import Dual  # noqa: F401 (part of this module's interface)
-
-Rotation = tuple[tuple[float, float, float], ...]
 
 
 @dataclass(frozen=True)
@@ -156,44 +155,6 @@ def gyroscopic(link: Link, w):
     return cross(w, inertia_times(link.I, w))
 
 
-def _combination(terms):
-    """sum of coef * x, with the constant coefficients 0 and +-1 left out."""
-    total = None
-    for coef, x in terms:
-        if isinstance(coef, float):
-            if coef == 0.0:
-                continue
-            term = x if coef == 1.0 else -x if coef == -1.0 else coef * x
-        else:
-            term = coef * x
-        total = term if total is None else total + term
-    return 0.0 if total is None else total
-
-
-def rotate(R, v):
-    """R v."""
-    return tuple(_combination(zip(R[j], v)) for j in range(3))
-
-
-def rotate_back(R, v):
-    """R^T v."""
-    return tuple(_combination((R[k][j], v[k]) for k in range(3)) for j in range(3))
-
-
-def turn(u, c, s) -> Rotation:
-    """Rot(u, theta) = c (1 - u u^T) + s [u]x + u u^T, given c, s of theta."""
-    skew = ((0.0, -u[2], u[1]), (u[2], 0.0, -u[0]), (-u[1], u[0], 0.0))
-    rows = []
-    for j in range(3):
-        row = []
-        for k in range(3):
-            outer = u[j] * u[k]
-            entry = _combination((((1.0 if j == k else 0.0) - outer, c), (skew[j][k], s)))
-            row.append(entry + outer if outer else entry)
-        rows.append(tuple(row))
-    return tuple(rows)
-
-
 def to_child(link: Link, rot, v):
     """R_i^T v: a vector of frame i-1 expressed in frame i (R_i = R0 Rot R1, rot = Rot, None
     for a prismatic joint)."""
@@ -237,7 +198,7 @@ def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3, at: int = -1):
     its frame, the moment taken about its origin (see ``flange_wrench``); tau balances it (a load pressing
     on the flange raises tau like a weight would). Friction is not included.
     """
-    moves = steps(links, cs)
+    links, moves = fused(links, cs, steps(links, cs))
     motion = forward_motion(links, moves, qd, qdd, gravity)
     parent = parents(links)
     tau = [0.0] * len(links)
@@ -248,10 +209,10 @@ def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3, at: int = -1):
     for i in reversed(range(len(links))):
         link, (w, dw, a) = links[i], motion[i]
         f, n = carried[i] or (ZERO3, ZERO3)
-        force = add(scale(link.m, a), cross(dw, link.h), cross(w, cross(w, link.h)))
+        force = add(cross(w, cross(w, link.h)), cross(dw, link.h), scale(link.m, a))
         moment = add(inertia_times(link.I, dw), gyroscopic(link, w), cross(link.h, a))
         f = add(force, f)
-        n = add(moment, n, cross(link.p, f))
+        n = add(moment, cross(link.p, f), n)
         tau[i] = dot(link.b, f if link.prismatic else n) + link.armature * qdd[i]
         if parent[i] >= 0:
             gather(carried, parent[i], to_parent_wrench(link, moves[i], f, n))
@@ -275,7 +236,7 @@ def forward_motion(links, moves, qd, qdd, gravity, at_joints=False):
     for i, (link, (rot, p0), qd_i, qdd_i) in enumerate(zip(links, moves, qd, qdd)):
         w, dw, a = base if parent[i] < 0 else at_origins[parent[i]]
         if p0 is not None:  # the joint origin's acceleration, in frame i-1
-            a = add(a, cross(dw, p0), cross(w, cross(w, p0)))
+            a = add(cross(dw, p0), cross(w, cross(w, p0)), a)
         if link.prismatic:  # sliding: qdd e, and Coriolis 2 w x (qd e)
             a = add(a, scale(qdd_i, link.e), cross(scale(2.0 * qd_i, w), link.e))
             w, dw = to_child(link, None, w), to_child(link, None, dw)
@@ -284,7 +245,7 @@ def forward_motion(links, moves, qd, qdd, gravity, at_joints=False):
             w = add(w_parent, scale(qd_i, link.b))
             dw = add(to_child(link, rot, dw), scale(qdd_i, link.b), cross(w_parent, scale(qd_i, link.b)))
         a_joint = to_child(link, rot, a)
-        a = add(a_joint, cross(dw, link.p), cross(w, cross(w, link.p)))
+        a = add(cross(dw, link.p), cross(w, cross(w, link.p)), a_joint)
         at_origins.append((w, dw, a))
         motion.append((w, dw, a_joint if at_joints else a))
     return motion
