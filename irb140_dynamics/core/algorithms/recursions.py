@@ -37,7 +37,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from irb140_dynamics.core.algorithms.rotations import Rotation, _combination, fused, rotate, rotate_back, turn  # noqa: F401 (part of this module's interface)
+from irb140_dynamics.core.algorithms.rotations import Rotation, combination, fused, rotate, rotate_back, turn  # noqa: F401 (part of this module's interface)
 from irb140_dynamics.core.algorithms.topology import ancestors, children, parents  # noqa: F401 (part of this module's interface)
 from irb140_dynamics.core.model.joints import Z_AXIS, snap
 from irb140_dynamics.core.model.rigid_body import ZERO3, Inertia6, Vector3, shift_inertia
@@ -329,7 +329,7 @@ def _one_turn(link: Link, rot):
 
 def _product(A, B) -> Rotation:
     """A B, the constants 0 and +-1 left out."""
-    return tuple(tuple(_combination((A[j][k], B[k][l]) for k in range(3)) for l in range(3)) for j in range(3))
+    return tuple(tuple(combination((A[j][k], B[k][l]) for k in range(3)) for l in range(3)) for j in range(3))
 
 
 def _rotate_inertia(link, rot, inertia):

@@ -9,7 +9,7 @@ from dataclasses import replace
 Rotation = tuple[tuple[float, float, float], ...]
 
 
-def _combination(terms):
+def combination(terms):
     """sum of coef * x, with the constant coefficients 0 and +-1 left out."""
     total = None
     for coef, x in terms:
@@ -25,12 +25,12 @@ def _combination(terms):
 
 def rotate(R, v):
     """R v."""
-    return tuple(_combination(zip(R[j], v)) for j in range(3))
+    return tuple(combination(zip(R[j], v)) for j in range(3))
 
 
 def rotate_back(R, v):
     """R^T v."""
-    return tuple(_combination((R[k][j], v[k]) for k in range(3)) for j in range(3))
+    return tuple(combination((R[k][j], v[k]) for k in range(3)) for j in range(3))
 
 
 def turn(u, c, s) -> Rotation:
@@ -41,7 +41,7 @@ def turn(u, c, s) -> Rotation:
         row = []
         for k in range(3):
             outer = u[j] * u[k]
-            entry = _combination((((1.0 if j == k else 0.0) - outer, c), (skew[j][k], s)))
+            entry = combination((((1.0 if j == k else 0.0) - outer, c), (skew[j][k], s)))
             row.append(entry + outer if outer else entry)
         rows.append(tuple(row))
     return tuple(rows)
@@ -66,7 +66,7 @@ def fused(links, cs, moves):
             outer,
         )
         A, B, C = (_times(_times(link.R0, part), link.R1) for part in parts)
-        entries = [[_combination(((A[j][k], x[0]), (B[j][k], x[1]))) for k in range(3)] for j in range(3)]
+        entries = [[combination(((A[j][k], x[0]), (B[j][k], x[1]))) for k in range(3)] for j in range(3)]
         rot = tuple(tuple(e + C[j][k] if C[j][k] else e for k, e in enumerate(row)) for j, row in enumerate(entries))
         fused_links.append(replace(link, R0=None, R1=None))
         fused_moves.append((rot, link.p0))
