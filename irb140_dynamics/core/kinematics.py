@@ -44,19 +44,22 @@ def link_frames(model: RobotModel, q) -> np.ndarray:
     return np.array(frames)
 
 
-def _turn(axis: np.ndarray, angle: float) -> np.ndarray:
-    """Rot(axis, angle) as a 4x4 transform (Rodrigues, as joints.axis_rotation, on floats)."""
+def _rodrigues(axis: np.ndarray, c, s):
+    """The rows of Rot(axis, angle) from its cos c and sin s (floats, or arrays of them),
+    as joints.axis_rotation."""
     x, y, z = axis.tolist()
-    c, s = math.cos(angle), math.sin(angle)
     v = 1.0 - c
-    return np.array(
-        [
-            [c + v * x * x, v * x * y - s * z, v * x * z + s * y, 0.0],
-            [v * x * y + s * z, c + v * y * y, v * y * z - s * x, 0.0],
-            [v * x * z - s * y, v * y * z + s * x, c + v * z * z, 0.0],
-            [0.0, 0.0, 0.0, 1.0],
-        ]
+    return (
+        (c + v * x * x, v * x * y - s * z, v * x * z + s * y),
+        (v * x * y + s * z, c + v * y * y, v * y * z - s * x),
+        (v * x * z - s * y, v * y * z + s * x, c + v * z * z),
     )
+
+
+def _turn(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rot(axis, angle) as a 4x4 transform, on floats."""
+    rows = _rodrigues(axis, math.cos(angle), math.sin(angle))
+    return np.array([[*row, 0.0] for row in rows] + [[0.0, 0.0, 0.0, 1.0]])
 
 
 def _slide(axis: np.ndarray, distance: float) -> np.ndarray:
@@ -153,14 +156,10 @@ def flange_jacobians(model: RobotModel, Q) -> np.ndarray:
 
 def _turns(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
     """``_turn`` of each angle (N,): (N, 4, 4), cos and sin by the math module as there."""
-    x, y, z = axis.tolist()
     c = np.array([math.cos(a) for a in angles.tolist()])
     s = np.array([math.sin(a) for a in angles.tolist()])
-    v = 1.0 - c
     M = np.zeros((len(angles), 4, 4))
-    M[:, 0, 0], M[:, 0, 1], M[:, 0, 2] = c + v * x * x, v * x * y - s * z, v * x * z + s * y
-    M[:, 1, 0], M[:, 1, 1], M[:, 1, 2] = v * x * y + s * z, c + v * y * y, v * y * z - s * x
-    M[:, 2, 0], M[:, 2, 1], M[:, 2, 2] = v * x * z - s * y, v * y * z + s * x, c + v * z * z
+    M[:, :3, :3] = np.stack([np.stack(row, axis=-1) for row in _rodrigues(axis, c, s)], axis=-2)
     M[:, 3, 3] = 1.0
     return M
 
