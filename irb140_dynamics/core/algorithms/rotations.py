@@ -33,16 +33,25 @@ def rotate_back(R, v):
     return tuple(combination((R[k][j], v[k]) for k in range(3)) for j in range(3))
 
 
+def _parts(u) -> tuple[Rotation, Rotation, Rotation]:
+    """(1 - u u^T, [u]x, u u^T): Rot(u, theta) = c (1 - u u^T) + s [u]x + u u^T."""
+    outer = tuple(tuple(u[j] * u[k] for k in range(3)) for j in range(3))
+    return (
+        tuple(tuple((1.0 if j == k else 0.0) - outer[j][k] for k in range(3)) for j in range(3)),
+        ((0.0, -u[2], u[1]), (u[2], 0.0, -u[0]), (-u[1], u[0], 0.0)),
+        outer,
+    )
+
+
 def turn(u, c, s) -> Rotation:
-    """Rot(u, theta) = c (1 - u u^T) + s [u]x + u u^T, given c, s of theta."""
-    skew = ((0.0, -u[2], u[1]), (u[2], 0.0, -u[0]), (-u[1], u[0], 0.0))
+    """Rot(u, theta) (see ``_parts``), given c, s of theta."""
+    across, skew, outer = _parts(u)
     rows = []
     for j in range(3):
         row = []
         for k in range(3):
-            outer = u[j] * u[k]
-            entry = combination((((1.0 if j == k else 0.0) - outer, c), (skew[j][k], s)))
-            row.append(entry + outer if outer else entry)
+            entry = combination(((across[j][k], c), (skew[j][k], s)))
+            row.append(entry + outer[j][k] if outer[j][k] else entry)
         rows.append(tuple(row))
     return tuple(rows)
 
@@ -58,14 +67,7 @@ def fused(links, cs, moves):
             fused_links.append(link)
             fused_moves.append(move)
             continue
-        u = link.u
-        outer = tuple(tuple(u[j] * u[k] for k in range(3)) for j in range(3))
-        parts = (
-            tuple(tuple((1.0 if j == k else 0.0) - outer[j][k] for k in range(3)) for j in range(3)),
-            ((0.0, -u[2], u[1]), (u[2], 0.0, -u[0]), (-u[1], u[0], 0.0)),
-            outer,
-        )
-        A, B, C = (_times(_times(link.R0, part), link.R1) for part in parts)
+        A, B, C = (_times(_times(link.R0, part), link.R1) for part in _parts(link.u))
         entries = [[combination(((A[j][k], x[0]), (B[j][k], x[1]))) for k in range(3)] for j in range(3)]
         rot = tuple(tuple(e + C[j][k] if C[j][k] else e for k, e in enumerate(row)) for j, row in enumerate(entries))
         fused_links.append(replace(link, R0=None, R1=None))
