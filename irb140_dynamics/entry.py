@@ -8,10 +8,11 @@ then ``finish(main)``:
 - From ``start`` on, SIGINT and SIGTERM (and the kind's other stop signals) are noted, never
   raised: a Ctrl-C while NumPy, rclpy or MuJoCo load cannot cut an extension module's
   start-up half-way (a traceback, or the interpreter killing itself with SIGINT as it
-  exits). A tool runs OpenBLAS on one thread unless OPENBLAS_NUM_THREADS or
+  exits). Every executable runs OpenBLAS on one thread unless OPENBLAS_NUM_THREADS or
   OMP_NUM_THREADS says otherwise: its linear algebra is on small matrices, where
   OpenBLAS's threads spin while they wait (on a busy machine identify took 5 to 20 times
-  the CPU time of one thread). An exception nobody catches is one line
+  the CPU time of one thread), and starting them doubles NumPy's import (0.17 against
+  0.09 CPU-s): a node beside a 1 kHz controller wants neither. An exception nobody catches is one line
   ('<name>: cannot start: ...' for a missing module, '<name>: internal error: ...'
   otherwise) and exit status 1; IRB140_TRACEBACK=1 shows the traceback.
 - ``finish(main)`` calls main() and exits with its status. A node gets Python's own
@@ -34,17 +35,16 @@ from typing import NamedTuple, NoReturn
 
 
 class Kind(NamedTuple):
-    """What sort of executable: which signals stop it, how it ends when one came while it
-    started, and whether OpenBLAS runs on one thread."""
+    """What sort of executable: which signals stop it, and how it ends when one came while
+    it started."""
 
     stop_signals: tuple[int, ...]
     stopped_early_status: int | None  # exit status without a line; None: main() decides
-    one_blas_thread: bool
 
 
-NODE = Kind((signal.SIGINT, signal.SIGTERM), 0, False)
-TOOL = Kind((signal.SIGINT, signal.SIGTERM), None, True)
-RECORDER = Kind((signal.SIGINT, signal.SIGTERM, signal.SIGHUP), None, True)  # record: SIGHUP stops it too
+NODE = Kind((signal.SIGINT, signal.SIGTERM), 0)
+TOOL = Kind((signal.SIGINT, signal.SIGTERM), None)
+RECORDER = Kind((signal.SIGINT, signal.SIGTERM, signal.SIGHUP), None)  # record: SIGHUP stops it too
 
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")
 INTERRUPTED = 128 + signal.SIGINT  # a tool's exit status after Ctrl-C
@@ -89,7 +89,7 @@ _program: _Program | None = None  # set by start(), in an executable's process o
 def start(name: str, kind: Kind) -> None:
     """The executable ``name`` begins (before its heavy imports): see the module's docstring."""
     global _program
-    if kind.one_blas_thread and "numpy" not in sys.modules and not set(BLAS_THREAD_VARIABLES) & set(os.environ):
+    if "numpy" not in sys.modules and not set(BLAS_THREAD_VARIABLES) & set(os.environ):
         os.environ["OPENBLAS_NUM_THREADS"] = "1"
     _program = _Program(name, kind)
     sys.excepthook = _program.uncaught

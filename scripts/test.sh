@@ -12,6 +12,9 @@ ruff format --check --quiet . || { echo "files not formatted: run ruff format ."
 # PYTHONDONTWRITEBYTECODE): each worker would otherwise rewrite and compile every test
 # module again, and each process the tests start compile what env.sh did not.
 unset PYTHONDONTWRITEBYTECODE
+# OpenBLAS on one thread, as the package's executables run it (entry.py): two workers on two
+# cores, with small matrices, where more threads only spin while they wait.
+export OPENBLAS_NUM_THREADS="${OPENBLAS_NUM_THREADS:-1}"
 # Two workers (pytest-xdist), a test file each at a time: the suite's processes and nodes
 # wait on each other as much as they compute, so two keep both cores busy. `-n 0` after
 # the script's name runs it in one process.

@@ -218,10 +218,11 @@ SHOW_THREADS = """
         ("RECORDER", {}, "1 None"),
         ("TOOL", {"OPENBLAS_NUM_THREADS": "2"}, "2 None"),
         ("TOOL", {"OMP_NUM_THREADS": "3"}, "None 3"),
-        ("NODE", {}, "None None"),
+        ("NODE", {}, "1 None"),
+        ("NODE", {"OPENBLAS_NUM_THREADS": "2"}, "2 None"),
     ],
 )
-def test_a_tool_runs_openblas_on_one_thread_unless_told_otherwise(tmp_path, kind, given, shown):
+def test_every_executable_runs_openblas_on_one_thread_unless_told_otherwise(tmp_path, kind, given, shown):
     unset = {"OPENBLAS_NUM_THREADS": None, "OMP_NUM_THREADS": None}
     code, output = run_program(tmp_path, SHOW_THREADS.format(kind=kind), {**unset, **given})
     assert code == 0 and output == shown + "\n", output

@@ -4,12 +4,13 @@ payload.mass set every 100 ms for 5 s through the parameter service: every joint
 sent once the stream is answered gets its gravity_torques.
 
 A queue of 10 at 1 kHz holds 10 ms: a node the machine leaves unscheduled longer loses
-states whatever it does. As a 1 kHz controller is run, the node runs at a raised priority
-where the test may give one (as root: nice -10), so that what is measured is the node's own
-stalls, not the other work of a busy machine (the suite's other worker)."""
+states whatever it does. As a 1 kHz controller is run, the node runs at a real-time priority
+where the test may give one (SCHED_FIFO 10, else nice -10), so that what is measured is the
+node's own stalls, not the other work of a busy machine (the suite's other worker)."""
 
 import os
 import shutil
+import subprocess
 import threading
 import time
 import uuid
@@ -30,7 +31,11 @@ NAMES = [f"joint_{i}" for i in range(1, 7)]
 
 
 def raised_priority(command: list[str]) -> list[str]:
-    """``command`` at nice -10 where this process may raise a priority (root), else as it is."""
+    """``command`` at real-time priority (SCHED_FIFO 10) where this process may give one, else
+    at nice -10 where it may raise a priority (root), else as it is."""
+    fifo = ["chrt", "--fifo", "10"]
+    if shutil.which("chrt") and subprocess.run([*fifo, "true"], capture_output=True).returncode == 0:
+        return [*fifo, *command]
     return ["nice", "-n", "-10", *command] if os.geteuid() == 0 and shutil.which("nice") else command
 
 
