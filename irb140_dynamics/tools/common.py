@@ -102,7 +102,8 @@ def arm_of(args: argparse.Namespace, chain_for: str | None = None):
     if chain_for and not arm.model.is_chain:
         raise ToolError(
             f"{chain_for} takes one serial chain, but {shown(arm.origin)} gives {len(arm.model.joints)} joints "
-            "as a tree or with mimic joints: give --tip LINK, the end effector's URDF link"
+            "as a tree or with mimic joints: give --tip LINK, the end effector's URDF link (the rest of the tree held "
+            "at zero, or at --hold JOINT=VALUE)"
         )
     return replace(arm, given=values)
 

@@ -74,7 +74,9 @@ def held_positions(tree: UrdfTree, in_model: Collection[str], given: Mapping[str
             leader = mimic.get("joint")
             position = multiplier * positions[leader] + offset
             given_by[joint.name] = given_by[leader]
-            positions[joint.name] = _within_limits(joint, position, f" for mimic joint {joint.name!r}", given_by[leader])
+            positions[joint.name] = _within_limits(
+                joint, position, f" for mimic joint {joint.name!r}", given_by[leader]
+            )
         if len(positions) == before:
             break
     return positions
