@@ -291,7 +291,8 @@ def test_external_wrench_links_that_the_model_does_not_move_stop_the_start_in_on
 def test_payload_check_node_checks_the_payload_on_its_link_with_the_other_arm_in_its_worst_pose():
     """test_payload_tree's PITCH_TORSO: the torso's limit between the payload's worst torque
     with the other arm at zero and in its worst pose: OVER-LIMIT, at the tree's worst torque;
-    its torque now the tree's gravity at the joint state (the other arm's pose in it)."""
+    its torque now the tree's gravity at the joint state (the other arm's pose in it); the
+    report names the other arm's worst pose for the torso (its numbers: test_payload_tree)."""
     from std_srvs.srv import Trigger
 
     from irb140_dynamics.core.payload import workspace_load
@@ -322,3 +323,6 @@ def test_payload_check_node_checks_the_payload_on_its_link_with_the_other_arm_in
     now = gravity(model.with_payload(LOAD), q)[:3]
     rows = {line.split()[0]: float(line.split()[1]) for line in reply.message.splitlines()[3:6]}
     np.testing.assert_allclose([rows[name] for name in ("torso", "l1", "l2")], now, atol=5e-4)
+    rest = reply.message.splitlines()[6]  # the other arm in the torso's worst pose: the one line of the rest
+    assert rest.startswith("the rest of the tree in torso's worst pose [deg]: r1 ") and ", r2 " in rest
+    assert "rest of the tree" not in "\n".join(reply.message.splitlines()[7:])
