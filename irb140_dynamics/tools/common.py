@@ -17,7 +17,7 @@ from irb140_dynamics.tools.cli import BadArgument, ToolError, shown
 
 
 def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model") -> None:
-    """--params-file, --urdf, --base, --tip and -p: the arm, read as ``core.io.arm_source`` says."""
+    """--params-file, --urdf, --base, --tip, --hold and -p: the arm, read as ``core.io.arm_source`` says."""
     group = parser.add_argument_group(role)
     group.add_argument(
         "--params-file",
@@ -47,6 +47,14 @@ def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model"
         help="the URDF link the chain ends at (default: none, the whole tree below --base)",
     )
     group.add_argument(
+        "--hold",
+        action="append",
+        default=[],
+        metavar="JOINT=VALUE",
+        help="a URDF joint the model leaves out (the rest of the tree with --tip, one above --base) held at VALUE "
+        "[rad, m] (repeatable; over model.held_positions; default: zero; a mimic joint follows its joint)",
+    )
+    group.add_argument(
         "-p",
         dest="overrides",
         action="append",
@@ -61,7 +69,7 @@ def arm_of(args: argparse.Namespace, chain_for: str | None = None):
     ToolError in one line for a bad file or value; BadArgument (exit status 2) for a name no
     executable of the package knows, with the nearest known one. ``chain_for``: what needs a
     serial chain (the payload analysis): ToolError naming --tip for a tree or mimic joints."""
-    from irb140_dynamics.core.io.arm_source import given_values, read_arm, read_urdf_file
+    from irb140_dynamics.core.io.arm_source import HeldPositionError, given_values, read_arm, read_urdf_file
     from irb140_dynamics.core.io.parameter_names import known_parameter_names, unknown_names
     from irb140_dynamics.core.io.params_file import read_parameter_file
 
@@ -79,7 +87,10 @@ def arm_of(args: argparse.Namespace, chain_for: str | None = None):
             getattr(args, "tip", None),
             origin=params_file,
             relative_to=Path(params_file).parent if params_file else None,
+            hold=getattr(args, "hold", None) or (),
         )
+    except HeldPositionError as error:  # a bad argument: exit status 2
+        raise BadArgument(one_line(error)) from None
     except ValueError as error:
         raise ToolError(in_option_words(one_line(error), params_file, args.base, args.tip, dict(overrides))) from None
     known = known_parameter_names(arm.model.joint_names, from_urdf=arm.urdf is not None)
@@ -91,7 +102,8 @@ def arm_of(args: argparse.Namespace, chain_for: str | None = None):
     if chain_for and not arm.model.is_chain:
         raise ToolError(
             f"{chain_for} takes one serial chain, but {shown(arm.origin)} gives {len(arm.model.joints)} joints "
-            "as a tree or with mimic joints: give --tip LINK, the end effector's URDF link"
+            "as a tree or with mimic joints: give --tip LINK, the end effector's URDF link (the rest of the tree held "
+            "at zero, or at --hold JOINT=VALUE)"
         )
     return replace(arm, given=values)
 

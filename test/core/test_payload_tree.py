@@ -112,6 +112,15 @@ def test_a_payload_fitting_with_the_other_arm_at_zero_is_over_the_limit_in_its_w
     assert fits.verdict == "OK" and over.verdict == "OVER-LIMIT" and over.over == ["torso"]
     assert over.headline().startswith(f"OVER-LIMIT: 1.500 kg does not fit: torso needs {tree_worst:.3f} N m at (")
     assert over.joint_names == ("torso", "l1", "l2") and len(over.q) == 3
+    # the report says the whole tree's worst pose of each joint: the torque found is the tree's there
+    pose = over.workspace.tree_pose[0]
+    np.testing.assert_array_equal(pose[:3], over.workspace.pose[0])
+    there = gravity_batch(whole.with_payload(PAYLOAD), pose[None])[0, 0]
+    assert there == pytest.approx(over.workspace.torque[0], rel=1e-12)
+    rest = ", ".join(f"{name} {round(np.degrees(x), 1) + 0.0:g}" for name, x in zip(("r1", "r2"), pose[3:]))
+    assert f"the rest of the tree in torso's worst pose [deg]: {rest}" in over.report().splitlines()
+    assert over.joint_figures(0)["rest of the tree in the worst pose [deg]"] == rest
+    assert fits.workspace.rest_pose == () and "rest of the tree" not in fits.report()
 
 
 def test_the_state_and_the_largest_payload_on_the_tree_are_the_trees_torques():

@@ -14,8 +14,8 @@ from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
-from irb140_dynamics.core import RigidBody, gravity
-from irb140_dynamics.core.io.arm_source import read_arm
+from irb140_dynamics.core import RigidBody, gravity, rnea
+from irb140_dynamics.core.io.arm_source import UrdfText, read_arm
 from irb140_dynamics.core.io.urdf import load_urdf
 from irb140_dynamics.core.monitoring.link_wrenches import SINGULAR_THRESHOLD, link_wrenches, wrench_places
 from irb140_dynamics.core.monitoring.wrench import TREE_REFUSAL, WrenchStream
@@ -108,6 +108,25 @@ def test_a_tree_payload_without_its_link_stops_a_tool_or_node_in_one_line():
         read_arm({"model.source": "robot_description", "robot_description": BAXTER, "payload.mass": 1.0})
     with pytest.raises(ValueError, match="payload.link names a URDF link"):
         read_arm({"payload.link": "tool0"})
+
+
+def test_a_node_holds_the_rest_of_the_tree_where_model_held_positions_says():
+    """id_node given a tip link and model.held_positions builds the model every tool reads
+    from the same values (the other arm turned, its mimic fingers following), not the one at
+    zero; a joint the URDF lacks stops its start in one line naming the parameter."""
+    values = {"model.tip_link": "la2", "model.held_positions": ["r1=0.4", "r2=-0.7"]}
+    described = [Parameter("model.source", value="robot_description"), Parameter("robot_description", value=TWO_ARMS)]
+    with running(IdNode, parameter_overrides=described + [Parameter(k, value=v) for k, v in values.items()]) as harness:
+        model = harness.node.settings.model
+    q, qd, qdd = ([0.3, -0.2, 0.5], [0.1, 0.4, -0.3], [1.0, -0.5, 0.2])
+    tool, zero = (read_arm(v, urdf=UrdfText(TWO_ARMS, "t")).model for v in (values, {"model.tip_link": "la2"}))
+    np.testing.assert_array_equal(rnea(model, q, qd, qdd), rnea(tool, q, qd, qdd))
+    assert abs(rnea(model, q, qd, qdd)[0] - rnea(zero, q, qd, qdd)[0]) > 0.01
+    misspelt = [Parameter("model.held_positions", value=["r_1=0.4"])]
+    with pytest.raises(ValueError) as refused, running(IdNode, parameter_overrides=described + misspelt):
+        pass
+    assert "model.held_positions r_1=0.4: the URDF has no joint 'r_1'; did you mean r1?" in str(refused.value)
+    assert "\n" not in str(refused.value)
 
 
 def test_markers_show_every_independent_joint_of_the_tree_at_pinocchios_joint_origins():
@@ -272,7 +291,8 @@ def test_external_wrench_links_that_the_model_does_not_move_stop_the_start_in_on
 def test_payload_check_node_checks_the_payload_on_its_link_with_the_other_arm_in_its_worst_pose():
     """test_payload_tree's PITCH_TORSO: the torso's limit between the payload's worst torque
     with the other arm at zero and in its worst pose: OVER-LIMIT, at the tree's worst torque;
-    its torque now the tree's gravity at the joint state (the other arm's pose in it)."""
+    its torque now the tree's gravity at the joint state (the other arm's pose in it); the
+    report names the other arm's worst pose for the torso (its numbers: test_payload_tree)."""
     from std_srvs.srv import Trigger
 
     from irb140_dynamics.core.payload import workspace_load
@@ -303,3 +323,6 @@ def test_payload_check_node_checks_the_payload_on_its_link_with_the_other_arm_in
     now = gravity(model.with_payload(LOAD), q)[:3]
     rows = {line.split()[0]: float(line.split()[1]) for line in reply.message.splitlines()[3:6]}
     np.testing.assert_allclose([rows[name] for name in ("torso", "l1", "l2")], now, atol=5e-4)
+    rest = reply.message.splitlines()[6]  # the other arm in the torso's worst pose: the one line of the rest
+    assert rest.startswith("the rest of the tree in torso's worst pose [deg]: r1 ") and ", r2 " in rest
+    assert "rest of the tree" not in "\n".join(reply.message.splitlines()[7:])

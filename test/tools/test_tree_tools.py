@@ -1,16 +1,19 @@
 """The tools on a whole tree (Baxter, test/data/urdf; test_urdf_trees' TWO_ARMS): the payload
 analysis (load_diagram, excitation --payload, identify --payload-only) refused in one line
 naming --tip, nothing written; export_urdf writes the tree and its mimic joints (read back:
-the same dynamics); equations writes the tree's code (the same torques as the core's)."""
+the same dynamics); equations writes the tree's code (the same torques as the core's) and the
+regressor of mimic joints (the core's)."""
 
 import numpy as np
 import pytest
 
 from irb140_dynamics.core import gravity, mass_matrix, rnea
 from irb140_dynamics.core.io.urdf import load_urdf
+from irb140_dynamics.core.regressor import regressor_batch
 from irb140_dynamics.tools import equations, excitation, export_urdf, identify, load_diagram
 
 from ..core.equations.support import import_file
+from ..core.equations.test_mimic_regressor import GRIPPER
 from ..core.test_urdf_trees import TWO_ARMS
 from ..support.paths import URDF_DATA
 
@@ -69,3 +72,19 @@ def test_equations_of_a_tree_with_mimic_joints_are_the_cores(tmp_path, capsys):
         capsys, equations, "--urdf", urdf, "--form", "latex", "--symbolic-parameters", "--out", tmp_path / "sym"
     )
     assert status == 1 and len(err.strip().splitlines()) == 1 and "mimic joints" in err
+
+
+def test_equations_write_the_regressor_of_mimic_joints_as_the_core(tmp_path, capsys):
+    """The Python form (C, SymPy, LaTeX: test/core/equations/test_mimic_regressor.py)."""
+    urdf = tmp_path / "gripper.urdf"
+    urdf.write_text(GRIPPER)
+    out = tmp_path / "gen"
+    status, _, err = run(capsys, equations, "--urdf", urdf, "--what", "regressor", "--form", "python", "--out", out)
+    assert status == 0, err
+    code = import_file(out / "gripper_eom.py", "gripper_regressor_eom")
+    model = load_urdf(GRIPPER).model
+    rng = np.random.default_rng(41)
+    Q, QD, QDD = (rng.uniform(-1.0, 1.0, (3, model.n)) for _ in range(3))
+    want = regressor_batch(model, Q, QD, QDD)
+    np.testing.assert_allclose(code.regressor(Q, QD, QDD), want, rtol=1e-12, atol=1e-12)
+    assert code.REGRESSOR_COLUMNS[-3:] == ("viscous3", "coulomb3", "armature3")

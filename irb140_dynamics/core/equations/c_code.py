@@ -7,8 +7,9 @@ qdd, Y)``; with symbolic parameters each takes ``p`` (the parameters) last.
 
 from __future__ import annotations
 
+import math
+
 from ..codegen import sincos
-from ..regressor import PARAMETERS_PER_JOINT
 from .printing import DESCRIPTIONS, CPrinter, header_lines, used_names
 from .symbolic import Equations
 
@@ -50,9 +51,7 @@ def _comment(lines: list[str]) -> str:
 
 def _signature(eq: Equations, name: str, prefix: str) -> str:
     n = eq.n
-    size = {"tau": f"{n}", "M": f"{n * n}", "Cqd": f"{n}", "g": f"{n}", "regressor": f"{n * PARAMETERS_PER_JOINT * n}"}[
-        name
-    ]
+    size = math.prod(eq.shapes[name])  # the regressor's n x 13 n_links (mimic joints' links too)
     args = [f"const double {arg}[{n}]" for arg in eq.arguments[name]]
     args.append(f"double {name if name != 'regressor' else 'Y'}[{size}]")
     if eq.parameters:

@@ -14,7 +14,7 @@ DESCRIPTIONS = {
     "M": "mass matrix M(q) [kg m^2] (armature on the diagonal)",
     "Cqd": "Coriolis and centrifugal torques C(q, qd) qd [N m]",
     "g": "gravity torques g(q) [N m]",
-    "regressor": "regressor Y(q, qd, qdd), tau = Y pi, n x 13n (columns: see REGRESSOR_COLUMNS)",
+    "regressor": "regressor Y(q, qd, qdd), tau = Y pi, n x 13 n_links (columns: see REGRESSOR_COLUMNS)",
 }
 
 

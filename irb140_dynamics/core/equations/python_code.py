@@ -8,7 +8,6 @@ states, chunk by chunk so that its intermediates stay in the CPU caches.
 from __future__ import annotations
 
 from ..codegen import sincos
-from ..regressor import PARAMETERS_PER_JOINT
 from .printing import DESCRIPTIONS, PythonPrinter, header_lines, used_names
 from .symbolic import Equations
 
@@ -64,7 +63,7 @@ def render(eq: Equations, reduced: dict, prefix: str, source: str, bodies: dict 
 def _function(eq: Equations, name: str, replacements, outputs, body=None) -> list[str]:
     printer = PythonPrinter()
     args = list(eq.arguments[name])
-    shape = {"M": (eq.n, eq.n), "regressor": (eq.n, PARAMETERS_PER_JOINT * eq.n)}.get(name, (eq.n,))
+    shape = eq.shapes[name]  # the regressor's n x 13 n_links (mimic joints' links too)
     signature = ", ".join(args + (["p=PARAMETERS"] if eq.parameters else []))
     used = used_names(replacements, outputs)
     kernel_args = args + (["p"] if eq.parameters else [])

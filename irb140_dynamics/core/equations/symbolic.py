@@ -11,7 +11,9 @@ subexpressions are then pulled out once per quantity (``reduced``).
     tau = M(q) qdd + C(q, qd) qd + g(q) + tau_f(qd)
 
 tau includes the friction tau_f (as ``rnea`` of the core does); M the armature; Cqd and g
-neither (as ``coriolis`` and ``gravity``). The regressor is n x 13n (see ``regressor``).
+neither (as ``coriolis`` and ``gravity``). The regressor is n x 13 n_links (see ``regressor``):
+with mimic joints each link's columns carried by the coordinates, G^T Y_all, and a mimic
+joint's friction and armature columns in the row of the joint it follows, as the core's.
 With ``symbolic`` parameters each link's inertial parameters, each joint's friction and
 armature, and the payload's are named symbols (``Parameter``); otherwise the model's numbers.
 """
@@ -107,8 +109,8 @@ def derive(model, what=DEFAULT_QUANTITIES, symbolic: bool = False, progress: Cal
     progress = progress or (lambda stage: None)
     n = model.n
     q, qd, qdd = joint_symbols(n)
-    if model.mimics is not None and (symbolic or "regressor" in what):
-        raise ValueError("a model with mimic joints is written with its numbers, without the regressor")
+    if model.mimics is not None and symbolic:
+        raise ValueError("a model with mimic joints is written with its numbers (no symbolic parameters)")
     if model.flange_joint is not None and symbolic:
         raise ValueError("symbolic parameters take the payload on the last link (no flange_joint)")
     links, parameters, friction = links_of(model, symbolic)
@@ -139,10 +141,12 @@ def derive(model, what=DEFAULT_QUANTITIES, symbolic: bool = False, progress: Cal
             shapes["g"], arguments["g"] = (n,), ("q",)
         if "regressor" in what:
             progress("the regressor")
-            Y = rigid_body_regressor(links, cs, qd, qdd, _exact(model.gravity))
-            quantities["regressor"] = _with_joint_columns(Y, qd, qdd, model.smoothing_velocity)
-            shapes["regressor"], arguments["regressor"] = (n, PARAMETERS_PER_JOINT * n), ("q", "qd", "qdd")
-    columns = _regressor_columns(n) if "regressor" in what else ()
+            Y = rigid_body_regressor(links, cs, full_qd, full_qdd, _exact(model.gravity))
+            Y = list(zip(*(project(column) for column in zip(*Y))))  # G^T Y_all, column by column
+            quantities["regressor"] = _with_joint_columns(Y, qd, qdd, model.smoothing_velocity, model.coordinates)
+            width = PARAMETERS_PER_JOINT * len(links)
+            shapes["regressor"], arguments["regressor"] = (n, width), ("q", "qd", "qdd")
+    columns = _regressor_columns(len(links)) if "regressor" in what else ()
     return Equations(
         n,
         model.joint_names,
@@ -272,16 +276,20 @@ def _friction(friction, i, qd_i):
     return viscous * qd_i + coulomb * sp.tanh(qd_i / sp.Float(smoothing))
 
 
-def _with_joint_columns(Y, qd, qdd, smoothing):
-    """The n x 13n regressor, row-major: the rigid-body block, then [qd, tanh(qd/v_s), qdd]
-    of each joint's friction and armature."""
-    n = len(Y)
-    rows = []
-    for i in range(n):
-        joint = [0] * (JOINT_TERMS * n)
-        joint[JOINT_TERMS * i : JOINT_TERMS * (i + 1)] = [qd[i], sp.tanh(qd[i] / sp.Float(smoothing)), qdd[i]]
-        rows += list(Y[i]) + joint
-    return rows
+def _with_joint_columns(Y, qd, qdd, smoothing, coordinates):
+    """The n x 13 n_links regressor, row-major: the rigid-body block, then each joint's
+    friction and armature columns [qd, tanh(qd/v_s), qdd], in the row of its coordinate k
+    (``coordinates``: (k, multiplier m, offset) per joint): a mimic joint's m^2 qd_k,
+    tanh(qd_k/v_s) when |m| = 1 (else 0: no such term), m^2 qdd_k (virtual work, as
+    ``regressor.regressor_batch``)."""
+    links = len(coordinates)
+    rows = [list(Y[k]) + [0] * (JOINT_TERMS * links) for k in range(len(Y))]
+    for i, (k, m, _) in enumerate(coordinates):
+        m2 = _exact(m * m)
+        coulomb = sp.tanh(qd[k] / sp.Float(smoothing)) if abs(m) == 1.0 else 0
+        start = len(Y[k]) + JOINT_TERMS * i
+        rows[k][start : start + JOINT_TERMS] = [m2 * qd[k], coulomb, m2 * qdd[k]]
+    return [x for row in rows for x in row]
 
 
 def _regressor_columns(n: int) -> tuple[str, ...]:

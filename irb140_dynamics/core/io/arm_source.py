@@ -23,6 +23,10 @@ dotted names, as rcl gives them to a node: ``given_values``), over the default a
   independent joint; mimic joints follow theirs). ``payload.link`` names the URDF link the
   payload hangs on (``LoadedUrdf.with_flange_at``; ``payload.com``/``.inertia`` in its
   frame); empty: the chain's tip link. On a tree a payload (``payload.mass`` > 0) needs it.
+  The joints the model leaves out (the rest of a tree when ``model.tip_link`` names one
+  end effector; those above base_link) are held at zero, or at ``model.held_positions``
+  (a list of 'JOINT=VALUE', rad or m; a tool's ``--hold JOINT=VALUE`` over them):
+  ``held_chain``, which refuses a bad one naming the option (``HeldPositionError``).
 
 Names given that are no parameter of the package: ``core.io.parameter_names``.
 Errors: a ValueError in one line naming the file or the parameter. No ROS.
@@ -30,6 +34,7 @@ Errors: a ValueError in one line naming the file or the parameter. No ROS.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -38,6 +43,7 @@ from typing import Any
 from irb140_dynamics.core.errors import one_line
 from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.core.io.urdf import LoadedUrdf, UrdfError, load_urdf, read_urdf
+from irb140_dynamics.core.io.urdf.held import HeldError
 from irb140_dynamics.core.model.joints import param_prefix
 from irb140_dynamics.core.model.rigid_body import finite_numbers
 from irb140_dynamics.core.model.robot_model import JOINT_DRIVE_FIELDS, RobotModel
@@ -46,6 +52,31 @@ SOURCES = ("parameters", "robot_description")
 DEFAULT_ROBOT_NAME = "irb140"  # model.name when none is given (the nodes' default too)
 URDF_ROBOT_NAME = "robot"  # a URDF's name when its <robot> has none
 ARM_PARAMETERS = ("gravity", "friction.smoothing_velocity", "payload.mass", "payload.com", "payload.inertia")
+HELD = "model.held_positions"  # ['JOINT=VALUE', ...]: the joints the URDF's model leaves out (tools: --hold)
+URDF_PARAMETERS = (  # model.source robot_description's (name, default, description); (): a string array, unset
+    (
+        "robot_description",
+        "",
+        "the URDF text (model.source robot_description); empty: model.urdf_file, else the robot_description topic",
+    ),
+    ("model.urdf_file", "", "a URDF file, when robot_description is empty; empty: the robot_description topic"),
+    ("model.base_link", "", "the URDF link the chain starts from (fixed); empty: the root link"),
+    (
+        "model.tip_link",
+        "",
+        "the URDF link where the chain ends, the payload's frame; empty: the only leaf, or with several the whole tree",
+    ),
+    (
+        HELD,
+        (),
+        "'JOINT=VALUE' (rad, m) of joints the model leaves out (the rest of the tree, those above model.base_link); "
+        "not given: zero; a mimic joint follows its joint",
+    ),
+)
+
+
+class HeldPositionError(ValueError):
+    """A held position refused (``held_chain``), in one line naming the option that gave it."""
 
 
 @dataclass(frozen=True)
@@ -97,6 +128,7 @@ def read_arm(
     tip_link: str | None = None,
     origin: str | None = None,
     relative_to: str | Path | None = None,
+    hold: Iterable[str] = (),
 ) -> Arm:
     """The arm of the module's docstring.
 
@@ -105,7 +137,7 @@ def read_arm(
     then ``base_link``/``tip_link`` are its own); ``base_link``/``tip_link``: the chain's ends
     over ``model.base_link``/``model.tip_link``; ``origin``: where the values came from (a
     params file), named in errors; ``relative_to``: the folder ``model.urdf_file`` may be
-    relative to.
+    relative to; ``hold``: a tool's --hold entries, 'JOINT=VALUE' over ``model.held_positions``.
     """
     source = values.get("model.source", "parameters")
     if source not in SOURCES:
@@ -114,7 +146,10 @@ def read_arm(
         urdf = _described_urdf(values, origin, relative_to)
     if urdf is not None:
         return _urdf_arm(values, urdf, base_link or values.get("model.base_link") or None,
-                         tip_link or values.get("model.tip_link") or None, origin)  # fmt: skip
+                         tip_link or values.get("model.tip_link") or None, origin, hold)  # fmt: skip
+    held = "--hold" if hold else HELD if values.get(HELD) else None
+    if held:
+        raise HeldPositionError(f"{held} holds joints of a URDF: give --urdf, or model.source: robot_description")
     if values.get("payload.link"):
         raise ValueError("payload.link names a URDF link: give --urdf, or model.source: robot_description")
     if base_link or tip_link:
@@ -176,13 +211,49 @@ def urdf_span(loaded: LoadedUrdf) -> str:
     return f"the tree below {loaded.base_link}"
 
 
-def _urdf_arm(values, urdf, base_link, tip_link, origin) -> Arm:
+def held_chain(text: str, base_link=None, tip_link=None, held=None, hold: Iterable[str] = ()) -> LoadedUrdf:
+    """``load_urdf`` with the held positions given: ``held`` (``model.held_positions``'s
+    value: 'JOINT=VALUE' entries, or None), ``hold`` (a tool's --hold entries) over them;
+    HeldPositionError in one line naming the option and the entry for a bad one."""
+    given = {**_held_entries(held, HELD), **_held_entries(hold, "--hold")}
+    try:
+        return load_urdf(text, base_link, tip_link, held={name: value for name, (value, _) in given.items()})
+    except HeldError as error:
+        value, option = given[error.joint]
+        raise HeldPositionError(f"{option} {error.joint}={value:g}: {error.reason}") from None
+
+
+def _held_entries(entries, option: str) -> dict[str, tuple[float, str]]:
+    """'JOINT=VALUE' entries -> {joint: (value, option)}; HeldPositionError naming ``option``
+    for one that is no such text, a value that is no finite number, a joint given twice."""
+    if entries is None or (isinstance(entries, (list, tuple)) and not entries):
+        return {}
+    if isinstance(entries, str) or not isinstance(entries, (list, tuple)):
+        raise HeldPositionError(f"{option}: expected a list of 'JOINT=VALUE' texts, got {entries!r}")
+    found: dict[str, tuple[float, str]] = {}
+    for entry in entries:
+        name, _, text = str(entry).rpartition("=")
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (isinstance(entry, str) and name.strip() and math.isfinite(value)):
+            raise HeldPositionError(f"{option} {entry}: expected JOINT=VALUE, the value a finite number (rad, m)")
+        if name.strip() in found:
+            raise HeldPositionError(f"{option} {entry}: {name.strip()} is given twice")
+        found[name.strip()] = (value, option)
+    return found
+
+
+def _urdf_arm(values, urdf, base_link, tip_link, origin, hold=()) -> Arm:
     """A chain read already (a node's) names no file in its errors: the parameter is named."""
     text, where = None, origin or "robot_description"
     if isinstance(urdf, UrdfText):
         text, where = urdf.text, urdf.origin
         try:
-            loaded = load_urdf(urdf.text, base_link, tip_link)
+            loaded = held_chain(urdf.text, base_link, tip_link, values.get(HELD), hold)
+        except HeldPositionError:
+            raise
         except ValueError as error:
             raise ValueError(f"{where}: {one_line(error)}") from None
     else:

@@ -84,6 +84,7 @@ MODEL_PARAMETER_NAMES = (
     "model.urdf_file",
     "model.base_link",
     "model.tip_link",
+    "model.held_positions",  # the joints a URDF's model leaves out, 'JOINT=VALUE' (core.io.arm_source)
     "payload.link",  # the URDF link the payload hangs on (core.io.arm_source)
     "tree.joints",  # a tree's or a model with mimic joints (see model.robot_model)
     "tree.parents",

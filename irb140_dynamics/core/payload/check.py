@@ -199,7 +199,8 @@ class PayloadCheck:
     # -- the figures, formatted once for the report and /diagnostics --------------------
 
     def joint_figures(self, j: int) -> dict[str, str]:
-        """Joint j's figures by label, in the order of the report's columns."""
+        """Joint j's figures by label, in the order of the report's columns (on a tree whose
+        rest loads the path, the rest of the tree in the worst pose last)."""
         L, load, now = self.limit[j], self.workspace, self.torque is not None
         worst_use = _percent(self.worst_use[j], L)  # of the bound: "<=" where it is not the torque found
         if load.gap[j] >= VISIBLE and worst_use != "-":
@@ -214,7 +215,7 @@ class PayloadCheck:
             "limit source": self.limits.reason(j),
             "worst static bound [N m]": f"{load.bound[j]:.3f}",
             "worst static gap [N m]": f"{load.gap[j]:.2g}",
-        }
+        } | ({"rest of the tree in the worst pose [deg]": load.rest_pose[j] or "-"} if load.rest_pose else {})
 
     def joint_status(self, j: int, warn_use: float) -> tuple[str, str]:
         """Joint j's level ('OK'; 'WARN' from ``warn_use`` %, when the payload loads it
@@ -254,6 +255,8 @@ class PayloadCheck:
         rows = [[name, *list(self.joint_figures(j).values())[:6]] for j, name in enumerate(self.joint_names)]
         lines = [self.headline(), f"payload {payload['payload mass [kg]']} kg at {payload['payload com [m]']} m"]
         lines += _table(header + ["worst pose [deg]"], rows, widths=(10, 11, 13, 8, 13, 8))
+        lines += [f"the rest of the tree in {name}'s worst pose [deg]: {rest}" for name, rest in
+                  zip(self.joint_names, self.workspace.rest_pose) if rest]  # fmt: skip
         lines.append("limits: " + self._limits_note())
         here = "" if self.max_payload_here is None else f"{_max_payload_text(payload, 'here')} here, "
         lines.append(f"max payload: {here}{_max_payload_text(payload, 'over the workspace')} over the workspace")

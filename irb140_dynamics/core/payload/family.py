@@ -54,16 +54,28 @@ class Extremes:
     values: np.ndarray  # (2n,)
     poses: np.ndarray  # (2n, n) rad
     bounds: np.ndarray  # (2n,), >= values
+    tree_poses: np.ndarray | None = None  # (2n, n_tree): on a tree, the whole tree's poses (path.widened)
 
     def largest(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per joint the signed torque of largest magnitude found, its pose, and a proven
         bound of the magnitude over the ranges: (n,), (n, n), (n,)."""
-        n = self.values.size // 2
-        values, bounds = self.values, self.bounds
-        positive = values[:n] >= values[n:] - RTOL * np.max(np.abs(values))  # a tie goes to +tau_j
+        n, values, bounds = self.values.size // 2, self.values, self.bounds
+        positive = self._positive()
         torque = np.where(positive, values[:n], -values[n:])
         pose = np.where(positive[:, None], self.poses[:n], self.poses[n:])
         return torque, pose, np.maximum(np.maximum(bounds[:n], bounds[n:]), np.abs(torque))
+
+    def largest_tree_pose(self) -> np.ndarray | None:
+        """Per joint the whole tree's pose of ``largest``'s torque, (n, n_tree); None on a chain."""
+        if self.tree_poses is None:
+            return None
+        n = self.values.size // 2
+        return np.where(self._positive()[:, None], self.tree_poses[:n], self.tree_poses[n:])
+
+    def _positive(self) -> np.ndarray:
+        """Per joint: +tau_j is the larger in size (a tie goes to +tau_j)."""
+        n, values = self.values.size // 2, self.values
+        return values[:n] >= values[n:] - RTOL * np.max(np.abs(values))
 
 
 @dataclass(frozen=True, eq=False)

@@ -121,6 +121,8 @@ class WorkspaceLoad:
     bound: np.ndarray  # (n,) N m: |tau_j| <= bound_j in every pose
     out_of_time: bool = False  # the analysis' deadline cut the search and proofs short
     rest: np.ndarray | float = 0.0  # (n,) N m of the bound: the rest of a tree's poses, bounded (path.slack)
+    tree_pose: np.ndarray | None = None  # (n, n_tree): on a tree, the whole tree's state of each joint's worst pose
+    rest_pose: tuple[str, ...] = ()  # per joint, the rest of the tree in its worst pose, in words (path.rest_poses)
 
     @property
     def gap(self) -> np.ndarray:
@@ -207,9 +209,11 @@ def workspace_load(
     family = payload_family(model, payload)
     G0, dG = family.static_torques(ranges.samples)
     load = family.extremes(payload.mass, ranges, G0 + payload.mass * dG)
-    torque, pose, bound = path.widened(payload, load).largest()
+    widened = path.widened(payload, load)
+    torque, pose, bound = widened.largest()
     best = _workspace_max_payload(family, ranges, np.maximum(L - path.slack, 0.0), G0, dG, payload.mass, load)
-    return WorkspaceLoad(payload, torque, pose, best, bound, ran_out(), path.slack)
+    tree_pose, rest_pose = widened.largest_tree_pose(), path.rest_poses(widened)
+    return WorkspaceLoad(payload, torque, pose, best, bound, ran_out(), path.slack, tree_pose, rest_pose)
 
 
 def _workspace_max_payload(family, ranges, L, G0, dG, own_mass: float, load: Extremes) -> MaxPayload:

@@ -103,7 +103,31 @@ class PayloadPath:
 
         values, poses = self._ranges.climb(torque, weights, warm)
         bounds = load.bounds + np.tile(self.slack, 2)
-        return Extremes(values, poses[:, self.columns], np.maximum(bounds, values))
+        return Extremes(values, poses[:, self.columns], np.maximum(bounds, values), poses)
+
+    @cached_property
+    def rest(self) -> np.ndarray:
+        """The tree's coordinates off the path that load it: its side branches' (none on a chain)."""
+        return np.flatnonzero(self.moving & ~np.isin(np.arange(self.tree.n), self.columns))
+
+    def rest_poses(self, load: Extremes) -> tuple[str, ...]:
+        """Per chain joint, the rest of the tree in that joint's worst pose (``widened``'s),
+        in words: "r1 12.3, r2 -45, finger 0.010 m" (deg; m for a prismatic joint), "" for a
+        joint whose torque no pose of the rest changes (``slack`` 0); () when nothing hangs
+        off the path."""
+        poses = load.largest_tree_pose()
+        if poses is None or not self.rest.size:
+            return ()
+        joints = [self.tree.independent_joints[k] for k in self.rest]
+        return tuple(
+            ", ".join(
+                f"{joint.name} {q:.3f} m" if joint.prismatic else f"{joint.name} {round(math.degrees(q), 1) + 0.0:g}"
+                for joint, q in zip(joints, pose[self.rest])
+            )
+            if share > 0.0
+            else ""
+            for pose, share in zip(poses, self.slack)
+        )
 
     @cached_property
     def _rest(self) -> np.ndarray:

@@ -23,9 +23,9 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from irb140_dynamics.core import Joint, RigidBody, RobotModel
 from irb140_dynamics.core.errors import check_choice, one_line
-from irb140_dynamics.core.io.arm_source import SOURCES, read_arm, read_urdf_file, urdf_span
+from irb140_dynamics.core.io.arm_source import SOURCES, held_chain, read_arm, read_urdf_file, urdf_span
 from irb140_dynamics.core.io.params_file import read_parameter_file
-from irb140_dynamics.core.io.urdf import LoadedUrdf, load_urdf
+from irb140_dynamics.core.io.urdf import LoadedUrdf
 from irb140_dynamics.core.io.urdf.writer import BASE, FLANGE
 from irb140_dynamics.core.model.robot_model import check_joint_names
 from irb140_dynamics.package_files import default_config_path
@@ -69,8 +69,8 @@ class ArmParameters:
         source = overrides.declare(SOURCE)
         check_choice("model.source", source, SOURCES)
         if source == "robot_description":
-            text, path, base, tip = (overrides.declare(spec) for spec in DESCRIPTION_PARAMETERS)
-            self._chain_ends = (base or None, tip or None)
+            text, path, base, tip, held = (overrides.declare(spec) for spec in DESCRIPTION_PARAMETERS)
+            self._chain_ends = (base or None, tip or None, held)  # held: model.held_positions
             origin = "robot_description parameter" if text else f"model.urdf_file {path}"
             if text or path:
                 self.urdf = self.read(text or read_urdf_file(path, "model.urdf_file").text, origin)
@@ -134,7 +134,7 @@ class ArmParameters:
     def read(self, text: str, origin: str = "robot_description topic") -> LoadedUrdf:
         """The URDF's chain (thread-safe: parsing only), or ValueError naming ``origin``."""
         try:
-            return load_urdf(text, *self._chain_ends)
+            return held_chain(text, *self._chain_ends)
         except ValueError as error:
             raise ValueError(f"{origin}: {error}") from None
 
@@ -211,9 +211,8 @@ class ArmParameters:
     def _announce(self, origin: str) -> None:
         urdf, logger = self.urdf, self._node.get_logger()
         self.robot_name = urdf.robot_name or "robot"
-        names, held = list(urdf.model.joint_names), urdf.held_joints
-        held = f"; held at zero: {', '.join(held)}" if held else ""
-        logger.info(f"model from the {origin}: {urdf_span(urdf)}, {len(names)} joints {names}{held}")
+        names = list(urdf.model.joint_names)
+        logger.info(f"model from the {origin}: {urdf_span(urdf)}, {len(names)} joints {names}{urdf.held_summary()}")
         for warning in urdf.warnings:
             logger.warning(warning)
         for note in urdf.notes:

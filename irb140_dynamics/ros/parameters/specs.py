@@ -10,7 +10,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-from irb140_dynamics.core.io.arm_source import DEFAULT_ROBOT_NAME
+from irb140_dynamics.core.io.arm_source import DEFAULT_ROBOT_NAME, URDF_PARAMETERS
 from irb140_dynamics.core.model.joints import MAX_FRICTION, MAX_TORQUE_LIMIT, param_prefix
 from irb140_dynamics.core.model.rigid_body import MAX_MASS
 from irb140_dynamics.ros.parameters.spec import Spec
@@ -57,20 +57,9 @@ SOURCE = Spec(
     "where the model comes from: 'parameters' (joint_names and <joint>.*) or 'robot_description' (URDF)",
     read_only=True,
 )
-DESCRIPTION_PARAMETERS = [  # model.source robot_description
-    Spec(name, "", description, read_only=True)
-    for name, description in (
-        (
-            "robot_description",
-            "the URDF text (model.source robot_description); empty: model.urdf_file, else the robot_description topic",
-        ),
-        ("model.urdf_file", "a URDF file, when robot_description is empty; empty: the robot_description topic"),
-        ("model.base_link", "the URDF link the chain starts from (fixed); empty: the root link"),
-        (
-            "model.tip_link",
-            "the URDF link where the chain ends, the payload's frame; empty: the only leaf, or with several the whole tree",
-        ),
-    )
+DESCRIPTION_PARAMETERS = [  # model.source robot_description (read-only)
+    Spec(name, default if default != () else Parameter.Type.STRING_ARRAY, description, read_only=True)
+    for name, default, description in URDF_PARAMETERS
 ]
 
 

@@ -7,12 +7,13 @@
   moved and turned into the link's frame), and the fixed joints between two moving
   joints make up the next one's origin. Fixed joints after the last moving joint up to
   tip_link give the model's ``flange`` (the tip_link frame, where the payload sits).
-- Joints hanging off the chain (a gripper's fingers) are held at zero: their bodies are
-  lumped into the chain link they hang from, and their names are returned.
+- Joints hanging off the chain (a gripper's fingers, another arm) are held, at zero or at
+  the positions given (``load_urdf``'s ``held``; module ``held``): their bodies are lumped into the chain link
+  they hang from, and their names are returned. So are the joints above base_link.
 - Bodies that do not move (base_link, what is fixed to it, what is above it) are left out;
   their inertials are not checked (an invalid one is a ``note``).
 - Gravity is the root link's -z (9.81 m/s^2), expressed in base_link's frame with the
-  joints between them at zero.
+  joints between them held (at zero unless given).
 - <limit lower upper> are the position limits (continuous joints: CONTINUOUS_LIMITS),
   ``effort`` the torque (prismatic: force) limit, ``velocity`` the velocity limit (0 or
   absent: none); <dynamics damping friction> are viscous and Coulomb friction.
@@ -40,7 +41,9 @@ from functools import partial, reduce
 import numpy as np
 
 from irb140_dynamics.core.io.text_files import InputFileError, read_text_file
+from irb140_dynamics.core.io.urdf.held import held_positions, motion
 from irb140_dynamics.core.io.urdf.tree import (
+    MOVING,
     UrdfError,
     UrdfJoint,
     UrdfTree,
@@ -50,7 +53,7 @@ from irb140_dynamics.core.io.urdf.tree import (
     number,
     parse_tree,
 )
-from irb140_dynamics.core.io.urdf.whole_tree import MOVING, carried_links, compose, moving_joints
+from irb140_dynamics.core.io.urdf.whole_tree import carried_links, compose, moving_joints
 from irb140_dynamics.core.model.joints import (
     MAX_TORQUE_LIMIT,
     Friction,
@@ -72,17 +75,27 @@ class LoadedUrdf:
     model: RobotModel
     base_link: str
     tip_link: str
-    held_joints: tuple[str, ...]  # moving joints off the chain, held at zero, bodies lumped
+    held_joints: tuple[str, ...]  # moving joints off the chain, held (at zero unless given), bodies lumped
     warnings: tuple[str, ...] = ()  # the chain's inertials taken as given though not physical
     notes: tuple[str, ...] = ()  # invalid inertials off the chain, ignored
     base_rotation: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))  # base_link's axes in the root's
     robot_name: str = ""  # <robot name="...">: the hardware_id of the nodes' /diagnostics
     carried: dict = field(default_factory=dict, compare=False, hash=False, repr=False)  # see with_flange_at
+    held_positions: tuple[tuple[str, float], ...] = ()  # the held joints not at zero: given, or following one
+
+    def held_summary(self) -> str:
+        """'; held at zero: a, b', or '; held: r1=0.4, r2=-0.7; at zero: a' (rad, m), for messages; '' for none."""
+        at = dict(self.held_positions)
+        zero = ", ".join(name for name in self.held_joints if name not in at)
+        if not at:
+            return f"; held at zero: {zero}" if zero else ""
+        given = ", ".join(f"{name}={value:g}" for name, value in at.items())
+        return f"; held: {given}" + (f"; at zero: {zero}" if zero else "")
 
     def with_flange_at(self, link: str) -> RobotModel:
         """The model with its flange (where the payload sits) at URDF link ``link``: on the
         link of the joint that carries it (``model.flange_joint``), placed as the URDF does
-        (the joints off the chain at zero); UrdfError unless the model moves that link."""
+        (the joints off the chain held); UrdfError unless the model moves that link."""
         if link not in self.carried:
             raise UrdfError("link", f"{clipped(repr(link), 80)} is not moved by the model's joints")
         joint, placement = self.carried[link]
@@ -99,17 +112,20 @@ def load_urdf(
     tip_link: str | None = None,
     max_chars: int | None = None,
     max_joints: int = MAX_JOINTS,
+    held: dict[str, float] | None = None,
 ) -> LoadedUrdf:
     """The chain from ``base_link`` (default: the root link) to ``tip_link`` as a RobotModel
     (gravity: the root's -z; payload: none). With no ``tip_link``, every moving joint below
     base_link: the chain to the only leaf, or the whole tree (see ``whole_tree``) when there
     are several. Mimic joints follow their joint (``model.Mimic``). ``max_chars``: the text's
-    size limit (default: MAX_URDF_CHARS, or IRB140_MAX_FILE_BYTES)."""
+    size limit (default: MAX_URDF_CHARS, or IRB140_MAX_FILE_BYTES). ``held``: positions of
+    joints the model leaves out (rad, m; the rest at zero), HeldError naming a bad one (see
+    ``held``)."""
     tree = parse_tree(text, max_chars)
     if not tip_link:
         tree._known("base_link", base_link or tree.root)
         if len(tree.leaves(base_link or tree.root)) > 1:
-            return _load_tree(tree, base_link or tree.root, max_joints)
+            return _load_tree(tree, base_link or tree.root, max_joints, held or {})
     base, tip, path = tree.chain(base_link, tip_link)
     span = f"from {clipped(repr(base), 60)} to {clipped(repr(tip), 60)}"
     for joint in path:
@@ -121,6 +137,7 @@ def load_urdf(
             )
     moving = [joint for joint in path if joint.kind in MOVING]
     mimics = mimics_of(moving)
+    positions = held_positions(tree, {joint.name for joint in moving}, held or {})
     if not moving:
         raise UrdfError("chain", f"no revolute, continuous or prismatic joint {span}")
     if len(moving) > max_joints:
@@ -135,10 +152,10 @@ def load_urdf(
         else:
             origins.append(compose(since_last, joint.origin))
             since_last = Placement()
-    held: list[str] = []
+    held_names: list[str] = []
     carried: list[list[str]] = []
     bodies = [
-        lumped(tree, joint.child, moving[k + 1].name if k + 1 < len(moving) else None, held, carried)
+        lumped(tree, joint.child, moving[k + 1].name if k + 1 < len(moving) else None, held_names, carried, positions)
         for k, joint in enumerate(moving)
     ]
     warnings, physical = _checked_inertials(tree, carried)
@@ -151,11 +168,13 @@ def load_urdf(
     joints = [
         _joint(joint, placement, body, ok) for joint, placement, (body, _), ok in zip(moving, origins, bodies, physical)
     ]
-    model = partial(RobotModel, tuple(joints), gravity=base_gravity(tree, base), flange=since_last, mimics=mimics)
-    return _loaded(tree, base, tip, moving, model, "chain", held, warnings, carried, "off the chain: ignored")
+    gravity = base_gravity(tree, base, positions)
+    model = partial(RobotModel, tuple(joints), gravity=gravity, flange=since_last, mimics=mimics)
+    ignored = "off the chain: ignored"
+    return _loaded(tree, base, tip, moving, model, "chain", held_names, warnings, carried, ignored, positions)
 
 
-def _loaded(tree, base, tip, moving, model, kind, held, warnings, carried, ignored) -> LoadedUrdf:
+def _loaded(tree, base, tip, moving, model, kind, held, warnings, carried, ignored, positions) -> LoadedUrdf:
     """The LoadedUrdf of ``model()`` (a ModelError as a UrdfError of ``kind``), with notes on
     the invalid inertials of the links ``carried`` leaves out (``ignored``: why they do not matter)."""
     try:
@@ -168,9 +187,10 @@ def _loaded(tree, base, tip, moving, model, kind, held, warnings, carried, ignor
         for name, body in tree.inertials.items()
         if name not in in_model and (problem := inertial_problem(name, body))
     ]
-    rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base))
-    links = carried_links(tree, moving)
-    return LoadedUrdf(made, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name, links)
+    rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base, positions))
+    links = carried_links(tree, moving, positions)
+    at = tuple(positions.items())
+    return LoadedUrdf(made, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name, links, at)
 
 
 def mimics_of(moving: list[UrdfJoint]) -> tuple | None:
@@ -216,17 +236,20 @@ def _checked_inertials(tree: UrdfTree, carried: list[list[str]]) -> tuple[list[s
     return warnings, physical
 
 
-def base_rotation(tree: UrdfTree, base: str) -> np.ndarray:
-    """base_link's axes in the root link's frame, the joints between them at zero."""
+def base_rotation(tree: UrdfTree, base: str, held=None) -> np.ndarray:
+    """base_link's axes in the root link's frame, the joints between them at ``held``'s
+    positions (``held.held_positions``), else zero."""
     R = np.eye(3)
     for joint in tree.path_from_root(base):
         R = R @ joint.origin.rotation()
+        if (held or {}).get(joint.name, 0.0) != 0.0:
+            R = R @ motion(joint, held[joint.name])[:3, :3]
     return R
 
 
-def base_gravity(tree: UrdfTree, base: str) -> tuple[float, float, float]:
-    """The root link's -z gravity in ``base``'s frame, the joints between them at zero."""
-    g = base_rotation(tree, base).T @ np.array([0.0, 0.0, -GRAVITY])
+def base_gravity(tree: UrdfTree, base: str, held=None) -> tuple[float, float, float]:
+    """The root link's -z gravity in ``base``'s frame, the joints between them held (``base_rotation``)."""
+    g = base_rotation(tree, base, held).T @ np.array([0.0, 0.0, -GRAVITY])
     g[np.abs(g) < 1e-12] = 0.0
     return tuple(float(x) + 0.0 for x in g)
 
@@ -245,11 +268,14 @@ def read_urdf(path, max_chars: int | None = None) -> str:
         raise UrdfError("file", f"{clipped(str(path), 120)}: {error.reason}") from None
 
 
-def lumped(tree: UrdfTree, link: str, stop, held: list[str], carried: list[list[str]]) -> tuple[RigidBody, bool]:
-    """Everything rigidly attached to ``link`` (joints off the chain at zero), up to the
-    chain joint ``stop`` (a name, None, or a set of names), as one body in ``link``'s frame;
-    and whether any had an inertial. The names of the links with an inertial are appended
-    to ``carried`` as a list."""
+def lumped(
+    tree: UrdfTree, link: str, stop, held: list[str], carried: list[list[str]], positions=None
+) -> tuple[RigidBody, bool]:
+    """Everything rigidly attached to ``link`` (joints off the chain held: at ``positions``,
+    else zero), up to the chain joint ``stop`` (a name, None, or a set of names), as one body
+    in ``link``'s frame; and whether any had an inertial. The names of the joints held are
+    appended to ``held``, those of the links with an inertial to ``carried`` as a list."""
+    positions = positions or {}
     stops = stop if isinstance(stop, (set, frozenset)) else {stop}
     bodies, stack, names = [], [(link, np.eye(4))], []
     carried.append(names)
@@ -265,9 +291,11 @@ def lumped(tree: UrdfTree, link: str, stop, held: list[str], carried: list[list[
             for joint in tree.child_joints[name]:
                 if joint.name in stops:
                     continue
+                at = T @ joint.origin.matrix()
                 if joint.kind != "fixed":
                     held.append(joint.name)
-                stack.append((joint.child, T @ joint.origin.matrix()))
+                    at = at @ motion(joint, positions[joint.name]) if positions.get(joint.name, 0.0) else at
+                stack.append((joint.child, at))
         return (reduce(combine, bodies) if bodies else RigidBody()), bool(names)
 
 
@@ -310,7 +338,7 @@ def _joint(joint: UrdfJoint, origin: Placement, body: RigidBody, physical: bool)
     )
 
 
-def _load_tree(tree: UrdfTree, base: str, max_joints: int) -> LoadedUrdf:
+def _load_tree(tree: UrdfTree, base: str, max_joints: int, held: dict[str, float]) -> LoadedUrdf:
     """The whole tree below ``base`` as a LoadedUrdf (see ``whole_tree``)."""
     moving, parents, origins = moving_joints(tree, base)
     where = f"below {clipped(repr(base), 60)}"
@@ -321,9 +349,9 @@ def _load_tree(tree: UrdfTree, base: str, max_joints: int) -> LoadedUrdf:
             "tree", f"{len(moving)} moving joints {where}, more than the limit of {max_joints} (max_joints)"
         )
     stops = {joint.name for joint in moving}
-    held: list[str] = []
+    positions = held_positions(tree, stops, held)  # only joints above base_link (or not below it) are held
     carried: list[list[str]] = []
-    bodies = [lumped(tree, joint.child, stops, held, carried) for joint in moving]
+    bodies = [lumped(tree, joint.child, stops, [], carried) for joint in moving]
     warnings, physical = _checked_inertials(tree, carried)
     subtree_mass = [body.mass for body, _ in bodies]
     for i in reversed(range(len(moving))):
@@ -339,6 +367,8 @@ def _load_tree(tree: UrdfTree, base: str, max_joints: int) -> LoadedUrdf:
         _joint(joint, placement, body, ok) for joint, placement, (body, _), ok in zip(moving, origins, bodies, physical)
     ]
     mimics = mimics_of(moving)
-    model = partial(RobotModel, tuple(joints), gravity=base_gravity(tree, base), parent=tuple(parents), mimics=mimics)
+    gravity = base_gravity(tree, base, positions)
+    model = partial(RobotModel, tuple(joints), gravity=gravity, parent=tuple(parents), mimics=mimics)
+    ignored = "not moved by the tree: ignored"
     tip = moving[-1].child
-    return _loaded(tree, base, tip, moving, model, "tree", (), warnings, carried, "not moved by the tree: ignored")
+    return _loaded(tree, base, tip, moving, model, "tree", (), warnings, carried, ignored, positions)

@@ -34,6 +34,7 @@ from irb140_dynamics.core.model.rigid_body import (
 )
 
 KINDS = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+MOVING = KINDS[:3]  # the kinds of joint with a position (the model's joints, or held)
 MAX_URDF_CHARS = MAX_TEXT_BYTES  # characters of URDF text at most (IRB140_MAX_FILE_BYTES changes it)
 PARSE_CHUNK = 1 << 14  # characters the XML parser (and the check for binary data) takes at a time
 MAX_LINE = 299  # characters of a refusal line at most

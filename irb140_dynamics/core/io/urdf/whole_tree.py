@@ -21,10 +21,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from irb140_dynamics.core.io.urdf.tree import UrdfError, UrdfTree, clipped
+from irb140_dynamics.core.io.urdf.held import motion_placement
+from irb140_dynamics.core.io.urdf.tree import MOVING, UrdfError, UrdfTree, clipped
 from irb140_dynamics.core.model.joints import Placement, matrix_rpy
-
-MOVING = ("revolute", "continuous", "prismatic")
 
 
 def moving_joints(tree: UrdfTree, base: str) -> tuple[list, list[int], list[Placement]]:
@@ -56,17 +55,22 @@ def moving_joints(tree: UrdfTree, base: str) -> tuple[list, list[int], list[Plac
     return moving, parents, origins
 
 
-def carried_links(tree: UrdfTree, moving: list) -> dict[str, tuple[str, Placement]]:
-    """Every link a moving joint of the model carries, fixed to its link or behind joints
-    held at zero: link -> (that joint's name, the link's frame in the joint's link frame)."""
-    names = {joint.name for joint in moving}
+def carried_links(tree: UrdfTree, moving: list, held=None) -> dict[str, tuple[str, Placement]]:
+    """Every link a moving joint of the model carries, fixed to its link or behind held joints
+    (at ``held``'s positions, else zero: ``held.held_positions``): link -> (that joint's name,
+    the link's frame in the joint's link frame)."""
+    names, held = {joint.name for joint in moving}, held or {}
     found = {}
     for joint in moving:
         stack = [(joint.child, Placement())]
         while stack:
             link, placement = stack.pop()
             found[link] = (joint.name, placement)
-            stack += [(j.child, compose(placement, j.origin)) for j in tree.child_joints[link] if j.name not in names]
+            stack += [
+                (j.child, compose(compose(placement, j.origin), motion_placement(j, held.get(j.name, 0.0))))
+                for j in tree.child_joints[link]
+                if j.name not in names
+            ]
     return found
 
 

@@ -1,0 +1,116 @@
+"""The joints a URDF's model leaves out, held at positions given: the rest of a tree (a second
+arm, a head, a gripper's fingers) while the model is one chain of it (a tip_link named), and
+the joints above base_link. Each is at zero unless given.
+
+A held joint's position places what hangs from it: the bodies lumped into the chain link
+they hang from (``reader.lumped``), the links a payload may hang on
+(``whole_tree.carried_links``) and, above base_link, gravity's direction in base_link's
+frame (``reader.base_rotation``). Held joints are at rest: the model's torques are those of
+the whole tree at the same positions with the held joints still.
+
+A mimic joint is not given: it follows its joint, ``multiplier * q + offset``, when that
+joint is given (a mimic of a mimic so too); otherwise it is at zero as the rest. Refused
+with ``HeldError`` (one line, naming the joint): a joint the URDF does not have (with the
+nearest name), a fixed, floating or planar one, a joint of the model (its position is the
+state's), a mimic joint, a value not finite or outside the joint's <limit lower upper>.
+Units: rad (revolute, continuous), m (prismatic).
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from collections.abc import Collection, Mapping
+
+import numpy as np
+
+from irb140_dynamics.core.io.urdf.tree import MOVING, UrdfError, UrdfJoint, UrdfTree, clipped, number
+from irb140_dynamics.core.model.joints import Placement, axis_rotation, matrix_rpy
+
+
+class HeldError(UrdfError):
+    """A held position refused; ``joint``: the joint whose given position it is (a mimic
+    joint's refusal names the joint it follows)."""
+
+    def __init__(self, joint: str, reason: str):
+        super().__init__(f'held joint "{joint}"', reason)
+        self.joint = joint
+
+
+def held_positions(tree: UrdfTree, in_model: Collection[str], given: Mapping[str, float]) -> dict[str, float]:
+    """The held joints' positions that are given (checked) and the mimic joints following
+    them; every other joint off the model is at zero. ``in_model``: the model's joints'
+    names (mimic joints too)."""
+    positions = {}
+    for name, value in given.items():
+        joint = tree.joints.get(name)
+        if joint is None:
+            known = [n for n, j in tree.joints.items() if j.kind in MOVING]
+            near = difflib.get_close_matches(name, known, n=1, cutoff=0.6)
+            hint = f"; did you mean {near[0]}?" if near else ""
+            raise HeldError(name, f"the URDF has no joint {clipped(repr(name), 80)}{hint}")
+        if joint.kind not in MOVING:
+            raise HeldError(name, f"a {joint.kind} joint: only revolute, continuous and prismatic joints are held")
+        if name in in_model:
+            raise HeldError(name, "a joint of the model, not held: its position is the state's")
+        mimic = joint.element.find("mimic")
+        if mimic is not None:
+            raise HeldError(
+                name,
+                f"a mimic joint: it follows {clipped(repr(mimic.get('joint')), 80)} (multiplier * q + offset); "
+                "give that joint's position",
+            )
+        positions[name] = _within_limits(joint, float(value), "", name)
+    given_by = {name: name for name in positions}  # the joint given that a mimic joint follows
+    followers = [j for j in tree.joints.values() if j.kind in MOVING and j.name not in in_model]
+    for _ in range(len(followers)):  # a mimic of a mimic follows in a later pass
+        before = len(positions)
+        for joint in followers:
+            mimic = joint.element.find("mimic")
+            if mimic is None or joint.name in positions or mimic.get("joint") not in positions:
+                continue
+            where = f"{joint.label} <mimic>"
+            multiplier, offset = number(mimic, "multiplier", where, 1.0), number(mimic, "offset", where, 0.0)
+            leader = mimic.get("joint")
+            position = multiplier * positions[leader] + offset
+            given_by[joint.name] = given_by[leader]
+            positions[joint.name] = _within_limits(
+                joint, position, f" for mimic joint {joint.name!r}", given_by[leader]
+            )
+        if len(positions) == before:
+            break
+    return positions
+
+
+def _within_limits(joint: UrdfJoint, value: float, why: str, given: str) -> float:
+    """``value``, or HeldError naming the joint ``given``: not finite, or outside the joint's
+    <limit lower upper> (a continuous joint, or one without <limit>, has none)."""
+    unit = "m" if joint.kind == "prismatic" else "rad"
+    if not math.isfinite(value):
+        raise HeldError(given, f"the position must be finite, got {value}{why}")
+    limit = joint.element.find("limit")
+    if joint.kind == "continuous" or limit is None:
+        return value
+    where = f"{joint.label} <limit>"
+    lower, upper = number(limit, "lower", where, 0.0), number(limit, "upper", where, 0.0)
+    if not lower <= value <= upper:
+        raise HeldError(given, f"{value:g} {unit}{why} is outside its limits [{lower:g}, {upper:g}] {unit}")
+    return value
+
+
+def motion(joint: UrdfJoint, q: float) -> np.ndarray:
+    """The 4x4 transform a moving joint at ``q`` puts between its origin and its child link."""
+    T = np.eye(4)
+    if joint.kind == "prismatic":
+        T[:3, 3] = np.asarray(joint.axis, dtype=float) * q
+    else:
+        T[:3, :3] = axis_rotation(joint.axis, q)
+    return T
+
+
+def motion_placement(joint: UrdfJoint, q: float) -> Placement:
+    """``motion`` as a Placement; the identity (exactly) at q = 0."""
+    if q == 0.0:
+        return Placement()
+    T = motion(joint, q)
+    return Placement(tuple(T[:3, 3].tolist()), matrix_rpy(T[:3, :3]))

@@ -1,0 +1,90 @@
+"""The rest of a tree held at the positions given (core.io.urdf.held, read through
+core.io.arm_source.read_arm as every node and tool reads an arm): a chain's torques are the
+whole tree's at the same positions with the held joints at rest (test_urdf_trees' TWO_ARMS:
+the other arm and its mimic fingers, a payload on a held link; test_payload_tree's pitching
+torso above base_link, turning gravity); the load diagram's masses move where the held arm
+loads a joint (the torso) and stay where it cannot (the last joint). The tools' --hold:
+test/tools/test_hold_option.py."""
+
+import numpy as np
+import pytest
+
+from irb140_dynamics.core import RigidBody, gravity, rnea
+from irb140_dynamics.core.io.arm_source import UrdfText, read_arm
+from irb140_dynamics.core.io.urdf import load_urdf
+from irb140_dynamics.core.payload import derive_torque_limits
+from irb140_dynamics.core.payload.diagram import load_diagram
+
+from .test_payload_tree import PITCH_TORSO, _joint, _link
+from .test_urdf_trees import TWO_ARMS
+
+PAYLOAD = RigidBody(1.5, (0.05, -0.02, 0.03))
+# PITCH_TORSO with torque limits: the torso limits a payload near the flange, l2 one far off it
+LIMITED = f"""<robot name="limited_torso"><link name="base"/>
+  {_joint("torso", "base", "torso", "0 0 0.3", "0 1 0", -0.6, 0.6, effort=120)}{_link("torso", 5.0, "0 0 0.2")}
+  {_joint("l1", "torso", "la1", "0 0.2 0.5", "0 1 0", -1.5, 1.5, effort=200)}{_link("la1", 2.0, "0.15 0 0")}
+  {_joint("l2", "la1", "la2", "0.3 0 0", "0 1 0", -2.0, 2.0, effort=15)}{_link("la2", 1.0, "0.1 0 0")}
+  {_joint("r1", "torso", "ra1", "0 -0.2 0.5", "0 0 1", -3.1416, 3.1416)}{_link("ra1", 1.0)}
+  {_joint("r2", "ra1", "ra2", "0 0 0", "0 1 0", -1.5708, 1.5708)}{_link("ra2", 3.0, "0.3 0 0")}
+</robot>"""
+
+
+def arm(text, tip="la2", base=None, hold=(), **values):
+    return read_arm({name.replace("__", "."): v for name, v in values.items()}, None, UrdfText(text, "t"), base, tip,
+                    hold=hold)  # fmt: skip
+
+
+def whole_tree_at(whole, chain, q, held):
+    """The whole tree's joint vector: the chain's values by name, the held positions, the rest 0."""
+    named = {**dict(zip(chain.joint_names, q)), **held}
+    return np.array([named.get(name, 0.0) for name in whole.joint_names])
+
+
+def test_the_chain_with_the_other_arm_held_is_the_whole_tree_at_those_positions():
+    held = {"r1": 0.4, "r2": -0.7}  # the params file's r2 = 0.1 under --hold's
+    chain = arm(TWO_ARMS, hold=["r2=-0.7"], model__held_positions=["r1=0.4", "r2=0.1"])
+    # finger_b follows r2 as -0.5 r2 + 0.01 (prismatic, m), finger_a as 2 r2 + 0.2
+    assert chain.urdf.held_summary() == "; held: r1=0.4, r2=-0.7, finger_b=0.36, finger_a=-1.2"
+    whole = load_urdf(TWO_ARMS).model
+    on_chain = [whole.joint_names.index(name) for name in chain.model.joint_names]
+    rng = np.random.default_rng(40)
+    for _ in range(3):
+        q, qd, qdd = (rng.uniform(-1.0, 1.0, chain.model.n) for _ in range(3))
+        expected = rnea(whole, whole_tree_at(whole, chain.model, q, held), *(
+            whole_tree_at(whole, chain.model, v, {}) for v in (qd, qdd)))  # fmt: skip
+        np.testing.assert_allclose(rnea(chain.model, q, qd, qdd), expected[on_chain], rtol=1e-12, atol=1e-12)
+    # a payload on a link of the held arm: carried by the torso through the held joints
+    carrying = arm(TWO_ARMS, hold=["r1=0.4", "r2=-0.7"], payload__link="fa", payload__mass=PAYLOAD.mass,
+                   payload__com=list(PAYLOAD.com))  # fmt: skip
+    whole_carrying = read_arm({"payload.link": "fa", "payload.mass": PAYLOAD.mass, "payload.com": list(PAYLOAD.com)},
+                              urdf=UrdfText(TWO_ARMS, "t")).model  # fmt: skip
+    q = rng.uniform(-1.0, 1.0, chain.model.n)
+    at = {**held, "finger_b": 0.36, "finger_a": -1.2}
+    expected = gravity(whole_carrying, whole_tree_at(whole, chain.model, q, held))[on_chain]
+    np.testing.assert_allclose(gravity(carrying.model, q), expected, rtol=1e-12, atol=1e-12)
+    assert dict(carrying.urdf.held_positions) == pytest.approx(at, abs=1e-15)
+
+
+def test_a_torso_above_base_link_held_turns_gravity():
+    held = {"torso": 0.4, "r2": 0.9}
+    chain = arm(PITCH_TORSO, base="torso", hold=[f"{name}={value}" for name, value in held.items()])
+    assert chain.model.gravity == pytest.approx((9.81 * np.sin(0.4), 0.0, -9.81 * np.cos(0.4)), abs=1e-15)
+    whole = load_urdf(PITCH_TORSO).model
+    on_chain = [whole.joint_names.index(name) for name in chain.model.joint_names]
+    q = np.array([0.3, -0.5])
+    expected = gravity(whole, whole_tree_at(whole, chain.model, q, held))[on_chain]
+    np.testing.assert_allclose(gravity(chain.model, q), expected, rtol=1e-12, atol=1e-12)
+
+
+def test_the_load_diagram_moves_where_the_held_arm_loads_a_joint_and_only_there():
+    """At l = 0 the torso limits the payload, and the other arm's pose changes its torque; at
+    l = 0.2 m the last joint does, whose torque no pose of the other arm touches."""
+    masses = []
+    for hold in ((), ("r2=1.2",)):
+        model = arm(LIMITED, hold=hold).model
+        diagram = load_diagram(model, derive_torque_limits(model).values, np.array([0.0]), np.array([0.0, 0.2]))
+        assert [p.joint for p in diagram.points] == [0, 2] and all(p.proven for p in diagram.points)
+        masses.append([p.mass for p in diagram.points])
+    (torso_zero, last_zero), (torso_held, last_held) = masses
+    assert torso_held > 1.05 * torso_zero  # r2 at 1.2 rad swings the other arm's CoM nearer the torso's axis
+    assert last_held == pytest.approx(last_zero, rel=1e-9)
