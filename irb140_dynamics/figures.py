@@ -77,7 +77,7 @@ def _wrap(text, extent, width: float) -> bool:
 
 def texts_outside(figure) -> list[str]:
     """The texts (visible, not empty) whose tight bounding box is not inside the figure."""
-    figure.canvas.draw()
+    figure.draw_without_rendering()
     renderer = figure.canvas.get_renderer()
     box, slack = figure.bbox, 0.5  # pixels: rounding
     outside = []
@@ -106,7 +106,7 @@ def round_steps(low: float, high: float, most: int = 10):
 def figure_problems(figure, dpi=None) -> list[str]:
     """What keeps ``figure`` from reading well, saved at ``dpi`` (default: the figure's);
     see the module. An empty list: nothing."""
-    figure.canvas.draw()
+    figure.draw_without_rendering()
     renderer = figure.canvas.get_renderer()
     problems = []
     width = figure.get_figwidth() * (dpi if isinstance(dpi, (int, float)) else figure.dpi)
@@ -173,7 +173,7 @@ def label_curves(axes, curves, texts, **style) -> list:
     import numpy as np
 
     figure = axes.figure
-    figure.canvas.draw()
+    figure.draw_without_rendering()
     renderer = figure.canvas.get_renderer()
     frame = axes.get_window_extent(renderer)
     style = {"fontsize": 9, "ha": "center", "va": "center", "zorder": 6, **style}
@@ -246,7 +246,7 @@ def _legends(figure) -> list:
 def legends_over_data(figure) -> list[str]:
     """The legends (each named by its entries) that cover plotted data of an axes where the
     axes show it: a line or a marker, a bar, a scatter point, a contour line."""
-    figure.canvas.draw()
+    figure.draw_without_rendering()
     renderer = figure.canvas.get_renderer()
     return [
         repr(", ".join(t.get_text() for t in legend.get_texts()))
@@ -281,7 +281,7 @@ def clear_legend(axes, rect=(0.0, 0.0, 1.0, 1.0), **style):
     figure = axes.figure
     for place in PLACES:
         legend = axes.legend(loc=place, **style)
-        figure.canvas.draw()
+        figure.draw_without_rendering()
         if not _over_data(legend, figure, figure.canvas.get_renderer()):
             return legend
     legend = axes.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), **style)
