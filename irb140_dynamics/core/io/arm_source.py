@@ -200,8 +200,13 @@ def payload_carrier(loaded: LoadedUrdf, values: Mapping[str, Any]) -> RobotModel
 
 
 def is_one_chain(model: RobotModel) -> bool:
-    """Each joint hangs from the one before (mimic joints allowed): one tip, the payload's default place."""
-    return all(p == i - 1 for i, p in enumerate(model.parent))
+    """Every independent joint is on the path from the base to the flange's link (mimic joints
+    may hang off it: a gripper's other finger following the chain's): one tip, the payload's default place."""
+    path, k = set(), model.carrier
+    while k >= 0:
+        path.add(k)
+        k = model.parent[k]
+    return path.issuperset(model.independent)
 
 
 def urdf_span(loaded: LoadedUrdf) -> str:
