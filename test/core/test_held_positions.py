@@ -13,7 +13,7 @@ import pinocchio as pin
 import pytest
 
 from irb140_dynamics.core import RigidBody, gravity, mass_matrix, rnea
-from irb140_dynamics.core.io.arm_source import HeldPositionError, UrdfText, read_arm
+from irb140_dynamics.core.io.arm_source import HeldPositionError, UrdfText, model_summary, read_arm
 from irb140_dynamics.core.io.urdf import load_urdf
 from irb140_dynamics.core.payload import derive_torque_limits
 from irb140_dynamics.core.payload.diagram import load_diagram
@@ -48,7 +48,9 @@ def test_the_chain_with_the_other_arm_held_is_the_whole_tree_at_those_positions(
     held = {"r1": 0.4, "r2": -0.7}  # the params file's r2 = 0.1 under --hold's
     chain = arm(TWO_ARMS, hold=["r2=-0.7"], model__held_positions=["r1=0.4", "r2=0.1"])
     # finger_b follows r2 as -0.5 r2 + 0.01 (prismatic, m), finger_a as 2 r2 + 0.2
-    assert chain.urdf.held_summary() == "; held: r1=0.4, r2=-0.7, finger_b=0.36, finger_a=-1.2"
+    assert chain.urdf.held_summary() == "held: r1=0.4, r2=-0.7, finger_b=0.36, finger_a=-1.2"
+    assert model_summary(chain.urdf) == "base -> la2, 3 joints ['torso', 'l1', 'l2']; " + chain.urdf.held_summary()
+    assert model_summary(load_urdf(TWO_ARMS)) == "the tree below base, 5 joints ['torso', 'l1', 'l2', 'r1', 'r2']"
     whole = load_urdf(TWO_ARMS).model
     on_chain = [whole.joint_names.index(name) for name in chain.model.joint_names]
     rng = np.random.default_rng(40)

@@ -209,6 +209,12 @@ def is_one_chain(model: RobotModel) -> bool:
     return path.issuperset(model.independent)
 
 
+def model_summary(loaded: LoadedUrdf) -> str:
+    """A URDF's model in one line, as the nodes log it: 'base -> tool0, 6 joints [...]; held at zero: a, b'."""
+    names = list(loaded.model.joint_names)
+    return "; ".join(filter(None, (f"{urdf_span(loaded)}, {len(names)} joints {names}", loaded.held_summary())))
+
+
 def urdf_span(loaded: LoadedUrdf) -> str:
     """What of the URDF the model is, for messages: 'base_link -> tool0', or 'the tree below base'."""
     if is_one_chain(loaded.model):

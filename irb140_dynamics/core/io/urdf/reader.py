@@ -89,13 +89,13 @@ class LoadedUrdf:
     held_positions: tuple[tuple[str, float], ...] = ()  # the held joints not at zero: given, or following one
 
     def held_summary(self) -> str:
-        """'; held at zero: a, b', or '; held: r1=0.4, r2=-0.7; at zero: a' (rad, m), for messages; '' for none."""
+        """'held at zero: a, b', or 'held: r1=0.4, r2=-0.7; at zero: a' (rad, m), for messages; '' for none."""
         at = dict(self.held_positions)
         zero = ", ".join(name for name in self.held_joints if name not in at)
         if not at:
-            return f"; held at zero: {zero}" if zero else ""
+            return f"held at zero: {zero}" if zero else ""
         given = ", ".join(f"{name}={value:g}" for name, value in at.items())
-        return f"; held: {given}" + (f"; at zero: {zero}" if zero else "")
+        return f"held: {given}" + (f"; at zero: {zero}" if zero else "")
 
     def with_flange_at(self, link: str) -> RobotModel:
         """The model with its flange (where the payload sits) at URDF link ``link``: on the
