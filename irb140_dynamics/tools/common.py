@@ -52,7 +52,8 @@ def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model"
         default=[],
         metavar="JOINT=VALUE",
         help="a URDF joint the model leaves out (the rest of the tree with --tip, one above --base) held at VALUE "
-        "[rad, m] (repeatable; over model.held_positions; default: zero; a mimic joint follows its joint)",
+        "[rad, m] (repeatable; over model.held_positions; default: zero, or its limit nearest zero where zero is "
+        "outside its range; a mimic joint follows its joint)",
     )
     group.add_argument(
         "-p",

@@ -24,9 +24,10 @@ dotted names, as rcl gives them to a node: ``given_values``), over the default a
   payload hangs on (``LoadedUrdf.with_flange_at``; ``payload.com``/``.inertia`` in its
   frame); empty: the chain's tip link. On a tree a payload (``payload.mass`` > 0) needs it.
   The joints the model leaves out (the rest of a tree when ``model.tip_link`` names one
-  end effector; those above base_link) are held at zero, or at ``model.held_positions``
-  (a list of 'JOINT=VALUE', rad or m; a tool's ``--hold JOINT=VALUE`` over them):
-  ``held_chain``, which refuses a bad one naming the option (``HeldPositionError``).
+  end effector; those above base_link) are held at ``model.held_positions`` (a list of
+  'JOINT=VALUE', rad or m; a tool's ``--hold JOINT=VALUE`` over them), else at zero or the
+  limit nearest it (``core.io.urdf.held``): ``held_chain``, which refuses a bad one naming
+  the option (``HeldPositionError``); on an arm of parameters any is refused.
 
 Names given that are no parameter of the package: ``core.io.parameter_names``.
 Errors: a ValueError in one line naming the file or the parameter. No ROS.
@@ -70,7 +71,7 @@ URDF_PARAMETERS = (  # model.source robot_description's (name, default, descript
         HELD,
         (),
         "'JOINT=VALUE' (rad, m) of joints the model leaves out (the rest of the tree, those above model.base_link); "
-        "not given: zero; a mimic joint follows its joint",
+        "not given: zero, or the limit nearest it; a mimic joint follows its joint",
     ),
 )
 

@@ -1,6 +1,6 @@
 """The joints a URDF's model leaves out, held at positions given: the rest of a tree (a second
 arm, a head, a gripper's fingers) while the model is one chain of it (a tip_link named), and
-the joints above base_link. Each is at zero unless given.
+the joints above base_link. Each is where given, else at its default (below).
 
 A held joint's position places what hangs from it: the bodies lumped into the chain link
 they hang from (``reader.lumped``), the links a payload may hang on
