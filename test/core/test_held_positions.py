@@ -14,13 +14,15 @@ import pytest
 
 from irb140_dynamics.core import RigidBody, gravity, mass_matrix, rnea
 from irb140_dynamics.core.io.arm_source import HeldPositionError, UrdfText, model_summary, read_arm
-from irb140_dynamics.core.io.urdf import load_urdf
+from irb140_dynamics.core.io.urdf import UrdfError, load_urdf
 from irb140_dynamics.core.payload import derive_torque_limits
 from irb140_dynamics.core.payload.diagram import load_diagram
 
 from ..support.pinocchio_trees import corpus_files, pinocchio_state, worst_error
 from .test_payload_tree import PITCH_TORSO, _joint, _link
 from .test_urdf_trees import TWO_ARMS
+from .test_urdf_trees import _joint as _tree_joint
+from .test_urdf_trees import _link as _tree_link
 
 PAYLOAD = RigidBody(1.5, (0.05, -0.02, 0.03))
 # PITCH_TORSO with torque limits: the torso limits a payload near the flange, l2 one far off it
@@ -191,3 +193,21 @@ def test_a_joint_whose_range_excludes_zero_is_held_at_its_nearest_limit_and_said
     assert whole_tree_error(default.model, whole, np.random.default_rng(44), {"r2": -0.3}) < 1e-12
     with pytest.raises(HeldPositionError, match=r"--hold r2=0: 0 rad is outside its limits \[-1.5708, -0.3\] rad"):
         arm(R2_BELOW_ZERO, hold=["r2=0"])
+
+
+def test_a_mimic_of_a_mimic_off_the_chain_follows_the_chains_joint_and_one_above_base_link_is_refused():
+    """Off the chain j1, j2: m1 follows j2 (2 q + 0.1), m2 follows m1 (-0.5 q + 0.3): both
+    the model's, m2 following j2 as -q + 0.25. A mimic joint of j2 above base_link would turn
+    base_link with the state: refused in one line."""
+    links = "".join(_tree_link(name) for name in ("a", "b", "c", "d", "e"))
+    text = f"""<robot name="mimics"><link name="root"/>{links}
+      {_tree_joint("j1", "root", "a")}{_tree_joint("j2", "a", "b")}
+      {_tree_joint("m1", "a", "c", extra='<mimic joint="j2" multiplier="2" offset="0.1"/>')}
+      {_tree_joint("m2", "c", "d", extra='<mimic joint="m1" multiplier="-0.5" offset="0.3"/>')}
+      {_tree_joint("up", "root", "e", extra='<mimic joint="j2"/>')}</robot>"""
+    model = load_urdf(text, tip_link="b").model
+    assert [j.name for j in model.joints] == ["j1", "j2", "m1", "m2"] and model.parent == (-1, 0, 0, 2)
+    np.testing.assert_allclose(model.all_positions([0.3, 0.4]), [0.3, 0.4, 0.9, -0.15], rtol=1e-15)
+    below_up = text.replace('<parent link="root"/><child link="a"/>', '<parent link="e"/><child link="a"/>')
+    with pytest.raises(UrdfError, match=r'^URDF joint "up": a mimic joint above base_link \'e\' following \'j2\''):
+        load_urdf(below_up, base_link="e", tip_link="b")
