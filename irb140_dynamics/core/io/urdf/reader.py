@@ -16,7 +16,7 @@
 - Bodies that do not move (base_link, what is fixed to it, what is above it) are left out;
   their inertials are not checked (an invalid one is a ``note``).
 - Gravity is the root link's -z (9.81 m/s^2), expressed in base_link's frame with the
-  joints between them held (at zero unless given).
+  joints between them held (where given, else at zero or the limit nearest it).
 - <limit lower upper> are the position limits (continuous joints: CONTINUOUS_LIMITS),
   ``effort`` the torque (prismatic: force) limit, ``velocity`` the velocity limit (0 or
   absent: none); <dynamics damping friction> are viscous and Coulomb friction.
@@ -80,7 +80,7 @@ class LoadedUrdf:
     model: RobotModel
     base_link: str
     tip_link: str
-    held_joints: tuple[str, ...]  # moving joints off the chain, held (at zero unless given), bodies lumped
+    held_joints: tuple[str, ...]  # moving joints off the chain, held (module held), bodies lumped
     warnings: tuple[str, ...] = ()  # the chain's inertials taken as given though not physical
     notes: tuple[str, ...] = ()  # invalid inertials off the chain, ignored
     base_rotation: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))  # base_link's axes in the root's
