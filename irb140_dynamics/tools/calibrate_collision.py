@@ -2,7 +2,7 @@
 
     irb140-calibrate-collision BAG --out COLLISION.yaml [--margin 1.5] [--observer-gain 100]
         [--topic /joint_states] [--params-file ARM.yaml | --urdf ARM.urdf [--base LINK] [--tip LINK]]
-        [-p NAME:=VALUE] [--quiet]
+        [--hold JOINT=VALUE] [-p NAME:=VALUE] [--quiet]
     (or: ros2 run irb140_dynamics calibrate_collision ..., python -m irb140_dynamics.tools.calibrate_collision ...)
 
 BAG: a ROS 2 bag (directory, .mcap or .db3) or a CSV file of joint states with positions,

@@ -52,7 +52,8 @@ def add_model_arguments(parser: argparse.ArgumentParser, role: str = "the model"
         default=[],
         metavar="JOINT=VALUE",
         help="a URDF joint the model leaves out (the rest of the tree with --tip, one above --base) held at VALUE "
-        "[rad, m] (repeatable; over model.held_positions; default: zero; a mimic joint follows its joint)",
+        "[rad, m] (repeatable; over model.held_positions; default: zero, or its limit nearest zero where zero is "
+        "outside its range; a mimic joint follows its joint)",
     )
     group.add_argument(
         "-p",
@@ -100,12 +101,29 @@ def arm_of(args: argparse.Namespace, chain_for: str | None = None):
     if arm.urdf is None and not params_file:  # the package's own arm: named by its file
         arm = replace(arm, origin=str(default_config_path()))
     if chain_for and not arm.model.is_chain:
-        raise ToolError(
-            f"{chain_for} takes one serial chain, but {shown(arm.origin)} gives {len(arm.model.joints)} joints "
-            "as a tree or with mimic joints: give --tip LINK, the end effector's URDF link (the rest of the tree held "
-            "at zero, or at --hold JOINT=VALUE)"
-        )
+        raise ToolError(_chain_refusal(chain_for, arm))
     return replace(arm, given=values)
+
+
+def _chain_refusal(chain_for: str, arm) -> str:
+    """Why ``arm`` is no serial chain for ``chain_for``, and what to give: a --tip for a tree;
+    for a chain with mimic joints (in it, or following it off it: a gripper's other finger),
+    a --tip above the joint they follow, that joint held."""
+    from irb140_dynamics.core.io.arm_source import is_one_chain
+
+    model = arm.model
+    if not is_one_chain(model) or model.mimics is None:
+        return (
+            f"{chain_for} takes one serial chain, but {shown(arm.origin)} gives {len(model.joints)} joints as a tree "
+            "or with mimic joints: give --tip LINK, the end effector's URDF link (the rest of the tree held at zero, "
+            "or at --hold JOINT=VALUE)"
+        )
+    name, leader = next((j.name, m.joint) for j, m in zip(model.joints, model.mimics) if m is not None)
+    return (
+        f"{chain_for} takes one serial chain without mimic joints, but in {shown(arm.origin)} {name!r} follows "
+        f"{leader!r}: end the chain above {leader!r} (--tip, the link it hangs from) and hold it there "
+        f"(--hold {leader}=VALUE)"
+    )
 
 
 def _unknown_text(unknown, overrides: dict, params_file) -> str:

@@ -1,6 +1,6 @@
 """excitation: a periodic trajectory that makes the arm's dynamic parameters identifiable.
 
-    irb140-excitation --out FILE [--params-file F | --urdf FILE [--base L] [--tip L] [--hold J=V]]
+    irb140-excitation --out FILE [--params-file F | --urdf FILE [--base L] [--tip L]] [--hold J=V]
                       [-p NAME:=VALUE] [--rate HZ] [--period S]
                       [--harmonics K] [--periods P] [--seed N] [--iterations N]
                       [--payload [--pose Q1,...,Qn] [--effort-noise N|P%] [--record-rate HZ]]

@@ -1,7 +1,7 @@
 """export_urdf: the current model as URDF (the IRB-140's with the report's shapes).
 
     irb140-export-urdf [--out FILE] [--params-file FILE | --urdf FILE [--base LINK] [--tip LINK]]
-                       [-p NAME:=VALUE ...] > arm.urdf
+                       [--hold JOINT=VALUE ...] [-p NAME:=VALUE ...] > arm.urdf
     (or: ros2 run irb140_dynamics export_urdf ..., python -m irb140_dynamics.tools.export_urdf ...)
 
 The model is read as every tool and node reads it (``core.io.arm_source``): the default

@@ -1,7 +1,7 @@
 """identify: the arm's dynamic parameters from a recording of its joint states.
 
     irb140-identify BAG --out IDENTIFIED.yaml [--topic /joint_states]
-        [--params-file PRIOR.yaml | --urdf PRIOR.urdf [--base LINK] [--tip LINK]] [-p NAME:=VALUE]
+        [--params-file PRIOR.yaml | --urdf PRIOR.urdf [--base LINK] [--tip LINK]] [--hold JOINT=VALUE] [-p NAME:=VALUE]
         [--urdf-out IDENTIFIED.urdf] [--plots DIR] [--validate BAG2] [--offsets]
     irb140-identify --payload-only --params-file ARM.yaml BAG --out LOAD.yaml
     (or: ros2 run irb140_dynamics identify ..., python -m irb140_dynamics.tools.identify ...)

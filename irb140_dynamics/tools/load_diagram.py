@@ -1,6 +1,6 @@
 """load_diagram: the arm's load diagram, the largest payload per centre-of-mass position.
 
-    irb140-load-diagram --out DIR [--params-file F | --urdf U [--base B] [--tip T] [--hold J=V]] [-p NAME:=VALUE]
+    irb140-load-diagram --out DIR [--params-file F | --urdf U [--base B] [--tip T]] [--hold J=V] [-p NAME:=VALUE]
                         [--z-max 0.3] [--l-max 0.2] [--step 0.01] [--rated-mass 6.0]
     (or: ros2 run irb140_dynamics load_diagram ..., python -m irb140_dynamics.tools.load_diagram ...)
 

@@ -34,6 +34,7 @@ from irb140_dynamics.core.urdf import load_urdf
 
 from ..support import pinocchio_model
 from ..support.common import full_sweep, loaded_irb140, random_model, random_urdf_model
+from ..support.pinocchio_trees import pinocchio_state
 from .test_urdf_any_chain import KINDS, chain_urdf
 from .test_urdf_corpus import FILES, chains
 
@@ -116,9 +117,10 @@ def of_robot_model(robot) -> Reference:
     )
 
 
-def of_urdf(text: str, model) -> Reference:
+def of_urdf(text: str, model, held=()) -> Reference:
     """The reference for a chain loaded from ``text``: Pinocchio's reading of the text, the
-    joints off the chain locked at zero; its friction from Pinocchio's damping and friction."""
+    joints off the chain locked where the model holds them (``held``: a LoadedUrdf's
+    ``held_positions``; the rest at zero); its friction from Pinocchio's damping and friction."""
     full = pin.buildModelFromXML(text)
     names = model.joint_names
     counts = Counter(frame.name for frame in full.frames)
@@ -127,7 +129,7 @@ def of_urdf(text: str, model) -> Reference:
             frame.name += f"#{k}"
     kept = {full.getJointId(name) for name in names}
     locked = [j for j in range(1, full.njoints) if j not in kept]
-    reduced = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
+    reduced = pin.buildReducedModel(full, locked, pinocchio_state(full, [], [], [], [], held)[0]) if locked else full
     reduced.gravity.linear = full.gravity.linear
     joints = [reduced.joints[reduced.getJointId(name)] for name in names]
     index = [j.idx_v for j in joints]
@@ -219,16 +221,17 @@ def test_chains_of_example_robot_data_agree_with_pinocchio():
         loaded = []
         for base, tip in chains(text):
             try:
-                model = load_urdf(text, base, tip).model
+                chain = load_urdf(text, base, tip)
+                model = chain.model
             except ModelError as refusal:  # mimic joints: the corpus test checks the refusals
                 assert "mimic" in str(refusal)
                 continue
             if model.mimics is None:  # with mimic joints the derivatives are refused (test_urdf_trees)
-                loaded.append(model)
+                loaded.append((model, chain.held_positions))
         if not full_sweep() and len(loaded) > 1:
             loaded = [loaded[rng.integers(len(loaded))]]
-        for model in loaded:
-            compare(model, of_urdf(text, model), rng, states=1, label=f"{path.split('/robots/')[-1]}")
+        for model, held in loaded:
+            compare(model, of_urdf(text, model, held), rng, states=1, label=f"{path.split('/robots/')[-1]}")
             compared += 1
     assert compared >= 50
 

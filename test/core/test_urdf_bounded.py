@@ -39,8 +39,10 @@ def refusal(text, **kwargs) -> str:
 
 def test_the_seed_text_loads():
     loaded = load_urdf(SEED_TEXT, "base", "tool0")
-    assert [j.kind for j in loaded.model.joints] == ["revolute", "prismatic", "revolute"]
-    assert loaded.held_joints == ("finger",)
+    # the finger off the chain follows j3: a mimic joint of the model, hanging off the chain's last link
+    assert [j.kind for j in loaded.model.joints] == ["revolute", "prismatic", "revolute", "prismatic"]
+    assert loaded.model.joint_names == ("j1", "slide-2", "j3") and loaded.model.parent == (-1, 0, 1, 2)
+    assert loaded.held_joints == ()
     assert outcome(SEED_TEXT, {"base_link": "base", "tip_link": "tool0"}) == "loaded"
 
 

@@ -21,6 +21,7 @@ from irb140_dynamics.core.monitoring.link_wrenches import SINGULAR_THRESHOLD, li
 from irb140_dynamics.core.monitoring.wrench import TREE_REFUSAL, WrenchStream
 from irb140_dynamics.nodes.id_node.markers import build_markers
 from irb140_dynamics.nodes.id_node.node import IdNode
+from irb140_dynamics.nodes.payload_check_node.node import PayloadCheckNode
 from irb140_dynamics.nodes.sim_node.node import SimNode
 
 from ..core.test_urdf_trees import TWO_ARMS, _without_mimics
@@ -326,3 +327,16 @@ def test_payload_check_node_checks_the_payload_on_its_link_with_the_other_arm_in
     rest = reply.message.splitlines()[6]  # the other arm in the torso's worst pose: the one line of the rest
     assert rest.startswith("the rest of the tree in torso's worst pose [deg]: r1 ") and ", r2 " in rest
     assert "rest of the tree" not in "\n".join(reply.message.splitlines()[7:])
+
+
+@pytest.mark.parametrize("node", [IdNode, PayloadCheckNode, SimNode])
+def test_held_positions_on_an_arm_of_parameters_stop_a_node_in_one_line_as_a_tool(node):
+    """model.held_positions holds joints of a URDF: on the built-in arm (no URDF) every node
+    refuses it at its start in read_arm's line, as the tools do (it was warned about, ignored)."""
+    with pytest.raises(ValueError) as tool:
+        read_arm({"model.held_positions": ["joint_2=0.1"]})
+    held = [Parameter("model.held_positions", value=["joint_2=0.1"])]
+    with pytest.raises(ValueError) as refused, running(node, parameter_overrides=held):
+        pass
+    assert str(refused.value) == str(tool.value) and "\n" not in str(refused.value)
+    assert str(tool.value).startswith("model.held_positions holds joints of a URDF")

@@ -34,10 +34,15 @@ def corpus_files() -> list[str]:
     return sorted(str(distribution.locate_file(f)) for f in distribution.files or () if str(f).endswith(".urdf"))
 
 
-def pinocchio_state(full: pin.Model, names, q, qd, qdd):
-    """Pinocchio's q, v, a: the named joints at q, qd, qdd, the others at zero."""
+def pinocchio_state(full: pin.Model, names, q, qd, qdd, held=None):
+    """Pinocchio's q, v, a: the named joints at q, qd, qdd, the joints ``held`` at its
+    positions (a LoadedUrdf's ``held_positions``; a mimic joint of Pinocchio's ``mimic=True``
+    model follows its joint there), the others at zero."""
     pq, v, a = pin.neutral(full), np.zeros(full.nv), np.zeros(full.nv)
-    for name, x, xd, xdd in zip(names, q, qd, qdd):
+    held = dict(held or {})
+    rest = [name for name in held if full.joints[full.getJointId(name)].nq > 0]
+    for name, x, xd, xdd in zip([*rest, *names], [*(held[n] for n in rest), *q], [0.0] * len(rest) + [*qd],
+                                [0.0] * len(rest) + [*qdd]):  # fmt: skip
         joint = full.joints[full.getJointId(name)]
         if joint.nq == 2:  # continuous: (cos, sin)
             pq[joint.idx_q : joint.idx_q + 2] = math.cos(x), math.sin(x)
@@ -47,8 +52,9 @@ def pinocchio_state(full: pin.Model, names, q, qd, qdd):
     return pq, v, a
 
 
-def reference(full: pin.Model, follows_mimics: bool, model, q, qd, qdd):
-    """Pinocchio's (tau without friction, g, M) of ``model`` at (q, qd, qdd)."""
+def reference(full: pin.Model, follows_mimics: bool, model, q, qd, qdd, held=None):
+    """Pinocchio's (tau without friction, g, M) of ``model`` at (q, qd, qdd), the joints
+    ``held`` at its positions (``pinocchio_state``)."""
     if model.mimics is None or follows_mimics:
         names, G = model.joint_names, np.eye(model.n)
         state = q, qd, qdd
@@ -56,7 +62,7 @@ def reference(full: pin.Model, follows_mimics: bool, model, q, qd, qdd):
         names, G = [j.name for j in model.joints], model.mimic_matrix()
         state = model.all_positions(q), G @ qd, G @ qdd
     index = [full.joints[full.getJointId(name)].idx_v for name in names]
-    pq, v, a = pinocchio_state(full, names, *state)
+    pq, v, a = pinocchio_state(full, names, *state, held=held)
     tau = pin.rnea(full, full.createData(), pq, v, a)[index]
     g = pin.computeGeneralizedGravity(full, full.createData(), pq)[index]
     M = pin.crba(full, full.createData(), pq)
@@ -64,16 +70,17 @@ def reference(full: pin.Model, follows_mimics: bool, model, q, qd, qdd):
     return G.T @ tau, G.T @ g, G.T @ M @ G
 
 
-def worst_error(text: str, model, rng, states: int) -> float:
+def worst_error(text: str, model, rng, states: int, held=None) -> float:
     """The largest difference of rnea (friction taken out), gravity and M from Pinocchio's
-    over ``states`` random states, relative to the largest of Pinocchio's (at least 1)."""
+    over ``states`` random states, relative to the largest of Pinocchio's (at least 1); the
+    joints ``held`` at its positions (a LoadedUrdf's ``held_positions``)."""
     from irb140_dynamics.core import gravity, mass_matrix, rnea
 
     full, follows = pinocchio_of(text, model.mimics is not None)
     worst = 0.0
     for _ in range(states):
         q, qd, qdd = rng.uniform(-1.5, 1.5, model.n), rng.uniform(-2, 2, model.n), rng.uniform(-3, 3, model.n)
-        tau, g, M = reference(full, follows, model, q, qd, qdd)
+        tau, g, M = reference(full, follows, model, q, qd, qdd, held)
         friction = 0.0 if model.friction is None else model.friction.torques(qd)
         for ours, theirs in (
             (rnea(model, q, qd, qdd) - friction, tau),

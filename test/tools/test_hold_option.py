@@ -54,3 +54,15 @@ def test_holding_without_a_urdf_or_a_joint_a_chain_lacks_is_refused(tmp_path, ca
     chain = (URDF_DATA / "ur5.urdf").read_text()  # one chain: nothing off it to hold
     status, out, err = run_check(capsys, tmp_path, "--hold", "elbow_jont=0.1", text=chain, mass="1")
     assert status == 2 and "--hold elbow_jont=0.1: the URDF has no joint 'elbow_jont'; did you mean elbow_joint?" in err
+
+
+def test_a_chain_whose_joint_a_gripper_follows_says_where_to_end_it(tmp_path, capsys):
+    """TWO_ARMS to ra2: its fingers follow r2 (mimic joints of the model, off the chain): the
+    load diagram takes a chain without them and says so, naming the joint to end above and
+    hold; ending there (ra1), the fingers follow the r2 held."""
+    status, out, err = run_check(capsys, tmp_path, "--tip", "ra2", text=TWO_ARMS, mass="1")
+    assert (status, out, err.count("\n")) == (1, "", 1), err
+    assert "takes one serial chain without mimic joints" in err and "'finger_b' follows 'r2'" in err
+    assert "end the chain above 'r2' (--tip, the link it hangs from) and hold it there (--hold r2=VALUE)" in err
+    status, out, err = run_check(capsys, tmp_path, "--tip", "ra1", "--hold", "r2=0.3", text=TWO_ARMS, mass="1")
+    assert status == 0 and "inside" in out, (out, err)

@@ -24,9 +24,10 @@ dotted names, as rcl gives them to a node: ``given_values``), over the default a
   payload hangs on (``LoadedUrdf.with_flange_at``; ``payload.com``/``.inertia`` in its
   frame); empty: the chain's tip link. On a tree a payload (``payload.mass`` > 0) needs it.
   The joints the model leaves out (the rest of a tree when ``model.tip_link`` names one
-  end effector; those above base_link) are held at zero, or at ``model.held_positions``
-  (a list of 'JOINT=VALUE', rad or m; a tool's ``--hold JOINT=VALUE`` over them):
-  ``held_chain``, which refuses a bad one naming the option (``HeldPositionError``).
+  end effector; those above base_link) are held at ``model.held_positions`` (a list of
+  'JOINT=VALUE', rad or m; a tool's ``--hold JOINT=VALUE`` over them), else at zero or the
+  limit nearest it (``core.io.urdf.held``): ``held_chain``, which refuses a bad one naming
+  the option (``HeldPositionError``); on an arm of parameters any is refused.
 
 Names given that are no parameter of the package: ``core.io.parameter_names``.
 Errors: a ValueError in one line naming the file or the parameter. No ROS.
@@ -70,7 +71,7 @@ URDF_PARAMETERS = (  # model.source robot_description's (name, default, descript
         HELD,
         (),
         "'JOINT=VALUE' (rad, m) of joints the model leaves out (the rest of the tree, those above model.base_link); "
-        "not given: zero; a mimic joint follows its joint",
+        "not given: zero, or the limit nearest it; a mimic joint follows its joint",
     ),
 )
 
@@ -200,8 +201,19 @@ def payload_carrier(loaded: LoadedUrdf, values: Mapping[str, Any]) -> RobotModel
 
 
 def is_one_chain(model: RobotModel) -> bool:
-    """Each joint hangs from the one before (mimic joints allowed): one tip, the payload's default place."""
-    return all(p == i - 1 for i, p in enumerate(model.parent))
+    """Every independent joint is on the path from the base to the flange's link (mimic joints
+    may hang off it: a gripper's other finger following the chain's): one tip, the payload's default place."""
+    path, k = set(), model.carrier
+    while k >= 0:
+        path.add(k)
+        k = model.parent[k]
+    return path.issuperset(model.independent)
+
+
+def model_summary(loaded: LoadedUrdf) -> str:
+    """A URDF's model in one line, as the nodes log it: 'base -> tool0, 6 joints [...]; held at zero: a, b'."""
+    names = list(loaded.model.joint_names)
+    return "; ".join(filter(None, (f"{urdf_span(loaded)}, {len(names)} joints {names}", loaded.held_summary())))
 
 
 def urdf_span(loaded: LoadedUrdf) -> str:

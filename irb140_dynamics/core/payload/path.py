@@ -65,8 +65,10 @@ class PayloadPath:
 
     @property
     def moves(self) -> bool:
-        """Something hangs off the path: the chain is not the tree's path alone."""
-        return self.tree is not self.chain and bool(self.moving.sum() > self.columns.size)
+        """Something whose pose changes the path's torques hangs off it (``slack`` > 0): the
+        chain is not the tree's path alone (a branch moved by coordinates of its own, or by
+        the path's: mimic joints following a path joint, a gripper's other finger)."""
+        return self.tree is not self.chain and bool(self.slack.any())
 
     def family(self, payload: RigidBody) -> PayloadFamily:
         """``payload``'s shape at any mass on the whole tree (its torques, all its joints)."""

@@ -23,7 +23,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
 from irb140_dynamics.core import Joint, RigidBody, RobotModel
 from irb140_dynamics.core.errors import check_choice, one_line
-from irb140_dynamics.core.io.arm_source import SOURCES, held_chain, read_arm, read_urdf_file, urdf_span
+from irb140_dynamics.core.io.arm_source import SOURCES, held_chain, model_summary, read_arm, read_urdf_file
 from irb140_dynamics.core.io.params_file import read_parameter_file
 from irb140_dynamics.core.io.urdf import LoadedUrdf
 from irb140_dynamics.core.io.urdf.writer import BASE, FLANGE
@@ -87,7 +87,7 @@ class ArmParameters:
             joint_names = check_joint_names(overrides.declare(joint_names_spec(defaults["joint_names"])))
             self.robot_name = overrides.declare(MODEL_NAME)
             arm = model_specs(joint_names, defaults)
-        # payload.link on an arm of parameters: refused unless empty (read_arm)
+        # payload.link, model.held_positions on an arm of parameters: refused unless empty (read_arm)
         self.declare([*arm, PAYLOAD_LINK, *specs, *([] if joint_names is None else self._joint_specs(joint_names))])
         overrides.warn_unknown(joint_names)
         if self.urdf is not None:
@@ -211,8 +211,7 @@ class ArmParameters:
     def _announce(self, origin: str) -> None:
         urdf, logger = self.urdf, self._node.get_logger()
         self.robot_name = urdf.robot_name or "robot"
-        names = list(urdf.model.joint_names)
-        logger.info(f"model from the {origin}: {urdf_span(urdf)}, {len(names)} joints {names}{urdf.held_summary()}")
+        logger.info(f"model from the {origin}: {model_summary(urdf)}")
         for warning in urdf.warnings:
             logger.warning(warning)
         for note in urdf.notes:

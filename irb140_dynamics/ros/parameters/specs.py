@@ -10,7 +10,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-from irb140_dynamics.core.io.arm_source import DEFAULT_ROBOT_NAME, URDF_PARAMETERS
+from irb140_dynamics.core.io.arm_source import DEFAULT_ROBOT_NAME, HELD, URDF_PARAMETERS
 from irb140_dynamics.core.model.joints import MAX_FRICTION, MAX_TORQUE_LIMIT, param_prefix
 from irb140_dynamics.core.model.rigid_body import MAX_MASS
 from irb140_dynamics.ros.parameters.spec import Spec
@@ -104,6 +104,7 @@ def model_specs(joint_names: list[str], defaults: dict[str, Any]) -> list[Spec]:
         *_body_specs(
             "payload", "the payload on the flange", "flange frame", lambda name, kind: defaults.get(name, kind)
         ),
+        *(spec for spec in DESCRIPTION_PARAMETERS if spec.name == HELD),  # an arm of parameters: refused (read_arm)
     ]
     for name in joint_names:
         joint = param_prefix(name)  # the joint's parameter prefix (its name, if a parameter name)

@@ -1,6 +1,6 @@
 """The joints a URDF's model leaves out, held at positions given: the rest of a tree (a second
 arm, a head, a gripper's fingers) while the model is one chain of it (a tip_link named), and
-the joints above base_link. Each is at zero unless given.
+the joints above base_link. Each is where given, else at its default (below).
 
 A held joint's position places what hangs from it: the bodies lumped into the chain link
 they hang from (``reader.lumped``), the links a payload may hang on
@@ -8,10 +8,12 @@ they hang from (``reader.lumped``), the links a payload may hang on
 frame (``reader.base_rotation``). Held joints are at rest: the model's torques are those of
 the whole tree at the same positions with the held joints still.
 
-A mimic joint is not given: it follows its joint, ``multiplier * q + offset``, when that
-joint is given (a mimic of a mimic so too); otherwise it is at zero as the rest. Refused
-with ``HeldError`` (one line, naming the joint): a joint the URDF does not have (with the
-nearest name), a fixed, floating or planar one, a joint of the model (its position is the
+A joint not given is at zero, or where zero is outside its <limit lower upper> at the limit
+nearest zero (a ``note`` says so: ``default_note``). A mimic joint is not given: it follows
+its joint, ``multiplier * q + offset``, given or not (a mimic of a mimic so too); one
+following a joint of the model is no held joint but the model's (``whole_tree.mimic_branches``).
+Refused with ``HeldError`` (one line, naming the joint): a joint the URDF does not have (with
+the nearest name), a fixed, floating or planar one, a joint of the model (its position is the
 state's), a mimic joint, a value not finite or outside the joint's <limit lower upper>.
 Units: rad (revolute, continuous), m (prismatic).
 """
@@ -37,31 +39,27 @@ class HeldError(UrdfError):
         self.joint = joint
 
 
-def held_positions(tree: UrdfTree, in_model: Collection[str], given: Mapping[str, float]) -> dict[str, float]:
-    """The held joints' positions that are given (checked) and the mimic joints following
-    them; every other joint off the model is at zero. ``in_model``: the model's joints'
-    names (mimic joints too)."""
-    positions = {}
-    for name, value in given.items():
-        joint = tree.joints.get(name)
-        if joint is None:
-            known = [n for n, j in tree.joints.items() if j.kind in MOVING]
-            near = difflib.get_close_matches(name, known, n=1, cutoff=0.6)
-            hint = f"; did you mean {near[0]}?" if near else ""
-            raise HeldError(name, f"the URDF has no joint {clipped(repr(name), 80)}{hint}")
-        if joint.kind not in MOVING:
-            raise HeldError(name, f"a {joint.kind} joint: only revolute, continuous and prismatic joints are held")
-        if name in in_model:
-            raise HeldError(name, "a joint of the model, not held: its position is the state's")
-        mimic = joint.element.find("mimic")
-        if mimic is not None:
-            raise HeldError(
-                name,
-                f"a mimic joint: it follows {clipped(repr(mimic.get('joint')), 80)} (multiplier * q + offset); "
-                "give that joint's position",
-            )
-        positions[name] = _within_limits(joint, float(value), "", name)
-    given_by = {name: name for name in positions}  # the joint given that a mimic joint follows
+def held_positions(
+    tree: UrdfTree, in_model: Collection[str], given: Mapping[str, float], at_limit: list | None = None
+) -> dict[str, float]:
+    """Every moving joint off the model at its held position (the module's): given (checked),
+    else its default (``default_position``), a mimic joint following its joint. ``in_model``:
+    the model's joints' names (mimic joints too); ``at_limit``: the names of the joints not
+    given and held at a limit are appended to it."""
+    for name in given:
+        _check_given(tree, in_model, name)
+    positions, given_by = {}, {}  # given_by: the joint given that a mimic joint follows (None: a default)
+    for joint in tree.joints.values():
+        if joint.kind not in MOVING or joint.name in in_model or joint.element.find("mimic") is not None:
+            continue
+        if joint.name in given:
+            positions[joint.name] = _within_limits(joint, float(given[joint.name]), "", joint.name)
+            given_by[joint.name] = joint.name
+        else:
+            positions[joint.name], limited = default_position(joint)
+            given_by[joint.name] = None
+            if limited and at_limit is not None:
+                at_limit.append(joint.name)
     followers = [j for j in tree.joints.values() if j.kind in MOVING and j.name not in in_model]
     for _ in range(len(followers)):  # a mimic of a mimic follows in a later pass
         before = len(positions)
@@ -73,13 +71,62 @@ def held_positions(tree: UrdfTree, in_model: Collection[str], given: Mapping[str
             multiplier, offset = number(mimic, "multiplier", where, 1.0), number(mimic, "offset", where, 0.0)
             leader = mimic.get("joint")
             position = multiplier * positions[leader] + offset
-            given_by[joint.name] = given_by[leader]
-            positions[joint.name] = _within_limits(
-                joint, position, f" for mimic joint {joint.name!r}", given_by[leader]
-            )
+            given_by[joint.name] = source = given_by[leader]
+            if source is not None:  # a default places a mimic joint where the URDF's tree at that position does
+                position = _within_limits(joint, position, f" for mimic joint {joint.name!r}", source)
+            positions[joint.name] = position
         if len(positions) == before:
             break
     return positions
+
+
+def _check_given(tree: UrdfTree, in_model: Collection[str], name: str) -> None:
+    """HeldError unless ``name`` is a moving joint off the model and no mimic joint."""
+    joint = tree.joints.get(name)
+    if joint is None:
+        known = [n for n, j in tree.joints.items() if j.kind in MOVING]
+        near = difflib.get_close_matches(name, known, n=1, cutoff=0.6)
+        hint = f"; did you mean {near[0]}?" if near else ""
+        raise HeldError(name, f"the URDF has no joint {clipped(repr(name), 80)}{hint}")
+    if joint.kind not in MOVING:
+        raise HeldError(name, f"a {joint.kind} joint: only revolute, continuous and prismatic joints are held")
+    mimic = joint.element.find("mimic")
+    if name in in_model:
+        of = (
+            f"a mimic joint of the model following {clipped(repr(mimic.get('joint')), 80)}" if mimic is not None else ""
+        )
+        raise HeldError(name, f"{of or 'a joint of the model'}, not held: its position is the state's")
+    if mimic is not None:
+        raise HeldError(
+            name,
+            f"a mimic joint: it follows {clipped(repr(mimic.get('joint')), 80)} (multiplier * q + offset); "
+            "give that joint's position",
+        )
+
+
+def default_position(joint: UrdfJoint) -> tuple[float, bool]:
+    """(where a joint not given is held, whether that is a limit): zero, or the limit nearest
+    zero when its <limit lower upper> excludes zero (a continuous joint, one without <limit>
+    or with one unreadable: zero)."""
+    limit = joint.element.find("limit")
+    if joint.kind == "continuous" or limit is None:
+        return 0.0, False
+    try:
+        lower, upper = number(limit, "lower", joint.label, 0.0), number(limit, "upper", joint.label, 0.0)
+    except UrdfError:  # the model's joints' limits are checked where they are read; a held one's only if given
+        return 0.0, False
+    if lower <= 0.0 <= upper or lower > upper:
+        return 0.0, False
+    return (lower if lower > 0.0 else upper), True
+
+
+def default_note(joint: UrdfJoint, value: float) -> str:
+    """The note of a joint held at a limit by default (``default_position``)."""
+    unit = "m" if joint.kind == "prismatic" else "rad"
+    return (
+        f"{joint.label}: not given, held at {value:g} {unit}, its limit nearest zero (zero is outside its range); "
+        "give its position to hold it elsewhere"
+    )
 
 
 def _within_limits(joint: UrdfJoint, value: float, why: str, given: str) -> float:

@@ -7,13 +7,16 @@
   moved and turned into the link's frame), and the fixed joints between two moving
   joints make up the next one's origin. Fixed joints after the last moving joint up to
   tip_link give the model's ``flange`` (the tip_link frame, where the payload sits).
-- Joints hanging off the chain (a gripper's fingers, another arm) are held, at zero or at
-  the positions given (``load_urdf``'s ``held``; module ``held``): their bodies are lumped into the chain link
-  they hang from, and their names are returned. So are the joints above base_link.
+- Joints hanging off the chain (a gripper's fingers, another arm) are held where given
+  (``load_urdf``'s ``held``), else at zero or the limit nearest it (module ``held``): their
+  bodies are lumped into the chain link they hang from, their names returned. So are the
+  joints above base_link. A mimic joint off the chain following a joint of it (a gripper's
+  other finger) is the model's, hanging off the chain with what is below it
+  (``whole_tree.mimic_branches``; ``flange_joint``: the chain's last joint).
 - Bodies that do not move (base_link, what is fixed to it, what is above it) are left out;
   their inertials are not checked (an invalid one is a ``note``).
 - Gravity is the root link's -z (9.81 m/s^2), expressed in base_link's frame with the
-  joints between them held (at zero unless given).
+  joints between them held (where given, else at zero or the limit nearest it).
 - <limit lower upper> are the position limits (continuous joints: CONTINUOUS_LIMITS),
   ``effort`` the torque (prismatic: force) limit, ``velocity`` the velocity limit (0 or
   absent: none); <dynamics damping friction> are viscous and Coulomb friction.
@@ -23,8 +26,8 @@
 - A joint that moves no mass (nothing after it has an inertial) is a ``warning``: M(q) is
   then singular, forward dynamics needs a payload.
 - Mimic joints (<mimic joint multiplier offset>) follow their joint (``model.Mimic``): the
-  model's ``joint_names`` are the others. One following a joint that is not in the model
-  is refused, as a mimic of a mimic.
+  model's ``joint_names`` are the others. One in the chain following a joint that is not in
+  it is refused, as a mimic of a mimic there, and one above base_link following the chain.
 - With no tip_link and several leaves below base_link, the whole tree (``whole_tree``).
 - Refused, with UrdfError naming the element: floating and planar joints in the chain
   (or the tree); a revolute or prismatic joint without <limit>; a chain of more than
@@ -41,7 +44,7 @@ from functools import partial, reduce
 import numpy as np
 
 from irb140_dynamics.core.io.text_files import InputFileError, read_text_file
-from irb140_dynamics.core.io.urdf.held import held_positions, motion
+from irb140_dynamics.core.io.urdf.held import default_note, held_positions, motion
 from irb140_dynamics.core.io.urdf.tree import (
     MOVING,
     UrdfError,
@@ -53,13 +56,15 @@ from irb140_dynamics.core.io.urdf.tree import (
     number,
     parse_tree,
 )
-from irb140_dynamics.core.io.urdf.whole_tree import carried_links, compose, moving_joints
-from irb140_dynamics.core.model.joints import (
-    MAX_TORQUE_LIMIT,
-    Friction,
-    Joint,
-    Placement,
+from irb140_dynamics.core.io.urdf.whole_tree import (
+    carried_links,
+    chain_followers,
+    compose,
+    mimic_branches,
+    moving_joints,
+    refuse_followers_above,
 )
+from irb140_dynamics.core.model.joints import MAX_TORQUE_LIMIT, Friction, Joint, Placement
 from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, combine, placed
 from irb140_dynamics.core.model.robot_model import Mimic, RobotModel
 
@@ -75,7 +80,7 @@ class LoadedUrdf:
     model: RobotModel
     base_link: str
     tip_link: str
-    held_joints: tuple[str, ...]  # moving joints off the chain, held (at zero unless given), bodies lumped
+    held_joints: tuple[str, ...]  # moving joints off the chain, held (module held), bodies lumped
     warnings: tuple[str, ...] = ()  # the chain's inertials taken as given though not physical
     notes: tuple[str, ...] = ()  # invalid inertials off the chain, ignored
     base_rotation: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))  # base_link's axes in the root's
@@ -84,13 +89,13 @@ class LoadedUrdf:
     held_positions: tuple[tuple[str, float], ...] = ()  # the held joints not at zero: given, or following one
 
     def held_summary(self) -> str:
-        """'; held at zero: a, b', or '; held: r1=0.4, r2=-0.7; at zero: a' (rad, m), for messages; '' for none."""
+        """'held at zero: a, b', or 'held: r1=0.4, r2=-0.7; at zero: a' (rad, m), for messages; '' for none."""
         at = dict(self.held_positions)
         zero = ", ".join(name for name in self.held_joints if name not in at)
         if not at:
-            return f"; held at zero: {zero}" if zero else ""
+            return f"held at zero: {zero}" if zero else ""
         given = ", ".join(f"{name}={value:g}" for name, value in at.items())
-        return f"; held: {given}" + (f"; at zero: {zero}" if zero else "")
+        return f"held: {given}" + (f"; at zero: {zero}" if zero else "")
 
     def with_flange_at(self, link: str) -> RobotModel:
         """The model with its flange (where the payload sits) at URDF link ``link``: on the
@@ -136,14 +141,18 @@ def load_urdf(
                 "prismatic and fixed joints are supported there",
             )
     moving = [joint for joint in path if joint.kind in MOVING]
-    mimics = mimics_of(moving)
-    positions = held_positions(tree, {joint.name for joint in moving}, held or {})
     if not moving:
         raise UrdfError("chain", f"no revolute, continuous or prismatic joint {span}")
     if len(moving) > max_joints:
         raise UrdfError(
             "chain", f"{len(moving)} moving joints {span}, more than the limit of {max_joints} (max_joints)"
         )
+    mimics = mimics_of(moving)
+    follows = chain_followers(tree, moving, mimics)
+    refuse_followers_above(tree, base, follows)
+    at_limit: list[str] = []
+    positions = held_positions(tree, {joint.name for joint in moving} | set(follows), held or {}, at_limit)
+    branches, branch_parents, branch_origins = mimic_branches(tree, moving, follows, positions)
 
     origins, since_last = [], Placement()
     for joint in path:
@@ -152,31 +161,37 @@ def load_urdf(
         else:
             origins.append(compose(since_last, joint.origin))
             since_last = Placement()
+    joined = [*moving, *branches]  # the chain, then the mimic joints hanging off it
+    stops = {joint.name for joint in joined}
     held_names: list[str] = []
     carried: list[list[str]] = []
-    bodies = [
-        lumped(tree, joint.child, moving[k + 1].name if k + 1 < len(moving) else None, held_names, carried, positions)
-        for k, joint in enumerate(moving)
-    ]
+    bodies = [lumped(tree, joint.child, stops, held_names, carried, positions) for joint in joined]
     warnings, physical = _checked_inertials(tree, carried)
-    for k, joint in enumerate(moving):
-        if sum(body.mass for body, _ in bodies[k:]) == 0.0:
-            warnings.append(
-                f'URDF joint "{clipped(joint.name, 100)}": moves no mass (M(q) is singular: forward '
-                "dynamics needs a payload)"
-            )
-    joints = [
-        _joint(joint, placement, body, ok) for joint, placement, (body, _), ok in zip(moving, origins, bodies, physical)
+    parents = [*range(-1, len(moving) - 1), *branch_parents]
+    moved = [body.mass for body, _ in bodies]
+    for i in reversed(range(len(joined))):
+        if parents[i] >= 0:
+            moved[parents[i]] += moved[i]
+    warnings += [
+        f'URDF joint "{clipped(joint.name, 100)}": moves no mass (M(q) is singular: forward dynamics needs a payload)'
+        for joint, mass in zip(moving, moved)
+        if mass == 0.0
     ]
-    gravity = base_gravity(tree, base, positions)
-    model = partial(RobotModel, tuple(joints), gravity=gravity, flange=since_last, mimics=mimics)
+    joints = [
+        _joint(joint, placement, body, ok)
+        for joint, placement, (body, _), ok in zip(joined, [*origins, *branch_origins], bodies, physical)
+    ]
+    mimics = (*(mimics or (None,) * len(moving)), *(follows[joint.name] for joint in branches))
+    model = partial(RobotModel, tuple(joints), gravity=base_gravity(tree, base, positions), flange=since_last,
+                    parent=tuple(parents), mimics=mimics, flange_joint=moving[-1].name)  # fmt: skip
     ignored = "off the chain: ignored"
-    return _loaded(tree, base, tip, moving, model, "chain", held_names, warnings, carried, ignored, positions)
+    return _loaded(tree, base, tip, joined, model, "chain", held_names, warnings, carried, ignored, positions, at_limit)
 
 
-def _loaded(tree, base, tip, moving, model, kind, held, warnings, carried, ignored, positions) -> LoadedUrdf:
+def _loaded(tree, base, tip, moving, model, kind, held, warnings, carried, ignored, positions, at_limit) -> LoadedUrdf:
     """The LoadedUrdf of ``model()`` (a ModelError as a UrdfError of ``kind``), with notes on
-    the invalid inertials of the links ``carried`` leaves out (``ignored``: why they do not matter)."""
+    the joints held at a limit by default (``at_limit``, ``held.default_note``) and on the
+    invalid inertials of the links ``carried`` leaves out (``ignored``: why they do not matter)."""
     try:
         made = model()
     except ModelError as error:
@@ -189,7 +204,9 @@ def _loaded(tree, base, tip, moving, model, kind, held, warnings, carried, ignor
     ]
     rotation = tuple(tuple(float(x) for x in row) for row in base_rotation(tree, base, positions))
     links = carried_links(tree, moving, positions)
-    at = tuple(positions.items())
+    matter = {*held, *(joint.name for joint in tree.path_from_root(base))}  # the held joints that place a body
+    at = tuple((name, value) for name, value in positions.items() if name in matter and value != 0.0)
+    notes = [default_note(tree.joints[name], positions[name]) for name in at_limit if name in matter] + notes
     return LoadedUrdf(made, base, tip, tuple(held), tuple(warnings), tuple(notes), rotation, tree.name, links, at)
 
 
@@ -349,7 +366,8 @@ def _load_tree(tree: UrdfTree, base: str, max_joints: int, held: dict[str, float
             "tree", f"{len(moving)} moving joints {where}, more than the limit of {max_joints} (max_joints)"
         )
     stops = {joint.name for joint in moving}
-    positions = held_positions(tree, stops, held)  # only joints above base_link (or not below it) are held
+    at_limit: list[str] = []
+    positions = held_positions(tree, stops, held, at_limit)  # only joints above base_link (or not below it) are held
     carried: list[list[str]] = []
     bodies = [lumped(tree, joint.child, stops, [], carried) for joint in moving]
     warnings, physical = _checked_inertials(tree, carried)
@@ -371,4 +389,4 @@ def _load_tree(tree: UrdfTree, base: str, max_joints: int, held: dict[str, float
     model = partial(RobotModel, tuple(joints), gravity=gravity, parent=tuple(parents), mimics=mimics)
     ignored = "not moved by the tree: ignored"
     tip = moving[-1].child
-    return _loaded(tree, base, tip, moving, model, "tree", (), warnings, carried, ignored, positions)
+    return _loaded(tree, base, tip, moving, model, "tree", (), warnings, carried, ignored, positions, at_limit)

@@ -22,8 +22,9 @@ from __future__ import annotations
 import numpy as np
 
 from irb140_dynamics.core.io.urdf.held import motion_placement
-from irb140_dynamics.core.io.urdf.tree import MOVING, UrdfError, UrdfTree, clipped
+from irb140_dynamics.core.io.urdf.tree import MOVING, UrdfError, UrdfTree, clipped, number
 from irb140_dynamics.core.model.joints import Placement, matrix_rpy
+from irb140_dynamics.core.model.tree import Mimic
 
 
 def moving_joints(tree: UrdfTree, base: str) -> tuple[list, list[int], list[Placement]]:
@@ -53,6 +54,67 @@ def moving_joints(tree: UrdfTree, base: str) -> tuple[list, list[int], list[Plac
             )
         stack += [(child, above, placement) for child in reversed(tree.child_joints[joint.child])]
     return moving, parents, origins
+
+
+def chain_followers(tree: UrdfTree, chain: list, mimics: tuple | None) -> dict:
+    """Every mimic joint off ``chain`` that follows a joint of it, or a joint that does (a mimic
+    of a mimic): name -> its ``Mimic`` of the independent chain joint it comes to, the
+    multipliers and offsets composed. ``mimics``: the chain's (``reader.mimics_of``)."""
+    names = {joint.name for joint in chain}
+    follows = {j.name: m for j, m in zip(chain, mimics or ()) if m is not None}
+    pending = [j for j in tree.joints.values() if j.kind in MOVING and j.name not in names]
+    for _ in range(len(pending)):  # a mimic of a mimic joins in a later pass
+        before = len(follows)
+        for joint in pending:
+            element = joint.element.find("mimic")
+            leader = None if element is None else element.get("joint")
+            if joint.name in follows or not (leader in names or leader in follows):
+                continue
+            where = f"{joint.label} <mimic>"
+            multiplier, offset = number(element, "multiplier", where, 1.0), number(element, "offset", where, 0.0)
+            above = follows.get(leader, Mimic(leader))  # the joint it comes to: an independent one of the chain
+            follows[joint.name] = Mimic(above.joint, multiplier * above.multiplier, multiplier * above.offset + offset)
+        if len(follows) == before:
+            break
+    return {name: mimic for name, mimic in follows.items() if name not in names}
+
+
+def refuse_followers_above(tree: UrdfTree, base: str, follows: dict) -> None:
+    """UrdfError for a mimic joint above base_link that follows a joint of the model: it would turn base_link."""
+    for joint in tree.path_from_root(base):
+        if joint.name in follows:
+            raise UrdfError(
+                joint.label,
+                f"a mimic joint above base_link {clipped(repr(base), 60)} following {follows[joint.name].joint!r}, "
+                "a joint of the chain: name a base_link above it",
+            )
+
+
+def mimic_branches(tree: UrdfTree, chain: list, follows: dict, held=None) -> tuple[list, list[int], list]:
+    """The joints of ``follows`` (``chain_followers``) hanging below ``chain``'s links, as
+    joints of the model: (them, depth first below each chain link in the file's order; each
+    one's parent index among chain + them; each one's origin in its parent's link frame, the
+    fixed and held joints between composed, held at ``held``'s positions, else zero)."""
+    names = {joint.name for joint in chain}
+    held = held or {}
+    joints, parents, origins = [], [], []
+    stack = [
+        (j, k, Placement())
+        for k in reversed(range(len(chain)))
+        for j in reversed(tree.child_joints[chain[k].child])
+        if j.name not in names
+    ]
+    while stack:
+        joint, above, placement = stack.pop()
+        if joint.name in follows:
+            joints.append(joint)
+            parents.append(above)
+            origins.append(compose(placement, joint.origin))
+            above, placement = len(chain) + len(joints) - 1, Placement()
+        else:
+            placement = compose(compose(placement, joint.origin), motion_placement(joint, held.get(joint.name, 0.0)))
+        stack += [(j, above, placement) for j in reversed(tree.child_joints[joint.child]) if j.name not in names]
+    return joints, parents, origins
 
 
 def carried_links(tree: UrdfTree, moving: list, held=None) -> dict[str, tuple[str, Placement]]:
