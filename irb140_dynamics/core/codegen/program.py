@@ -74,13 +74,15 @@ def traced(
     groups = ((("q", len(angles)),) if angles is not None else ()) + tuple(inputs.items())
     builder = _Builder(mimic_angles)
     index: dict[Sym, int] = {}  # each node -> its operation (a merged one's: its first's)
+    ops = builder.ops
     for x, first in merging(outputs):
         if first is not x:
             index[x] = index[first]
         elif x.op == "var":
             index[x] = builder.variable(x.name, angles)
-        else:
-            index[x] = builder.add(x.op, tuple(index[a] if type(a) is Sym else float(a) for a in x.args))
+        else:  # builder.add, inline: most of a program's operations come this way
+            index[x] = len(ops)
+            ops.append((x.op, tuple(index[a] if type(a) is Sym else float(a) for a in x.args)))
     results = tuple(index[out] if isinstance(out, Sym) else float(out) for out in outputs)
     return Program(name, groups, tuple(builder.ops), results)
 

@@ -200,14 +200,25 @@ def merging(outputs: list):
     graph's nodes in its own depth-first order (a duplicate's operands are merged already)."""
     done: dict[tuple, Sym] = {}
     first_of: dict[Sym, Sym] = {}
+    copysign = math.copysign
     for x in operands_first(outputs):
-        if x.op == "var":
+        op, args = x.op, x.args
+        if op == "var":
             first_of[x] = x
             yield x, x
             continue
-        # an operand's key: its first's identity, or a constant's value and sign (-0.0 is not 0.0)
-        keys = [(0, id(first_of[a])) if type(a) is Sym else (1, float(a), math.copysign(1.0, a)) for a in x.args]
-        key = (x.op, *(sorted(keys) if x.op in "+*" else keys))
+        # an operand's key: its first's identity (an int), or a constant's value and sign
+        # (a tuple: -0.0 is not 0.0); those of + and * in one order: ints first, each kind sorted
+        a = args[0]
+        ka = id(first_of[a]) if type(a) is Sym else (float(a), copysign(1.0, a))
+        if len(args) == 1:
+            key = (op, ka)
+        else:
+            b = args[1]
+            kb = id(first_of[b]) if type(b) is Sym else (float(b), copysign(1.0, b))
+            if op in "+*" and (kb < ka if type(ka) is type(kb) else type(kb) is int):
+                ka, kb = kb, ka
+            key = (op, ka, kb)
         first = done.setdefault(key, x)
         first_of[x] = first
         yield x, first
