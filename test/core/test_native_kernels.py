@@ -68,6 +68,12 @@ def frictionless(model):
     return replace(model, joints=tuple(replace(j, friction=Friction()) for j in model.joints))
 
 
+def offset_arm():
+    """The IRB-140 with an offset payload, no friction: the arm most tests here compile (the
+    bit-for-bit test's first), so that its kernels are compiled once in a run."""
+    return frictionless(irb140(payload=OFFSET_PAYLOAD))
+
+
 def promoted(model, names=KERNELS):
     """The model with its kernels compiled as C (asked for at once, not after PROMOTE_AFTER calls)."""
     done = prepare(model, timeout=120.0, names=names)
@@ -101,7 +107,7 @@ def test_native_kernels_give_the_python_numbers_bit_for_bit(arm):
 
 
 def test_a_kernel_is_compiled_after_enough_calls_and_used_from_then_on(monkeypatch):
-    model = frictionless(irb140(payload=OFFSET_PAYLOAD))
+    model = offset_arm()
     q = np.linspace(-1.0, 1.0, 6)
     want = rnea(model, q, q, q)
     for _ in range(PROMOTE_AFTER):
@@ -116,7 +122,7 @@ def test_a_kernel_is_compiled_after_enough_calls_and_used_from_then_on(monkeypat
 
 
 def test_results_are_arrays_of_their_own():
-    model = promoted(frictionless(irb140()))
+    model = promoted(offset_arm())
     q = np.zeros(6)
     first, second = rnea(model, q, q, q), rnea(model, q + 0.5, q, q)
     kept = first.copy()
@@ -129,7 +135,7 @@ def test_results_are_arrays_of_their_own():
 
 
 def test_non_finite_inputs_and_results_are_refused_as_by_the_python_form():
-    model = promoted(frictionless(irb140()))
+    model = promoted(offset_arm())
     q = np.zeros(6)
     with pytest.raises(ValueError, match="qd: must be finite"):
         rnea(model, q, np.array([0.0, np.inf, 0, 0, 0, 0]), q)
@@ -160,7 +166,7 @@ def test_friction_is_inside_the_native_torques_and_a_flange_wrench_takes_the_pyt
 def test_without_a_compiler_or_when_disabled_everything_stays_python(monkeypatch):
     monkeypatch.setenv("IRB140_NATIVE", "0")
     assert not native.enabled()
-    model = frictionless(irb140(payload=OFFSET_PAYLOAD))
+    model = offset_arm()
     q = np.full(6, 0.2)
     for _ in range(PROMOTE_AFTER + 1):
         rnea(model, q, q, q)
@@ -184,7 +190,7 @@ def test_a_compile_that_fails_leaves_the_python_form(monkeypatch):
 
 
 def test_a_library_is_compiled_once_and_then_loaded_from_the_cache():
-    source, _, _ = c_code.kernel_source(kernels_of(irb140()).gravity_torques.program)
+    source, _, _ = c_code.kernel_source(kernels_of(irb140(payload=OFFSET_PAYLOAD)).gravity_torques.program)
     path = library.library(source)
     stamp = path.stat().st_mtime_ns
     assert library.library(source) == path and path.stat().st_mtime_ns == stamp
@@ -240,7 +246,7 @@ def test_a_cc_that_is_not_a_compiler_leaves_the_python_form(monkeypatch, tmp_pat
 
 
 def test_a_forked_child_computes_and_waits():
-    model, python_model = promoted(frictionless(irb140())), frictionless(irb140())
+    model, python_model = promoted(offset_arm()), offset_arm()
     q = np.full(6, 0.7)
     pid = os.fork()
     if pid == 0:  # the child: no worker thread until asked; exit code 0 if all right
@@ -299,9 +305,9 @@ def test_a_cache_folder_others_can_write_to_is_not_used(tmp_path, monkeypatch):
 def test_without_python_headers_the_kernels_are_called_through_ctypes(monkeypatch):
     monkeypatch.setattr(compiler, "headers", lambda: None)
     with installed(compiler.Compiler()):  # nothing built by this process yet
-        model = promoted(frictionless(irb140(payload=OFFSET_PAYLOAD)))
+        model = promoted(offset_arm())
     assert isinstance(kernels_of(model).rnea.native, compiler.CtypesKernel)
-    python_model = frictionless(irb140(payload=OFFSET_PAYLOAD))
+    python_model = offset_arm()
     for q, qd, qdd in zip(*states(model, count=50)):
         np.testing.assert_array_equal(rnea(model, q, qd, qdd), rnea(python_model, q, qd, qdd))
         np.testing.assert_array_equal(mass_matrix(model, q), mass_matrix(python_model, q))
@@ -365,8 +371,8 @@ def native_off():
 
 
 def test_the_extension_takes_any_float64_vector_and_leaves_the_rest_to_the_python_form():
-    model = promoted(frictionless(irb140(payload=OFFSET_PAYLOAD)))
-    python_model = frictionless(irb140(payload=OFFSET_PAYLOAD))
+    model = promoted(offset_arm())
+    python_model = offset_arm()
     Q = np.random.default_rng(4).uniform(-2.0, 2.0, (6, 3))
     column = Q[:, 1]  # strided
     readonly = Q[:, 2].copy()

@@ -105,9 +105,10 @@ def _moving_below(root, children) -> dict[str, int]:
     return below
 
 
-def worst_error(text: str, base: str, tip: str, rng) -> float:
-    """The largest relative difference from Pinocchio over STATES random states."""
-    loaded = load_urdf(text, base, tip)
+def worst_error(text: str, base: str, tip: str, rng, loaded=None) -> float:
+    """The largest relative difference from Pinocchio over STATES random states; ``loaded``
+    the chain's load_urdf result already made (else loaded here)."""
+    loaded = loaded or load_urdf(text, base, tip)
     model, held = loaded.model, loaded.held_positions  # the joints off the chain where the model holds them
     if model.mimics is not None:
         return mimic_worst_error(text, model, rng, STATES, held)
@@ -136,26 +137,29 @@ def run_corpus(files, rng, compared_per_file: int | None = None) -> dict[str, li
     for path in files:
         text = Path(path).read_text()
         loaded, mimics = [], []  # every chain with mimic joints compared
+        models = {}  # label -> the chain as loaded (None: a tree, loaded when compared)
         for base, tip in chains(text):
             label = f"{path.split('/robots/')[-1]} {base} -> {tip}"
             try:
-                mimic = load_urdf(text, base, tip).model.mimics is not None
+                chain = load_urdf(text, base, tip)
+                mimic = chain.model.mimics is not None
             except ModelError as refusal:
                 if "<mimic>" not in str(refusal) or "\n" in str(refusal):
                     tally["refused"].append(f"{label}: {refusal}")
                     continue
                 # refused: the tree from the link above the joints they follow
                 base, tip = with_the_followed_joints(text, base, tip), None
-                label, mimic = f"{label} (the tree below {base})", True
+                label, mimic, chain = f"{label} (the tree below {base})", True, None
             except Exception as crash:  # counted and shown
                 tally["crash"].append(f"{label}: {type(crash).__name__}: {crash}")
                 continue
+            models[label] = chain
             (mimics if mimic else loaded).append((label, base, tip))
         if compared_per_file is not None and len(loaded) > compared_per_file:
             loaded = [loaded[k] for k in sorted(rng.choice(len(loaded), compared_per_file, replace=False))]
         for label, base, tip in loaded + mimics:
             try:
-                error = worst_error(text, base, tip, rng)
+                error = worst_error(text, base, tip, rng, models[label])
             except Exception as crash:  # counted and shown
                 tally["crash"].append(f"{label}: {type(crash).__name__}: {crash}")
                 continue

@@ -15,7 +15,7 @@ from irb140_dynamics.core.algorithms import analytical_derivatives as analytical
 from irb140_dynamics.core.algorithms import derivatives
 from irb140_dynamics.core.algorithms import recursions as algorithms
 from irb140_dynamics.core.algorithms.linear import inverse, negated, times, times_vector
-from irb140_dynamics.core.codegen.trace import operands_first, tanh
+from irb140_dynamics.core.codegen.trace import size, tanh
 from irb140_dynamics.core.scalars.dual import Dual
 
 REFERENCES = 2  # frames tried for the analytical derivatives: links 0 and 1 (see _shortest)
@@ -131,4 +131,4 @@ def _shortest(matrices_in, n: int) -> list:
     for the r of the first REFERENCES links whose traced code is the shortest: which one is
     depends on where the arm's geometry has its zeros."""
     candidates = [[x for matrix in matrices_in(r) for row in matrix for x in row] for r in range(min(REFERENCES, n))]
-    return min(candidates, key=lambda outputs: len(operands_first(outputs)))
+    return min(candidates, key=size)

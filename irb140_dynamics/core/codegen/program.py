@@ -23,7 +23,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from irb140_dynamics.core.codegen.trace import Sym, merged, operands_first, trace
+from irb140_dynamics.core.codegen.trace import Sym, merging, trace
 
 ANGLES = ("cos", "sin")
 
@@ -71,17 +71,19 @@ def traced(
     once, the joint angles' cos and sin as operations on q (a mimic joint's on
     multiplier * q_k)."""
     _, outputs = trace(algorithm, inputs, angles, mimic_angles)
-    outputs = merged(outputs)
     groups = ((("q", len(angles)),) if angles is not None else ()) + tuple(inputs.items())
     builder = _Builder(mimic_angles)
-    index: dict[int, int] = {}
-    for x in operands_first(outputs):
-        if x.op == "var":
-            index[id(x)] = builder.variable(x.name, angles)
-        else:
-            args = tuple(index[id(a)] if isinstance(a, Sym) else float(a) for a in x.args)
-            index[id(x)] = builder.add(x.op, args)
-    results = tuple(index[id(out)] if isinstance(out, Sym) else float(out) for out in outputs)
+    index: dict[Sym, int] = {}  # each node -> its operation (a merged one's: its first's)
+    ops = builder.ops
+    for x, first in merging(outputs):
+        if first is not x:
+            index[x] = index[first]
+        elif x.op == "var":
+            index[x] = builder.variable(x.name, angles)
+        else:  # builder.add, inline: most of a program's operations come this way
+            index[x] = len(ops)
+            ops.append((x.op, tuple(index[a] if type(a) is Sym else float(a) for a in x.args)))
+    results = tuple(index[out] if isinstance(out, Sym) else float(out) for out in outputs)
     return Program(name, groups, tuple(builder.ops), results)
 
 

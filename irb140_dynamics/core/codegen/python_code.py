@@ -45,12 +45,20 @@ def statements(program: Program) -> tuple[list[tuple[str, str]], list[str]]:
     for out in program.outputs:
         if isinstance(out, int):
             uses[out] += 2  # an output is always stored in a variable
-    exprs: list[str] = []
-    depth: list[int] = []
+    exprs: list[str] = []  # each operation's text: its variable, or its expression inline
+    depth: list[int] = []  # the nesting depth of an inline expression (0: a variable)
     lines: list[tuple[str, str]] = []
+    constants: dict[float, str] = {}  # a constant's text, written once (zeros: see constant)
 
-    def operand(a) -> str:
-        return exprs[a] if isinstance(a, int) else constant(a)
+    def operand(a) -> tuple[str, int]:
+        if type(a) is int:
+            return exprs[a], depth[a]
+        text = constants.get(a) if a else None
+        if text is None:
+            text = constant(a)
+            if a:
+                constants[a] = text
+        return text, 0
 
     for k, (op, args) in enumerate(program.ops):
         if op == "in":
@@ -65,14 +73,12 @@ def statements(program: Program) -> tuple[list[tuple[str, str]], list[str]]:
             exprs.append(name)
             depth.append(0)
             continue
-        operands = [operand(a) for a in args]
-        if op == "neg":
-            expr = f"-{operands[0]}"
-        elif op == "tanh":
-            expr = f"tanh({operands[0]})"
+        if len(args) == 2:
+            (x, dx), (y, dy) = operand(args[0]), operand(args[1])
+            expr, d = f"{x} {op} {y}", 1 + (dx if dx > dy else dy)
         else:
-            expr = f"{operands[0]} {op} {operands[1]}"
-        d = 1 + max((depth[a] for a in args if isinstance(a, int)), default=0)
+            x, dx = operand(args[0])
+            expr, d = (f"-{x}" if op == "neg" else f"tanh({x})"), 1 + dx
         if uses[k] == 1 and d < MAX_INLINE_DEPTH:
             exprs.append(f"({expr})")
             depth.append(d)
@@ -80,7 +86,7 @@ def statements(program: Program) -> tuple[list[tuple[str, str]], list[str]]:
             lines.append((f"t{k}", expr))
             exprs.append(f"t{k}")
             depth.append(0)
-    return lines, [operand(out) for out in program.outputs]
+    return lines, [operand(out)[0] for out in program.outputs]
 
 
 def unpacked(program: Program) -> list[str]:

@@ -4,7 +4,7 @@ The algorithms in ``algorithms`` run once on symbols instead of numbers. Every o
 on a symbol is recorded; operations on the model's constants are done right away, and
 identities that are exact in floating point are folded (x*0 = 0 for finite x, x*1, x+0,
 x+(-y) = x-y), and an operation recorded again on the same operands is done once
-(``merged``). ``program`` lowers what is left into the intermediate form the emitters
+(``merging``). ``program`` lowers what is left into the intermediate form the emitters
 read: no loops, no lookups, no zero terms.
 
 What is recorded are the very floating-point operations of running the algorithm on
@@ -20,37 +20,34 @@ from collections.abc import Callable, Sequence
 class Sym:
     """A traced scalar: an input, or an operation on traced scalars and constants."""
 
-    __slots__ = ("op", "args", "name", "uses", "index")
+    __slots__ = ("op", "args", "name")
 
     def __init__(self, op: str, args: tuple = (), name: str | None = None):
         self.op, self.args, self.name = op, args, name
-        self.uses = 0
-        self.index = -1
 
     # Folding: constants are Python floats, so constant-constant arithmetic never gets here.
-    # Other scalar types (dual numbers) get NotImplemented and handle the operation.
+    # Other scalar types (dual numbers) get NotImplemented and handle the operation. Each
+    # operation looks at a traced operand first: the most frequent case, tested cheapest.
     def __add__(self, other):
-        if not isinstance(other, _SCALARS):
+        if other.__class__ is Sym:
+            if other.op == "neg":
+                return Sym("-", (self, other.args[0]))
+            if self.op == "neg":
+                return Sym("-", (other, self.args[0]))
+            return Sym("+", (self, other))
+        if not _is_const(other):
             return NotImplemented
-        if _is_const(other):
-            return self if other == 0 else Sym("+", (self, float(other)))
-        if other.op == "neg":
-            return Sym("-", (self, other.args[0]))
-        if self.op == "neg":
-            return Sym("-", (other, self.args[0]))
-        return Sym("+", (self, other))
+        return self if other == 0 else Sym("+", (self, float(other)))
 
     def __radd__(self, other):
         return self.__add__(other)
 
     def __sub__(self, other):
-        if not isinstance(other, _SCALARS):
+        if other.__class__ is Sym:
+            return self + other.args[0] if other.op == "neg" else Sym("-", (self, other))
+        if not _is_const(other):
             return NotImplemented
-        if _is_const(other):
-            return self if other == 0 else Sym("-", (self, float(other)))
-        if other.op == "neg":
-            return self + other.args[0]
-        return Sym("-", (self, other))
+        return self if other == 0 else Sym("-", (self, float(other)))
 
     def __rsub__(self, other):
         if not isinstance(other, _SCALARS):
@@ -62,26 +59,26 @@ class Sym:
         return Sym("-", (float(other), self))
 
     def __mul__(self, other):
-        if not isinstance(other, _SCALARS):
+        if other.__class__ is Sym:
+            # (-x) y = -(x y), exactly: the negation moves out, where a sum takes it as a subtraction
+            if self.op == "neg":
+                if other.op == "neg":
+                    return Sym("*", (self.args[0], other.args[0]))
+                return -(self.args[0] * other)
+            if other.op == "neg":
+                return -(self * other.args[0])
+            return Sym("*", (self, other))
+        if not _is_const(other):
             return NotImplemented
-        if _is_const(other):
-            if other == 0:
-                return 0.0
-            if other == 1:
-                return self
-            if other == -1:
-                return -self
-            if self.op == "neg":  # (-x) c = x (-c)
-                return Sym("*", (self.args[0], -float(other)))
-            return Sym("*", (self, float(other)))
-        # (-x) y = -(x y), exactly: the negation moves out, where a sum takes it as a subtraction
-        if self.op == "neg" and other.op == "neg":
-            return Sym("*", (self.args[0], other.args[0]))
-        if self.op == "neg":
-            return -(self.args[0] * other)
-        if other.op == "neg":
-            return -(self * other.args[0])
-        return Sym("*", (self, other))
+        if other == 0:
+            return 0.0
+        if other == 1:
+            return self
+        if other == -1:
+            return -self
+        if self.op == "neg":  # (-x) c = x (-c)
+            return Sym("*", (self.args[0], -float(other)))
+        return Sym("*", (self, float(other)))
 
     def __rmul__(self, other):
         return self.__mul__(other)
@@ -118,6 +115,7 @@ def tanh(x):
 
 
 def _is_const(x) -> bool:
+    """Whether ``x`` is a constant (a float or an int): ValueError if it is not finite."""
     if isinstance(x, (float, int)):
         if not math.isfinite(x):
             raise ValueError(f"non-finite constant {x} in a traced algorithm")
@@ -160,36 +158,67 @@ def trace(
 
 def operands_first(outputs: list) -> list[Sym]:
     """The nodes the outputs need, each after its operands (depth first, in the outputs' order)."""
-    order, seen = [], set()
+    order, seen = [], set()  # a Sym hashes by identity
     for out in outputs:
-        stack = [(out, False)]
+        if type(out) is not Sym or out in seen:
+            continue
+        seen.add(out)
+        stack = [(out, iter(out.args))]
         while stack:
-            x, expanded = stack.pop()
-            if not isinstance(x, Sym):
-                continue
-            if expanded:
+            x, operands = stack[-1]
+            for a in operands:  # resumed where it stopped: the next operand not seen yet
+                if type(a) is Sym and a not in seen:
+                    seen.add(a)
+                    stack.append((a, iter(a.args)))
+                    break
+            else:
+                stack.pop()
                 order.append(x)
-            elif id(x) not in seen:
-                seen.add(id(x))
-                stack.append((x, True))
-                stack.extend((arg, False) for arg in reversed(x.args))
     return order
 
 
-def merged(outputs: list) -> list:
-    """The outputs with each operation done once: the tracer records an operation again
-    each time the algorithm does it, on the same operands, or swapped (exact: IEEE + and *
-    commute)."""
+def size(outputs: list) -> int:
+    """How many nodes the outputs need: ``len(operands_first(outputs))``, without the order."""
+    seen: set[Sym] = set()
+    stack = [out for out in outputs if type(out) is Sym]
+    while stack:
+        x = stack.pop()
+        if type(x) is Sym and x not in seen:
+            seen.add(x)
+            stack.extend(x.args)
+    return len(seen)
+
+
+def merging(outputs: list):
+    """Each operation done once: the tracer records an operation again each time the
+    algorithm does it, on the same operands, or swapped (exact: IEEE + and * commute).
+
+    Yields (node, first) for each node the outputs need, operands first (``operands_first``),
+    ``first`` the first of them doing the same operation on the same operands (their firsts;
+    swapped for + and *): itself, or one before it. A node that is its own first is an
+    operation of the merged graph, on its operands' firsts; in this order they are the merged
+    graph's nodes in its own depth-first order (a duplicate's operands are merged already)."""
     done: dict[tuple, Sym] = {}
-    new: dict[int, Sym] = {}
+    first_of: dict[Sym, Sym] = {}
+    copysign = math.copysign
     for x in operands_first(outputs):
-        if x.op == "var":
-            new[id(x)] = x
+        op, args = x.op, x.args
+        if op == "var":
+            first_of[x] = x
+            yield x, x
             continue
-        args = tuple(new[id(a)] if isinstance(a, Sym) else a for a in x.args)
-        keys = [("s", id(a)) if isinstance(a, Sym) else ("c", repr(float(a))) for a in args]
-        key = (x.op, *(sorted(keys) if x.op in "+*" else keys))
-        if key not in done:
-            done[key] = Sym(x.op, args)
-        new[id(x)] = done[key]
-    return [new[id(out)] if isinstance(out, Sym) else out for out in outputs]
+        # an operand's key: its first's identity (an int), or a constant's value and sign
+        # (a tuple: -0.0 is not 0.0); those of + and * in one order: ints first, each kind sorted
+        a = args[0]
+        ka = id(first_of[a]) if type(a) is Sym else (float(a), copysign(1.0, a))
+        if len(args) == 1:
+            key = (op, ka)
+        else:
+            b = args[1]
+            kb = id(first_of[b]) if type(b) is Sym else (float(b), copysign(1.0, b))
+            if op in "+*" and (kb < ka if type(ka) is type(kb) else type(kb) is int):
+                ka, kb = kb, ka
+            key = (op, ka, kb)
+        first = done.setdefault(key, x)
+        first_of[x] = first
+        yield x, first

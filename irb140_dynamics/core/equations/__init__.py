@@ -18,7 +18,7 @@ from . import c_code, derivative_code, latex, python_code, sympy_code
 from .printing import reduced_quantities
 from .symbolic import DEFAULT_QUANTITIES, Equations, derive
 from .symbolic import QUANTITIES as SYMBOLIC_QUANTITIES
-from .traced import traced_bodies
+from .traced import KERNEL_OF, traced_bodies
 
 FORMS = ("latex", "sympy", "c", "python")
 _TRACED_EMITTERS = {"c": c_code.render, "python": python_code.render}  # numbers: the programs' bodies
@@ -54,8 +54,12 @@ def generate(
     if derivatives and (symbolic or any(form != "c" for form in forms)):
         raise ValueError(f"{derivatives[0]}: the derivatives are written in the C form of a model with numbers")
     what = tuple(w for w in what if w not in derivative_code.DERIVATIVE_QUANTITIES)
-    equations = derive(model, what, symbolic, progress)
-    progress("common subexpressions")
+    # the C and Python forms of a model with numbers write tau, M, Cqd and g from the code
+    # generator's programs (traced): SymPy derives only what another form or quantity reads
+    programs_only = not symbolic and all(form in _TRACED_EMITTERS for form in forms)
+    equations = derive(model, what, symbolic, progress, frozenset(KERNEL_OF) if programs_only else frozenset())
+    if any(equations.quantities.values()):
+        progress("common subexpressions")
     reduced = reduced_quantities(equations)
     files = {}
     for form in forms:

@@ -80,8 +80,9 @@ def header_lines(eq: Equations, source: str, traced: bool = False) -> list[str]:
 
 
 def reduced_quantities(eq: Equations) -> dict[str, tuple[list, list]]:
-    """Each quantity as (replacements, outputs) of its common subexpressions."""
-    return {name: reduced(exprs) for name, exprs in eq.quantities.items()}
+    """Each quantity as (replacements, outputs) of its common subexpressions (none of one
+    without expressions, see symbolic.derive)."""
+    return {name: reduced(exprs) if exprs else ([], []) for name, exprs in eq.quantities.items()}
 
 
 def used_names(replacements, outputs) -> set[str]:

@@ -101,8 +101,17 @@ def _angles(coordinates, q) -> list:
     return cs
 
 
-def derive(model, what=DEFAULT_QUANTITIES, symbolic: bool = False, progress: Callable[[str], None] = None):
-    """The Equations of ``model`` for the quantities ``what`` (names from QUANTITIES)."""
+def derive(
+    model,
+    what=DEFAULT_QUANTITIES,
+    symbolic: bool = False,
+    progress: Callable[[str], None] = None,
+    unexpressed: frozenset = frozenset(),
+):
+    """The Equations of ``model`` for the quantities ``what`` (names from QUANTITIES); those
+    named in ``unexpressed`` (tau, M, Cqd, g) with their shape and arguments but no
+    expressions (an empty list): the C and Python forms of a model with numbers write them
+    from the code generator's programs (see traced), SymPy need not derive them."""
     unknown = [w for w in what if w not in QUANTITIES]
     if unknown:
         raise ValueError(f"unknown quantity {unknown[0]!r}: choose from {', '.join(QUANTITIES)}")
@@ -122,23 +131,23 @@ def derive(model, what=DEFAULT_QUANTITIES, symbolic: bool = False, progress: Cal
     quantities, shapes, arguments = {}, {}, {}
     with distribute(False):
         if "tau" in what:
-            progress("tau by Newton-Euler")
-            tau = project(algorithms.rnea(links, cs, full_qd, full_qdd, _exact(model.gravity)))
-            quantities["tau"] = [t + _friction(friction, i, qd[i]) for i, t in enumerate(tau)]
             shapes["tau"], arguments["tau"] = (n,), ("q", "qd", "qdd")
+            if _derived(quantities, "tau", unexpressed, progress, "tau by Newton-Euler"):
+                tau = project(algorithms.rnea(links, cs, full_qd, full_qdd, _exact(model.gravity)))
+                quantities["tau"] = [t + _friction(friction, i, qd[i]) for i, t in enumerate(tau)]
         if "M" in what:
-            progress("M by composite rigid bodies")
-            M = coordinates.projected_matrix(algorithms.crba(links, cs))
-            quantities["M"] = [M[i][j] for i in range(n) for j in range(n)]
             shapes["M"], arguments["M"] = (n, n), ("q",)
+            if _derived(quantities, "M", unexpressed, progress, "M by composite rigid bodies"):
+                M = coordinates.projected_matrix(algorithms.crba(links, cs))
+                quantities["M"] = [M[i][j] for i in range(n) for j in range(n)]
         if "C" in what:
-            progress("C(q, qd) qd by Newton-Euler")
-            quantities["Cqd"] = project(algorithms.rnea(links, cs, full_qd, zeros, (0, 0, 0)))
             shapes["Cqd"], arguments["Cqd"] = (n,), ("q", "qd")
+            if _derived(quantities, "Cqd", unexpressed, progress, "C(q, qd) qd by Newton-Euler"):
+                quantities["Cqd"] = project(algorithms.rnea(links, cs, full_qd, zeros, (0, 0, 0)))
         if "g" in what:
-            progress("g by Newton-Euler")
-            quantities["g"] = project(algorithms.rnea(links, cs, zeros, zeros, _exact(model.gravity)))
             shapes["g"], arguments["g"] = (n,), ("q",)
+            if _derived(quantities, "g", unexpressed, progress, "g by Newton-Euler"):
+                quantities["g"] = project(algorithms.rnea(links, cs, zeros, zeros, _exact(model.gravity)))
         if "regressor" in what:
             progress("the regressor")
             Y = rigid_body_regressor(links, cs, full_qd, full_qdd, _exact(model.gravity))
@@ -160,6 +169,16 @@ def derive(model, what=DEFAULT_QUANTITIES, symbolic: bool = False, progress: Cal
         arguments,
         columns,
     )
+
+
+def _derived(quantities: dict, name: str, unexpressed, progress, stage: str) -> bool:
+    """Whether the quantity ``name`` is to be derived here (``progress`` told the stage);
+    it is listed in ``quantities`` either way, without expressions until derived."""
+    quantities[name] = []
+    if name in unexpressed:
+        return False
+    progress(stage)
+    return True
 
 
 def reduced(expressions: list, prefix: str = "x"):

@@ -1,7 +1,9 @@
 """The derivatives and M^-1 that ``equations`` writes in C (--what dtau,qdd,dqdd,Minv) are
-the native kernels' arithmetic: compiled with warnings as errors, they give the numbers of
+the kernels' arithmetic: compiled with warnings as errors, they give the numbers of
 rnea_derivatives, forward_dynamics_derivatives, inverse_mass_matrix and the forward
-dynamics kernel bit for bit."""
+dynamics kernel bit for bit. On the IRB-140 those run native (the derivative kernels'
+C, compiled by the package, and its matrices returned apart); on the Panda their Python
+form, which any native form must equal bit for bit before it is used (test_native_kernels)."""
 
 import ctypes
 from dataclasses import replace
@@ -30,6 +32,7 @@ from .support import arms, compile_c, compiler, random_states
 pytestmark = pytest.mark.skipif(compiler() is None, reason="no C compiler (cc or gcc) on this machine")
 
 WHAT = ("dtau", "qdd", "dqdd", "Minv")
+STATES = 20  # random states compared bit for bit
 QDD_KERNEL = "forward_dynamics_qdd"
 
 
@@ -83,10 +86,10 @@ def test_the_written_derivatives_are_the_native_kernels_arithmetic(tmp_path, arm
 
     names = (*DERIVATIVE_KERNELS, QDD_KERNEL)
     kernels = kernels_of(model)
-    if native.enabled():
+    if native.enabled() and arm.startswith("irb140"):
         assert prepare(model, timeout=600.0, names=names).native
     forward = kernels.forward_dynamics_qdd
-    for q, qd, x in zip(*random_states(n, seed=5, count=100)):
+    for q, qd, x in zip(*random_states(n, seed=5, count=STATES)):
         tau = 10.0 * x
         dq, dqd, _ = rnea_derivatives(model, q, qd, x)
         assert [m.tobytes() for m in dtau(q, qd, x)] == [dq.tobytes(), dqd.tobytes()]
