@@ -148,9 +148,11 @@ def inertia_times(inertia, v):
 
 
 def gyroscopic(link: Link, w):
-    """w x (I w), as ((Izz - Iyy) w_y w_z, ...) for numbers without products of inertia (not the payload's)."""
+    """w x (I w), as ((Izz - Iyy) w_y w_z, ...) where the products of inertia are the constant 0
+    (the payload's link's moments of inertia may be a kernel's inputs: their differences are
+    then computed, once)."""
     xx, yy, zz, xy, xz, yz = link.I
-    if not link.carrier and all(type(x) is float for x in link.I) and xy == xz == yz == 0.0:
+    if all(type(x) is float and x == 0.0 for x in (xy, xz, yz)):
         return ((zz - yy) * (w[1] * w[2]), (xx - zz) * (w[2] * w[0]), (yy - xx) * (w[0] * w[1]))
     return cross(w, inertia_times(link.I, w))
 
