@@ -4,8 +4,10 @@ A kernel takes ``sine(theta)`` and ``cosine(theta)`` of each joint angle. Left t
 (sin, cos, or gcc's sincos), those are n calls one after the other, each a branchy routine
 the processor does not overlap with the next: on a 6-joint arm they took about half the
 time of the generated C. Here the C computes all the angles of a program first (``batched``:
-one call of ``sin_cos_angles``, a loop without a branch that gcc -O2 vectorizes, two angles
-per SSE2 register), and the Python forms likewise (``hoisted``: one ``sin_cos_rows``):
+in pairs of GCC's vector extensions, two angles per SSE2 or NEON register, left there for
+the kernel to read, with one branch for every angle beyond the range; for other compilers
+one call of ``sin_cos_angles``, a loop without a branch that gcc -O2 vectorizes), and the
+Python forms likewise (``hoisted``: one ``sin_cos_rows``):
 
 - Cody-Waite range reduction: k, the integer nearest theta * 2 / pi (rounded by adding and
   subtracting 1.5 * 2^52), and r = theta - k pi / 2 with pi / 2 split in three parts of 33
