@@ -10,9 +10,19 @@ import mpmath
 import numpy as np
 import pytest
 
-from irb140_dynamics.core.codegen.sincos import C_SOURCE, LIBM_BEYOND, cosine, cosine_array, sine, sine_array
+from irb140_dynamics.core.codegen.sincos import (
+    C_SOURCE,
+    LIBM_BEYOND,
+    batched,
+    cosine,
+    cosine_array,
+    sine,
+    sine_array,
+)
 
 from .equations.support import CC_FLAGS, compiler
+
+FUNCTIONS = (("s", "sine"), ("c", "cosine"))
 
 
 def exact(function, x: np.ndarray) -> np.ndarray:
@@ -63,20 +73,32 @@ def test_floats_and_arrays_give_the_same_bits():
 
 @pytest.mark.skipif(compiler() is None, reason="no C compiler (cc or gcc) on this machine")
 def test_the_c_gives_the_same_bits(tmp_path):
-    """Four angles at a time, as the kernels' loop (vectorized by gcc -O2) runs them."""
+    """Four angles at a time, as the kernels compute them: in pairs of vectors where the
+    compiler has GCC's vector extensions (SINCOS_PAIRS), and by the loop (vectorized by gcc
+    -O2) that other compilers run; values beyond the range take libm's in both."""
+    names = [f"t{i}" for i in range(3)]  # padded to a fourth angle, as a kernel's
+    angle_lines, _ = batched(
+        [(f"{f}{i}", f"{function}({t})") for i, t in enumerate(names) for f, function in FUNCTIONS]
+    )
+    loop = "#undef SINCOS_PAIRS\n" + "\n".join(angle_lines)
     source = "#include <math.h>\n" + C_SOURCE
     source += "void angles4(const double *t, double *s, double *c) { sin_cos_angles(4, t, s, c); }\n"
+    for name, lines in (("pairs3", "\n".join(angle_lines)), ("loop3", loop)):
+        source += f"void {name}(const double *t, double *s, double *c) {{\n"
+        source += "".join(f"    const double {t} = t[{i}];\n" for i, t in enumerate(names))
+        source += lines + "\n" + "".join(f"    s[{i}] = s{i}; c[{i}] = c{i};\n" for i in range(3)) + "}\n"
     (tmp_path / "sincos.c").write_text(source)
     library = tmp_path / "libsincos.so"
     command = [compiler(), *CC_FLAGS, "-shared", "-fPIC", str(tmp_path / "sincos.c"), "-o", str(library), "-lm"]
     subprocess.run(command, check=True, capture_output=True, timeout=60)
-    angles4 = ctypes.CDLL(str(library)).angles4
-    x = np.concatenate([angles(4, boundaries=True), [0.0, -0.0, LIBM_BEYOND, 2e6, np.inf, np.nan]])
-    x = np.concatenate([x, np.zeros(-len(x) % 4)])
-    s, c = np.empty_like(x), np.empty_like(x)
-    pointer = ctypes.POINTER(ctypes.c_double)
-    for i in range(0, len(x), 4):
-        angles4(*(a[i:].ctypes.data_as(pointer) for a in (x, s, c)))
-    with np.errstate(invalid="ignore"):
-        assert s.tobytes() == sine_array(x).tobytes()
-        assert c.tobytes() == cosine_array(x).tobytes()
+    x = np.concatenate([angles(4, boundaries=True), [0.0, -0.0, LIBM_BEYOND, 2e6, np.inf, np.nan, -np.inf, -2e6]])
+    for name, size in (("angles4", 4), ("pairs3", 3), ("loop3", 3)):
+        function = getattr(ctypes.CDLL(str(library)), name)
+        t = np.concatenate([x, np.zeros(-len(x) % size)])
+        s, c = np.empty_like(t), np.empty_like(t)
+        pointer = ctypes.POINTER(ctypes.c_double)
+        for i in range(0, len(t), size):
+            function(*(a[i:].ctypes.data_as(pointer) for a in (t, s, c)))
+        with np.errstate(invalid="ignore"):
+            assert s.tobytes() == sine_array(t).tobytes(), name
+            assert c.tobytes() == cosine_array(t).tobytes(), name

@@ -37,8 +37,19 @@ from functools import lru_cache
 
 import numpy as np
 
-from irb140_dynamics.core.algorithms.rotations import Rotation, combination, fused, rotate, rotate_back, turn  # noqa: F401 (part of this module's interface)
+from irb140_dynamics.core.algorithms.leaf import cheap_turn_axis, leaf_wrench
+from irb140_dynamics.core.algorithms.rotations import (  # noqa: F401 (part of this module's interface)
+    Rotation,
+    combination,
+    fused,
+    rotate,
+    rotate_back,
+    turn,
+    turned,
+    turned_about,
+)
 from irb140_dynamics.core.algorithms.topology import ancestors, children, parents  # noqa: F401 (part of this module's interface)
+from irb140_dynamics.core.algorithms.vectors import add, cross, dot, gyroscopic, inertia_times, scale  # noqa: F401 (part of this module's interface)
 from irb140_dynamics.core.model.joints import Z_AXIS, snap
 from irb140_dynamics.core.model.rigid_body import ZERO3, Inertia6, Vector3, shift_inertia
 from irb140_dynamics.core.scalars.dual import Dual  # noqa: F401 (part of this module's interface)
@@ -119,42 +130,6 @@ def _rows(R) -> Rotation:
     return tuple(tuple(float(x) for x in row) for row in R)
 
 
-# -- 3-vector algebra ---------------------------------------------------------------
-
-
-def add(*vectors):
-    return tuple(sum(components[1:], components[0]) for components in zip(*vectors))
-
-
-def scale(k, v):
-    return (k * v[0], k * v[1], k * v[2])
-
-
-def dot(u, v):
-    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
-
-
-def cross(u, v):
-    return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
-
-
-def inertia_times(inertia, v):
-    xx, yy, zz, xy, xz, yz = inertia
-    return (
-        xx * v[0] + xy * v[1] + xz * v[2],
-        xy * v[0] + yy * v[1] + yz * v[2],
-        xz * v[0] + yz * v[1] + zz * v[2],
-    )
-
-
-def gyroscopic(link: Link, w):
-    """w x (I w), as ((Izz - Iyy) w_y w_z, ...) for numbers without products of inertia (not the payload's)."""
-    xx, yy, zz, xy, xz, yz = link.I
-    if not link.carrier and all(type(x) is float for x in link.I) and xy == xz == yz == 0.0:
-        return ((zz - yy) * (w[1] * w[2]), (xx - zz) * (w[2] * w[0]), (yy - xx) * (w[0] * w[1]))
-    return cross(w, inertia_times(link.I, w))
-
-
 def to_child(link: Link, rot, v):
     """R_i^T v: a vector of frame i-1 expressed in frame i (R_i = R0 Rot R1, rot = Rot, None
     for a prismatic joint)."""
@@ -198,19 +173,34 @@ def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3, at: int = -1):
     its frame, the moment taken about its origin (see ``flange_wrench``); tau balances it (a load pressing
     on the flange raises tau like a weight would). Friction is not included.
     """
-    links, moves = fused(links, cs, steps(links, cs))
+    plain = steps(links, cs)
+    links, moves = fused(links, cs, plain)
     motion = forward_motion(links, moves, qd, qdd, gravity)
-    parent = parents(links)
+    parent, below = parents(links), children(links)
     tau = [0.0] * len(links)
     # the wrench each link's children (the environment, for the last one) exert on it, about
     # its origin o_i in its frame; gathered as the backward pass reaches them
     carried = [None] * len(links)
     carried[at] = scale(-1.0, f_ext), scale(-1.0, n_ext)
+    base = ZERO3, ZERO3, scale(-1.0, gravity)
     for i in reversed(range(len(links))):
-        link, (w, dw, a) = links[i], motion[i]
+        link = links[i]
+        axis = None if below[i] or moves[i] is not plain[i] else cheap_turn_axis(link)
+        if axis is not None:  # a leaf whose inertia turns cheaply: its wrench before its turn
+            motion_i = motion[parent[i]] if parent[i] >= 0 else base
+            f, n = leaf_wrench(link, moves[i], motion_i, qd[i], qdd[i], carried[i], axis)
+            tau[i] = dot(link.u, n) + link.armature * qdd[i]
+            if parent[i] >= 0:
+                if link.R0 is not None:
+                    f, n = rotate(link.R0, f), rotate(link.R0, n)
+                if moves[i][1] is not None:
+                    n = add(n, cross(moves[i][1], f))
+                gather(carried, parent[i], (f, n))
+            continue
+        w, dw, a = motion[i]
         f, n = carried[i] or (ZERO3, ZERO3)
         force = add(cross(w, cross(w, link.h)), cross(dw, link.h), scale(link.m, a))
-        moment = add(inertia_times(link.I, dw), gyroscopic(link, w), cross(link.h, a))
+        moment = add(inertia_times(link.I, dw), gyroscopic(link.I, w), cross(link.h, a))
         f = add(force, f)
         n = add(moment, cross(link.p, f), n)
         tau[i] = dot(link.b, f if link.prismatic else n) + link.armature * qdd[i]
@@ -338,24 +328,5 @@ def _rotate_inertia(link, rot, inertia):
     if link.R1 is not None:
         inertia = turned(link.R1, inertia)
     if rot is not None:
-        inertia = _turned_about_z(rot, inertia) if link.u == Z_AXIS else turned(rot, inertia)
+        inertia = turned_about(rot, inertia, 2) if link.u == Z_AXIS else turned(rot, inertia)
     return inertia if link.R0 is None else turned(link.R0, inertia)
-
-
-def turned(R, inertia):
-    """R I R^T: columns of R I, then R (R I)^T."""
-    xx, yy, zz, xy, xz, yz = inertia
-    rows_of_ri = list(zip(*(rotate(R, col) for col in ((xx, xy, xz), (xy, yy, yz), (xz, yz, zz)))))
-    col0, col1, col2 = (rotate(R, row) for row in rows_of_ri)
-    return (col0[0], col1[1], col2[2], col1[0], col2[0], col2[1])
-
-
-def _turned_about_z(rot, inertia):
-    """Rot_z I Rot_z^T by the double angle: with C = cos 2t, S = sin 2t, the xx, yy, xy
-    block turns by 2t about its mean; xz, yz turn by t."""
-    c, s = rot[0][0], rot[1][0]
-    xx, yy, zz, xy, xz, yz = inertia
-    C, S = c * c - s * s, (c * s) * 2.0
-    mean, half = (xx + yy) * 0.5, (xx - yy) * 0.5
-    x = half * C - xy * S
-    return (mean + x, mean - x, zz, half * S + xy * C, c * xz - s * yz, s * xz + c * yz)

@@ -85,3 +85,47 @@ def _times(R, S):
     if R is None or S is None:
         return S if R is None else R
     return tuple(tuple(R[j][0] * S[0][k] + R[j][1] * S[1][k] + R[j][2] * S[2][k] for k in range(3)) for j in range(3))
+
+
+def turned(R, inertia):
+    """R I R^T of an inertia (xx, yy, zz, xy, xz, yz): columns of R I, then R (R I)^T."""
+    xx, yy, zz, xy, xz, yz = inertia
+    rows_of_ri = list(zip(*(rotate(R, col) for col in ((xx, xy, xz), (xy, yy, yz), (xz, yz, zz)))))
+    col0, col1, col2 = (rotate(R, row) for row in rows_of_ri)
+    return (col0[0], col1[1], col2[2], col1[0], col2[0], col2[1])
+
+
+INERTIA_INDEX = {  # (row, column) -> the entry of (xx, yy, zz, xy, xz, yz)
+    (0, 0): 0,
+    (1, 1): 1,
+    (2, 2): 2,
+    (0, 1): 3,
+    (1, 0): 3,
+    (0, 2): 4,
+    (2, 0): 4,
+    (1, 2): 5,
+    (2, 1): 5,
+}
+
+
+def turned_about(rot, inertia, k: int):
+    """Rot I Rot^T for a turn ``rot`` about the coordinate axis k (either sign) by the double
+    angle: in the turn's plane (i, j) = (k+1, k+2), with C = cos 2t, S = sin 2t, the ii, jj,
+    ij block turns by 2t about its mean; ik, jk turn by t; kk stays."""
+    i, j = (k + 1) % 3, (k + 2) % 3
+    c, s = rot[i][i], rot[j][i]
+    ii, jj, kk, ij, ik, jk = (inertia[INERTIA_INDEX[pair]] for pair in ((i, i), (j, j), (k, k), (i, j), (i, k), (j, k)))
+    C, S = c * c - s * s, (c * s) * 2.0
+    mean, half = (ii + jj) * 0.5, (ii - jj) * 0.5
+    x = half * C - ij * S
+    out = [None] * 6
+    for pair, value in (
+        ((i, i), mean + x),
+        ((j, j), mean - x),
+        ((k, k), kk),
+        ((i, j), half * S + ij * C),
+        ((i, k), c * ik - s * jk),
+        ((j, k), s * ik + c * jk),
+    ):
+        out[INERTIA_INDEX[pair]] = value
+    return tuple(out)

@@ -3,8 +3,8 @@ dynamics in closed form (``algorithms.analytical_derivatives``), the forward dyn
 M^-1 (``algorithms.derivatives``, ``algorithms.linear``) on an arm's links.
 
 Each is ``recipe(arm, cs, *groups, k, friction)`` with ``arm`` an ``ArmKernels``. The joint
-friction is part of these kernels: its coefficients follow, in ``k``, the nonzero ones of
-the 13 numbers (payload, gravity): viscous v (n), then, with ``friction`` "coulomb", the
+friction is part of these kernels: its coefficients follow, in ``k``, the inputs of the 13
+numbers (payload, gravity; ``kernels.inputs_of``): viscous v (n), then, with ``friction`` "coulomb", the
 Coulomb levels c (n) and the smoothing velocity v_s, as ``Kernels`` binds them; ``friction``
 None: none. Matrices are written row by row.
 """
@@ -26,7 +26,7 @@ def friction_terms(arm, k, qd, kind: str | None):
     computes the torques (tau_f,i = v_i qd_i + c_i tanh(qd_i / v_s)); None without friction."""
     if kind is None:
         return None
-    start, n = sum(arm.nonzero), arm.n
+    start, n = arm.inputs, arm.n
     viscous = k[start : start + n]
     if kind == "viscous":
         return [v * x for v, x in zip(viscous, qd)], list(viscous)

@@ -156,12 +156,11 @@ class Kernels:
         self.gravity = model.gravity
         at = model.carrier  # the payload's link: the last one's, or the flange_joint's
         carrier = links[at]
-        constants = (carrier.m, *carrier.h, *carrier.I, *model.gravity)
         # plain floats: a NumPy scalar (a URDF inertial turned by NumPy) would make every
         # operation it enters several times slower
-        self.constants = tuple(float(x) for x in constants if x != 0.0)
+        layout, self.constants = inputs_of(tuple(float(x) for x in (carrier.m, *carrier.h, *carrier.I, *model.gravity)))
         arm = links[:at] + (replace(carrier, m=0.0, h=ZERO3, I=ZERO6),) + links[at + 1 :]
-        self._arm = _arm(arm, model.flange, tuple(x != 0.0 for x in constants), coupling(model), at)
+        self._arm = _arm(arm, model.flange, layout, coupling(model), at)
         self._friction = model.friction
         self._made: dict[str, Kernel] = {}
         self._lock = threading.Lock()  # one kernel of a name, also when threads ask at once
@@ -260,9 +259,28 @@ def prepare(model, timeout: float | None = None, names: tuple[str, ...] = NATIVE
     return kernels_of(model).prepare(timeout, names)
 
 
+def inputs_of(numbers: tuple[float, ...]) -> tuple[tuple[int | None, ...], tuple[float, ...]]:
+    """(each of the 13 numbers' index in ``k``, None for the constant 0; k's values): an
+    input per nonzero number, but equal moments of inertia (Ixx, Iyy, Izz) take the same, so
+    that the traces fold their difference (the tracer's x - x = 0): a body symmetric about
+    its joint's axis turns at no cost (``rotations.turned_about``), and needs no angle."""
+    layout: list[int | None] = []
+    values: list[float] = []
+    for j, x in enumerate(numbers):
+        same = [e for e in range(4, j) if j <= 6 and numbers[e] == x]
+        if x == 0.0:
+            layout.append(None)
+        elif same:
+            layout.append(layout[same[0]])
+        else:
+            layout.append(len(values))
+            values.append(x)
+    return tuple(layout), tuple(values)
+
+
 @lru_cache(maxsize=ARMS_CACHED)
-def _arm(links, flange, nonzero: tuple[bool, ...], coupled=None, carrier: int = -1) -> ArmKernels:
-    return ArmKernels(links, flange, nonzero, coupled, carrier)
+def _arm(links, flange, layout: tuple[int | None, ...], coupled=None, carrier: int = -1) -> ArmKernels:
+    return ArmKernels(links, flange, layout, coupled, carrier)
 
 
 @dataclass(frozen=True)
@@ -274,14 +292,15 @@ class _Flange:
 
 class ArmKernels(Coordinates):
     """The traces of an arm (its links, the last one's inertia left out), each made once on
-    first use; the last link's inertia and gravity come from the argument ``k``, its
-    nonzero ones of the 13 numbers (``nonzero``), the others are zero."""
+    first use; the last link's inertia and gravity come from the argument ``k``: each of the
+    13 numbers k[layout[j]], or 0 where layout[j] is None (see ``inputs_of``)."""
 
-    def __init__(self, links, flange, nonzero: tuple[bool, ...], coupled=None, carrier: int = -1):
+    def __init__(self, links, flange, layout: tuple[int | None, ...], coupled=None, carrier: int = -1):
         self.links = links
         self.carrier = carrier % len(links)  # the link the payload and a flange wrench are on
         self.flange = _Flange(flange)
-        self.nonzero = nonzero
+        self.layout = layout
+        self.inputs = 1 + max((j for j in layout if j is not None), default=-1)  # k's the 13 numbers take
         self._traces: dict[str, Trace] = {}
         self._lock = threading.RLock()  # one trace of a kernel, also when threads ask at once
         Coordinates.__init__(self, links, coupled)
@@ -306,7 +325,7 @@ class ArmKernels(Coordinates):
                 base, friction = _friction_kind(name)
                 recipe = RECIPES[base]
                 inputs = {group: 6 if group == "wrench" else self.n for group in recipe.groups}
-                inputs["k"] = sum(self.nonzero) + {None: 0, "viscous": self.n, "coulomb": 2 * self.n + 1}[friction]
+                inputs["k"] = self.inputs + {None: 0, "viscous": self.n, "coulomb": 2 * self.n + 1}[friction]
                 algorithm = partial(recipe.algorithm, friction=friction) if recipe.friction else recipe.algorithm
                 program = traced(name, lambda *args: algorithm(self, *args), inputs, self.angles, self.mimic_angles)
                 if recipe.matrices:
@@ -316,9 +335,8 @@ class ArmKernels(Coordinates):
         return trace
 
     def _spread(self, k) -> tuple:
-        """The 13 numbers from the nonzero ones in k."""
-        given = iter(k)
-        return tuple(next(given) if used else 0.0 for used in self.nonzero)
+        """The 13 numbers from their inputs in k."""
+        return tuple(0.0 if j is None else k[j] for j in self.layout)
 
     def links_with(self, k):
         """The links with the carrier's (the last one's) inertia from k."""

@@ -4,8 +4,10 @@ A kernel takes ``sine(theta)`` and ``cosine(theta)`` of each joint angle. Left t
 (sin, cos, or gcc's sincos), those are n calls one after the other, each a branchy routine
 the processor does not overlap with the next: on a 6-joint arm they took about half the
 time of the generated C. Here the C computes all the angles of a program first (``batched``:
-one call of ``sin_cos_angles``, a loop without a branch that gcc -O2 vectorizes, two angles
-per SSE2 register), and the Python forms likewise (``hoisted``: one ``sin_cos_rows``):
+in pairs of GCC's vector extensions, two angles per SSE2 or NEON register, left there for
+the kernel to read, with one branch for every angle beyond the range; for other compilers
+one call of ``sin_cos_angles``, a loop without a branch that gcc -O2 vectorizes), and the
+Python forms likewise (``hoisted``: one ``sin_cos_rows``):
 
 - Cody-Waite range reduction: k, the integer nearest theta * 2 / pi (rounded by adding and
   subtracting 1.5 * 2^52), and r = theta - k pi / 2 with pi / 2 split in three parts of 33
@@ -148,9 +150,9 @@ sin_cos_rows = _namespace["sin_cos_rows"]
 sine_array, cosine_array = _namespace["sine_array"], _namespace["cosine_array"]
 
 
-def _c_steps() -> str:
-    named = re.sub(rf"\b({'|'.join(CONSTANTS)})\b", r"SINCOS_\1", _STEPS.replace("theta", "theta[i]"))
-    return "\n".join(f"        const double {line};" for line in named.split("\n"))
+def _c_steps(theta: str = "theta[i]", scalar: str = "double") -> str:
+    named = re.sub(rf"\b({'|'.join(CONSTANTS)})\b", r"SINCOS_\1", _STEPS.replace("theta", theta))
+    return "\n".join(f"        const {scalar} {line};" for line in named.split("\n"))
 
 
 C_SOURCE = (
@@ -192,6 +194,41 @@ SINCOS_INLINE void sin_cos_angles(int n, const double *theta, double *sin_theta,
     }}
 }}
 
+#if defined(__GNUC__)
+/* Two angles in one vector of GCC's (and Clang's) extensions, an SSE2 (NEON) register: the
+   same steps on both lanes, the results left in registers where the kernels read them
+   (sin_cos_angles' arrays cost a store and a load on the way to the first joint's turn). */
+#define SINCOS_PAIRS 1
+typedef double sincos_pair __attribute__((vector_size(16)));
+typedef long long sincos_bits __attribute__((vector_size(16)));
+
+SINCOS_INLINE void sin_cos_pair(sincos_pair theta, sincos_pair *sin_theta, sincos_pair *cos_theta)
+{{
+{_c_steps("theta", "sincos_pair")}
+        const sincos_bits j = (sincos_bits)rounded, s_bits = (sincos_bits)s, c_bits = (sincos_bits)c;
+        const sincos_bits odd = 0 - (j & 1);
+        *sin_theta = (sincos_pair)(((s_bits & ~odd) | (c_bits & odd)) ^ ((j & 2) << 62));
+        *cos_theta = (sincos_pair)(((c_bits & ~odd) | (s_bits & odd)) ^ (((j + 1) & 2) << 62));
+}}
+
+/* lanes of -1 where |theta| <= {LIBM_BEYOND!r} (not for a NaN), else 0 */
+SINCOS_INLINE sincos_bits sin_cos_inside(sincos_pair theta)
+{{
+    return (theta <= {LIBM_BEYOND!r}) & (theta >= -{LIBM_BEYOND!r});
+}}
+
+/* libm's sine and cosine of a pair's angles beyond {LIBM_BEYOND:g} or not finite */
+SINCOS_INLINE void sin_cos_beyond(sincos_pair theta, sincos_pair *sin_theta, sincos_pair *cos_theta)
+{{
+    for (int i = 0; i < 2; ++i) {{
+        if (!(fabs(theta[i]) <= {LIBM_BEYOND!r})) {{
+            (*sin_theta)[i] = sin(theta[i]);
+            (*cos_theta)[i] = cos(theta[i]);
+        }}
+    }}
+}}
+#endif
+
 SINCOS_INLINE double sine(double theta)
 {{
     double s, c;
@@ -229,16 +266,28 @@ def _input_angles(assignments):
 
 def batched(assignments: list[tuple[str, str]]) -> tuple[list[str], list[tuple[str, str]]]:
     """(C lines computing the joint angles' sines and cosines at once, the other assignments):
-    one call of ``sin_cos_angles`` on every distinct theta of an input (padded to an even
-    count: two per vector), first."""
+    every distinct theta of an input (padded to an even count: two per vector), first, in
+    pairs of vectors (``sin_cos_pair``) where the compiler has GCC's vector extensions, else
+    by one call of ``sin_cos_angles``."""
     thetas, angles, rest = _input_angles(assignments)
     if not thetas:
         return [], rest
     values = [*thetas, *(["0.0"] if len(thetas) % 2 else [])]
     n = len(values)
-    lines = [f"    const double theta[{n}] = {{{', '.join(values)}}};"]
+    pairs = range(n // 2)
+    lines = ["#if defined(SINCOS_PAIRS)"]
+    lines += [f"    const sincos_pair theta_{p} = {{{values[2 * p]}, {values[2 * p + 1]}}};" for p in pairs]
+    lines += [f"    sincos_pair sin_{p}, cos_{p};" for p in pairs]
+    lines += [f"    sin_cos_pair(theta_{p}, &sin_{p}, &cos_{p});" for p in pairs]
+    inside = " & ".join(f"sin_cos_inside(theta_{p})" for p in pairs)
+    lines += [f"    const sincos_bits inside = {inside};", "    if (!(inside[0] & inside[1])) {"]
+    lines += [f"        sin_cos_beyond(theta_{p}, &sin_{p}, &cos_{p});" for p in pairs]
+    lines += ["    }"]
+    lines += [f"    const double {var} = {f[:3]}_{i // 2}[{i % 2}];" for var, f, i in angles]
+    lines += ["#else", f"    const double theta[{n}] = {{{', '.join(values)}}};"]
     lines += [f"    double sin_theta[{n}], cos_theta[{n}];", f"    sin_cos_angles({n}, theta, sin_theta, cos_theta);"]
-    return lines + [f"    const double {var} = {f[:3]}_theta[{i}];" for var, f, i in angles], rest
+    lines += [f"    const double {var} = {f[:3]}_theta[{i}];" for var, f, i in angles]
+    return [*lines, "#endif"], rest
 
 
 def hoisted(assignments: list[tuple[str, str]]) -> list[tuple[str, str]]:

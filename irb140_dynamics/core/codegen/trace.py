@@ -2,8 +2,8 @@
 
 The algorithms in ``algorithms`` run once on symbols instead of numbers. Every operation
 on a symbol is recorded; operations on the model's constants are done right away, and
-identities that are exact in floating point are folded (x*0 = 0 for finite x, x*1, x+0,
-x+(-y) = x-y), and an operation recorded again on the same operands is done once
+identities that are exact in floating point are folded (x*0 = 0 and x-x = 0 for finite x,
+x*1, x+0, x+(-y) = x-y), and an operation recorded again on the same operands is done once
 (``merging``). ``program`` lowers what is left into the intermediate form the emitters
 read: no loops, no lookups, no zero terms.
 
@@ -44,6 +44,8 @@ class Sym:
 
     def __sub__(self, other):
         if other.__class__ is Sym:
+            if _same(self, other):  # x - x = 0 for finite x
+                return 0.0
             return self + other.args[0] if other.op == "neg" else Sym("-", (self, other))
         if not _is_const(other):
             return NotImplemented
@@ -112,6 +114,18 @@ _SCALARS = (Sym, float, int)
 def tanh(x):
     """tanh of a traced scalar (recorded) or of a constant (computed)."""
     return Sym("tanh", (x,)) if isinstance(x, Sym) else math.tanh(x)
+
+
+def _same(a, b, depth: int = 8) -> bool:
+    """Whether a and b are the same operations on the same operands (up to ``depth`` deep):
+    the same value."""
+    if a is b:
+        return True
+    if not isinstance(a, Sym) or not isinstance(b, Sym):
+        return isinstance(a, float) and isinstance(b, float) and repr(a) == repr(b)
+    if a.op != b.op or a.op == "var" or depth == 0 or len(a.args) != len(b.args):
+        return False
+    return all(_same(x, y, depth - 1) for x, y in zip(a.args, b.args))
 
 
 def _is_const(x) -> bool:

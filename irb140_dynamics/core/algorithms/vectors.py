@@ -1,0 +1,39 @@
+"""3-vectors as tuples of scalars (any type with + - *, see ``recursions``), and an inertia
+(xx, yy, zz, xy, xz, yz) times a vector."""
+
+from __future__ import annotations
+
+
+def add(*vectors):
+    return tuple(sum(components[1:], components[0]) for components in zip(*vectors))
+
+
+def scale(k, v):
+    return (k * v[0], k * v[1], k * v[2])
+
+
+def dot(u, v):
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+
+
+def cross(u, v):
+    return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+
+
+def inertia_times(inertia, v):
+    xx, yy, zz, xy, xz, yz = inertia
+    return (
+        xx * v[0] + xy * v[1] + xz * v[2],
+        xy * v[0] + yy * v[1] + yz * v[2],
+        xz * v[0] + yz * v[1] + zz * v[2],
+    )
+
+
+def gyroscopic(inertia, w):
+    """w x (I w), as ((Izz - Iyy) w_y w_z, ...) where the products of inertia are the constant 0
+    (the payload's link's moments of inertia may be a kernel's inputs: their differences are
+    then computed, once)."""
+    xx, yy, zz, xy, xz, yz = inertia
+    if all(type(x) is float and x == 0.0 for x in (xy, xz, yz)):
+        return ((zz - yy) * (w[1] * w[2]), (xx - zz) * (w[2] * w[0]), (yy - xx) * (w[0] * w[1]))
+    return cross(w, inertia_times(inertia, w))
