@@ -244,7 +244,7 @@ def _cold_point(model: RobotModel, L_arm: np.ndarray, z: float, l: float):
     def make():
         return _point(shapes.family(z, l), ranges, L_arm, None, z, l)
 
-    point, poses = _remembered(model, ("point", L_arm.tobytes(), z, l), make)
+    point, poses = _remembered(model, ("point", L_arm.tobytes(), np.array([z, l]).tobytes()), make)
     return point, None if poses is None else poses.copy()
 
 

@@ -58,9 +58,11 @@ def expand(coefficients, centre):
         D = flat[rows]
         b = D.shape[0]
         for k in range(d - 1, -1, -1):  # the last joint first; each pass turns the axes once
-            turned = np.matmul(D.reshape(b, c * size // 3, 3), M[rows, k])
-            D = turned.reshape(b, c, size // 3, 3).transpose(0, 1, 3, 2).reshape(b, c * size)
-        result[rows] = D
+            turned = np.matmul(D.reshape(b, c * size // 3, 3), M[rows, k]).reshape(b, c, size // 3, 3)
+            D = result[rows] if k == 0 else np.empty((b, c * size))  # (the last pass: into the result)
+            D.reshape(b, c, 3, size // 3)[...] = turned.transpose(0, 1, 3, 2)
+        if d == 0:
+            result[rows] = D
     return result.reshape(shape)
 
 

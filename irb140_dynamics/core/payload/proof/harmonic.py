@@ -20,7 +20,8 @@ are linear in gravity, so tau_j = g_j . omega_j with g_j the gravity in frame j,
 not depend on theta_j, which is set to 0 (the subchain from link j, by rnea too).
 
 Cost: 3^n torques for tau and about 3^n / 2 for the omegas, each one rnea pass on Interval
-arrays (3^6 = 729 states for six joints). Beyond MAX_JOINTS joints the sums grow too large
+arrays (3^6 = 729 states for six joints), on a grid with an axis per joint: what depends on
+the first joints only is computed once per their values. Beyond MAX_JOINTS joints the sums grow too large
 and ``certify`` falls back to plain interval bounds.
 """
 
