@@ -258,10 +258,13 @@ def _fit(values: Interval, d: int, first: int = 0) -> HarmonicSum:
     shape = lead + (3,) * d
     c = Interval(values.lo.reshape(shape), values.hi.reshape(shape))
     for axis in range(len(lead), len(shape)):
-        f0, f1, f2 = (Interval(np.take(c.lo, i, axis), np.take(c.hi, i, axis)) for i in range(3))
+        at = [(slice(None),) * axis + (i,) for i in range(3)]  # (views, not copies)
+        f0, f1, f2 = (Interval(c.lo[i], c.hi[i]) for i in at)
         A, B = (f0 + f2) * 0.5, (f0 - f2) * 0.5
         C = f1 - A
-        c = Interval(np.stack([A.lo, B.lo, C.lo], axis), np.stack([A.hi, B.hi, C.hi], axis))
+        c = Interval(np.empty(shape), np.empty(shape))
+        for i, part in zip(at, (A, B, C)):
+            c.lo[i], c.hi[i] = part.lo, part.hi
     flat = lead + (3**d,)
     return HarmonicSum(tuple(range(first, first + d)), Interval(c.lo.reshape(flat), c.hi.reshape(flat)))
 
