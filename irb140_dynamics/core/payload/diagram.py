@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -45,6 +45,7 @@ from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.payload.family import PayloadFamily
 from irb140_dynamics.core.payload.limits import limit_values, smallest_max_payload
 from irb140_dynamics.core.payload.proof.harmonic import MAX_JOINTS, StaticForms
+from irb140_dynamics.core.payload.stop import ran_out
 from irb140_dynamics.core.payload.workspace import JointRanges
 
 MARGINS = (0.005, 0.015)  # the proof aims at (1 - margin) of the mass the search finds; the next if it fails
@@ -144,8 +145,8 @@ def load_diagram(
     z, l = np.asarray(z, dtype=float), np.asarray(l, dtype=float)
     job = (model, L, l)
     rows: list[list[DiagramPoint]] = [[] for _ in z]
-    _, shapes, ranges = _arm_of(model)  # (made before the workers fork: they inherit it, compiled)
-    alone = _holds_alone(shapes.family(0.0, 0.0), ranges, np.append(L, np.inf))
+    _arm_of(model)  # (made before the workers fork: they inherit it, compiled)
+    alone = _alone(model, np.append(L, np.inf))
     if workers > 1 and z.size > 1:
         import multiprocessing
 
@@ -184,17 +185,38 @@ def _quiet() -> None:
 
 
 _JOBS: list = [None]
-_ARMS: dict = {}  # per process: the pivoted arm and its forms, per model
+_ARMS: dict = {}  # per process: the pivoted arm and its forms, per arm (the last ARMS_KEPT)
+_PROVEN: dict = {}  # per process and arm: cold-started points and the arm alone's proof, per limits
+ARMS_KEPT, POINTS_KEPT = 2, 64
 
 
 def _arm_of(model: RobotModel):
-    """(model, its pivoted arm's shapes, that arm's ranges), made once per model."""
-    key = id(model)
+    """(model, its pivoted arm's shapes, that arm's ranges), made once per arm (the same
+    joints, flange and gravity: its payload is replaced anyway)."""
+    key = _arm_key(model)
     if key not in _ARMS:
-        _ARMS.clear()
+        while len(_ARMS) >= ARMS_KEPT:
+            _PROVEN.pop(_ARMS.pop(next(iter(_ARMS)))[0], None)
         arm = pivoted(model)
-        _ARMS[key] = (model, _Shapes(arm), JointRanges.of(arm))
-    return _ARMS[key]
+        _ARMS[key] = (key, model, _Shapes(arm), JointRanges.of(arm))
+    return _ARMS[key][1:]
+
+
+def _arm_key(model: RobotModel) -> tuple:
+    return tuple(getattr(model, f.name) for f in fields(model) if f.name != "payload")
+
+
+def _remembered(model: RobotModel, what: tuple, make):
+    """make(), remembered per arm and ``what`` (a result the deadline cut short is not)."""
+    known = _PROVEN.setdefault(_arm_key(model), {})
+    if what not in known:
+        result = make()
+        if ran_out():
+            return result
+        while len(known) >= POINTS_KEPT:
+            known.pop(next(iter(known)))
+        known[what] = result
+    return known[what]
 
 
 def _holds_alone(family: PayloadFamily, ranges: JointRanges, L: np.ndarray) -> bool:
@@ -209,6 +231,23 @@ def _holds_alone(family: PayloadFamily, ranges: JointRanges, L: np.ndarray) -> b
     return bool(np.all(proof.bounds[limited] <= ceiling[limited]))
 
 
+def _alone(model: RobotModel, L_arm: np.ndarray) -> bool:
+    """``_holds_alone`` of ``model``'s pivoted arm, remembered."""
+    _, shapes, ranges = _arm_of(model)
+    return _remembered(model, ("alone", L_arm.tobytes()), lambda: _holds_alone(shapes.family(0.0, 0.0), ranges, L_arm))
+
+
+def _cold_point(model: RobotModel, L_arm: np.ndarray, z: float, l: float):
+    """``_point`` at (z, l) with no warm start, remembered: (the point, its poses)."""
+    _, shapes, ranges = _arm_of(model)
+
+    def make():
+        return _point(shapes.family(z, l), ranges, L_arm, None, z, l)
+
+    point, poses = _remembered(model, ("point", L_arm.tobytes(), np.array([z, l]).tobytes()), make)
+    return point, None if poses is None else poses.copy()
+
+
 def _row(item, job=None):
     """(i, the points at z for every l), warm-starting each point from the last."""
     i, z = item
@@ -217,7 +256,10 @@ def _row(item, job=None):
     L_arm = np.append(L, np.inf)
     warm, points = None, []
     for lk in l:
-        point, warm = _point(shapes.family(float(z), float(lk)), ranges, L_arm, warm, float(z), float(lk))
+        if warm is None:
+            point, warm = _cold_point(model, L_arm, float(z), float(lk))
+        else:
+            point, warm = _point(shapes.family(float(z), float(lk)), ranges, L_arm, warm, float(z), float(lk))
         points.append(point)
     return i, points
 
@@ -329,7 +371,7 @@ def check_point(model: RobotModel, limits: Sequence[float], mass: float, z: floa
     L = limit_values(limits, model.n)
     _, shapes, ranges = _arm_of(model)
     L_arm = np.append(L, np.inf)
-    point, _ = _point(shapes.family(float(z), float(l)), ranges, L_arm, None, float(z), float(l))
+    point, _ = _cold_point(model, L_arm, float(z), float(l))
     name = None if point.joint is None else model.joint_names[point.joint]
     proven = point.mass if point.proven else math.nan
     result = PointCheck(float(mass), float(z), float(l), False, proven, point.found, name)
@@ -337,7 +379,7 @@ def check_point(model: RobotModel, limits: Sequence[float], mass: float, z: floa
         return replace(result, reason=point.reason or "no mass holds there")
     if mass >= point.found:
         return replace(result, reason=f"exceeds {name}'s limit in a pose found")
-    alone = _holds_alone(shapes.family(0.0, 0.0), ranges, L_arm)
+    alone = _alone(model, L_arm)
     if point.proven and alone and mass <= point.mass:  # torques affine in the mass: every lighter one holds
         return replace(result, inside=True)
     if _proven_at(shapes.family(float(z), float(l)), ranges, L_arm, float(mass)):

@@ -129,31 +129,48 @@ class JointRanges:
         """Coordinate ascent from every start X[s, k] (for objective k), each step exact.
 
         Near a maximum the sweeps' steps shrink geometrically, by lam each; where that
-        holds, the step to the limit, step * lam / (1 - lam), is tried too (Aitken).
+        holds, the step to the limit, step * lam / (1 - lam), is tried too (Aitken). The
+        poses a sweep's first step needs are evaluated with that trial, for both outcomes:
+        one call of the torques fewer per sweep (the same numbers: each pose's torques are
+        its own).
         """
         X = X.copy()
-        F = self._values(torque, W, X)
+        moving = np.flatnonzero(self.lower < self.upper)  # (a coordinate held has no step)
+        first = moving[0] if moving.size and not self._special(moving[0]) else None
+        ahead = None if first is None else self._values(torque, W, _thirds(X, first))  # the first step's values
+        F = self._values(torque, W, X) if ahead is None else ahead[0]
         step = np.zeros_like(X)
         for _ in range(max_sweeps):
             before, X_before = F, X.copy()
-            for k in np.flatnonzero(self.lower < self.upper):  # (a coordinate held has no step)
+            for k in moving:
                 if out_of_time():
                     return X, self._values(torque, W, X)
-                X, F = self._coordinate_step(torque, W, X, k, tol)
+                X, F = self._coordinate_step(torque, W, X, k, tol, ahead if k == first else None)
             step, last = X - X_before, step
             lam = np.sum(step * last, axis=-1) / np.maximum(np.sum(last * last, axis=-1), 1e-300)
             jump = np.clip(lam, 0.0, 0.95) / (1 - np.clip(lam, 0.0, 0.95))
             trial = np.clip(X + jump[..., None] * step, self.lower, self.upper)
-            f = self._values(torque, W, trial)
+            if first is None:
+                f = self._values(torque, W, trial)
+            else:  # (both outcomes' first step: 3 poses each, the first the pose itself)
+                both = self._values(torque, W, np.concatenate([_thirds(X, first), _thirds(trial, first)]))
+                f = both[3]
             better = f > F + 0.01 * tol
             X, F = np.where(better[..., None], trial, X), np.where(better, f, F)
+            if first is not None:
+                ahead = np.where(better, both[3:], both[:3])
             if np.all(F - before <= tol):
                 break
-        return X, self._values(torque, W, X)
+        return X, (self._values(torque, W, X) if ahead is None else ahead[0])
 
-    def _coordinate_step(self, torque, W, X, k, tol):
+    def _special(self, k) -> bool:
+        """Is coordinate k searched otherwise than by its exact harmonic maximum?"""
+        return bool((self.gridded is not None and self.gridded[k]) or (self.sliding is not None and self.sliding[k]))
+
+    def _coordinate_step(self, torque, W, X, k, tol, f=None):
         """Each X[s, k] moved to the exact maximum along angle k (a prismatic joint: the
-        better end of its range, static torques being affine in it): (X, values)."""
+        better end of its range, static torques being affine in it): (X, values). ``f``:
+        the values at ``_thirds(X, k)``, if known."""
         if self.gridded is not None and self.gridded[k]:  # a grid, then a finer one about its best
             step = (self.upper[k] - self.lower[k]) / (GRID - 1)
             X, F = self._best_of(torque, W, X, k, tol, np.linspace(self.lower[k], self.upper[k], GRID))
@@ -161,9 +178,8 @@ class JointRanges:
             return self._best_of(torque, W, X, k, tol, np.clip(finer, self.lower[k], self.upper[k]))
         if self.sliding is not None and self.sliding[k]:
             return self._best_of(torque, W, X, k, tol, np.array([self.lower[k], self.upper[k]]))
-        trial = np.repeat(X[None], 3, axis=0)
-        trial[..., k] += _THIRDS.reshape(3, 1, 1)
-        f = self._values(torque, W, trial)  # (3, S, K), f[0] at X
+        trial = _thirds(X, k)
+        f = self._values(torque, W, trial) if f is None else f  # (3, S, K), f[0] at X
         theta = trial[..., k]
         A = f.mean(axis=0)
         B = 2 / 3 * np.sum(f * np.cos(theta), axis=0)
@@ -198,6 +214,13 @@ class JointRanges:
                 keep = self._values(torque, W, trial) >= best - tol
                 poses = np.where(keep[:, None], trial, poses)
         return self._values(torque, W, poses), poses
+
+
+def _thirds(X, k):
+    """X three times, angle k turned by 0, 2 pi / 3 and 4 pi / 3: (3, ...) poses."""
+    trial = np.repeat(X[None], 3, axis=0)
+    trial[..., k] += _THIRDS.reshape((3,) + (1,) * (X.ndim - 1))
+    return trial
 
 
 def _wrapped(Q, k=slice(None)):

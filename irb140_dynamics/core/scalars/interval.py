@@ -121,19 +121,22 @@ def _outward(lo, hi) -> Interval:
     return Interval(np.nextafter(lo, _DOWN), np.nextafter(hi, _UP))
 
 
-_EXPONENT = 0x7FF0000000000000  # a double's exponent bits: all set for inf and nan
-
-
 def _step(x: np.ndarray, direction: int) -> np.ndarray:
     """x (float64, changed in place) one ulp up (direction 1) or down (-1): np.nextafter
     toward +-inf, bit for bit, at a fraction of its cost. A finite nonzero double's
     neighbour is its bit pattern as an integer plus or minus one (by its sign); zeros,
     infinities and nans are left to np.nextafter."""
     bits = x.view(np.int64)
-    special = ((bits & _EXPONENT) == _EXPONENT) | ((bits << 1) == 0)
-    held = x[special]
-    bits += direction * ((bits >> 63) | 1)
-    if held.size:
+    special = ~np.isfinite(x)
+    special |= x == 0
+    held = x[special] if special.any() else None
+    away = bits >> 63  # -1 where negative, else 0: | 1 gives the step of a bit pattern away from 0
+    away |= 1
+    if direction > 0:
+        bits += away
+    else:
+        bits -= away
+    if held is not None:
         x[special] = np.nextafter(held, direction * np.inf)
     return x
 

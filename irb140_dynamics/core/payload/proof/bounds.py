@@ -38,23 +38,32 @@ def rounding(d: int) -> float:
 
 
 def expand(coefficients, centre):
-    """The sums (B, 3^d) re-expanded about the centres (B, d): factors 1, v, s per joint."""
+    """The sums (B, ..., 3^d) re-expanded about the centres (B, d), each box's sums about its
+    own centre: factors 1, v, s per joint."""
+    coefficients = np.asarray(coefficients, dtype=float)
     B, d = centre.shape
-    c, s = np.cos(centre), np.sin(centre)
+    shape = coefficients.shape
+    size = 3**d
+    c = coefficients.size // max(B * size, 1)  # sums per box: one rotation each joint serves them all
+    c_, s_ = np.cos(centre), np.sin(centre)
     M = np.zeros((B, d, 3, 3))  # row: 1, cos theta, sin theta; column: 1, v, s
     M[:, :, 0, 0] = 1.0
-    M[:, :, 1, 0], M[:, :, 1, 1], M[:, :, 1, 2] = c, -c, -s
-    M[:, :, 2, 0], M[:, :, 2, 1], M[:, :, 2, 2] = s, -s, c
-    coefficients = np.asarray(coefficients, dtype=float)
-    result = np.empty((B, 3**d))
-    step = max(1, _CELLS // 3**d)
+    M[:, :, 1, 0], M[:, :, 1, 1], M[:, :, 1, 2] = c_, -c_, -s_
+    M[:, :, 2, 0], M[:, :, 2, 1], M[:, :, 2, 2] = s_, -s_, c_
+    flat = coefficients.reshape(B, c * size)
+    result = np.empty((B, c * size))
+    step = max(1, _CELLS // (c * size))
     for first in range(0, B, step):  # a few boxes at a time: each pass's copy stays in the caches
         rows = slice(first, first + step)
-        D = coefficients[rows]
+        D = flat[rows]
+        b = D.shape[0]
         for k in range(d - 1, -1, -1):  # the last joint first; each pass turns the axes once
-            D = np.matmul(D.reshape(D.shape[0], -1, 3), M[rows, k]).transpose(0, 2, 1).reshape(D.shape[0], -1)
-        result[rows] = D
-    return result
+            turned = np.matmul(D.reshape(b, c * size // 3, 3), M[rows, k]).reshape(b, c, size // 3, 3)
+            D = result[rows] if k == 0 else np.empty((b, c * size))  # (the last pass: into the result)
+            D.reshape(b, c, 3, size // 3)[...] = turned.transpose(0, 1, 3, 2)
+        if d == 0:
+            result[rows] = D
+    return result.reshape(shape)
 
 
 def sizes(radius):
@@ -83,9 +92,9 @@ def model(D, W, radius):
     curvature = np.where(b < 0, b, np.where(wide, 0.0, 2 * b / (1 + np.cos(np.minimum(radius, _WIDE)))))
     high = terms[:, where.high].sum(axis=1) + np.where(wide & (b >= 0), terms[:, where.single_v], 0.0).sum(axis=1)
     Q = np.zeros((B, d, d))
-    k, l = np.triu_indices(d, 1)
+    k, l = where.upper
     Q[:, k, l] = Q[:, l, k] = D[:, where.pair]
-    Q[:, np.arange(d), np.arange(d)] = curvature
+    Q[:, where.diagonal, where.diagonal] = curvature
     return g, Q, high, terms
 
 
@@ -121,21 +130,24 @@ def _dual(g, Q, sigma, diagonal, off):
     B, d = g.shape
     size = np.abs(Q).max(axis=(1, 2)) + (np.abs(g) / sigma).max(axis=1) + 1e-300
     mu = 0.5 * np.maximum(0.0, diagonal + off) + np.abs(g) / (2 * sigma) + 1e-9 * size[:, None]
-    rows = np.arange(d)
-    S = -Q.copy()
+    rows = layout(d).diagonal
+    S = -Q
     S[:, rows, rows] += 2 * mu
     inverse = np.linalg.inv(S)
     x = np.einsum("bkl,bl->bk", inverse, g)
+    # the sweeps on (d, ..., B) arrays: each k's numbers in a row
+    inverse, x, mu, sigma_k = inverse.transpose(1, 2, 0).copy(), x.T.copy(), mu.T.copy(), sigma.T
     for _ in range(2):
         for k in range(d):  # the best mu_k for the others (Sherman-Morrison), S kept definite
-            h = inverse[:, k, k]
-            step = np.maximum((np.maximum(np.abs(x[:, k]) / sigma[:, k], 0.01) - 1) / (2 * h), -mu[:, k])
+            h = inverse[k, k]
+            step = np.maximum((np.maximum(np.abs(x[k]) / sigma_k[k], 0.01) - 1) / (2 * h), -mu[k])
             scale = 2 * step / (1 + 2 * step * h)
-            column = inverse[:, :, k].copy()
-            x -= (scale * x[:, k])[:, None] * column
-            inverse -= scale[:, None, None] * column[:, :, None] * column[:, None, :]
-            mu[:, k] += step
-    S = -Q.copy()
+            column = inverse[:, k].copy()
+            x -= (scale * x[k]) * column
+            inverse -= (scale * column)[:, None] * column
+            mu[k] += step
+    mu = mu.T
+    S = -Q
     S[:, rows, rows] += 2 * np.maximum(mu, 0.0)
     lam, V = np.linalg.eigh(S)
     # the computed eigenpairs are exact for S + E, |E| <= 16 d U |S|: S >= (1 - eta)(S + E)
@@ -157,6 +169,9 @@ class Layout:
     single_s: np.ndarray  # the term s_k alone, per k
     single_v: np.ndarray  # v_k alone
     pair: np.ndarray  # s_k s_l, k < l
+    upper: tuple[np.ndarray, np.ndarray]  # (k, l) of those pairs
+    higher: np.ndarray  # terms other than the constant and the s_k alone
+    diagonal: np.ndarray  # 0 .. d - 1
 
 
 @cache
@@ -172,6 +187,9 @@ def layout(d: int) -> Layout:
         single_s=2 * place,
         single_v=place,
         pair=2 * place[k] + 2 * place[l],
+        upper=(k, l),
+        higher=np.isin(np.arange(3**d), 2 * place, invert=True) & (np.arange(3**d) != 0),
+        diagonal=np.arange(d),
     )
 
 
@@ -183,6 +201,11 @@ def squared_model(N, W, sigma, radius):
     |v|^2 = |v(c)|^2 + 2 v(c) . delta + |delta|^2, delta = v - v(c) = A s + rest: the first
     two terms as a quadratic model, |delta|^2 <= |A s|^2 + 2 |A s| |rest| + |rest|^2 by the
     sizes of the terms."""
+    return _squared_model(N, W, sigma, radius)[:5]
+
+
+def _squared_model(N, W, sigma, radius):
+    """``squared_model``, and the sizes of each sum's terms of degree >= 2 (B, c)."""
     where = layout(radius.shape[1])
     middle = N[:, :, 0]
     along = np.einsum("bc,bca->ba", middle, N)
@@ -193,11 +216,12 @@ def squared_model(N, W, sigma, radius):
     terms = along_terms + rest.sum(axis=1)
     rest[:, :, 0] = 0.0
     rest[:, :, where.single_s] = 0.0
-    rest = np.sqrt((rest.sum(axis=2) ** 2).sum(axis=1))
+    higher = rest.sum(axis=2)
+    rest = np.sqrt((higher**2).sum(axis=1))
     linear = (np.sqrt((A**2).sum(axis=1)) * sigma).sum(axis=1)
     size = np.sqrt((middle**2).sum(axis=1))
     squared = size**2 + 2 * high_v + 2 * linear * rest + rest**2
-    return size, squared, g_v, Q_v + np.einsum("bck,bcl->bkl", A, A), terms
+    return size, squared, g_v, Q_v + np.einsum("bck,bcl->bkl", A, A), terms, higher
 
 
 def turned_squared_max(N, W, sigma, radius, turn, enough=None):
@@ -217,15 +241,14 @@ def turned_squared_max(N, W, sigma, radius, turn, enough=None):
     B, _, size_d = N.shape
     where = layout(radius.shape[1])
     a, X = N[:, :3], N[:, 3:].reshape(B, 2, 3, size_d)
-    size, squared, g, Q, terms = squared_model(a, W, sigma, radius)
+    size, squared, g, Q, terms, Ha = _squared_model(a, W, sigma, radius)
     a0, X0 = a[:, :, 0], X[:, :, :, 0]
     Aa, AX = a[:, :, where.single_s], X[:, :, :, where.single_s]
     w0 = np.einsum("bc,bpc->bp", a0, X0)
     J = np.einsum("bck,bpc->bpk", Aa, X0) + np.einsum("bc,bpck->bpk", a0, AX)
-    higher = np.ones(size_d, dtype=bool)
-    higher[0] = False
-    higher[where.single_s] = False
-    Ha, HX = (np.abs(a) * higher * W[:, None]).sum(axis=2), (np.abs(X) * higher * W[:, None, None]).sum(axis=3)
+    higher = where.higher
+    sized = np.abs(X) * W[:, None, None]
+    HX = (sized * higher).sum(axis=3)
     La, LX = np.einsum("bck,bk->bc", np.abs(Aa), sigma), np.einsum("bpck,bk->bpc", np.abs(AX), sigma)
     first = np.einsum("bpa,ba->bp", np.abs(np.einsum("bc,bpca->bpa", a0, X * higher)), W)
     first = first + np.einsum("bpa,ba->bp", np.abs(np.einsum("bpc,bca->bpa", X0, a * higher)), W)
@@ -251,5 +274,5 @@ def turned_squared_max(N, W, sigma, radius, turn, enough=None):
         modelled = constant + quadratic_max(g_all, Q_all, sigma[rows], enough_rows)
         bound[rows] = np.fmin(bound[rows], modelled)  # (nan: the other)
     bound = bound * (1 + 1e-12) + 1e-12 * (squared + turn**2 + 2 * b)  # (the rounding of the products)
-    weight = terms + (np.abs(X) * W[:, None, None]).sum(axis=(1, 2)) * size[:, None]
+    weight = terms + sized.sum(axis=(1, 2)) * size[:, None]
     return np.sqrt(size**2 + 2 * b + turn**2), bound, weight

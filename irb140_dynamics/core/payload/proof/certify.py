@@ -348,8 +348,7 @@ class _Group:
         B, d = centre.shape
         g, Q, base = value_model
         pairs = self.levers.shape[1] // 2
-        N = expand(self.levers[owner].reshape(B * 2 * pairs, -1), np.repeat(centre, 2 * pairs, axis=0))
-        N = N.reshape(B, pairs, 2, -1)
+        N = expand(self.levers[owner], centre).reshape(B, pairs, 2, -1)
         models = [squared_model(N[:, p], W, sigma, radius) for p in range(pairs)]
         reached = np.where(self.reached[owner], 1.0, -1.0)  # (a value at the centres: a real one, or below)
         at_centre = sum(m[0] * reached[:, p] for p, m in enumerate(models))
@@ -366,10 +365,13 @@ class _Group:
         bound = constant + quadratic_max(g_all, Q_all, sigma, enough)
         bound = bound + room + 1e-12 * np.abs(bound)
         rows = np.flatnonzero(~(bound <= target))
-        if rows.size:
-            second = base[rows] + quadratic_max(g[rows], Q[rows], sigma[rows]) + self.lever_slack[owner[rows]]
-            for _, squared, g_v, Q_v, _ in models:
-                norm_max = squared[rows] + quadratic_max(2 * g_v[rows], 2 * Q_v[rows], sigma[rows])
+        if rows.size:  # (the value's model and each lever's in one stack)
+            stack_g = np.concatenate([g[rows]] + [2 * m[2][rows] for m in models])
+            stack_Q = np.concatenate([Q[rows]] + [2 * m[3][rows] for m in models])
+            tops = quadratic_max(stack_g, stack_Q, np.tile(sigma[rows], (1 + pairs, 1))).reshape(1 + pairs, -1)
+            second = base[rows] + tops[0] + self.lever_slack[owner[rows]]
+            for (_, squared, _, _, _), top in zip(models, tops[1:]):
+                norm_max = squared[rows] + top
                 second = second + np.sqrt(np.maximum(norm_max, 0.0)) * (1 + 1e-12)
             bound[rows] = np.fmin(bound[rows], second + room[rows] + 1e-12 * np.abs(second))  # (nan: the other)
         return bound, at_centre - 1e-12 * sum(m[0] for m in models), lever_terms
@@ -378,8 +380,8 @@ class _Group:
         """|tau_j| <= |g| |omega_j| over the boxes, |g| |omega_j| at the centres, and the
         joints' weights in it (|omega_j|^2 by its quadratic model, ``bounds.squared_model``)."""
         B, n = centre.shape
-        e, c = self.norm_dims, self.norms.shape[1]
-        N = expand(self.norms[owner].reshape(B * c, -1), np.repeat(centre[:, e], c, axis=0)).reshape(B, c, -1)
+        e = self.norm_dims
+        N = expand(self.norms[owner], centre[:, e])
         W, sigma = sizes(radius[:, e]), sizes_of_s(radius[:, e])
         gravity, slack = self.gravity[owner], self.norm_slack[owner]
         enough = ((target - slack) / gravity) ** 2  # |omega|^2 that would do

@@ -20,13 +20,13 @@ are linear in gravity, so tau_j = g_j . omega_j with g_j the gravity in frame j,
 not depend on theta_j, which is set to 0 (the subchain from link j, by rnea too).
 
 Cost: 3^n torques for tau and about 3^n / 2 for the omegas, each one rnea pass on Interval
-arrays (3^6 = 729 states for six joints). Beyond MAX_JOINTS joints the sums grow too large
+arrays (3^6 = 729 states for six joints), on a grid with an axis per joint: what depends on
+the first joints only is computed once per their values. Beyond MAX_JOINTS joints the sums grow too large
 and ``certify`` falls back to plain interval bounds.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import dataclass
 
@@ -217,38 +217,39 @@ def _forms(links, gravity, sliding) -> StaticForms:
     n = len(links)
     zeros = [0.0] * n
     values = algorithms.rnea(links, _circle_points(n, sliding=sliding), zeros, zeros, gravity)
-    torque = _fit(_stack(values, 3**n), n)
+    torque = _fit(_stack(values, (3,) * n), n)
     omega = []
     for j in range(n):
         rest = n - j - 1
         own = (sliding[j][0],) if sliding[j] is not None else (1.0, 0.0)  # (omega_j does not depend on it)
-        cs = [own] + _circle_points(rest, copies=3, sliding=sliding[j + 1 :])
-        unit_gravity = tuple(Interval(np.repeat(np.eye(3)[axis], 3**rest)) for axis in range(3))
+        cs = [own] + _circle_points(rest, lead=1, sliding=sliding[j + 1 :])
+        unit_gravity = tuple(Interval(np.eye(3)[axis].reshape((3,) + (1,) * rest)) for axis in range(3))
         per_axis = algorithms.rnea(links[j:], cs, zeros[j:], zeros[j:], unit_gravity)[0]
-        lo, hi = bounds_of(per_axis, 3 * 3**rest)
+        lo, hi = bounds_of(per_axis, (3,) * (rest + 1))
         omega.append(_fit(Interval(lo.reshape(3, -1), hi.reshape(3, -1)), rest, first=j + 1))
     norm = math.hypot(*gravity)
     return StaticForms(torque, tuple(omega), float(np.nextafter(norm * (1 + 4e-16), np.inf)), tuple(sliding))
 
 
-def _circle_points(d: int, copies: int = 1, sliding=()) -> list:
-    """(cos, sin) pairs for d joints over the 3^d combinations of theta in {0, pi/2, pi},
-    the first joint slowest; ``copies`` times over; a prismatic joint's (c + r sin theta,)."""
-    digits = np.tile(np.array(list(itertools.product(range(3), repeat=d)), dtype=int), (copies, 1))
+def _circle_points(d: int, lead: int = 0, sliding=()) -> list:
+    """(cos, sin) pairs for d joints at theta in {0, pi/2, pi}, joint k's along axis lead + k
+    of a grid of lead + d axes (the first joint slowest; the arrays broadcast, so that what
+    depends on the first joints only is computed once per their values, the same numbers);
+    a prismatic joint's (c + r sin theta,)."""
     points = []
-    for k, column in enumerate(digits.T):
+    for k in range(d):
+        shape = (1,) * (lead + k) + (3,) + (1,) * (d - k - 1)
         cr = sliding[k] if k < len(sliding) else None
-        points.append(
-            (Interval(_COS[column]), Interval(_SIN[column]))
-            if cr is None
-            else (Interval(_SIN[column]) * cr[1] + cr[0],)
-        )
+        c, s = Interval(_COS.reshape(shape)), Interval(_SIN.reshape(shape))
+        points.append((c, s) if cr is None else (s * cr[1] + cr[0],))
     return points
 
 
-def _stack(values, size: int) -> Interval:
-    bounds = [bounds_of(v, size) for v in values]
-    return Interval(np.array([b[0] for b in bounds]), np.array([b[1] for b in bounds]))
+def _stack(values, shape: tuple) -> Interval:
+    """The sums' values (each over a grid ``shape``, or broadcasting to it) as (len, size) arrays."""
+    bounds = [bounds_of(v, shape) for v in values]
+    lo, hi = np.array([b[0] for b in bounds]), np.array([b[1] for b in bounds])
+    return Interval(lo.reshape(len(values), -1), hi.reshape(len(values), -1))
 
 
 def _fit(values: Interval, d: int, first: int = 0) -> HarmonicSum:
@@ -257,10 +258,13 @@ def _fit(values: Interval, d: int, first: int = 0) -> HarmonicSum:
     shape = lead + (3,) * d
     c = Interval(values.lo.reshape(shape), values.hi.reshape(shape))
     for axis in range(len(lead), len(shape)):
-        f0, f1, f2 = (Interval(np.take(c.lo, i, axis), np.take(c.hi, i, axis)) for i in range(3))
+        at = [(slice(None),) * axis + (i,) for i in range(3)]  # (views, not copies)
+        f0, f1, f2 = (Interval(c.lo[i], c.hi[i]) for i in at)
         A, B = (f0 + f2) * 0.5, (f0 - f2) * 0.5
         C = f1 - A
-        c = Interval(np.stack([A.lo, B.lo, C.lo], axis), np.stack([A.hi, B.hi, C.hi], axis))
+        c = Interval(np.empty(shape), np.empty(shape))
+        for i, part in zip(at, (A, B, C)):
+            c.lo[i], c.hi[i] = part.lo, part.hi
     flat = lead + (3**d,)
     return HarmonicSum(tuple(range(first, first + d)), Interval(c.lo.reshape(flat), c.hi.reshape(flat)))
 
