@@ -119,11 +119,24 @@ def _chain_refusal(chain_for: str, arm) -> str:
             "or at --hold JOINT=VALUE)"
         )
     name, leader = next((j.name, m.joint) for j, m in zip(model.joints, model.mimics) if m is not None)
-    return (
-        f"{chain_for} takes one serial chain without mimic joints, but in {shown(arm.origin)} {name!r} follows "
-        f"{leader!r}: end the chain above {leader!r} (--tip, the link it hangs from) and hold it there "
-        f"(--hold {leader}=VALUE)"
-    )
+    return _mimic_refusal(chain_for, name, leader)
+
+
+def _mimic_refusal(chain_for: str, name: str, leader: str) -> str:
+    """'X' follows 'Y': end above Y and hold it, the advice whole in the error line: the
+    names cut to the room left by the --hold hint (which names Y whole)."""
+    from irb140_dynamics.core.errors import LINE_LIMIT
+    from irb140_dynamics.core.io.urdf.tree import clipped
+
+    def text(follower: str, followed: str) -> str:
+        return (
+            f"{chain_for} takes a chain without mimic joints: {follower} follows {followed}; end the chain above "
+            f"{followed} (--tip LINK) and hold it (--hold {leader}=VALUE)"
+        )
+
+    room = LINE_LIMIT - len(f"{chain_for.split()[0]}: error: ") - len(text("", ""))
+    each = max(12, room // 3)
+    return text(clipped(repr(name), each), clipped(repr(leader), each))
 
 
 def _unknown_text(unknown, overrides: dict, params_file) -> str:

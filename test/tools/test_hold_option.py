@@ -62,7 +62,16 @@ def test_a_chain_whose_joint_a_gripper_follows_says_where_to_end_it(tmp_path, ca
     hold; ending there (ra1), the fingers follow the r2 held."""
     status, out, err = run_check(capsys, tmp_path, "--tip", "ra2", text=TWO_ARMS, mass="1")
     assert (status, out, err.count("\n")) == (2, "", 1), err  # bad input to a check: 2 (1 is its answer: outside)
-    assert "takes one serial chain without mimic joints" in err and "'finger_b' follows 'r2'" in err
-    assert "end the chain above 'r2' (--tip, the link it hangs from) and hold it there (--hold r2=VALUE)" in err
+    assert "takes a chain without mimic joints: 'finger_b' follows 'r2'" in err
+    assert err.rstrip().endswith("end the chain above 'r2' (--tip LINK) and hold it (--hold r2=VALUE)"), err
     status, out, err = run_check(capsys, tmp_path, "--tip", "ra1", "--hold", "r2=0.3", text=TWO_ARMS, mass="1")
     assert status == 0 and "inside" in out, (out, err)
+
+
+def test_the_advice_to_end_the_chain_is_whole_for_long_joint_names(tmp_path, capsys):
+    """Long names (vendors' grippers) are cut where they are named, never the advice."""
+    leader, follower = "gripper_left_finger_joint_" + "x" * 40, "gripper_left_outer_finger_left_joint_" + "y" * 40
+    text = TWO_ARMS.replace('"r2"', f'"{leader}"').replace('"finger_b"', f'"{follower}"')
+    status, out, err = run_check(capsys, tmp_path, "--tip", "ra2", text=text, mass="1")
+    assert status == 2 and err.count("\n") == 1 and len(err) < 300, err
+    assert err.rstrip().endswith(f"(--tip LINK) and hold it (--hold {leader}=VALUE)"), err
