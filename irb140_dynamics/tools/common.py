@@ -91,7 +91,7 @@ def arm_of(args: argparse.Namespace, chain_for: str | None = None):
             hold=getattr(args, "hold", None) or (),
         )
     except HeldPositionError as error:  # a bad argument: exit status 2
-        raise BadArgument(one_line(error)) from None
+        raise BadArgument(in_option_words(one_line(error))) from None
     except ValueError as error:
         raise ToolError(in_option_words(one_line(error), params_file, args.base, args.tip, dict(overrides))) from None
     known = known_parameter_names(arm.model.joint_names, from_urdf=arm.urdf is not None)
@@ -173,7 +173,8 @@ _CHAIN_END = re.compile(r"URDF (base|tip)_link(?=:)|(?<=below )(base|tip)_link(?
 def in_option_words(message: str, params_file=None, base=None, tip=None, overrides=None) -> str:
     """A model error in a tool's words: the URDF chain's ends are its --base and --tip
     options (the core names them base_link and tip_link, as the nodes' model.base_link and
-    model.tip_link); model.<end>_link where only the params file (or -p) named that end."""
+    model.tip_link); model.<end>_link where only the params file (or -p) named that end. A
+    URDF wanted is --urdf (the core names the nodes' model.urdf_file)."""
     named = dict(overrides or {})
     if params_file:
         from irb140_dynamics.core.io.params_file import read_parameter_file
@@ -186,7 +187,9 @@ def in_option_words(message: str, params_file=None, base=None, tip=None, overrid
         end = next(group for group in match.groups() if group)
         return f"model.{end}_link" if given[end] is None and named.get(f"model.{end}_link") else f"--{end}"
 
-    return _CHAIN_END.sub(option, message)
+    from irb140_dynamics.core.io.arm_source import GIVE_A_URDF
+
+    return _CHAIN_END.sub(option, message).replace(GIVE_A_URDF, "give --urdf, or model.source: robot_description")
 
 
 def model_inputs(args: argparse.Namespace) -> list[tuple[str, Path]]:

@@ -51,6 +51,9 @@ def test_holding_without_a_urdf_or_a_joint_a_chain_lacks_is_refused(tmp_path, ca
     status = load_diagram.main(["--check", "1", "0", "0", "--hold", "joint_1=0.1"])
     _, err = capsys.readouterr()
     assert status == 2 and "--hold holds joints of a URDF: give --urdf" in err and err.count("\n") == 1
+    status = load_diagram.main(["--check", "1", "0", "0", "-p", "model.held_positions:=[joint_1=0.1]"])
+    _, err = capsys.readouterr()  # the core's line (a node's words: model.urdf_file) in the tool's
+    assert status == 2 and "model.held_positions holds joints of a URDF: give --urdf, or model.source" in err, err
     chain = (URDF_DATA / "ur5.urdf").read_text()  # one chain: nothing off it to hold
     status, out, err = run_check(capsys, tmp_path, "--hold", "elbow_jont=0.1", text=chain, mass="1")
     assert status == 2 and "--hold elbow_jont=0.1: the URDF has no joint 'elbow_jont'; did you mean elbow_joint?" in err
