@@ -8,6 +8,7 @@ and acted on here, when ``run`` begins.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import signal
@@ -252,6 +253,25 @@ def threading_is_not_main() -> bool:
     import threading
 
     return threading.current_thread() is not threading.main_thread()
+
+
+@contextlib.contextmanager
+def errors_as_bad_input():
+    """Within it, an error (a ToolError, bad input, a defect of ours) exits with status 2:
+    for a tool whose status 1 is an answer (load_diagram --check: outside). Ctrl-C and a
+    closed standard output keep theirs."""
+    try:
+        yield
+    except ToolError as error:
+        error.status = 2
+        raise
+    except BrokenPipeError:
+        raise
+    except Exception as error:
+        if os.environ.get("IRB140_TRACEBACK"):  # for the developers
+            raise
+        known = isinstance(error, (ValueError, OSError, ArithmeticError, MemoryError, RecursionError))
+        raise BadArgument(_describe(error) if known else f"internal error: {type(error).__name__}: {error}") from None
 
 
 def run(tool: str, body: Callable[[Interrupts], int]) -> int:

@@ -91,7 +91,7 @@ def arm_of(args: argparse.Namespace, chain_for: str | None = None):
             hold=getattr(args, "hold", None) or (),
         )
     except HeldPositionError as error:  # a bad argument: exit status 2
-        raise BadArgument(one_line(error)) from None
+        raise BadArgument(in_option_words(one_line(error))) from None
     except ValueError as error:
         raise ToolError(in_option_words(one_line(error), params_file, args.base, args.tip, dict(overrides))) from None
     known = known_parameter_names(arm.model.joint_names, from_urdf=arm.urdf is not None)
@@ -119,11 +119,24 @@ def _chain_refusal(chain_for: str, arm) -> str:
             "or at --hold JOINT=VALUE)"
         )
     name, leader = next((j.name, m.joint) for j, m in zip(model.joints, model.mimics) if m is not None)
-    return (
-        f"{chain_for} takes one serial chain without mimic joints, but in {shown(arm.origin)} {name!r} follows "
-        f"{leader!r}: end the chain above {leader!r} (--tip, the link it hangs from) and hold it there "
-        f"(--hold {leader}=VALUE)"
-    )
+    return _mimic_refusal(chain_for, name, leader)
+
+
+def _mimic_refusal(chain_for: str, name: str, leader: str) -> str:
+    """'X' follows 'Y': end above Y and hold it, the advice whole in the error line: the
+    names cut to the room left by the --hold hint (which names Y whole)."""
+    from irb140_dynamics.core.errors import LINE_LIMIT
+    from irb140_dynamics.core.io.urdf.tree import clipped
+
+    def text(follower: str, followed: str) -> str:
+        return (
+            f"{chain_for} takes a chain without mimic joints: {follower} follows {followed}; end the chain above "
+            f"{followed} (--tip LINK) and hold it (--hold {leader}=VALUE)"
+        )
+
+    room = LINE_LIMIT - len(f"{chain_for.split()[0]}: error: ") - len(text("", ""))
+    each = max(12, room // 3)
+    return text(clipped(repr(name), each), clipped(repr(leader), each))
 
 
 def _unknown_text(unknown, overrides: dict, params_file) -> str:
@@ -160,7 +173,8 @@ _CHAIN_END = re.compile(r"URDF (base|tip)_link(?=:)|(?<=below )(base|tip)_link(?
 def in_option_words(message: str, params_file=None, base=None, tip=None, overrides=None) -> str:
     """A model error in a tool's words: the URDF chain's ends are its --base and --tip
     options (the core names them base_link and tip_link, as the nodes' model.base_link and
-    model.tip_link); model.<end>_link where only the params file (or -p) named that end."""
+    model.tip_link); model.<end>_link where only the params file (or -p) named that end. A
+    URDF wanted is --urdf (the core names the nodes' model.urdf_file)."""
     named = dict(overrides or {})
     if params_file:
         from irb140_dynamics.core.io.params_file import read_parameter_file
@@ -173,7 +187,9 @@ def in_option_words(message: str, params_file=None, base=None, tip=None, overrid
         end = next(group for group in match.groups() if group)
         return f"model.{end}_link" if given[end] is None and named.get(f"model.{end}_link") else f"--{end}"
 
-    return _CHAIN_END.sub(option, message)
+    from irb140_dynamics.core.io.arm_source import GIVE_A_URDF
+
+    return _CHAIN_END.sub(option, message).replace(GIVE_A_URDF, "give --urdf, or model.source: robot_description")
 
 
 def model_inputs(args: argparse.Namespace) -> list[tuple[str, Path]]:

@@ -12,7 +12,7 @@ Derived by running the package's own recursions on symbols (irb140_dynamics.core
 FORM: latex, sympy, c or python. --what defaults to tau,M,C,g (C: the torques C(q, qd) qd);
 dtau, qdd, dqdd and Minv (the derivatives, the forward dynamics, M^-1) are written in the C
 form of a model with numbers. --out may exist: the tool's files in it are replaced, nothing
-else is touched; on any error nothing is written there.
+else is touched; on any error nothing is written there (and no folder made).
 """
 
 from __future__ import annotations
@@ -25,9 +25,7 @@ if __name__ == "__main__":  # python -m: the entry first, before the heavy impor
 import argparse
 import os
 import re
-import shutil
 import sys
-import tempfile
 import threading
 import time
 from dataclasses import replace
@@ -36,11 +34,11 @@ from pathlib import Path
 from ..core import RigidBody
 from ..core.equations import DEFAULT_QUANTITIES, FORMS, QUANTITIES, file_names, generate
 from ..core.errors import one_line
-from ..core.io.atomic import replace_all
 from ..package_files import default_config_path
-from .cli import ToolError, check_model_paths, refuse_input_as_output, run
+from .cli import ToolError, check_model_paths, files_in, output_directory, refuse_input_as_output, run
 from .common import add_model_arguments, model_inputs
 from .common import arm_of as _arm_of
+from .outputs import Outputs
 
 NAME = "equations"
 QUIET_SECONDS = 2.0  # a progress line on stderr once the work takes longer than this
@@ -70,10 +68,10 @@ def parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    return run(NAME, lambda interrupts: _main(sys.argv[1:] if argv is None else argv))
+    return run(NAME, lambda interrupts: _main(sys.argv[1:] if argv is None else argv, interrupts))
 
 
-def _main(argv: list[str]) -> int:
+def _main(argv: list[str], interrupts) -> int:
     args = parser().parse_args(argv)
     if args.form not in FORMS:
         raise ToolError(f"unknown form {args.form!r}: choose from {', '.join(FORMS)}")
@@ -89,23 +87,16 @@ def _main(argv: list[str]) -> int:
     prefix = args.prefix or _identifier(path.stem)
     if not prefix.isidentifier() or not prefix.isascii():
         raise ToolError(f"--prefix {prefix!r} is not a C identifier")
-    out = Path(args.out)
-    written = [(str(out / name), Path(os.path.abspath(out / name))) for name in file_names((args.form,), prefix)]
-    refuse_input_as_output(model_inputs(args), written)
-    staging = _staging_folder(out)
-    try:
-        with _Progress() as progress:
-            files = generate(model, (args.form,), what, args.symbolic_parameters, prefix, path.name, progress)
+    out = output_directory(args.out)  # checked before any work, made only with the files
+    refuse_input_as_output(model_inputs(args), files_in(out, args.out, file_names((args.form,), prefix)))
+    with _Progress() as progress:
+        files = generate(model, (args.form,), what, args.symbolic_parameters, prefix, path.name, progress)
+    with Outputs(interrupts) as outputs:  # all or none; no folder left behind
+        outputs.directory(out, args.out)
         for name, text in files.items():
-            _write_synced(staging / name, text)
-        try:  # all or none
-            replace_all((staging / name, out / name) for name in files)
-        except OSError as error:
-            raise ToolError(f"{error.filename}: cannot write ({error.strerror or error}); nothing written") from None
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
-    for name in files:
-        print(out / name)
+            outputs.text(out / name, os.path.normpath(os.path.join(args.out, name)), text)
+        for typed in outputs.commit():
+            print(typed)
     return 0
 
 
@@ -124,22 +115,6 @@ def arm_of(args: argparse.Namespace):
 def _identifier(stem: str) -> str:
     name = re.sub(r"\W", "_", stem.lower())
     return name if name[:1].isalpha() else f"robot_{name}"
-
-
-def _staging_folder(out: Path) -> Path:
-    """A temporary folder in ``out`` (created if absent): files are written there, then moved."""
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        return Path(tempfile.mkdtemp(prefix=".equations-", dir=out))
-    except OSError as error:
-        raise ToolError(f"--out {out}: cannot write there ({error.strerror or error})") from None
-
-
-def _write_synced(path: Path, text: str) -> None:
-    with open(path, "w", encoding="utf-8", newline="\n") as stream:
-        stream.write(text)
-        stream.flush()
-        os.fsync(stream.fileno())
 
 
 class _Progress:

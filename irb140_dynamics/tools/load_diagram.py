@@ -18,8 +18,8 @@ Meanwhile its progress on stderr: a bar with the points done and the time left o
 terminal, else a line per 10 %.
 The grid has at most 20,000 points (MAX_POINTS): a step that needs more is refused from
 its size alone, before any work, naming --step.
-Exit status 0; 1 with one line (a bad file, nothing written); 2 for a bad argument; 130
-after Ctrl-C.
+Exit status 0; 1 with one line (a bad file, nothing written); 2 for a bad argument; with
+--check 0 inside, 1 outside (or not proven), 2 for any bad input or file; 130 after Ctrl-C.
 """
 
 from __future__ import annotations
@@ -37,6 +37,7 @@ from irb140_dynamics.tools.cli import (
     Parser,
     ToolError,
     check_model_paths,
+    errors_as_bad_input,
     files_in,
     number,
     output_directory,
@@ -71,7 +72,7 @@ def parser() -> Parser:
         type=number(),
         metavar=("MASS", "Z", "L"),
         help="only say whether a tool of MASS kg with its CoM at Z, L [m] is inside the proven diagram "
-        "(exit 0) or not (1), with the margin and the limiting joint; --out is then not needed",
+        "(exit 0) or not (1), with the margin and the limiting joint (bad input: 2); --out is then not needed",
     )
     return p
 
@@ -105,6 +106,14 @@ def main(argv: list[str] | None = None) -> int:
 def _diagram(argv: list[str], interrupts) -> int:
     arguments = parser()
     args = arguments.parse_args(argv)
+    if args.check is None:
+        return _answer(arguments, args, interrupts)
+    with errors_as_bad_input():  # status 1 is the check's answer: outside
+        return _answer(arguments, args, interrupts)
+
+
+def _answer(arguments: Parser, args, interrupts) -> int:
+    """The diagram written, or the --check answered (``args`` parsed by ``arguments``)."""
     sizes = grid_size(args.z_max, args.step), grid_size(args.l_max, args.step)
     if sizes[0] * sizes[1] > MAX_POINTS:  # a bad argument, refused before any work: a tiny step costs nothing
         shown = " x ".join(f"{s:.0f}" if math.isfinite(s) else "too many" for s in sizes)

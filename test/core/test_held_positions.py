@@ -211,3 +211,13 @@ def test_a_mimic_of_a_mimic_off_the_chain_follows_the_chains_joint_and_one_above
     below_up = text.replace('<parent link="root"/><child link="a"/>', '<parent link="e"/><child link="a"/>')
     with pytest.raises(UrdfError, match=r'^URDF joint "up": a mimic joint above base_link \'e\' following \'j2\''):
         load_urdf(below_up, base_link="e", tip_link="b")
+
+
+def test_names_of_a_urdf_on_an_arm_of_parameters_are_refused_in_a_nodes_words():
+    """A node has no --urdf: read_arm (what nodes and tools share) names model.urdf_file; the
+    tools' words are their own (test/tools/test_hold_option.py: give --urdf)."""
+    for values in ({"model.held_positions": ["joint_2=0.1"]}, {"payload.link": "link_3"}):
+        with pytest.raises(ValueError) as refused:
+            read_arm(values)
+        assert "model.source: robot_description with model.urdf_file" in str(refused.value)
+        assert "--urdf" not in str(refused.value)

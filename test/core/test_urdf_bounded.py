@@ -60,6 +60,7 @@ def test_a_10000_link_chain_loads_without_recursion():
 def test_more_moving_joints_than_the_limit_are_refused_in_one_line():
     line = refusal(long_chain(10_000, 1))
     assert f"10000 moving joints from 'l0' to 'l10000', more than the limit of {MAX_JOINTS}" in line
+    assert "max_joints" not in line and "load part of it" in line  # the limit and what to do, no argument name
     assert load_urdf(long_chain(120, 1), max_joints=120).model.n == 120
 
 

@@ -33,10 +33,9 @@ from irb140_dynamics.core.urdf import load_urdf
 from irb140_dynamics.identification.base import find_base_parameters
 
 from ..support.common import full_sweep
-from ..support.pinocchio_trees import corpus_files, worst_error
+from ..support.pinocchio_trees import corpus_files, pinocchio_of, reference, worst_error
 
 RTOL = 1e-9
-MAX_JOINTS = 128  # TIAGo++ with its hands has 101 moving joints, beyond load_urdf's default
 QUICK_FILES = 6  # compared in the suite (seeded), besides the mimic ones
 # refusals a whole file may get, each one line: no moving joint at all, a mimic joint of a
 # joint the file does not have (alex_psyonic_hands), not a URDF (ur3.urdf is a xacro stub)
@@ -53,7 +52,7 @@ def test_every_tree_of_example_robot_data_agrees_with_pinocchio():
     for path in FILES:
         text = Path(path).read_text()
         try:
-            loaded.append((path, text, load_urdf(text, max_joints=MAX_JOINTS).model))
+            loaded.append((path, text, load_urdf(text).model))
         except ModelError as refusal:
             assert "\n" not in str(refusal) and any(reason in str(refusal) for reason in REFUSALS), (path, refusal)
             refused.append(path)
@@ -67,6 +66,22 @@ def test_every_tree_of_example_robot_data_agrees_with_pinocchio():
         chosen += [min(with_mimics, key=lambda entry: len(entry[2].joints))]  # the Panda: a tree with a mimic
     errors = {path.split("/robots/")[-1]: worst_error(text, model, rng, states=1) for path, text, model in chosen}
     assert all(error <= RTOL for error in errors.values()), errors
+
+
+TIAGO_DUAL = [path for path in FILES if path.endswith("/tiago_dual.urdf")]
+
+
+@pytest.mark.skipif(not TIAGO_DUAL, reason="example-robot-data is not installed")
+def test_tiago_dual_loads_whole_with_its_101_joints_and_its_gravity_is_pinocchios():
+    text = Path(TIAGO_DUAL[0]).read_text()
+    loaded = load_urdf(text)  # the whole robot: base, torso, two arms, two hands, head
+    model = loaded.model
+    assert model.n == 101 and loaded.held_joints == ()
+    q = np.random.default_rng(101).uniform(-1.5, 1.5, model.n)
+    full, follows = pinocchio_of(text, model.mimics is not None)
+    zero = np.zeros(model.n)
+    _, g, _ = reference(full, follows, model, q, zero, zero, loaded.held_positions)
+    assert np.max(np.abs(gravity(model, q) - g)) <= RTOL * np.max(np.abs(g))
 
 
 LIMIT = '<limit lower="-2" upper="2" effort="10" velocity="1"/>'

@@ -26,6 +26,7 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 
+from irb140_dynamics.core.urdf import MAX_JOINTS
 from irb140_dynamics.nodes.id_node.node import IdNode
 from irb140_dynamics.ros.parameters.arm import DESCRIPTION_QOS
 from irb140_dynamics.ros.runtime.spin import spin
@@ -176,7 +177,7 @@ def test_no_joint_state_goes_unanswered_while_a_urdf_is_refused_or_swapped_in():
         assert {probe.answered[stamp] for stamp in during_refusal} == {tuple(UR5_JOINTS)}  # the model before
         assert probe.answered[probe.sent[-1]] == tuple(PANDA_JOINTS)
         refusal = next(line for line in probe.log if "refused a robot_description" in line)
-        assert "keeping the model of 6 joints" in refusal and "more than the limit of 100" in refusal, refusal
+        assert "keeping the model of 6 joints" in refusal and f"more than the limit of {MAX_JOINTS}" in refusal, refusal
     finally:
         probe.streaming.clear()
         rclpy.try_shutdown(context=context)

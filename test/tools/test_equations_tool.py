@@ -87,11 +87,29 @@ def test_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys, args, reason
     assert not out.exists()
 
 
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["--urdf", "{two_arms}", "--form", "sympy", "--what", "regressor", "--symbolic-parameters"],
+        ["--params-file", CONFIG, "--form", "latex", "--what", "dtau"],
+    ],
+    ids=["symbolic parameters with mimic joints", "dtau not in C"],
+)
+def test_a_refused_generation_leaves_no_out_folder(tmp_path, capsys, args):
+    from ..core.test_urdf_trees import TWO_ARMS
+
+    (tmp_path / "two_arms.urdf").write_text(TWO_ARMS)
+    args = [str(tmp_path / "two_arms.urdf") if a == "{two_arms}" else a for a in args]
+    status, printed, err = run(capsys, *args, "--out", tmp_path / "new" / "out")
+    assert status == 1 and printed == "" and err.count("\n") == 1, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["two_arms.urdf"]  # no out, nor its parent
+
+
 def test_unwritable_out_is_one_line(tmp_path, capsys):
     blocker = tmp_path / "a_file"
     blocker.write_text("")
     status, _, err = run(capsys, "--params-file", CONFIG, "--form", "c", "--out", blocker / "gen")
-    assert status != 0 and err.count("\n") == 1 and "cannot write there" in err, err
+    assert status != 0 and err.count("\n") == 1 and "a_file is not a directory" in err, err
 
 
 def test_a_failure_while_generating_writes_nothing(tmp_path, capsys, monkeypatch):

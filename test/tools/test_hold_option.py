@@ -51,6 +51,9 @@ def test_holding_without_a_urdf_or_a_joint_a_chain_lacks_is_refused(tmp_path, ca
     status = load_diagram.main(["--check", "1", "0", "0", "--hold", "joint_1=0.1"])
     _, err = capsys.readouterr()
     assert status == 2 and "--hold holds joints of a URDF: give --urdf" in err and err.count("\n") == 1
+    status = load_diagram.main(["--check", "1", "0", "0", "-p", "model.held_positions:=[joint_1=0.1]"])
+    _, err = capsys.readouterr()  # the core's line (a node's words: model.urdf_file) in the tool's
+    assert status == 2 and "model.held_positions holds joints of a URDF: give --urdf, or model.source" in err, err
     chain = (URDF_DATA / "ur5.urdf").read_text()  # one chain: nothing off it to hold
     status, out, err = run_check(capsys, tmp_path, "--hold", "elbow_jont=0.1", text=chain, mass="1")
     assert status == 2 and "--hold elbow_jont=0.1: the URDF has no joint 'elbow_jont'; did you mean elbow_joint?" in err
@@ -61,8 +64,17 @@ def test_a_chain_whose_joint_a_gripper_follows_says_where_to_end_it(tmp_path, ca
     load diagram takes a chain without them and says so, naming the joint to end above and
     hold; ending there (ra1), the fingers follow the r2 held."""
     status, out, err = run_check(capsys, tmp_path, "--tip", "ra2", text=TWO_ARMS, mass="1")
-    assert (status, out, err.count("\n")) == (1, "", 1), err
-    assert "takes one serial chain without mimic joints" in err and "'finger_b' follows 'r2'" in err
-    assert "end the chain above 'r2' (--tip, the link it hangs from) and hold it there (--hold r2=VALUE)" in err
+    assert (status, out, err.count("\n")) == (2, "", 1), err  # bad input to a check: 2 (1 is its answer: outside)
+    assert "takes a chain without mimic joints: 'finger_b' follows 'r2'" in err
+    assert err.rstrip().endswith("end the chain above 'r2' (--tip LINK) and hold it (--hold r2=VALUE)"), err
     status, out, err = run_check(capsys, tmp_path, "--tip", "ra1", "--hold", "r2=0.3", text=TWO_ARMS, mass="1")
     assert status == 0 and "inside" in out, (out, err)
+
+
+def test_the_advice_to_end_the_chain_is_whole_for_long_joint_names(tmp_path, capsys):
+    """Long names (vendors' grippers) are cut where they are named, never the advice."""
+    leader, follower = "gripper_left_finger_joint_" + "x" * 40, "gripper_left_outer_finger_left_joint_" + "y" * 40
+    text = TWO_ARMS.replace('"r2"', f'"{leader}"').replace('"finger_b"', f'"{follower}"')
+    status, out, err = run_check(capsys, tmp_path, "--tip", "ra2", text=text, mass="1")
+    assert status == 2 and err.count("\n") == 1 and len(err) < 300, err
+    assert err.rstrip().endswith(f"(--tip LINK) and hold it (--hold {leader}=VALUE)"), err

@@ -83,6 +83,22 @@ def test_a_bad_check_is_a_bad_argument(capsys, arguments, says):
     assert err.count("\n") == 1 and says in err, err
 
 
+@pytest.mark.parametrize(
+    "arguments, says",
+    [
+        (["--urdf", str(URDF_DATA / "ur5.urdf"), "--tip", "nosuchlink"], "nosuchlink"),
+        (["--params-file", "missing.yaml"], "missing.yaml: no such file or directory"),
+        (["--urdf", "bad.urdf"], "bad.urdf"),
+    ],
+)
+def test_bad_input_to_a_check_exits_2_not_the_answer_outside(tmp_path, capsys, monkeypatch, arguments, says):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "bad.urdf").write_text("<robot name='x'><link name='a'/>")
+    assert main([*arguments, "--check", "1", "0.1", "0.05"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and says in err and "Traceback" not in err, err
+
+
 def test_the_rated_payload_is_the_arms_own():
     """--rated-mass over rated_payload.mass over nothing stated (the limits then derived
     from the nodes' default, 6 kg at the flange, and no curve marked)."""

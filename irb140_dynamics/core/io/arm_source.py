@@ -50,6 +50,9 @@ from irb140_dynamics.core.model.rigid_body import finite_numbers
 from irb140_dynamics.core.model.robot_model import JOINT_DRIVE_FIELDS, RobotModel
 
 SOURCES = ("parameters", "robot_description")
+# what an arm of parameters lacks for a URDF's names, in the nodes' words (the tools' "give --urdf, ..."
+# in tools.common.in_option_words)
+GIVE_A_URDF = "give model.source: robot_description with model.urdf_file"
 DEFAULT_ROBOT_NAME = "irb140"  # model.name when none is given (the nodes' default too)
 URDF_ROBOT_NAME = "robot"  # a URDF's name when its <robot> has none
 ARM_PARAMETERS = ("gravity", "friction.smoothing_velocity", "payload.mass", "payload.com", "payload.inertia")
@@ -150,9 +153,9 @@ def read_arm(
                          tip_link or values.get("model.tip_link") or None, origin, hold)  # fmt: skip
     held = "--hold" if hold else HELD if values.get(HELD) else None
     if held:
-        raise HeldPositionError(f"{held} holds joints of a URDF: give --urdf, or model.source: robot_description")
+        raise HeldPositionError(f"{held} holds joints of a URDF: {GIVE_A_URDF}")
     if values.get("payload.link"):
-        raise ValueError("payload.link names a URDF link: give --urdf, or model.source: robot_description")
+        raise ValueError(f"payload.link names a URDF link: {GIVE_A_URDF}")
     if base_link or tip_link:
         raise ValueError(
             "--base and --tip choose a URDF's chain: give --urdf, or a parameter file with "

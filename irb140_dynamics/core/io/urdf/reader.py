@@ -69,7 +69,9 @@ from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, combine
 from irb140_dynamics.core.model.robot_model import Mimic, RobotModel
 
 CONTINUOUS_LIMITS = (-4 * math.pi, 4 * math.pi)  # rad: two turns either way, every angle within
-MAX_JOINTS = 100  # moving joints in a chain at most (the longest public arms and legs have 10)
+MAX_JOINTS = 256  # moving joints of a chain or tree at most: TIAGo++ whole has 101; the kernels' trace
+# grows with n (a 101-joint tree: M traced in 0.2 s) and M's with a chain's depth squared (a
+# 256-joint chain: about 18 s), so a larger model would stall the first call
 GRAVITY = 9.81  # m/s^2, along the root link's -z
 
 
@@ -144,9 +146,7 @@ def load_urdf(
     if not moving:
         raise UrdfError("chain", f"no revolute, continuous or prismatic joint {span}")
     if len(moving) > max_joints:
-        raise UrdfError(
-            "chain", f"{len(moving)} moving joints {span}, more than the limit of {max_joints} (max_joints)"
-        )
+        raise UrdfError("chain", f"{len(moving)} moving joints {span}, {_beyond(max_joints)}")
     mimics = mimics_of(moving)
     follows = chain_followers(tree, moving, mimics)
     refuse_followers_above(tree, base, follows)
@@ -355,6 +355,14 @@ def _joint(joint: UrdfJoint, origin: Placement, body: RigidBody, physical: bool)
     )
 
 
+def _beyond(max_joints: int) -> str:
+    """Why a model of more than ``max_joints`` moving joints is refused, for the one-line error."""
+    return (
+        f"more than the limit of {max_joints} (the generated dynamics grow with the joints): "
+        "load part of it, from a lower base link or to a tip link"
+    )
+
+
 def _load_tree(tree: UrdfTree, base: str, max_joints: int, held: dict[str, float]) -> LoadedUrdf:
     """The whole tree below ``base`` as a LoadedUrdf (see ``whole_tree``)."""
     moving, parents, origins = moving_joints(tree, base)
@@ -362,9 +370,7 @@ def _load_tree(tree: UrdfTree, base: str, max_joints: int, held: dict[str, float
     if not moving:
         raise UrdfError("tree", f"no revolute, continuous or prismatic joint {where}")
     if len(moving) > max_joints:
-        raise UrdfError(
-            "tree", f"{len(moving)} moving joints {where}, more than the limit of {max_joints} (max_joints)"
-        )
+        raise UrdfError("tree", f"{len(moving)} moving joints {where}, {_beyond(max_joints)}")
     stops = {joint.name for joint in moving}
     at_limit: list[str] = []
     positions = held_positions(tree, stops, held, at_limit)  # only joints above base_link (or not below it) are held
