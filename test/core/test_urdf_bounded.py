@@ -66,7 +66,9 @@ def test_more_moving_joints_than_the_limit_are_refused_in_one_line():
 
 def test_text_over_the_size_limit_is_refused_before_parsing():
     text = SEED_TEXT + " " * 1000
-    assert "more than the limit of 1000 (max_chars)" in refusal(text, max_chars=1000)
+    assert "more than the limit of 1000 (the environment's IRB140_MAX_FILE_BYTES sets it)" in refusal(
+        text, max_chars=1000
+    )
     assert "more than the limit" in refusal("<" * 10, max_chars=5)  # not parsed: no XML error
 
 

@@ -151,7 +151,10 @@ def checked_text(text, max_chars: int | None = None) -> str:
     if not isinstance(text, str):
         raise UrdfError("document", f"expected text, got {type(text).__name__}")
     if len(text) > max_chars:
-        raise UrdfError("document", f"{len(text)} characters, more than the limit of {max_chars} (max_chars)")
+        raise UrdfError(
+            "document",
+            f"{len(text)} characters, more than the limit of {max_chars} (the environment's IRB140_MAX_FILE_BYTES sets it)",
+        )
     for start in range(0, len(text), PARSE_CHUNK):  # in chunks, as the parse (see _parsed)
         binary = _CONTROL.search(text, start, start + PARSE_CHUNK)
         if binary:
