@@ -281,11 +281,11 @@ def clear_legend(axes, rect=(0.0, 0.0, 1.0, 1.0), **style):
     """The legend of ``axes`` at the first of PLACES where it covers no data (matplotlib's
     "best" only picks the place that covers least), else beside the axes, on the right, the
     figure laid out again (``fit_text`` with ``rect``). Call after the layout: the places
-    are judged in pixels: the figure is drawn once, each place's legend found where its own
-    drawing puts it, without drawing the figure again."""
+    are judged in pixels: the figure is drawn once (unless nothing changed since its last
+    drawing), each place's legend found where its own drawing puts it, without drawing the
+    figure again."""
     figure = axes.figure
-    figure.draw_without_rendering()
-    renderer = figure.canvas.get_renderer()
+    renderer = _drawn(figure)
     for place in PLACES:
         legend = axes.legend(loc=place, **style)
         if not _over_data(legend, figure, renderer):
@@ -293,6 +293,15 @@ def clear_legend(axes, rect=(0.0, 0.0, 1.0, 1.0), **style):
     legend = axes.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), **style)
     fit_text(figure, rect)
     return legend
+
+
+def _drawn(figure):
+    """The figure's renderer, the figure drawn as it stands: drawn now unless matplotlib
+    marks nothing changed since its last drawing (``stale``, what interactive backends
+    redraw by)."""
+    if figure.stale:
+        figure.draw_without_rendering()
+    return figure.canvas.get_renderer()
 
 
 def _data_of(axes) -> list:
