@@ -75,9 +75,11 @@ def _wrap(text, extent, width: float) -> bool:
     return True
 
 
-def texts_outside(figure) -> list[str]:
-    """The texts (visible, not empty) whose tight bounding box is not inside the figure."""
-    figure.draw_without_rendering()
+def texts_outside(figure, drawn: bool = False) -> list[str]:
+    """The texts (visible, not empty) whose tight bounding box is not inside the figure
+    (``drawn``: the figure is drawn as it stands, no need to draw it again)."""
+    if not drawn:
+        figure.draw_without_rendering()
     renderer = figure.canvas.get_renderer()
     box, slack = figure.bbox, 0.5  # pixels: rounding
     outside = []
@@ -116,7 +118,7 @@ def figure_problems(figure, dpi=None) -> list[str]:
     titles = [figure.get_suptitle()] + [a.get_title(loc) for a in figure.axes for loc in ("left", "center", "right")]
     if not any(t.strip() for t in titles):
         problems.append("no title")
-    problems += [f"outside the figure: {t!r}" for t in texts_outside(figure)]
+    problems += [f"outside the figure: {t!r}" for t in texts_outside(figure, drawn=True)]
     from matplotlib.text import Text
 
     boxes = [(t, Text.get_window_extent(t, renderer)) for t in texts]  # (an annotation's text, not its arrow)
@@ -131,7 +133,7 @@ def figure_problems(figure, dpi=None) -> list[str]:
             if wide > OVERLAP and high > OVERLAP:
                 problems.append(f"over each other: {a.get_text()!r} and {b.get_text()!r}")
     problems += [f"upside down: {t.get_text()!r}" for t in texts if 90 < t.get_rotation() % 360 < 270]
-    problems += [f"legend over data: {name}" for name in legends_over_data(figure)]
+    problems += [f"legend over data: {name}" for name in legends_over_data(figure, drawn=True)]
     problems += negative_ticks(figure)
     for axes in figure.axes:
         for axis in (axes.xaxis, axes.yaxis):
@@ -243,10 +245,12 @@ def _legends(figure) -> list:
     return [legend for legend in legends if legend.get_visible()]
 
 
-def legends_over_data(figure) -> list[str]:
+def legends_over_data(figure, drawn: bool = False) -> list[str]:
     """The legends (each named by its entries) that cover plotted data of an axes where the
-    axes show it: a line or a marker, a bar, a scatter point, a contour line."""
-    figure.draw_without_rendering()
+    axes show it: a line or a marker, a bar, a scatter point, a contour line (``drawn``: as
+    ``texts_outside``)."""
+    if not drawn:
+        figure.draw_without_rendering()
     renderer = figure.canvas.get_renderer()
     return [
         repr(", ".join(t.get_text() for t in legend.get_texts()))
@@ -277,16 +281,27 @@ def clear_legend(axes, rect=(0.0, 0.0, 1.0, 1.0), **style):
     """The legend of ``axes`` at the first of PLACES where it covers no data (matplotlib's
     "best" only picks the place that covers least), else beside the axes, on the right, the
     figure laid out again (``fit_text`` with ``rect``). Call after the layout: the places
-    are judged in pixels."""
+    are judged in pixels: the figure is drawn once (unless nothing changed since its last
+    drawing), each place's legend found where its own drawing puts it, without drawing the
+    figure again."""
     figure = axes.figure
+    renderer = _drawn(figure)
     for place in PLACES:
         legend = axes.legend(loc=place, **style)
-        figure.draw_without_rendering()
-        if not _over_data(legend, figure, figure.canvas.get_renderer()):
+        if not _over_data(legend, figure, renderer):
             return legend
     legend = axes.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), **style)
     fit_text(figure, rect)
     return legend
+
+
+def _drawn(figure):
+    """The figure's renderer, the figure drawn as it stands: drawn now unless matplotlib
+    marks nothing changed since its last drawing (``stale``, what interactive backends
+    redraw by)."""
+    if figure.stale:
+        figure.draw_without_rendering()
+    return figure.canvas.get_renderer()
 
 
 def _data_of(axes) -> list:

@@ -58,19 +58,22 @@ def run(arm: RobotModel, trajectory, duration: float, noise: EffortNoise, seed: 
     sim = SimulatedArm(arm, period=1.0 / CONTROL_RATE)
     sim.reset(Q_ref[0], QD_ref[0])
     kp, kd = scale * KP, scale * KD
-    if not pushes:  # the same loop in one call (SimulatedArm.follow)
-        Q, QD, TAU = (x[::RECORD_EVERY] for x in sim.follow(feed_forward, Q_ref, QD_ref, kp, kd))
-    else:
-        kept = range(0, steps, RECORD_EVERY)
-        Q, QD, TAU = (np.empty((len(kept), arm.n)) for _ in range(3))
-        for k in range(steps):
-            q, qd = sim.q, sim.qd
-            force = next((p.force for p in pushes if p.start <= t[k] < p.end), None)
-            wrench = None if force is None else np.concatenate([force, np.zeros(3)])
-            sim.step(feed_forward[k] + kp * (Q_ref[k] - q) + kd * (QD_ref[k] - qd), wrench)
-            if k % RECORD_EVERY == 0:
-                i = k // RECORD_EVERY
-                Q[i], QD[i], TAU[i] = q, qd, sim.applied
+    forces = [next((p.force for p in pushes if p.start <= tk < p.end), None) for tk in t]
+    pushed = np.flatnonzero([force is not None for force in forces])
+    Q, QD, TAU = (np.empty((steps, arm.n)) for _ in range(3))
+    k = 0
+    while k < steps:  # the steps unpushed in one call each (SimulatedArm.follow: step's physics)
+        following = np.searchsorted(pushed, k)
+        end = int(pushed[following]) if following < len(pushed) else steps
+        if end > k:
+            Q[k:end], QD[k:end], TAU[k:end] = sim.follow(feed_forward[k:end], Q_ref[k:end], QD_ref[k:end], kp, kd)
+            k = end
+            continue
+        Q[k], QD[k] = sim.q, sim.qd
+        sim.step(feed_forward[k] + kp * (Q_ref[k] - Q[k]) + kd * (QD_ref[k] - QD[k]), [*forces[k], 0.0, 0.0, 0.0])
+        TAU[k] = sim.applied
+        k += 1
+    Q, QD, TAU = Q[::RECORD_EVERY], QD[::RECORD_EVERY], TAU[::RECORD_EVERY]
     sigma = noise.sigma(arm, np.abs(TAU).max(axis=0))
     measured = TAU + np.random.default_rng(seed).normal(size=TAU.shape) * sigma
     return t[::RECORD_EVERY], Q, QD, measured

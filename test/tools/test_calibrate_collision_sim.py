@@ -23,6 +23,7 @@ import re
 import numpy as np
 import pytest
 
+from irb140_dynamics.core import gravity_batch, kernels_of
 from irb140_dynamics.core.io.params_file import load_model, parameter_file_text, read_parameter_file
 from irb140_dynamics.core.monitoring.collision import OBSERVER_GAP as MAX_GAP
 from irb140_dynamics.core.monitoring.observer import MomentumObserver
@@ -63,14 +64,31 @@ def _ur5(work):
 ARMS = {"irb140": _irb140, "ur5": _ur5}
 
 
+def observer_terms(model, Q, QD) -> tuple[list, list]:
+    """Per sample, the terms id_node hands the observer with each joint state (its
+    ``monitor_terms``): p = M(q) qd and beta = C(q, qd)^T qd - g(q) - tau_f(qd), here for the
+    whole recording at once (the momentum kernel's array form; equal to rounding)."""
+    n = model.n
+    terms = np.empty((len(Q), 2 * n))
+    for i, values in enumerate(kernels_of(model).momentum.array(np.ascontiguousarray(Q.T), np.ascontiguousarray(QD.T))):
+        terms[:, i] = values
+    beta = terms[:, n:] - gravity_batch(model, Q)
+    if model.friction is not None:
+        beta -= model.friction.torques(QD)
+    return terms[:, :n].tolist(), beta.tolist()
+
+
 def flags(model, thresholds, recording) -> np.ndarray:
-    """Per sample: id_node's collision flag over the recording (observer at GAIN)."""
+    """Per sample: id_node's collision flag over the recording (observer at GAIN, given
+    each sample's terms as id_node gives them)."""
     observer = MomentumObserver(model, GAIN, MAX_GAP)
     t, Q, QD, TAU = recording
+    P, B = observer_terms(model, Q, QD)
+    limits, times, efforts = thresholds.tolist(), t.tolist(), TAU.tolist()
     flagged = np.zeros(len(t), dtype=bool)
     for k in range(len(t)):
-        r = np.abs(observer.advance(float(t[k]), Q[k], QD[k], TAU[k]))
-        flagged[k] = bool((r > thresholds).any())
+        r = observer.advance(times[k], Q[k], QD[k], efforts[k], None, (P[k], B[k]))
+        flagged[k] = any(abs(x) > limit for x, limit in zip(r, limits))
     return flagged
 
 

@@ -120,15 +120,6 @@ def test_identify_with_a_folder_where_a_plot_goes_keeps_the_other_plot_and_write
     ]
 
 
-@pytest.mark.slow  # a whole identification
-def test_identify_names_its_plots_as_typed_in_one_path(recording, tmp_path, capsys, monkeypatch):
-    """--plots plots/ (the folder with its slash): 'wrote plots/torques.png', no '//'."""
-    monkeypatch.chdir(tmp_path)
-    assert identify.main([str(recording), "--out", "identified.yaml", "--plots", "plots/", "--quiet"]) == 0
-    wrote = [line for line in capsys.readouterr().out.splitlines() if line.startswith("wrote ")]
-    assert wrote == ["wrote identified.yaml", "wrote plots/torques.png", "wrote plots/residuals.png"], wrote
-
-
 # no output over an input
 
 
@@ -278,20 +269,30 @@ RUNS = {
     "retime": (retime.main, ["--params-file", CONFIG, TRAJECTORY, "o/out.yaml", "--plot", "o/out.png"], 2),
     "identify": (
         identify.main,
-        ["RECORDING", "--urdf", URDF, "--out", "o/arm.yaml", "--plots", "o/plots", "--quiet"],
+        ["RECORDING", "--urdf", URDF, "--out", "o/arm.yaml", "--plots", "o/plots/", "--quiet"],
         4,
     ),
+}
+# What a run says it wrote: identify names its plots as typed, in one path (--plots o/plots/,
+# the folder with its slash: 'wrote o/plots/torques.png', no '//').
+WROTE = {
+    "identify": ["wrote o/arm.yaml", "wrote o/arm.urdf", "wrote o/plots/torques.png", "wrote o/plots/residuals.png"]
 }
 
 
 @pytest.mark.slow  # identify and the retiming's kernels
 @pytest.mark.parametrize("tool", sorted(RUNS))
 def test_every_file_a_tool_writes_has_the_mode_the_umask_gives(tool, umask, recording, tmp_path, monkeypatch, capsys):
+    """Each file written has the umask's mode; and the run says it wrote what WROTE has
+    (one identification for both checks)."""
     main, arguments, count = RUNS[tool]
     monkeypatch.chdir(tmp_path)
     (tmp_path / "o").mkdir()
     arguments = [str(recording) if a == "RECORDING" else str(a) for a in arguments]
     assert main(arguments) == 0, capsys.readouterr().err
+    if tool in WROTE:
+        wrote = [line for line in capsys.readouterr().out.splitlines() if line.startswith("wrote ")]
+        assert wrote == WROTE[tool], wrote
     files = [p for p in (tmp_path / "o").rglob("*") if p.is_file()]
     assert len(files) == count, files
     assert modes(tmp_path / "o", umask) == {}
