@@ -10,9 +10,10 @@ model is), so models that differ only in payload or gravity share their traced c
 it along the flange axis, traces nothing; the code is as short as a fully folded one.
 
 The kernels' native form (C) is made by a compiler outside the core (see
-``irb140_dynamics.native_hook``): ``prepare`` asks for it now, and a kernel whose Python form
-has run PROMOTE_AFTER times asks for it in the background; the calls use it once it is on
-the kernel (``Kernel.native``).
+``irb140_dynamics.native_hook``): ``prepare`` asks for it now, and a kernel whose Python forms
+have run PROMOTE_AFTER times (a call of many states counting once) asks for it in the
+background; the calls use it once it is on the kernel (``Kernel.native``, and
+``Kernel.native_batch`` for many states at once).
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ from irb140_dynamics.core.model.per_model import PerModel
 from irb140_dynamics.core.model.rigid_body import ZERO3, ZERO6
 
 ARMS_CACHED = 16  # arms whose traced code is kept (a model change is a new arm)
-PROMOTE_AFTER = 1000  # calls of a kernel's Python form before it is made native in the background
+PROMOTE_AFTER = 1000  # calls of a kernel's Python forms before it is made native in the background
 NATIVE_KERNELS = (WITH_FRICTION, "gravity_torques", "mass_matrix")  # what rnea, gravity, mass_matrix call
 
 
@@ -58,9 +59,13 @@ class Kernel:
     ``constants`` (payload and gravity). ``scalar`` on floats, ``array`` on NumPy arrays,
     ``into`` writing into given arrays; ``native``: None, or the same program compiled as C
     (put here by a compiler, see native_hook), a function of the argument groups but k as
-    float64 arrays returning an array or None (then the Python form answers)."""
+    float64 arrays returning an array or None (then the Python form answers);
+    ``native_batch``: None, or that C over N states, a function of the groups as (length, N)
+    float64 columns returning an (N, outputs) array (N whole matrices for a ``full_matrix``
+    kernel) or None (then ``array`` answers for them all)."""
 
     native = None
+    native_batch = None
 
     def __init__(self, trace: Trace, constants: tuple):
         self.trace, self.constants = trace, constants
@@ -69,8 +74,8 @@ class Kernel:
         self._calls = 0
 
     def used(self) -> None:
-        """Count a call of the Python form; the PROMOTE_AFTER-th asks for the native one.
-        Each call compares the count it wrote: with threads, a count can be written twice
+        """Count a call of a Python form (``scalar``, or ``array`` on a batch of states: once);
+        the PROMOTE_AFTER-th asks for the native one. Each call compares the count it wrote: with threads, a count can be written twice
         (then asked for twice, harmless) but none is skipped, so it is asked for."""
         calls = self._calls = self._calls + 1
         if calls == PROMOTE_AFTER:
