@@ -21,7 +21,8 @@ from typing import Protocol
 
 class Compiler(Protocol):
     """What makes kernels native: each kernel is a ``core.codegen.kernels.Kernel``, given its
-    ``native`` form when one is made (and checked to give the Python form's bits)."""
+    ``native`` form (and ``native_batch``, for many states) when one is made (and checked
+    to give the Python form's bits)."""
 
     def unavailable(self) -> str | None:
         """Why no kernel can be made native here (e.g. 'IRB140_NATIVE=0', 'no C compiler'),

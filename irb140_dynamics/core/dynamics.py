@@ -7,11 +7,12 @@ M includes the joints' armature (rotor inertia); tau_f is joint friction (see ``
 Single-state functions take sequences of n numbers and return NumPy arrays; the
 ``*_batch`` forms take arrays shaped (N, n) and give the same numbers for N states at once.
 All run the model's generated kernels (``codegen.kernels.kernels_of``), traced on first
-use; the single-state ``rnea``, ``gravity`` and ``mass_matrix`` run them as C once compiled
-(by the ``native`` room): in the background after PROMOTE_AFTER calls, or at once with
-``prepare(model, timeout)``. What a state is, and the checks of each argument, are in
-``states``: anything else raises ValueError naming the argument (the kernels fold
-constants: a NaN times a zero constant would vanish). A result is never silently
+use; ``rnea``, ``gravity``, ``mass_matrix`` and the batch forms run them as C once
+compiled (by the ``native`` room), the same numbers bit for bit: in the background after
+PROMOTE_AFTER calls (a batch counting once), or at once with ``prepare(model, timeout)``.
+What a state is, and the checks of each argument, are in ``states``: anything else raises
+ValueError naming the argument (the kernels fold constants: a NaN times a zero constant
+would vanish). A result is never silently
 non-finite: where velocities, accelerations, torques or a wrench are so large that it
 overflows, ValueError says so, naming the inputs. g(q) and M(q) need no such check: q
 enters through cos and sin only, and the model's sanity caps keep them finite.
@@ -162,32 +163,31 @@ def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayL
 def rnea_batch(model: RobotModel, Q, QD, QDD) -> np.ndarray:
     """rnea for N states: Q, QD, QDD shaped (N, n) -> tau shaped (N, n)."""
     columns = states(model.n, Q=Q, QD=QD, QDD=QDD)
-    tau = _with_friction(model, _evaluate(kernels_of(model).rnea.array, *columns), columns[1])
+    tau = _with_friction(model, _run(kernels_of(model).rnea, *columns), columns[1])
     return finite_results(tau, "rnea_batch", "Q", "QD", "QDD")
 
 
 def gravity_batch(model: RobotModel, Q) -> np.ndarray:
     """gravity for N states: Q shaped (N, n) -> g shaped (N, n)."""
-    return _evaluate(kernels_of(model).gravity_torques.array, *states(model.n, Q=Q))
+    return _run(kernels_of(model).gravity_torques, *states(model.n, Q=Q))
 
 
 def coriolis_batch(model: RobotModel, Q, QD) -> np.ndarray:
     """coriolis for N states: (N, n) -> C(q, qd) qd shaped (N, n)."""
-    return finite_results(
-        _evaluate(kernels_of(model).coriolis.array, *states(model.n, Q=Q, QD=QD)), "coriolis_batch", "Q", "QD"
-    )
+    return finite_results(_run(kernels_of(model).coriolis, *states(model.n, Q=Q, QD=QD)), "coriolis_batch", "Q", "QD")
 
 
 def mass_matrix_batch(model: RobotModel, Q) -> np.ndarray:
     """mass_matrix for N states: Q shaped (N, n) -> M shaped (N, n, n)."""
-    return _symmetric(_evaluate(kernels_of(model).mass_matrix.array, *states(model.n, Q=Q)), model.n)
+    return _run(kernels_of(model).mass_matrix, *states(model.n, Q=Q))
 
 
 def forward_dynamics_batch(model: RobotModel, Q, QD, TAU) -> np.ndarray:
     """forward_dynamics for N states: (N, n) arrays -> QDD shaped (N, n)."""
     q, qd, tau = states(model.n, Q=Q, QD=QD, TAU=TAU)
-    bias = _with_friction(model, _evaluate(kernels_of(model).rnea.array, q, qd, np.zeros_like(q)), qd)
-    M = _symmetric(_evaluate(kernels_of(model).mass_matrix.array, q), model.n)
+    kernels = kernels_of(model)
+    bias = _with_friction(model, _run(kernels.rnea, q, qd, np.zeros_like(q)), qd)
+    M = _run(kernels.mass_matrix, q)
     with np.errstate(over="ignore", invalid="ignore"):
         QDD = np.linalg.solve(M, (tau.T - bias)[..., None])[..., 0]
     return finite_results(QDD, "forward_dynamics_batch", "Q", "QD", "TAU")
@@ -204,6 +204,20 @@ def _with_friction(model: RobotModel, tau: np.ndarray, qd_columns: np.ndarray) -
 
 
 _CHUNK = 8192  # states per pass: the kernels' intermediates then stay in the CPU caches
+
+
+def _run(kernel, *columns: np.ndarray) -> np.ndarray:
+    """``kernel`` over states given as (n, N) columns: (N, outputs), whole (N, n, n)
+    matrices for a kernel of M. Its native form answers when it has one (the same bits as
+    the NumPy form); else, or where that declines (a result not finite), the NumPy form,
+    the call counted toward making the kernel native."""
+    if kernel.native_batch is not None:
+        result = kernel.native_batch(*columns)
+        if result is not None:
+            return result
+    kernel.used()
+    result = _evaluate(kernel.array, *columns)
+    return _symmetric(result, kernel.full_matrix) if kernel.full_matrix else result
 
 
 def _evaluate(kernel, *columns: np.ndarray) -> np.ndarray:

@@ -5,8 +5,10 @@ and with cos, sin and tanh left to libm, the C performs the very operations of t
 form in the same order, so its results are the same, bit for bit. That is checked before a
 native form is put on a kernel: on random inputs it must equal the Python kernel exactly,
 else it is never used. It is built as a CPython extension module (Python.h and NumPy's
-headers) whose functions take NumPy arrays directly; where Python.h is missing, as a plain
-library called through ctypes (slower per call, same numbers).
+headers) whose functions take NumPy arrays directly, one state (``Kernel.native``) or N
+states in one call (``Kernel.native_batch``, the same C function in a loop, checked as
+well); where Python.h is missing, as a plain library called through ctypes (slower per
+call, same numbers; no batch form).
 
 Compiling takes a C compiler (see ``library``), so no call of a kernel waits for it: one
 background thread compiles the kernels asked for (a kernel whose Python form has run
@@ -85,17 +87,19 @@ def headers() -> list[str] | None:
 
 
 def build(program, full_matrix: int = 0):
-    """The compiled form of ``program`` (compiled or loaded from the cache): (bind, lengths,
-    shape) with ``bind(constants: bytes)`` the kernel with those constants, a function of
-    the argument groups but k (1-D float64 arrays of ``lengths``) -> an array shaped
-    ``shape``, or None (anything else, or not finite)."""
+    """The compiled form of ``program`` (compiled or loaded from the cache): (bind,
+    bind_batch, lengths, shape) with ``bind(constants: bytes)`` the kernel with those
+    constants, a function of the argument groups but k (1-D float64 arrays of ``lengths``)
+    -> an array shaped ``shape``, or None (anything else, or not finite);
+    ``bind_batch(constants)`` the same over N states (see c_code.extension_source), or None
+    itself where there is none (ctypes, or a program of no state)."""
     lengths = [length for group, length in program.groups if group != "k"]
     source, _, outputs = c_code.kernel_source(program, full_matrix)
     shape = (full_matrix, full_matrix) if full_matrix else (outputs,)
     include = headers()
     if include is None:
         function = load(source)
-        return (lambda constants: CtypesKernel(function, constants, lengths, shape)), lengths, shape
+        return (lambda constants: CtypesKernel(function, constants, lengths, shape)), None, lengths, shape
     versions = "\0".join([source, sys.version, np.__version__, *include])
     name = "k" + hashlib.sha256(versions.encode()).hexdigest()[:24]
     extension = c_code.extension_source(program, name, full_matrix)
@@ -104,7 +108,7 @@ def build(program, full_matrix: int = 0):
         importlib.util.spec_from_loader(name, importlib.machinery.ExtensionFileLoader(name, str(path)))
     )
     module.__spec__.loader.exec_module(module)
-    return module.bind, lengths, shape
+    return module.bind, module.bind_batch if lengths else None, lengths, shape
 
 
 def load(source: str):
@@ -115,10 +119,12 @@ def load(source: str):
     return function
 
 
-def same_as_python(native, python, lengths: list[int], full_matrix: int) -> bool:
+def same_as_python(native, python, lengths: list[int], full_matrix: int, batch=None) -> bool:
     """Does ``native`` (arrays -> array, tuple of arrays or None) give exactly the Python
-    kernel's numbers (bound: k defaulted)?"""
+    kernel's numbers (bound: k defaulted)? And ``batch`` (when given: columns -> (N, ...)
+    array or None) the same numbers for the same states at once, read through strides?"""
     rng = random.Random(140)
+    states, wanted = [], []
     for _ in range(CHECKS):
         args = [[rng.uniform(-4.0, 4.0) for _ in range(length)] for length in lengths]
         want = list(python(*args))
@@ -127,9 +133,16 @@ def same_as_python(native, python, lengths: list[int], full_matrix: int) -> bool
         got = native(*(np.array(a) for a in args))
         if type(got) is tuple:  # a program's matrices (see c_code)
             got = np.concatenate([matrix.ravel() for matrix in got])
-        if got is None or got.tobytes() != array.array("d", want).tobytes():  # bits: -0.0 is not 0.0
+        expected = array.array("d", want).tobytes()
+        if got is None or got.tobytes() != expected:  # bits: -0.0 is not 0.0
             return False
-    return True
+        states.append(args)
+        wanted.append(expected)
+    if batch is None:
+        return True
+    columns = [np.array([args[g] for args in states]).T for g in range(len(lengths))]  # views: strided
+    got = batch(*columns)
+    return type(got) is np.ndarray and got.tobytes() == b"".join(wanted)
 
 
 class Compiler:
@@ -204,11 +217,10 @@ class Compiler:
         built = self._built.get((kernel.program, kernel.full_matrix))
         if built is None:
             return False
-        bind, lengths, _ = built
-        found = bind(array.array("d", kernel.constants).tobytes())
-        if not same_as_python(found, kernel.scalar, lengths, kernel.full_matrix):
+        forms = _bound(kernel, built)
+        if forms is None:
             return False
-        kernel.native = found
+        _put_on(kernel, forms)
         return True
 
     def _run(self) -> None:
@@ -221,11 +233,13 @@ class Compiler:
                 kernel.set()
                 continue
             try:
-                kernel.native = self._native(kernel)
+                forms = self._native(kernel)
             except Exception:  # never let the worker die: the Python form stays in use
-                kernel.native = None
+                forms = None
+            _put_on(kernel, forms)
 
-    def _native(self, kernel):
+    def _native(self, kernel) -> tuple | None:
+        """(native, batch) forms of ``kernel``, compiled or built already, checked; None if none."""
         program, full_matrix = kernel.program, kernel.full_matrix
         key = (program, full_matrix)
         if key not in self._built:
@@ -242,9 +256,27 @@ class Compiler:
         self._built[key] = built
         if built is None:
             return None
-        bind, lengths, _ = built
-        native = bind(array.array("d", kernel.constants).tobytes())
-        return native if same_as_python(native, kernel.scalar, lengths, full_matrix) else None
+        return _bound(kernel, built)
+
+
+def _bound(kernel, built: tuple) -> tuple | None:
+    """(native, batch) forms of ``kernel`` (its constants bound) from ``built`` (see
+    ``build``; batch None where there is none), or None when they differ from its Python form."""
+    bind, bind_batch, lengths, _ = built
+    constants = array.array("d", kernel.constants).tobytes()
+    native = bind(constants)
+    batch = None if bind_batch is None else bind_batch(constants)
+    if not same_as_python(native, kernel.scalar, lengths, kernel.full_matrix, batch):
+        return None
+    return native, batch
+
+
+def _put_on(kernel, forms: tuple | None) -> None:
+    """``forms`` (native, batch) put on ``kernel`` (None: none), the batch form first: one
+    that sees ``native`` sees the batch form too."""
+    native, batch = (None, None) if forms is None else forms
+    kernel.native_batch = batch
+    kernel.native = native
 
 
 COMPILER = Compiler()

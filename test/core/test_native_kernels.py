@@ -307,6 +307,7 @@ def test_without_python_headers_the_kernels_are_called_through_ctypes(monkeypatc
     with installed(compiler.Compiler()):  # nothing built by this process yet
         model = promoted(offset_arm())
     assert isinstance(kernels_of(model).rnea.native, compiler.CtypesKernel)
+    assert kernels_of(model).rnea.native_batch is None  # no batch form: the batch verbs take NumPy's
     python_model = offset_arm()
     for q, qd, qdd in zip(*states(model, count=50)):
         np.testing.assert_array_equal(rnea(model, q, qd, qdd), rnea(python_model, q, qd, qdd))

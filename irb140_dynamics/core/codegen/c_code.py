@@ -12,7 +12,11 @@ with constants ``k`` as a Python function of NumPy arrays, called with METH_FAST
 takes the argument groups but ``k`` (1-D float64 arrays of their lengths, any stride) and
 returns a new array, or None for anything else or a result that is not finite (the caller
 then takes the Python form, which says why). A program whose outputs are ``matrices`` (see
-``Program``) returns them as a tuple of new square arrays.
+``Program``) returns them as a tuple of new square arrays. ``bind_batch(k: bytes)`` returns
+the same kernel over N states: it takes each group as (length, N) float64 columns (any
+strides) and returns a new (N, outputs) array (N whole n x n matrices with ``full_matrix``),
+the per-state results row by row, or None as the per-state call would for any state (the
+caller then takes the Python form for them all).
 """
 
 from __future__ import annotations
@@ -114,11 +118,18 @@ def extension_source(program: Program, module: str, full_matrix: int = 0) -> str
         call = _ARRAY_CALL.format(
             inputs=max(inputs, 1), groups=len(lengths), takes=takes, ndim=2 if full_matrix else 1, shape=shape
         )
-    return _EXTENSION.format(
-        call=call,
-        kernel=kernel,
-        module=module,
-    )
+    if lengths:
+        batch = _BATCH_CALL.format(
+            inputs=max(inputs, 1),
+            outputs=outputs,
+            groups=len(lengths),
+            rows=", ".join(map(str, lengths)),
+            ndim=3 if full_matrix else 2,
+            per_state=f"{full_matrix}, {full_matrix}" if full_matrix else f"{outputs}",
+        )
+    else:  # no states to count
+        batch = _NO_BATCH
+    return _EXTENSION.format(call=call, batch=batch, kernel=kernel, module=module)
 
 
 _EXTENSION = """#define PY_SSIZE_T_CLEAN
@@ -141,18 +152,32 @@ static int take(PyObject *o, double *x, npy_intp n) {{
 
 {call}
 
-static PyMethodDef call_method = {{"kernel", (PyCFunction)(void (*)(void))call, METH_FASTCALL, NULL}};
+{batch}
 
-static PyObject *bind(PyObject *module, PyObject *k) {{
-    (void)module;
+static PyMethodDef call_method = {{"kernel", (PyCFunction)(void (*)(void))call, METH_FASTCALL, NULL}};
+static PyMethodDef batch_method = {{"batch", (PyCFunction)(void (*)(void))batch, METH_FASTCALL, NULL}};
+
+static PyObject *bound(PyMethodDef *method, PyObject *k) {{
     if (!PyBytes_CheckExact(k)) {{
         PyErr_SetString(PyExc_TypeError, "bind: the constants as bytes of doubles");
         return NULL;
     }}
-    return PyCFunction_NewEx(&call_method, k, NULL);
+    return PyCFunction_NewEx(method, k, NULL);
 }}
 
-static PyMethodDef methods[] = {{{{"bind", bind, METH_O, NULL}}, {{NULL, NULL, 0, NULL}}}};
+static PyObject *bind(PyObject *module, PyObject *k) {{
+    (void)module;
+    return bound(&call_method, k);
+}}
+
+static PyObject *bind_batch(PyObject *module, PyObject *k) {{
+    (void)module;
+    return bound(&batch_method, k);
+}}
+
+static PyMethodDef methods[] = {{
+    {{"bind", bind, METH_O, NULL}}, {{"bind_batch", bind_batch, METH_O, NULL}}, {{NULL, NULL, 0, NULL}}
+}};
 static struct PyModuleDef definition = {{PyModuleDef_HEAD_INIT, "{module}", NULL, -1, methods}};
 
 PyMODINIT_FUNC PyInit_{module}(void) {{
@@ -198,3 +223,54 @@ static PyObject *call(PyObject *k, PyObject *const *args, Py_ssize_t nargs) {{
     for (int i = 0; i < {count}; ++i) PyTuple_SET_ITEM(result, i, items[i]);
     return result;
 }}"""
+
+
+_BATCH_CALL = """/* a 2-D native float64 array of rows x N (N the first array's): its data and strides; 0 for anything else */
+static int columns(PyObject *o, npy_intp rows, npy_intp *N, const char **data, npy_intp *strides) {{
+    if (!PyArray_CheckExact(o)) return 0;
+    PyArrayObject *a = (PyArrayObject *)o;
+    if (PyArray_TYPE(a) != NPY_DOUBLE || PyArray_NDIM(a) != 2 || PyArray_DIM(a, 0) != rows
+        || !PyArray_ISNOTSWAPPED(a) || !PyArray_ISALIGNED(a)) return 0;
+    if (*N < 0) *N = PyArray_DIM(a, 1);
+    else if (PyArray_DIM(a, 1) != *N) return 0;
+    *data = PyArray_BYTES(a);
+    strides[0] = PyArray_STRIDE(a, 0);
+    strides[1] = PyArray_STRIDE(a, 1);
+    return 1;
+}}
+
+static PyObject *batch(PyObject *k, PyObject *const *args, Py_ssize_t nargs) {{
+    static const npy_intp rows[{groups}] = {{{rows}}};
+    const char *data[{groups}];
+    npy_intp strides[{groups}][2], N = -1;
+    if (nargs != {groups}) Py_RETURN_NONE;
+    for (int g = 0; g < {groups}; ++g)
+        if (!columns(args[g], rows[g], &N, &data[g], strides[g])) Py_RETURN_NONE;
+    npy_intp shape[] = {{N, {per_state}}};
+    PyObject *result = PyArray_SimpleNew({ndim}, shape, NPY_DOUBLE);
+    if (result == NULL) return NULL;
+    double *out = (double *)PyArray_DATA((PyArrayObject *)result);
+    const double *constants = (const double *)PyBytes_AS_STRING(k);
+    int failed = 0;
+    Py_BEGIN_ALLOW_THREADS
+    double x[{inputs}];
+    for (npy_intp s = 0; s < N && !failed; ++s) {{
+        double *to = x;
+        for (int g = 0; g < {groups}; ++g) {{
+            const char *p = data[g] + s * strides[g][1];
+            for (npy_intp i = 0; i < rows[g]; ++i) *to++ = *(const double *)(p + i * strides[g][0]);
+        }}
+        failed = kernel(x, constants, out + s * {outputs}) != 0;
+    }}
+    Py_END_ALLOW_THREADS
+    if (failed) {{
+        Py_DECREF(result);
+        Py_RETURN_NONE;
+    }}
+    return result;
+}}"""
+
+_NO_BATCH = """static PyObject *batch(PyObject *k, PyObject *const *args, Py_ssize_t nargs) {
+    (void)k, (void)args, (void)nargs;
+    Py_RETURN_NONE;
+}"""

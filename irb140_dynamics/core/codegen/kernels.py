@@ -10,9 +10,10 @@ model is), so models that differ only in payload or gravity share their traced c
 it along the flange axis, traces nothing; the code is as short as a fully folded one.
 
 The kernels' native form (C) is made by a compiler outside the core (see
-``irb140_dynamics.native_hook``): ``prepare`` asks for it now, and a kernel whose Python form
-has run PROMOTE_AFTER times asks for it in the background; the calls use it once it is on
-the kernel (``Kernel.native``).
+``irb140_dynamics.native_hook``): ``prepare`` asks for it now, and a kernel whose arm's Python
+forms have run PROMOTE_AFTER times (over the models sharing that code, a call of many states
+counting once) asks for it in the background; the calls use it once it is on the kernel
+(``Kernel.native``, and ``Kernel.native_batch`` for many states at once).
 """
 
 from __future__ import annotations
@@ -33,18 +34,20 @@ from irb140_dynamics.core.model.per_model import PerModel
 from irb140_dynamics.core.model.rigid_body import ZERO3, ZERO6
 
 ARMS_CACHED = 16  # arms whose traced code is kept (a model change is a new arm)
-PROMOTE_AFTER = 1000  # calls of a kernel's Python form before it is made native in the background
+PROMOTE_AFTER = 1000  # calls of an arm's kernel's Python forms before it is made native in the background
 NATIVE_KERNELS = (WITH_FRICTION, "gravity_torques", "mass_matrix")  # what rnea, gravity, mass_matrix call
 
 
 class Trace:
     """One algorithm traced on one arm (``program``, see program) and its Python forms,
     each ``bind(constants)``: the source on floats and on NumPy arrays, and on first use the
-    form writing into given arrays (see array_code)."""
+    form writing into given arrays (see array_code). ``calls``: of those forms, by every
+    model of the arm (see ``Kernel.used``)."""
 
     def __init__(self, program: Program, full_matrix: int = 0):
         self.program, self.full_matrix = program, full_matrix  # full_matrix: n to write M whole in C
         self.source, self.bind_scalar, self.bind_array = compile_python(program)
+        self.calls = 0
 
     @cached_property
     def writing(self) -> tuple:
@@ -58,22 +61,30 @@ class Kernel:
     ``constants`` (payload and gravity). ``scalar`` on floats, ``array`` on NumPy arrays,
     ``into`` writing into given arrays; ``native``: None, or the same program compiled as C
     (put here by a compiler, see native_hook), a function of the argument groups but k as
-    float64 arrays returning an array or None (then the Python form answers)."""
+    float64 arrays returning an array or None (then the Python form answers);
+    ``native_batch``: None, or that C over N states, a function of the groups as (length, N)
+    float64 columns returning an (N, outputs) array (N whole matrices for a ``full_matrix``
+    kernel) or None (then ``array`` answers for them all)."""
 
     native = None
+    native_batch = None
 
     def __init__(self, trace: Trace, constants: tuple):
         self.trace, self.constants = trace, constants
         self.program, self.full_matrix, self.source = trace.program, trace.full_matrix, trace.source
         self.scalar, self.array = trace.bind_scalar(constants), trace.bind_array(constants)
-        self._calls = 0
+        self._asked = False
 
     def used(self) -> None:
-        """Count a call of the Python form; the PROMOTE_AFTER-th asks for the native one.
-        Each call compares the count it wrote: with threads, a count can be written twice
-        (then asked for twice, harmless) but none is skipped, so it is asked for."""
-        calls = self._calls = self._calls + 1
-        if calls == PROMOTE_AFTER:
+        """Count a call of a Python form (``scalar``, or ``array`` on a batch of states: once)
+        on the arm's count: from the PROMOTE_AFTER-th on, the kernel's next call asks for its
+        native form, once. So a model of a busy arm (a search making a model per payload
+        mass) asks on its first call, and gets its native form as soon as the compiler has
+        bound the arm's code to its constants (nothing compiled again). With threads, a
+        kernel may ask twice (harmless), never not at all."""
+        calls = self.trace.calls = self.trace.calls + 1
+        if calls >= PROMOTE_AFTER and not self._asked:
+            self._asked = True
             compiler = native_hook.installed()
             if compiler is not None:
                 compiler.promote(self)
