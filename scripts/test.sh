@@ -12,10 +12,12 @@ ruff format --check --quiet . || { echo "files not formatted: run ruff format ."
 # PYTHONDONTWRITEBYTECODE): each worker would otherwise rewrite and compile every test
 # module again, and each process the tests start compile what env.sh did not.
 unset PYTHONDONTWRITEBYTECODE
-# OpenBLAS on one thread, as the package's executables run it (entry.py): two workers on two
-# cores, with small matrices, where more threads only spin while they wait.
+# OpenBLAS on one thread, as the package's executables run it (entry.py): three workers on
+# two cores, with small matrices, where more threads only spin while they wait.
 export OPENBLAS_NUM_THREADS="${OPENBLAS_NUM_THREADS:-1}"
-# Two workers (pytest-xdist), a test file each at a time: the suite's processes and nodes
-# wait on each other as much as they compute, so two keep both cores busy. `-n 0` after
+# Three workers (pytest-xdist), a test file each at a time, on two cores: the suite's
+# processes and nodes wait on each other (a start, DDS discovery, a simulated arm in real
+# time), and two workers left the cores idle a fifth of the run; a third fills those waits
+# (2026-11-29, 2 cores: 287 s with two, 256 s with three, 266 s with four). `-n 0` after
 # the script's name runs it in one process.
-exec python -m pytest -n 2 --dist loadfile "$@"
+exec python -m pytest -n 3 --dist loadfile "$@"
