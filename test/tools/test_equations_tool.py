@@ -96,7 +96,7 @@ def test_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys, args, reason
     ids=["symbolic parameters with mimic joints", "dtau not in C"],
 )
 def test_a_refused_generation_leaves_no_out_folder(tmp_path, capsys, args):
-    from ..core.test_urdf_trees import TWO_ARMS
+    from ..support.two_arms import TWO_ARMS
 
     (tmp_path / "two_arms.urdf").write_text(TWO_ARMS)
     args = [str(tmp_path / "two_arms.urdf") if a == "{two_arms}" else a for a in args]
