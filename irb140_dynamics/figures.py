@@ -75,12 +75,9 @@ def _wrap(text, extent, width: float) -> bool:
     return True
 
 
-def texts_outside(figure, drawn: bool = False) -> list[str]:
-    """The texts (visible, not empty) whose tight bounding box is not inside the figure
-    (``drawn``: the figure is drawn as it stands, no need to draw it again)."""
-    if not drawn:
-        figure.draw_without_rendering()
-    renderer = figure.canvas.get_renderer()
+def texts_outside(figure) -> list[str]:
+    """The texts (visible, not empty) whose tight bounding box is not inside the figure."""
+    renderer = _drawn(figure)
     box, slack = figure.bbox, 0.5  # pixels: rounding
     outside = []
     for text in _texts(figure):
@@ -108,8 +105,7 @@ def round_steps(low: float, high: float, most: int = 10):
 def figure_problems(figure, dpi=None) -> list[str]:
     """What keeps ``figure`` from reading well, saved at ``dpi`` (default: the figure's);
     see the module. An empty list: nothing."""
-    figure.draw_without_rendering()
-    renderer = figure.canvas.get_renderer()
+    renderer = _drawn(figure)
     problems = []
     width = figure.get_figwidth() * (dpi if isinstance(dpi, (int, float)) else figure.dpi)
     if width < MIN_WIDTH - 0.5:
@@ -118,7 +114,7 @@ def figure_problems(figure, dpi=None) -> list[str]:
     titles = [figure.get_suptitle()] + [a.get_title(loc) for a in figure.axes for loc in ("left", "center", "right")]
     if not any(t.strip() for t in titles):
         problems.append("no title")
-    problems += [f"outside the figure: {t!r}" for t in texts_outside(figure, drawn=True)]
+    problems += [f"outside the figure: {t!r}" for t in texts_outside(figure)]
     from matplotlib.text import Text
 
     boxes = [(t, Text.get_window_extent(t, renderer)) for t in texts]  # (an annotation's text, not its arrow)
@@ -133,7 +129,7 @@ def figure_problems(figure, dpi=None) -> list[str]:
             if wide > OVERLAP and high > OVERLAP:
                 problems.append(f"over each other: {a.get_text()!r} and {b.get_text()!r}")
     problems += [f"upside down: {t.get_text()!r}" for t in texts if 90 < t.get_rotation() % 360 < 270]
-    problems += [f"legend over data: {name}" for name in legends_over_data(figure, drawn=True)]
+    problems += [f"legend over data: {name}" for name in legends_over_data(figure)]
     problems += negative_ticks(figure)
     for axes in figure.axes:
         for axis in (axes.xaxis, axes.yaxis):
@@ -175,8 +171,7 @@ def label_curves(axes, curves, texts, **style) -> list:
     import numpy as np
 
     figure = axes.figure
-    figure.draw_without_rendering()
-    renderer = figure.canvas.get_renderer()
+    renderer = _drawn(figure)
     frame = axes.get_window_extent(renderer)
     style = {"fontsize": 9, "ha": "center", "va": "center", "zorder": 6, **style}
     style.setdefault("bbox", dict(boxstyle="round,pad=0.15", facecolor="white", edgecolor="none", alpha=0.85))
@@ -245,13 +240,10 @@ def _legends(figure) -> list:
     return [legend for legend in legends if legend.get_visible()]
 
 
-def legends_over_data(figure, drawn: bool = False) -> list[str]:
+def legends_over_data(figure) -> list[str]:
     """The legends (each named by its entries) that cover plotted data of an axes where the
-    axes show it: a line or a marker, a bar, a scatter point, a contour line (``drawn``: as
-    ``texts_outside``)."""
-    if not drawn:
-        figure.draw_without_rendering()
-    renderer = figure.canvas.get_renderer()
+    axes show it: a line or a marker, a bar, a scatter point, a contour line."""
+    renderer = _drawn(figure)
     return [
         repr(", ".join(t.get_text() for t in legend.get_texts()))
         for legend in _legends(figure)
