@@ -257,21 +257,16 @@ def threading_is_not_main() -> bool:
 
 @contextlib.contextmanager
 def errors_as_bad_input():
-    """Within it, an error (a ToolError, bad input, a defect of ours) exits with status 2:
-    for a tool whose status 1 is an answer (load_diagram --check: outside). Ctrl-C and a
-    closed standard output keep theirs."""
+    """Within it, an error (a ToolError, bad input, a defect of ours) exits with status 2,
+    said as ``run`` says it: for a tool whose status 1 is an answer (load_diagram --check:
+    outside). Ctrl-C and a closed standard output keep theirs."""
     try:
         yield
-    except ToolError as error:
-        error.status = 2
-        raise
     except BrokenPipeError:
         raise
     except Exception as error:
-        if os.environ.get("IRB140_TRACEBACK"):  # for the developers
-            raise
-        known = isinstance(error, (ValueError, OSError, ArithmeticError, MemoryError, RecursionError))
-        raise BadArgument(_describe(error) if known else f"internal error: {type(error).__name__}: {error}") from None
+        error.status = 2  # (read by _failed; a ToolError's class status, shadowed)
+        raise
 
 
 def run(tool: str, body: Callable[[Interrupts], int]) -> int:
@@ -313,7 +308,6 @@ def _failed(tool: str, error: BaseException, interrupts: Interrupts) -> int:
         return 128 + signal.SIGPIPE
     if isinstance(error, ToolError):
         _say(f"{tool}: error: {error}")
-        return error.status
     elif isinstance(error, (ValueError, OSError, ArithmeticError, MemoryError, RecursionError)):
         _say(f"{tool}: error: {_describe(error)}")
     elif isinstance(error, Exception):  # a defect of ours: still one line, not a traceback
@@ -322,7 +316,7 @@ def _failed(tool: str, error: BaseException, interrupts: Interrupts) -> int:
         _say(f"{tool}: internal error: {type(error).__name__}: {error}")
     else:  # GeneratorExit and the like
         raise error
-    return 1
+    return getattr(error, "status", 1)  # a ToolError's, or 2 from errors_as_bad_input
 
 
 def _quiet_stdout() -> None:
