@@ -64,13 +64,11 @@ def held_positions(
     for _ in range(len(followers)):  # a mimic of a mimic follows in a later pass
         before = len(positions)
         for joint in followers:
-            mimic = joint.element.find("mimic")
-            if mimic is None or joint.name in positions or mimic.get("joint") not in positions:
+            leader = joint.leader
+            if leader not in positions or joint.name in positions:
                 continue
-            where = f"{joint.label} <mimic>"
-            multiplier, offset = number(mimic, "multiplier", where, 1.0), number(mimic, "offset", where, 0.0)
-            leader = mimic.get("joint")
-            position = multiplier * positions[leader] + offset
+            mimic = joint.mimic
+            position = mimic.multiplier * positions[leader] + mimic.offset
             given_by[joint.name] = source = given_by[leader]
             if source is not None:  # a default places a mimic joint where the URDF's tree at that position does
                 position = _within_limits(joint, position, f" for mimic joint {joint.name!r}", source)
@@ -90,16 +88,14 @@ def _check_given(tree: UrdfTree, in_model: Collection[str], name: str) -> None:
         raise HeldError(name, f"the URDF has no joint {clipped(repr(name), 80)}{hint}")
     if joint.kind not in MOVING:
         raise HeldError(name, f"a {joint.kind} joint: only revolute, continuous and prismatic joints are held")
-    mimic = joint.element.find("mimic")
+    leader = joint.leader
     if name in in_model:
-        of = (
-            f"a mimic joint of the model following {clipped(repr(mimic.get('joint')), 80)}" if mimic is not None else ""
-        )
+        of = f"a mimic joint of the model following {clipped(repr(leader), 80)}" if leader is not None else ""
         raise HeldError(name, f"{of or 'a joint of the model'}, not held: its position is the state's")
-    if mimic is not None:
+    if joint.element.find("mimic") is not None:
         raise HeldError(
             name,
-            f"a mimic joint: it follows {clipped(repr(mimic.get('joint')), 80)} (multiplier * q + offset); "
+            f"a mimic joint: it follows {clipped(repr(leader), 80)} (multiplier * q + offset); "
             "give that joint's position",
         )
 

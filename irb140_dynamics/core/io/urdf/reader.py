@@ -66,7 +66,7 @@ from irb140_dynamics.core.io.urdf.whole_tree import (
 )
 from irb140_dynamics.core.model.joints import MAX_TORQUE_LIMIT, Friction, Joint, Placement
 from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, combine, placed
-from irb140_dynamics.core.model.robot_model import Mimic, RobotModel
+from irb140_dynamics.core.model.robot_model import RobotModel
 
 CONTINUOUS_LIMITS = (-4 * math.pi, 4 * math.pi)  # rad: two turns either way, every angle within
 MAX_JOINTS = 256  # moving joints of a chain or tree at most: TIAGo++ whole has 101; the kernels' trace
@@ -214,23 +214,14 @@ def mimics_of(moving: list[UrdfJoint]) -> tuple | None:
     """Per moving joint, the ``Mimic`` its <mimic joint= multiplier= offset=> gives (None:
     not a mimic joint); UrdfError for one following a joint that is not among ``moving``."""
     names = {joint.name for joint in moving}
-    mimics = []
-    for joint in moving:
-        element = joint.element.find("mimic")
-        if element is None:
-            mimics.append(None)
-            continue
-        where = f"{joint.label} <mimic>"
-        leader = element.get("joint")
-        if not leader:
-            raise UrdfError(where, "names no joint")
-        if leader not in names:
+    mimics = [joint.mimic for joint in moving]
+    for joint, mimic in zip(moving, mimics):
+        if mimic is not None and mimic.joint not in names:
             raise UrdfError(
-                where,
-                f"follows {clipped(repr(leader), 60)}, which is not a moving joint of the model "
+                f"{joint.label} <mimic>",
+                f"follows {clipped(repr(mimic.joint), 60)}, which is not a moving joint of the model "
                 "(name a base_link/tip_link taking it in, or one leaving the mimic joint out)",
             )
-        mimics.append(Mimic(leader, number(element, "multiplier", where, 1.0), number(element, "offset", where, 0.0)))
     return tuple(mimics) if any(m is not None for m in mimics) else None
 
 

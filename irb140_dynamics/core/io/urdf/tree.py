@@ -32,6 +32,7 @@ from irb140_dynamics.core.model.rigid_body import (
     physical_inertia,
     placed,
 )
+from irb140_dynamics.core.model.tree import Mimic
 
 KINDS = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 MOVING = KINDS[:3]  # the kinds of joint with a position (the model's joints, or held)
@@ -80,6 +81,26 @@ class UrdfJoint:
     @property
     def label(self) -> str:
         return f'joint "{self.name}"'
+
+    @property
+    def leader(self) -> str | None:
+        """The joint its <mimic joint=...> follows (None: it is no mimic joint, or names none)."""
+        element = self.element.find("mimic")
+        return None if element is None else element.get("joint")
+
+    @property
+    def mimic(self) -> Mimic | None:
+        """What its <mimic joint= multiplier= offset=> says (None: it is no mimic joint);
+        UrdfError for a <mimic> naming no joint or with a number that is not one."""
+        element = self.element.find("mimic")
+        if element is None:
+            return None
+        where = f"{self.label} <mimic>"
+        if not element.get("joint"):
+            raise UrdfError(where, "names no joint")
+        return Mimic(
+            element.get("joint"), number(element, "multiplier", where, 1.0), number(element, "offset", where, 0.0)
+        )
 
 
 @dataclass(frozen=True)

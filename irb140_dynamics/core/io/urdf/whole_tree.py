@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from irb140_dynamics.core.io.urdf.held import motion_placement
-from irb140_dynamics.core.io.urdf.tree import MOVING, UrdfError, UrdfTree, clipped, number
+from irb140_dynamics.core.io.urdf.tree import MOVING, UrdfError, UrdfTree, clipped
 from irb140_dynamics.core.model.joints import Placement, matrix_rpy
 from irb140_dynamics.core.model.tree import Mimic
 
@@ -31,29 +31,18 @@ def moving_joints(tree: UrdfTree, base: str) -> tuple[list, list[int], list[Plac
     """(the moving joints below ``base``, depth first in the file's order; each one's parent
     index, -1 for none; each one's origin in its parent's link frame, the fixed joints
     between them composed). UrdfError for a floating or planar joint."""
-    moving, parents, origins = [], [], []
-    # (joint, index of the moving joint whose link its parent link is fixed to, the
-    # placement of its parent link in that link): a joint's subtree is pushed on top of its
-    # next siblings, so the walk is depth first in the file's order (preorder)
-    stack = [(joint, -1, Placement()) for joint in reversed(tree.child_joints[base])]
-    while stack:
-        joint, above, placement = stack.pop()
-        if joint.kind in MOVING:
-            moving.append(joint)
-            parents.append(above)
-            origins.append(compose(placement, joint.origin))
-            above, placement = len(moving) - 1, Placement()
-        elif joint.kind == "fixed":
-            placement = compose(placement, joint.origin)
-        else:
-            hint = " (a floating base: name the link under it as base_link)" if joint.kind == "floating" else ""
-            raise UrdfError(
-                joint.label,
-                f"a {joint.kind} joint below {clipped(repr(base), 60)}: only revolute, continuous, "
-                f"prismatic and fixed joints are supported{hint}",
-            )
-        stack += [(child, above, placement) for child in reversed(tree.child_joints[joint.child])]
-    return moving, parents, origins
+
+    def fixed(joint, placement: Placement) -> Placement:
+        if joint.kind == "fixed":
+            return compose(placement, joint.origin)
+        hint = " (a floating base: name the link under it as base_link)" if joint.kind == "floating" else ""
+        raise UrdfError(
+            joint.label,
+            f"a {joint.kind} joint below {clipped(repr(base), 60)}: only revolute, continuous, "
+            f"prismatic and fixed joints are supported{hint}",
+        )
+
+    return _preorder(tree, [(joint, -1) for joint in tree.child_joints[base]], lambda j: j.kind in MOVING, fixed)
 
 
 def chain_followers(tree: UrdfTree, chain: list, mimics: tuple | None) -> dict:
@@ -66,14 +55,15 @@ def chain_followers(tree: UrdfTree, chain: list, mimics: tuple | None) -> dict:
     for _ in range(len(pending)):  # a mimic of a mimic joins in a later pass
         before = len(follows)
         for joint in pending:
-            element = joint.element.find("mimic")
-            leader = None if element is None else element.get("joint")
-            if joint.name in follows or not (leader in names or leader in follows):
+            if joint.name in follows or not (joint.leader in names or joint.leader in follows):
                 continue
-            where = f"{joint.label} <mimic>"
-            multiplier, offset = number(element, "multiplier", where, 1.0), number(element, "offset", where, 0.0)
-            above = follows.get(leader, Mimic(leader))  # the joint it comes to: an independent one of the chain
-            follows[joint.name] = Mimic(above.joint, multiplier * above.multiplier, multiplier * above.offset + offset)
+            mimic, above = (
+                joint.mimic,
+                follows.get(joint.leader, Mimic(joint.leader)),
+            )  # above: the chain joint it comes to
+            follows[joint.name] = Mimic(
+                above.joint, mimic.multiplier * above.multiplier, mimic.multiplier * above.offset + mimic.offset
+            )
         if len(follows) == before:
             break
     return {name: mimic for name, mimic in follows.items() if name not in names}
@@ -95,26 +85,35 @@ def mimic_branches(tree: UrdfTree, chain: list, follows: dict, held=None) -> tup
     joints of the model: (them, depth first below each chain link in the file's order; each
     one's parent index among chain + them; each one's origin in its parent's link frame, the
     fixed and held joints between composed, held at ``held``'s positions, else zero)."""
-    names = {joint.name for joint in chain}
-    held = held or {}
-    joints, parents, origins = [], [], []
-    stack = [
-        (j, k, Placement())
-        for k in reversed(range(len(chain)))
-        for j in reversed(tree.child_joints[chain[k].child])
-        if j.name not in names
-    ]
+    names, held = {joint.name for joint in chain}, held or {}
+
+    def held_at(joint, placement: Placement) -> Placement:
+        return compose(compose(placement, joint.origin), motion_placement(joint, held.get(joint.name, 0.0)))
+
+    starts = [(j, k) for k in range(len(chain)) for j in tree.child_joints[chain[k].child] if j.name not in names]
+    return _preorder(tree, starts, lambda j: j.name in follows, held_at, names, len(chain))
+
+
+def _preorder(tree: UrdfTree, starts: list, counted, passed, left_out=frozenset(), first: int = 0) -> tuple:
+    """(the joints ``counted`` below ``starts`` ((joint, the index of the model's joint above
+    it)), depth first in the file's order; each one's parent index; each one's origin in its
+    parent's link frame): another joint is passed through, ``passed(joint, placement)`` the
+    placement past it; the joints named in ``left_out`` and what is below them are not
+    walked; the joints found are numbered from ``first``."""
+    found, parents, origins = [], [], []
+    # a joint's subtree is pushed on top of its next siblings: depth first in the file's order
+    stack = [(joint, above, Placement()) for joint, above in reversed(starts)]
     while stack:
         joint, above, placement = stack.pop()
-        if joint.name in follows:
-            joints.append(joint)
+        if counted(joint):
+            found.append(joint)
             parents.append(above)
             origins.append(compose(placement, joint.origin))
-            above, placement = len(chain) + len(joints) - 1, Placement()
+            above, placement = first + len(found) - 1, Placement()
         else:
-            placement = compose(compose(placement, joint.origin), motion_placement(joint, held.get(joint.name, 0.0)))
-        stack += [(j, above, placement) for j in reversed(tree.child_joints[joint.child]) if j.name not in names]
-    return joints, parents, origins
+            placement = passed(joint, placement)
+        stack += [(j, above, placement) for j in reversed(tree.child_joints[joint.child]) if j.name not in left_out]
+    return found, parents, origins
 
 
 def carried_links(tree: UrdfTree, moving: list, held=None) -> dict[str, tuple[str, Placement]]:
