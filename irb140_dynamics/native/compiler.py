@@ -103,7 +103,7 @@ def build(program, full_matrix: int = 0):
     versions = "\0".join([source, sys.version, np.__version__, *include])
     name = "k" + hashlib.sha256(versions.encode()).hexdigest()[:24]
     extension = c_code.extension_source(program, name, full_matrix)
-    path = library(extension, [f"-I{folder}" for folder in include])
+    path = library(extension, [f"-I{folder}" for folder in include], c_code.EXTENSION_HEADER)
     module = importlib.util.module_from_spec(
         importlib.util.spec_from_loader(name, importlib.machinery.ExtensionFileLoader(name, str(path)))
     )

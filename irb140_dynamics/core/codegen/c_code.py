@@ -132,10 +132,14 @@ def extension_source(program: Program, module: str, full_matrix: int = 0) -> str
     return _EXTENSION.format(call=call, batch=batch, kernel=kernel, module=module)
 
 
-_EXTENSION = """#define PY_SSIZE_T_CLEAN
-#include <Python.h>
-#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
-#include <numpy/arrayobject.h>
+# the extension's header (name, text): Python's and NumPy's API, the bulk of a compile, one
+# header that a compiler may precompile once (see native.library.precompiled_header)
+EXTENSION_HEADER = (
+    "irb140_extension.h",
+    "#define PY_SSIZE_T_CLEAN\n#include <Python.h>\n"
+    "#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION\n#include <numpy/arrayobject.h>\n",
+)
+_EXTENSION = """#include "irb140_extension.h"
 
 {kernel}
 /* x[0:n] from a 1-D native float64 array of n entries; 0 for anything else */
