@@ -58,9 +58,9 @@ def expand(coefficients, centre):
         D = flat[rows]
         b = D.shape[0]
         for k in range(d - 1, -1, -1):  # the last joint first; each pass turns the axes once
-            turned = np.matmul(D.reshape(b, c * size // 3, 3), M[rows, k]).reshape(b, c, size // 3, 3)
-            D = result[rows] if k == 0 else np.empty((b, c * size))  # (the last pass: into the result)
-            D.reshape(b, c, 3, size // 3)[...] = turned.transpose(0, 1, 3, 2)
+            turned = result[rows] if k == 0 else np.empty((b, c * size))  # (the last pass: into the result)
+            np.matmul(D.reshape(b, c, size // 3, 3), M[rows, k, None], out=turned.reshape(b, c, 3, size // 3).mT)
+            D = turned
         if d == 0:
             result[rows] = D
     return result.reshape(shape)
