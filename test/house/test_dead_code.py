@@ -19,6 +19,7 @@ PACKAGE = "irb140_dynamics"
 THIS_FILE = Path(__file__).resolve()  # not a user: its own test names dead code on purpose
 USERS = (PACKAGE, "test", "bench", "launch")
 MIN_CONFIDENCE = 60
+WORD = re.compile(r"\w+")  # a name mentioned in a text: one of its runs of word characters (as \bname\b finds it)
 
 
 def unused_code(paths) -> set[str]:
@@ -38,13 +39,14 @@ def exported_but_unused() -> set[str]:
     the benchmarks mentions."""
     paths = [path for folder in USERS for path in (ROOT / folder).rglob("*.py") if path != THIS_FILE]
     texts = {path: path.read_text() for path in paths}
+    words = {path: set(WORD.findall(text)) for path, text in texts.items()}  # a name is mentioned: one of them
     found = set()
     for path, text in texts.items():
         if not path.is_relative_to(ROOT / PACKAGE):
             continue
         for name in _all_of(text):
-            word = re.compile(rf"\b{re.escape(name)}\b")
-            if not any(word.search(other) for other_path, other in texts.items() if other_path != path):
+            assert WORD.fullmatch(name), f"{path}: __all__ names {name!r}, not a name"
+            if not any(name in other for other_path, other in words.items() if other_path != path):
                 found.add(f"{path.relative_to(ROOT).as_posix()}: {name}")
     return found
 

@@ -84,7 +84,10 @@ def test_id_node_on_a_whole_tree_gives_every_independent_joint_as_pinocchio():
     assert np.abs(g).max() > 1.0  # the arms' weight is in it
 
 
-def test_a_payload_on_a_named_link_of_the_tree_as_pinocchio_and_none_without_a_link():
+def test_a_payload_on_a_named_link_of_the_tree_as_pinocchio_and_none_without_a_link(monkeypatch):
+    """(The kernels' Python form: the same numbers as the native one, which the whole tree's
+    test above runs; each payload link is code of its own, compiled by gcc for seconds.)"""
+    monkeypatch.setenv("IRB140_NATIVE", "0")
     values = dict(payload__link="left_gripper", payload__mass=PAYLOAD.mass, payload__com=list(PAYLOAD.com))
     values["payload__inertia"] = list(PAYLOAD.inertia)
     with running(IdNode, parameter_overrides=from_description(**values)) as harness:

@@ -19,6 +19,10 @@ from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 
 TIMEOUT = 30.0  # s, for anything that should happen at once on an idle machine (generous: 2 busy cores)
+# s: the executor's wait between checks for what wakes it by itself (a service's reply, a
+# task a node hands to its executor): spinning idle every 10 ms costs CPU (rclpy rebuilds
+# its wait set each time) that the node's worker threads would use
+WOKEN = 0.5
 
 
 class Harness:
@@ -32,12 +36,14 @@ class Harness:
         self.executor.add_node(self.probe)
         self.received: dict[str, list] = {}
 
-    def spin_until(self, done: Callable[[], bool], timeout: float = TIMEOUT) -> bool:
+    def spin_until(self, done: Callable[[], bool], timeout: float = TIMEOUT, poll: float = 0.01) -> bool:
+        """Spin until ``done()``, checked after each callback or every ``poll`` s: a longer
+        poll where what ``done`` waits for wakes the executor itself (a reply, a task)."""
         deadline = time.monotonic() + timeout
         while not done():
             if time.monotonic() > deadline:
                 return False
-            self.executor.spin_once(timeout_sec=0.01)
+            self.executor.spin_once(timeout_sec=poll)
         return True
 
     def spin_for(self, seconds: float) -> None:
@@ -61,7 +67,7 @@ class Harness:
 
     def call(self, future_maker: Callable[[], rclpy.task.Future]):
         future = future_maker()
-        assert self.spin_until(future.done), "no reply in time"
+        assert self.spin_until(future.done, poll=WOKEN), "no reply in time"
         return future.result()
 
     def parameter_client(self) -> AsyncParameterClient:
@@ -87,7 +93,7 @@ class Harness:
         """Spin until the node's accepted parameter changes are in force (built off its executor)."""
         rebuild = getattr(self.node, "rebuild", None)
         if rebuild is not None:
-            assert self.spin_until(lambda: rebuild.pending_since is None), "parameters not applied in time"
+            assert self.spin_until(lambda: rebuild.pending_since is None, poll=WOKEN), "parameters not applied in time"
 
     def close(self) -> None:
         self.executor.shutdown(timeout_sec=1.0)

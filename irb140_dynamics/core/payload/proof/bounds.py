@@ -53,14 +53,16 @@ def expand(coefficients, centre):
     flat = coefficients.reshape(B, c * size)
     result = np.empty((B, c * size))
     step = max(1, _CELLS // (c * size))
-    for first in range(0, B, step):  # a few boxes at a time: each pass's copy stays in the caches
+    for first in range(0, B, step):  # a few boxes at a time: each pass's output stays in the caches
         rows = slice(first, first + step)
         D = flat[rows]
         b = D.shape[0]
-        for k in range(d - 1, -1, -1):  # the last joint first; each pass turns the axes once
-            turned = np.matmul(D.reshape(b, c * size // 3, 3), M[rows, k]).reshape(b, c, size // 3, 3)
-            D = result[rows] if k == 0 else np.empty((b, c * size))  # (the last pass: into the result)
-            D.reshape(b, c, 3, size // 3)[...] = turned.transpose(0, 1, 3, 2)
+        for k in range(d - 1, -1, -1):  # the last joint first; each pass turns the axes once (out=: a view)
+            turned = result[rows] if k == 0 else np.empty((b, c * size))  # (the last pass: into the result)
+            np.matmul(
+                D.reshape(b, c, size // 3, 3), M[rows, k, None], out=turned.reshape(b, c, 3, size // 3).swapaxes(2, 3)
+            )
+            D = turned
         if d == 0:
             result[rows] = D
     return result.reshape(shape)
