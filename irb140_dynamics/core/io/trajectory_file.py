@@ -10,8 +10,7 @@ from irb140_dynamics.core.io.yaml_numbers import yaml_float, yaml_value
 
 def joint_trajectory_text(joint_names, times, Q, QD, QDD, comments: Iterable[str] = ()) -> str:
     """A trajectory_msgs/JointTrajectory as the YAML ``ros2 topic pub`` takes (one point a line)."""
-    lines = [f"# {line}".rstrip() for line in comments]
-    lines.append(f"joint_names: {yaml_value(list(joint_names))}")
+    lines = [f"joint_names: {yaml_value(list(joint_names))}"]
     lines.append("points:")
     for t, q, qd, qdd in zip(times, Q, QD, QDD):
         sec, nanosec = sec_nanosec(t)
@@ -20,7 +19,13 @@ def joint_trajectory_text(joint_names, times, Q, QD, QDD, comments: Iterable[str
             for name, values in (("positions", q), ("velocities", qd), ("accelerations", qdd))
         ]
         lines.append(f"- {{{', '.join(fields)}, time_from_start: {{sec: {sec}, nanosec: {nanosec}}}}}")
-    return "\n".join(lines) + "\n"
+    return commented(comments, "\n".join(lines) + "\n")
+
+
+def commented(comments: Iterable[str], text: str) -> str:
+    """``text`` under ``comments``, a YAML comment line each (changed without writing the
+    points again)."""
+    return "".join(f"# {line}".rstrip() + "\n" for line in comments) + text
 
 
 def read_joint_trajectory(path) -> object:
