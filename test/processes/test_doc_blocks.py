@@ -128,10 +128,16 @@ def run_shell(script: str, cwd: Path, env: dict, timeout: float = LINE_TIMEOUT) 
     return shell.returncode, stdout + stderr
 
 
+HELPS: dict[tuple[str, Path], tuple[int, str]] = {}  # (program, clone): its --help, run once per doc
+
+
 def check_synopsis(line: str, cwd: Path, env: dict) -> str | None:
-    """A usage synopsis: its executable's --help exits 0 and names every option it shows."""
+    """A usage synopsis: its executable's --help exits 0 and names every option it shows
+    (a doc showing a program's synopsis twice: its --help run once)."""
     program = line.split(" [", 1)[0].strip()  # what comes before the first optional part
-    code, output = run_shell(f"{program} --help", cwd, env, timeout=HELP_TIMEOUT)
+    if (program, cwd) not in HELPS:
+        HELPS[program, cwd] = run_shell(f"{program} --help", cwd, env, timeout=HELP_TIMEOUT)
+    code, output = HELPS[program, cwd]
     if code != 0 or "Traceback" in output:
         return f"`{program} --help` exited {code}:\n{output}"
     missing = [option for option in synopsis_options(line) if option not in output and option not in ("-h",)]
