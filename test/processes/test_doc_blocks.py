@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import hashlib
+import itertools
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -146,6 +148,22 @@ def check_synopsis(line: str, cwd: Path, env: dict) -> str | None:
     return None
 
 
+HEREDOC_JOB = re.compile(r"<<-?\s*'?(\w+)'?\s*&$")  # COMMAND <<'EOF' &: a here-document's command in the background
+
+
+def shell_commands(text: str) -> list[str]:
+    """logical_lines, with a here-document run in the background (``COMMAND <<'EOF' &``,
+    its lines, ``EOF``) joined into one command (``COMMAND <<'EOF'``, lines, ``EOF``, ``&``)."""
+    commands, lines = [], iter(logical_lines(text))
+    for line in lines:
+        heredoc = HEREDOC_JOB.search(line)
+        if heredoc:
+            body = list(itertools.takewhile(lambda body_line, end=heredoc[1]: body_line != end, lines))
+            line = "\n".join([line[:-1].rstrip(), *body, heredoc[1]]) + " &"
+        commands.append(line)
+    return commands
+
+
 def background_job(line: str) -> str | None:
     """The command of a line run in the background (``COMMAND &``), or None."""
     return line[:-1].strip() if line.endswith("&") and not line.endswith("&&") else None
@@ -169,9 +187,9 @@ def wait_for_job(job: tuple, timeout: float = LINE_TIMEOUT) -> str | None:
 
 def run_block(block: Block, cwd: Path, env: dict) -> str | None:
     """None when the block ran as the doc says, else what went wrong. A node runs as in a
-    terminal of its own (until its 'ready'); ``COMMAND &`` runs in the background, and
-    ``wait $!`` waits for the last one, as in the user's shell; the lines between, in a
-    shell, one after the other."""
+    terminal of its own (until its 'ready'); ``COMMAND &`` (a here-document's included)
+    runs in the background, and ``wait $!`` waits for the last one, as in the user's shell;
+    the lines between, in a shell, one after the other."""
     if block.kind == "python":
         done = subprocess.run(  # the python of the user's shell: .venv's
             ["python", "-c", block.text], cwd=cwd, env=env, capture_output=True, text=True, timeout=LINE_TIMEOUT
@@ -179,13 +197,13 @@ def run_block(block: Block, cwd: Path, env: dict) -> str | None:
         return None if done.returncode == 0 else f"exit {done.returncode}:\n{done.stdout}{done.stderr}"
     nodes, jobs, pending = [], [], []
     try:
-        for line in logical_lines(block.text):
-            if is_synopsis(line):
+        for line in shell_commands(block.text):
+            job = background_job(line)
+            if job is None and is_synopsis(line):
                 problem = check_synopsis(line, cwd, env)
                 if problem:
                     return problem
                 continue
-            job = background_job(line)
             if node_of(line) is None and job is None and not waits_for_the_last_job(line):
                 pending.append(line)
                 continue
@@ -199,7 +217,7 @@ def run_block(block: Block, cwd: Path, env: dict) -> str | None:
                 process = subprocess.Popen(
                     ["bash", "-c", f"exec {job}"], cwd=cwd, env=env, stdout=output, stderr=subprocess.STDOUT, text=True
                 )
-                jobs.append((line, process, output))
+                jobs.append((line.split("\n", 1)[0], process, output))
                 continue
             if waits_for_the_last_job(line):
                 problem = wait_for_job(jobs[-1]) if jobs else "`wait $!` with no job started"
