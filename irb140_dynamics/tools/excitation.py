@@ -206,7 +206,7 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
 
     import numpy as np
 
-    from irb140_dynamics.core.io.trajectory_file import joint_trajectory_text
+    from irb140_dynamics.core.io.trajectory_file import commented, joint_trajectory_text
     from irb140_dynamics.identification.base import find_base_parameters
     from irb140_dynamics.identification.excitation import check_limits, optimise_excitation
     from irb140_dynamics.tools.outputs import Outputs
@@ -263,12 +263,13 @@ def _excitation(args: argparse.Namespace, interrupts) -> int:
         "and record: ros2 bag record /joint_states",
         *expectation,
     ]
-    text = joint_trajectory_text(model.joint_names, times, Q, QD, QDD, comments)
+    points = joint_trajectory_text(model.joint_names, times, Q, QD, QDD)  # written once: 2 MB takes a second
+    text = commented(comments, points)
     if len(text) > SHELL_ARGUMENT_LIMIT:  # too long for "$(cat FILE)": the header says the way that works
         comments[comments.index("Move the arm to the first point first. Publish it, e.g.:") + 1] = PUBLISH.format(
             argument="--yaml-file FILE   (too long for one shell argument)"
         )
-        text = joint_trajectory_text(model.joint_names, times, Q, QD, QDD, comments)
+        text = commented(comments, points)
     with Outputs(interrupts) as outputs:
         outputs.text(out, args.out, text)
         print(  # before the commit: `| head` stops the tool with nothing written

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import hashlib
+import itertools
 import os
+import re
 import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -127,10 +130,16 @@ def run_shell(script: str, cwd: Path, env: dict, timeout: float = LINE_TIMEOUT) 
     return shell.returncode, stdout + stderr
 
 
+HELPS: dict[tuple[str, Path], tuple[int, str]] = {}  # (program, clone): its --help, run once per doc
+
+
 def check_synopsis(line: str, cwd: Path, env: dict) -> str | None:
-    """A usage synopsis: its executable's --help exits 0 and names every option it shows."""
+    """A usage synopsis: its executable's --help exits 0 and names every option it shows
+    (a doc showing a program's synopsis twice: its --help run once)."""
     program = line.split(" [", 1)[0].strip()  # what comes before the first optional part
-    code, output = run_shell(f"{program} --help", cwd, env, timeout=HELP_TIMEOUT)
+    if (program, cwd) not in HELPS:
+        HELPS[program, cwd] = run_shell(f"{program} --help", cwd, env, timeout=HELP_TIMEOUT)
+    code, output = HELPS[program, cwd]
     if code != 0 or "Traceback" in output:
         return f"`{program} --help` exited {code}:\n{output}"
     missing = [option for option in synopsis_options(line) if option not in output and option not in ("-h",)]
@@ -139,22 +148,63 @@ def check_synopsis(line: str, cwd: Path, env: dict) -> str | None:
     return None
 
 
+HEREDOC_JOB = re.compile(r"<<-?\s*'?(\w+)'?\s*&$")  # COMMAND <<'EOF' &: a here-document's command in the background
+
+
+def shell_commands(text: str) -> list[str]:
+    """logical_lines, with a here-document run in the background (``COMMAND <<'EOF' &``,
+    its lines, ``EOF``) joined into one command (``COMMAND <<'EOF'``, lines, ``EOF``, ``&``)."""
+    commands, lines = [], iter(logical_lines(text))
+    for line in lines:
+        heredoc = HEREDOC_JOB.search(line)
+        if heredoc:
+            body = list(itertools.takewhile(lambda body_line, end=heredoc[1]: body_line != end, lines))
+            line = "\n".join([line[:-1].rstrip(), *body, heredoc[1]]) + " &"
+        commands.append(line)
+    return commands
+
+
+def background_job(line: str) -> str | None:
+    """The command of a line run in the background (``COMMAND &``), or None."""
+    return line[:-1].strip() if line.endswith("&") and not line.endswith("&&") else None
+
+
+def waits_for_the_last_job(line: str) -> bool:
+    """``wait $!`` (a comment after it allowed)."""
+    return line.split("#", 1)[0].split() == ["wait", "$!"]
+
+
+def wait_for_job(job: tuple, timeout: float = LINE_TIMEOUT) -> str | None:
+    """``wait $!`` on a job started by run_block: None when it exits 0, else what went wrong."""
+    line, process, output = job
+    try:
+        code = process.wait(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return f"`{line}` still running after {timeout:g} s"
+    output.seek(0)
+    return None if code == 0 else f"`{line}` exited {code}:\n{output.read()}"
+
+
 def run_block(block: Block, cwd: Path, env: dict) -> str | None:
-    """None when the block ran as the doc says, else what went wrong."""
+    """None when the block ran as the doc says, else what went wrong. A node runs as in a
+    terminal of its own (until its 'ready'); ``COMMAND &`` (a here-document's included)
+    runs in the background, and ``wait $!`` waits for the last one, as in the user's shell;
+    the lines between, in a shell, one after the other."""
     if block.kind == "python":
         done = subprocess.run(  # the python of the user's shell: .venv's
             ["python", "-c", block.text], cwd=cwd, env=env, capture_output=True, text=True, timeout=LINE_TIMEOUT
         )
         return None if done.returncode == 0 else f"exit {done.returncode}:\n{done.stdout}{done.stderr}"
-    nodes, pending = [], []
+    nodes, jobs, pending = [], [], []
     try:
-        for line in logical_lines(block.text):
-            if is_synopsis(line):
+        for line in shell_commands(block.text):
+            job = background_job(line)
+            if job is None and is_synopsis(line):
                 problem = check_synopsis(line, cwd, env)
                 if problem:
                     return problem
                 continue
-            if node_of(line) is None:
+            if node_of(line) is None and job is None and not waits_for_the_last_job(line):
                 pending.append(line)
                 continue
             if pending:
@@ -162,6 +212,18 @@ def run_block(block: Block, cwd: Path, env: dict) -> str | None:
                 if code != 0:
                     return f"exit {code} of:\n{chr(10).join(pending)}\n{output}"
                 pending = []
+            if job is not None:
+                output = tempfile.TemporaryFile("w+")  # noqa: SIM115  (closed in the finally below)
+                process = subprocess.Popen(
+                    ["bash", "-c", f"exec {job}"], cwd=cwd, env=env, stdout=output, stderr=subprocess.STDOUT, text=True
+                )
+                jobs.append((line.split("\n", 1)[0], process, output))
+                continue
+            if waits_for_the_last_job(line):
+                problem = wait_for_job(jobs[-1]) if jobs else "`wait $!` with no job started"
+                if problem:
+                    return problem
+                continue
             process = subprocess.Popen(
                 ["bash", "-c", f"exec {line}"],
                 cwd=cwd,
@@ -180,6 +242,11 @@ def run_block(block: Block, cwd: Path, env: dict) -> str | None:
                 return f"exit {code} of:\n{chr(10).join(pending)}\n{output}"
     finally:
         stopped = [(line, *interrupt(process, lines)) for line, process, lines in reversed(nodes)]
+        for line, process, output in jobs:  # one still running (not waited for): Ctrl-C, as to the nodes
+            code = process.returncode if process.poll() is not None else interrupt(process)[0]
+            output.seek(0)
+            stopped.append((line, code, output.read()))
+            output.close()
     for line, code, output in stopped:
         if code != 0 or "Traceback" in output:
             return f"`{line}` exited {code} on Ctrl-C:\n{output}"

@@ -53,7 +53,8 @@ def stamp(msg) -> int:
 
 
 @pytest.mark.slow
-def test_gravity_compensation_holds_the_arm(probe, process):  # noqa: F811
+def test_gravity_compensation_holds_the_arm(stream_probe, process):  # noqa: F811
+    probe = stream_probe
     states = {}  # by stamp: sim_node publishes a state again, same stamp, while no command answers it
     probe.create_subscription(JointState, "joint_states", lambda msg: states.__setitem__(stamp(msg), msg), 10000)
     sim = process(

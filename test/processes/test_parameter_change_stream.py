@@ -67,9 +67,10 @@ def node_counts(probe, namespace: str):
     return latest
 
 
-def test_no_joint_state_goes_unanswered_while_the_payload_changes_every_100_ms(probe, id_node):
+def test_no_joint_state_goes_unanswered_while_the_payload_changes_every_100_ms(stream_probe, id_node):
     """Every joint state sent is received and answered by the node (its own counts, as it
     reports them on /diagnostics: what reaches a slower subscriber is DDS's concern)."""
+    probe = stream_probe
     namespace = id_node
     counts = node_counts(probe, namespace)
     answered = [0]
