@@ -109,7 +109,7 @@ def precompiled_header(folder: Path, cc: str, name: str, text: str, flags: list[
         compile_flags = [flag for flag in FLAGS if flag != "-shared"]
         try:
             _compile([cc, *compile_flags, *flags, "-x", "c-header", name, "-o", f"{name}.gch"], work)
-        except (subprocess.SubprocessError, OSError):
+        except subprocess.SubprocessError:  # (an OSError, the interpreter exiting included, stops the compile)
             return None
         made = folder / f"header-{key}-{_size(work / f'{name}.gch')}"
         try:
@@ -143,6 +143,8 @@ def _compile(args: list[str], work: Path) -> None:
     finally:
         _BUILDS.done(process)
     if process.returncode != 0:
+        if _BUILDS.stopped:  # killed at exit: no compile follows
+            raise OSError("the interpreter is exiting")
         raise subprocess.SubprocessError(error.decode(errors="replace").strip()[:300])
 
 
@@ -220,6 +222,10 @@ class _Builds:
         with contextlib.suppress(OSError):  # a node's loop comes first; the group: the driver's
             os.setpriority(os.PRIO_PGRP, process.pid, NICENESS)  # children started already too
         return process
+
+    @property
+    def stopped(self) -> bool:
+        return self._stopped
 
     def done(self, process: subprocess.Popen) -> None:
         with self._lock:
