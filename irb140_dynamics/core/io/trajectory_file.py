@@ -35,13 +35,13 @@ def read_joint_trajectory(path) -> object:
     import yaml
 
     try:
-        with open(path) as stream:  # (libyaml's loader where PyYAML has it: 5x faster on a long file)
-            loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-            written = _as_written(stream.read(), loader)
-            if written is not None:
-                return written
-            stream.seek(0)
-            return next((d for d in yaml.load_all(stream, Loader=loader) if d is not None), None)
+        with open(path) as stream:
+            text = stream.read()
+        loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # (libyaml's where PyYAML has it: 5x faster)
+        written = _as_written(text, loader)
+        if written is not None:
+            return written
+        return next((d for d in yaml.load_all(text, Loader=loader) if d is not None), None)
     except OSError as error:
         raise ValueError(f"{path}: cannot read: {error.strerror}") from None
     except yaml.YAMLError as error:
