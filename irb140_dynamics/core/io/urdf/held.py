@@ -26,7 +26,7 @@ from collections.abc import Collection, Mapping
 
 import numpy as np
 
-from irb140_dynamics.core.io.urdf.tree import MOVING, UrdfError, UrdfJoint, UrdfTree, clipped, number
+from irb140_dynamics.core.io.urdf.tree import MOVING, UrdfError, UrdfJoint, UrdfTree, clipped, in_leader_order, number
 from irb140_dynamics.core.model.joints import Placement, axis_rotation, matrix_rpy
 
 
@@ -61,20 +61,13 @@ def held_positions(
             if limited and at_limit is not None:
                 at_limit.append(joint.name)
     followers = [j for j in tree.joints.values() if j.kind in MOVING and j.name not in in_model]
-    for _ in range(len(followers)):  # a mimic of a mimic follows in a later pass
-        before = len(positions)
-        for joint in followers:
-            leader = joint.leader
-            if leader not in positions or joint.name in positions:
-                continue
-            mimic = joint.mimic
-            position = mimic.multiplier * positions[leader] + mimic.offset
-            given_by[joint.name] = source = given_by[leader]
-            if source is not None:  # a default places a mimic joint where the URDF's tree at that position does
-                position = _within_limits(joint, position, f" for mimic joint {joint.name!r}", source)
-            positions[joint.name] = position
-        if len(positions) == before:
-            break
+    for joint in in_leader_order(followers, list(positions)):
+        mimic = joint.mimic
+        position = mimic.multiplier * positions[joint.leader] + mimic.offset
+        given_by[joint.name] = source = given_by[joint.leader]
+        if source is not None:  # a default places a mimic joint where the URDF's tree at that position does
+            position = _within_limits(joint, position, f" for mimic joint {joint.name!r}", source)
+        positions[joint.name] = position
     return positions
 
 

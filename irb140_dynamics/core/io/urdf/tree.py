@@ -103,6 +103,22 @@ class UrdfJoint:
         )
 
 
+def in_leader_order(joints: list[UrdfJoint], leaders) -> list[UrdfJoint]:
+    """The mimic joints of ``joints`` that follow a joint named in ``leaders``, or one of them
+    that does (a mimic of a mimic), each after the joint it follows: in passes over
+    ``joints`` in their order, a mimic of a mimic joining in a later pass."""
+    known, order = set(leaders), []
+    for _ in range(len(joints)):
+        before = len(order)
+        for joint in joints:
+            if joint.name not in known and joint.leader in known:
+                known.add(joint.name)
+                order.append(joint)
+        if len(order) == before:
+            break
+    return order
+
+
 @dataclass(frozen=True)
 class UrdfTree:
     """Links (their inertial in the link frame, or None), joints, and the tree's shape."""

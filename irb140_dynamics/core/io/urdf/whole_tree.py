@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from irb140_dynamics.core.io.urdf.held import motion_placement
-from irb140_dynamics.core.io.urdf.tree import MOVING, UrdfError, UrdfTree, clipped
+from irb140_dynamics.core.io.urdf.tree import MOVING, UrdfError, UrdfTree, clipped, in_leader_order
 from irb140_dynamics.core.model.joints import Placement, matrix_rpy
 from irb140_dynamics.core.model.tree import Mimic
 
@@ -52,20 +52,11 @@ def chain_followers(tree: UrdfTree, chain: list, mimics: tuple | None) -> dict:
     names = {joint.name for joint in chain}
     follows = {j.name: m for j, m in zip(chain, mimics or ()) if m is not None}
     pending = [j for j in tree.joints.values() if j.kind in MOVING and j.name not in names]
-    for _ in range(len(pending)):  # a mimic of a mimic joins in a later pass
-        before = len(follows)
-        for joint in pending:
-            if joint.name in follows or not (joint.leader in names or joint.leader in follows):
-                continue
-            mimic, above = (
-                joint.mimic,
-                follows.get(joint.leader, Mimic(joint.leader)),
-            )  # above: the chain joint it comes to
-            follows[joint.name] = Mimic(
-                above.joint, mimic.multiplier * above.multiplier, mimic.multiplier * above.offset + mimic.offset
-            )
-        if len(follows) == before:
-            break
+    for joint in in_leader_order(pending, names):
+        mimic, above = joint.mimic, follows.get(joint.leader, Mimic(joint.leader))  # above: the chain joint it comes to
+        follows[joint.name] = Mimic(
+            above.joint, mimic.multiplier * above.multiplier, mimic.multiplier * above.offset + mimic.offset
+        )
     return {name: mimic for name, mimic in follows.items() if name not in names}
 
 
