@@ -10,7 +10,7 @@ the constant 0 (about its joint origin, in its joint frame): the double-angle fo
 from __future__ import annotations
 
 from irb140_dynamics.core.algorithms.rotations import INERTIA_INDEX, rotate, rotate_back, turned, turned_about
-from irb140_dynamics.core.algorithms.vectors import add, cross, inertia_times, scale
+from irb140_dynamics.core.algorithms.vectors import add, cross, inertia_times, scale, swept
 from irb140_dynamics.core.model.rigid_body import shift_inertia
 
 
@@ -50,7 +50,7 @@ def leaf_wrench(link, move, motion, qd_i, qdd_i, carried, axis: int):
     rot, p0 = move
     w, dw, a = motion
     if p0 is not None:
-        a = add(cross(dw, p0), cross(w, cross(w, p0)), a)
+        a = add(swept(w, dw, p0), a)
     if link.R0 is not None:
         w, dw, a = (rotate_back(link.R0, v) for v in (w, dw, a))
     spin = scale(qd_i, link.u)
@@ -60,7 +60,7 @@ def leaf_wrench(link, move, motion, qd_i, qdd_i, carried, axis: int):
     if link.R1 is not None:
         h, inertia = rotate(link.R1, h), turned(link.R1, inertia)
     h, inertia = rotate(rot, h), turned_about(rot, inertia, axis)
-    force = add(cross(w, cross(w, h)), cross(dw, h), scale(m, a))
+    force = add(swept(w, dw, h), scale(m, a))
     # w x (I w) by columns: the turned inertia's entries are computed, not the constants
     # gyroscopic reads (a zero there may be a kernel's input)
     moment = add(inertia_times(inertia, dw), cross(w, inertia_times(inertia, w)), cross(h, a))

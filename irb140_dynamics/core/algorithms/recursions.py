@@ -49,7 +49,7 @@ from irb140_dynamics.core.algorithms.rotations import (  # noqa: F401 (part of t
     turned_about,
 )
 from irb140_dynamics.core.algorithms.topology import ancestors, children, parents  # noqa: F401 (part of this module's interface)
-from irb140_dynamics.core.algorithms.vectors import add, cross, dot, gyroscopic, inertia_times, scale  # noqa: F401 (part of this module's interface)
+from irb140_dynamics.core.algorithms.vectors import add, cross, dot, gyroscopic, inertia_times, scale, swept  # noqa: F401 (part of this module's interface)
 from irb140_dynamics.core.model.joints import Z_AXIS, snap
 from irb140_dynamics.core.model.rigid_body import ZERO3, Inertia6, Vector3, shift_inertia
 from irb140_dynamics.core.scalars.dual import Dual  # noqa: F401 (part of this module's interface)
@@ -199,7 +199,7 @@ def rnea(links, cs, qd, qdd, gravity, f_ext=ZERO3, n_ext=ZERO3, at: int = -1):
             continue
         w, dw, a = motion[i]
         f, n = carried[i] or (ZERO3, ZERO3)
-        force = add(cross(w, cross(w, link.h)), cross(dw, link.h), scale(link.m, a))
+        force = add(swept(w, dw, link.h), scale(link.m, a))
         moment = add(inertia_times(link.I, dw), gyroscopic(link.I, w), cross(link.h, a))
         f = add(force, f)
         n = add(moment, cross(link.p, f), n)
@@ -226,7 +226,7 @@ def forward_motion(links, moves, qd, qdd, gravity, at_joints=False):
     for i, (link, (rot, p0), qd_i, qdd_i) in enumerate(zip(links, moves, qd, qdd)):
         w, dw, a = base if parent[i] < 0 else at_origins[parent[i]]
         if p0 is not None:  # the joint origin's acceleration, in frame i-1
-            a = add(cross(dw, p0), cross(w, cross(w, p0)), a)
+            a = add(swept(w, dw, p0), a)
         if link.prismatic:  # sliding: qdd e, and Coriolis 2 w x (qd e)
             a = add(a, scale(qdd_i, link.e), cross(scale(2.0 * qd_i, w), link.e))
             w, dw = to_child(link, None, w), to_child(link, None, dw)
@@ -235,7 +235,7 @@ def forward_motion(links, moves, qd, qdd, gravity, at_joints=False):
             w = add(w_parent, scale(qd_i, link.b))
             dw = add(to_child(link, rot, dw), scale(qdd_i, link.b), cross(w_parent, scale(qd_i, link.b)))
         a_joint = to_child(link, rot, a)
-        a = add(cross(dw, link.p), cross(w, cross(w, link.p)), a_joint)
+        a = add(swept(w, dw, link.p), a_joint)
         at_origins.append((w, dw, a))
         motion.append((w, dw, a_joint if at_joints else a))
     return motion

@@ -16,6 +16,7 @@ from irb140_dynamics.core.algorithms.recursions import (
     inertia_times,
     rotate,
     steps,
+    swept,
 )
 
 INERTIAL_PARAMETERS = 10  # per link: m, the first moment m c (3), the inertia's 6 entries
@@ -54,7 +55,7 @@ def _unit_wrenches(w, dw, a):
     """The wrench (about the joint origin) that each unit inertial parameter needs."""
     yield a, (0.0, 0.0, 0.0)  # m
     for e in _UNIT_VECTORS:  # m c
-        yield add(cross(dw, e), cross(w, cross(w, e))), cross(e, a)
+        yield swept(w, dw, e), cross(e, a)
     for E in _UNIT_INERTIAS:
         yield (0.0, 0.0, 0.0), add(inertia_times(E, dw), cross(w, inertia_times(E, w)))
 

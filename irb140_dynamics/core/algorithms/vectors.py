@@ -29,6 +29,19 @@ def inertia_times(inertia, v):
     )
 
 
+def swept(w, dw, v):
+    """dw x v + w x (w x v), the acceleration of a point v fixed on a body turning at w, dw
+    (less its origin's), by the 3 x 3 (dw~ + w~ w~) whose w~ w~ = w w^T - |w|^2 1 takes six
+    products of w's components: one body's sweeps of several points share them."""
+    xx, yy, zz = w[0] * w[0], w[1] * w[1], w[2] * w[2]
+    xy, xz, yz = w[0] * w[1], w[0] * w[2], w[1] * w[2]
+    return (
+        (xy - dw[2]) * v[1] + (xz + dw[1]) * v[2] - (yy + zz) * v[0],
+        (xy + dw[2]) * v[0] + (yz - dw[0]) * v[2] - (xx + zz) * v[1],
+        (xz - dw[1]) * v[0] + (yz + dw[0]) * v[1] - (xx + yy) * v[2],
+    )
+
+
 def gyroscopic(inertia, w):
     """w x (I w), as ((Izz - Iyy) w_y w_z, ...) where the products of inertia are the constant 0
     (the payload's link's moments of inertia may be a kernel's inputs: their differences are
