@@ -23,7 +23,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from irb140_dynamics.core.codegen.trace import Sym, merging, trace
+from irb140_dynamics.core.codegen.trace import Sym, merging, quarter_turns, trace
 
 ANGLES = ("cos", "sin")
 
@@ -73,6 +73,8 @@ def traced(
     _, outputs = trace(algorithm, inputs, angles, mimic_angles)
     groups = ((("q", len(angles)),) if angles is not None else ()) + tuple(inputs.items())
     builder = _Builder(mimic_angles)
+    if angles is not None:  # c_i and s_i are the cos and sin of q_i + the offset's rest
+        angles = [None if offset is None else quarter_turns(offset)[0] for offset in angles]
     index: dict[Sym, int] = {}  # each node -> its operation (a merged one's: its first's)
     ops = builder.ops
     for x, first in merging(outputs):

@@ -137,6 +137,27 @@ def _is_const(x) -> bool:
     return False
 
 
+QUARTER_TURN = math.pi / 2
+
+
+def quarter_turns(offset: float) -> tuple[float, int]:
+    """(rest, m) with offset = m * QUARTER_TURN + rest: an offset of a whole number of quarter
+    turns (m in -2..2, as the float pi / 2 times m) is (0.0, m), any other (offset, 0). The
+    angle of such a joint is then q itself, its cos and sin those of q turned m quarters
+    (exact: a swap and signs), where q + offset would be rounded and need an addition."""
+    for m in (1, -1, 2, -2):
+        if offset == m * QUARTER_TURN:
+            return 0.0, m
+    return offset, 0
+
+
+def quarter_turned(c, s, m: int) -> tuple:
+    """(cos, sin) of theta + m quarter turns from (c, s) = (cos, sin) of theta."""
+    for _ in range(m % 4):
+        c, s = -s, c
+    return c, s
+
+
 def trace(
     algorithm: Callable[..., Sequence],
     inputs: dict[str, int],
@@ -147,7 +168,8 @@ def trace(
 
     ``inputs`` names the argument groups and their lengths, e.g. {"qd": 6, "qdd": 6}.
     With ``angles`` (the theta offsets), a first argument ``q`` is added and the algorithm
-    receives the (cos, sin) pairs of q_i + offset_i (symbols c_i, s_i) as its first argument;
+    receives the (cos, sin) pairs of q_i + offset_i as its first argument (symbols c_i, s_i:
+    those of q_i + rest_i, turned by the offset's quarter turns, see ``quarter_turns``);
     an offset None marks a prismatic joint, whose entry is (q_i,). ``mimic_angles``, each
     (k, multiplier, offset, prismatic), append the entries of joints following q_k: the
     (cos, sin) of multiplier q_k + offset (symbols mc_j, ms_j), or (multiplier q_k + offset,)
@@ -158,7 +180,9 @@ def trace(
     if angles is not None:
         params.append("q")
         args["cs"] = [
-            (Sym("var", name=f"q{i}"),) if offset is None else (Sym("var", name=f"c{i}"), Sym("var", name=f"s{i}"))
+            (Sym("var", name=f"q{i}"),)
+            if offset is None
+            else quarter_turned(Sym("var", name=f"c{i}"), Sym("var", name=f"s{i}"), quarter_turns(offset)[1])
             for i, offset in enumerate(angles)
         ] + [
             (Sym("var", name=f"mq{j}"),) if prismatic else (Sym("var", name=f"mc{j}"), Sym("var", name=f"ms{j}"))
