@@ -35,6 +35,7 @@ from irb140_dynamics.core.urdf import load_urdf
 from ..support import pinocchio_model
 from ..support.common import full_sweep, loaded_irb140, random_model, random_urdf_model
 from ..support.pinocchio_trees import pinocchio_state
+from ..support.two_arms import TWO_ARMS
 from .test_urdf_any_chain import KINDS, chain_urdf
 from .test_urdf_corpus import FILES, chains
 
@@ -208,6 +209,30 @@ def test_urdf_chains_with_prismatic_and_continuous_joints_agree_with_pinocchio(k
     model = load_urdf(text, "base", "tip").model
     assert [j.kind for j in model.joints].count("prismatic") == KINDS[kinds].count("prismatic")
     compare(model, of_urdf(text, model), rng, label=kinds)
+
+
+def _tree(torso_turns: bool) -> str:
+    """TWO_ARMS (support.two_arms) with its fingers as joints of their own (no mimic): a
+    torso turning with two arms on it, or (``torso_turns`` False) held, so that each arm
+    hangs from the base."""
+    text = TWO_ARMS.replace('<mimic joint="r2" multiplier="-0.5" offset="0.01"/>', "")
+    text = text.replace('<mimic joint="r2" multiplier="2.0" offset="0.2"/>', "")
+    return (
+        text
+        if torso_turns
+        else text.replace('<joint name="torso" type="revolute">', '<joint name="torso" type="fixed">')
+    )
+
+
+@pytest.mark.parametrize("torso_turns", [True, False], ids=["on a turning torso", "from the base"])
+def test_trees_agree_with_pinocchio(torso_turns):
+    """A whole tree's derivatives (closed forms on its branches, in the base frame), a
+    prismatic finger and its damping included."""
+    text = _tree(torso_turns)
+    model = load_urdf(text).model
+    assert model.mimics is None and any(link.parent is not None for link in algorithms.chain(model))
+    assert [p < 0 for p in model.parent].count(True) == (1 if torso_turns else 2)
+    compare(model, of_urdf(text, model), np.random.default_rng(63 + torso_turns), label="tree")
 
 
 @pytest.mark.slow

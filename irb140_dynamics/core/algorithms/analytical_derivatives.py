@@ -23,12 +23,18 @@ and (k_i, l_i) = I_i v_i its momentum. Summed over the subtree (Y_j, BC_j compos
     M_jk = S_j . Y_k S_k                                       j <= k
 
 (for k <= j, d S_j / dq_k = S_k x S_j cancels the S_k x* F_j of F_j's derivative).
+
+On a tree "k <= j" reads "k is j or one of its ancestors", "k > j" "k is in j's subtree",
+and tau_j does not depend on a joint k that is neither; the composites sum over subtrees.
+A tree's are computed with each subtree on the base in the frame of its first link
+(``reference`` -1).
 """
 
 from __future__ import annotations
 
 from irb140_dynamics.core.algorithms.linear import inverse, negated, times, times_vector
 from irb140_dynamics.core.algorithms.recursions import add, cross, dot, rotate, scale, steps, to_child, turned
+from irb140_dynamics.core.algorithms.topology import parents
 from irb140_dynamics.core.model.rigid_body import ZERO3, shift_inertia
 
 IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
@@ -77,24 +83,33 @@ def _inertia_times(inertia, x):
 
 
 def _bodies(links, cs, gravity, r: int):
-    """(per link: its joint's axis S and its inertia (m, h, Ibar) about the origin, gravity),
-    all in the frame of link ``r``. The scalar products the derivatives are made of do not
-    depend on the frame; the links near the reference have few rotations between them and
-    it, so their quantities have few terms."""
-    moves = steps(links, cs)
-    for link, (rot, _) in zip(links[: r + 1], moves[: r + 1]):
-        gravity = to_child(link, rot, gravity)
+    """(per link: its joint's axis S and its inertia (m, h, Ibar) about the origin; {each
+    link on the base: gravity}), a chain's all in the frame of link ``r``; with ``r`` -1 (a
+    tree) each subtree on the base in the frame of its first link (the derivatives relate a
+    link only to its ancestors and its subtree). The scalar products the derivatives are
+    made of do not depend on the frame; the links near the reference have few rotations
+    between them and it, so their quantities have few terms."""
+    moves, parent = steps(links, cs), parents(links)
     placements, axes = [None] * len(links), [None] * len(links)
-    placements[r] = IDENTITY, ZERO3
-    for i in range(r + 1, len(links)):  # R_i = R_{i-1} L_i, o_i = o_{i-1} + R_{i-1} p0 + R_i p
-        R, o = placements[i - 1]
+    if r >= 0:
+        for link, (rot, _) in zip(links[: r + 1], moves[: r + 1]):
+            gravity = to_child(link, rot, gravity)
+        placements[r], gravities = (IDENTITY, ZERO3), {0: gravity}
+    else:
+        gravities = {i: to_child(links[i], moves[i][0], gravity) for i, p in enumerate(parent) if p < 0}
+        for i in gravities:
+            placements[i] = IDENTITY, ZERO3
+    for i in range(r + 1, len(links)):  # R_i = R_parent L_i, o_i = o_parent + R_parent p0 + R_i p
+        if placements[i] is not None:  # a tree's link on the base
+            continue
+        R, o = placements[parent[i]]
         (rot, p0), link = moves[i], links[i]
         joint_origin = o if p0 is None else add(o, rotate(R, p0))
         z = rotate(R if link.R0 is None else _product(R, link.R0), link.u)  # before Rot: fewer terms
         axes[i] = (ZERO3, z) if link.prismatic else (z, cross(joint_origin, z))
         R = _local(R, link, rot)
         placements[i] = R, add(joint_origin, rotate(R, link.p))
-    for i in reversed(range(r)):  # R_i = R_{i+1} L_{i+1}^T, o_i = o_{i+1} - R_{i+1} p - R_i p0
+    for i in reversed(range(r)):  # (a chain) R_i = R_{i+1} L_{i+1}^T, o_i = o_{i+1} - R_{i+1} p - R_i p0
         R, o = placements[i + 1]
         (rot, p0), link = moves[i + 1], links[i + 1]
         o = add(o, scale(-1.0, rotate(R, link.p)))
@@ -107,7 +122,7 @@ def _bodies(links, cs, gravity, r: int):
             joint_origin = add(o, scale(-1.0, rotate(R, link.p)))
             S = (ZERO3, z) if link.prismatic else (z, cross(joint_origin, z))
         out.append((S, shift_inertia(link.m, rotate(R, link.h), turned(R, link.I), o)))
-    return out, gravity
+    return out, gravities
 
 
 def _local(R, link, rot):
@@ -126,33 +141,52 @@ def _local_back(R, link, rot):
     return R
 
 
-def _motion(bodies, qd, qdd, gravity):
+def _motion(bodies, parent, qd, qdd, gravities):
     """The forward pass: per link psid, psidd, and its body's (momentum, force, Coriolis
-    block); qdd None: zero."""
-    v, a = (ZERO3, ZERO3), (ZERO3, scale(-1.0, gravity))
-    psid, psidd, parts = [], [], []
+    block); qdd None: zero. ``gravities``: see _bodies."""
+    psid, psidd, parts, motion = [], [], [], []
     for i, ((S, inertia), qd_i) in enumerate(zip(bodies, qd)):
+        v, a = ((ZERO3, ZERO3), (ZERO3, scale(-1.0, gravities[i]))) if parent[i] < 0 else motion[parent[i]]
         psid.append(_mcross(v, S))
         psidd.append(_add(_mcross(a, S), _mcross(v, psid[-1])))
         v = _add(v, _scale(qd_i, S))
         a = _add(a, _scale(qd_i, psid[-1])) if qdd is None else _add(a, _scale(qdd[i], S), _scale(qd_i, psid[-1]))
+        motion.append((v, a))
         momentum = _inertia_times(inertia, v)
         force = _add(_inertia_times(inertia, a), _fcross(v, momentum))
         parts.append((momentum, force, _coriolis_block(inertia, v, momentum)))
     return psid, psidd, parts
 
 
-def _composite_inertias(bodies, armature):
+def _lineage(parent) -> list[set[int]]:
+    """Each link with its ancestors."""
+    out = []
+    for i, p in enumerate(parent):
+        out.append({i} | (out[p] if p >= 0 else set()))
+    return out
+
+
+def _subtree_sums(own, parent, plus):
+    """Each link's ``own`` summed over its subtree, its own term first (a chain's: own_k
+    plus the next link's sum)."""
+    total = list(own)
+    for k in reversed(range(len(own))):
+        if parent[k] >= 0:
+            p = parent[k]
+            total[p] = plus(total[p], total[k])
+    return total
+
+
+def _composite_inertias(bodies, armature, parent, lineage):
     """(Y_k, alpha_k = Y_k S_k per link, M)."""
     n = len(bodies)
-    Y, alpha = [None] * n, [None] * n
-    for k in reversed(range(n)):
-        Y[k] = bodies[k][1] if k == n - 1 else _sum_inertia(bodies[k][1], Y[k + 1])
-        alpha[k] = _inertia_times(Y[k], bodies[k][0])
-    M = [[None] * n for _ in range(n)]
+    Y = _subtree_sums([body[1] for body in bodies], parent, _sum_inertia)
+    alpha = [_inertia_times(Y[k], bodies[k][0]) for k in range(n)]
+    M = [[0.0] * n for _ in range(n)]
     for j in range(n):
         for k in range(j, n):
-            M[j][k] = M[k][j] = _dot(bodies[j][0], alpha[k])
+            if j in lineage[k]:
+                M[j][k] = M[k][j] = _dot(bodies[j][0], alpha[k])
         M[j][j] = M[j][j] + armature[j]
     return Y, alpha, M
 
@@ -186,67 +220,71 @@ def _sum_inertia(a, b):
 def rnea_partials(links, cs, qd, qdd, gravity, friction_slopes=None, reference: int = 0):
     """(d tau / dq, d tau / dqd, M), each n rows of n (friction given by its slopes d tau_f,i /
     d qd_i; armature on M's diagonal), computed in the frame of link ``reference``."""
-    first_turns = _turns_about_gravity(links, gravity)
-    bodies, gravity = _bodies(links, cs, gravity, reference)
-    Y, alpha, M = _composite_inertias(bodies, [link.armature for link in links])
-    motion = _motion(bodies, qd, qdd, gravity)
-    dq, dqd = _partials(bodies, Y, alpha, *motion, friction_slopes, first_turns)
+    parent = parents(links)
+    lineage = _lineage(parent)
+    first_turns = _turns_about_gravity(links, gravity, lineage)
+    bodies, gravities = _bodies(links, cs, gravity, reference)
+    Y, alpha, M = _composite_inertias(bodies, [link.armature for link in links], parent, lineage)
+    motion = _motion(bodies, parent, qd, qdd, gravities)
+    dq, dqd = _partials(bodies, parent, lineage, Y, alpha, *motion, friction_slopes, first_turns)
     return dq, dqd, M
 
 
 def forward_dynamics_partials(links, cs, qd, tau, gravity, friction=None, reference: int = 0):
     """(d qdd / dq, d qdd / dqd, M^-1) at qdd = FD(q, qd, tau); ``friction``: (torques,
     slopes) at qd, or None. The bias torques come from the same pass, at qdd = 0."""
-    n = len(links)
-    first_turns = _turns_about_gravity(links, gravity)
-    bodies, gravity = _bodies(links, cs, gravity, reference)
-    Y, alpha, M = _composite_inertias(bodies, [link.armature for link in links])
+    n, parent = len(links), parents(links)
+    lineage = _lineage(parent)
+    first_turns = _turns_about_gravity(links, gravity, lineage)
+    bodies, gravities = _bodies(links, cs, gravity, reference)
+    Y, alpha, M = _composite_inertias(bodies, [link.armature for link in links], parent, lineage)
     Minv = inverse(M)
-    psid, psidd, parts = _motion(bodies, qd, None, gravity)
-    total, bias = None, [None] * n
-    for j in reversed(range(n)):
-        total = parts[j][1] if total is None else _add(parts[j][1], total)
-        bias[j] = _dot(bodies[j][0], total)
+    psid, psidd, parts = _motion(bodies, parent, qd, None, gravities)
+    total = _subtree_sums([part[1] for part in parts], parent, _add)
+    bias = [_dot(bodies[j][0], total[j]) for j in range(n)]
     if friction is not None:
         bias = [b + f for b, f in zip(bias, friction[0])]
     qdd = times_vector(Minv, [t - b for t, b in zip(tau, bias)])
     # with qdd: a_i gains A_i = sum_{l <= i} S_l qdd_l, psidd_k gains A_{k-1} x S_k, f_i gains I_i A_i
-    A = None
+    A = [None] * n
     for i, ((S, inertia), part) in enumerate(zip(bodies, parts)):
-        if A is not None:
-            psidd[i] = _add(psidd[i], _mcross(A, S))
-        A = _scale(qdd[i], S) if A is None else _add(A, _scale(qdd[i], S))
-        parts[i] = (part[0], _add(part[1], _inertia_times(inertia, A)), part[2])
-    dq, dqd = _partials(bodies, Y, alpha, psid, psidd, parts, friction and friction[1], first_turns)
+        above = A[parent[i]] if parent[i] >= 0 else None
+        if above is not None:
+            psidd[i] = _add(psidd[i], _mcross(above, S))
+        A[i] = _scale(qdd[i], S) if above is None else _add(above, _scale(qdd[i], S))
+        parts[i] = (part[0], _add(part[1], _inertia_times(inertia, A[i])), part[2])
+    slopes = friction and friction[1]
+    dq, dqd = _partials(bodies, parent, lineage, Y, alpha, psid, psidd, parts, slopes, first_turns)
     negative = negated(Minv)  # once for both products
     return times(negative, dq), times(negative, dqd), Minv
 
 
-def _turns_about_gravity(links, gravity) -> bool:
-    """Whether the first joint turns the whole arm about the direction of gravity (its axis
-    and gravity parallel, as zeros of the traced constants show): then nothing depends on
-    q_0, and d tau / dq_0 is zero, exactly."""
+def _turns_about_gravity(links, gravity, lineage) -> bool:
+    """Whether the first joint turns the whole arm (every link) about the direction of
+    gravity (its axis and gravity parallel, as zeros of the traced constants show): then
+    nothing depends on q_0, and d tau / dq_0 is zero, exactly."""
     first = links[0]
-    if first.prismatic:
+    if first.prismatic or not all(0 in line for line in lineage):
         return False
     axis = first.u if first.R0 is None else rotate(first.R0, first.u)
     return all(isinstance(c, float) and c == 0.0 for c in cross(gravity, axis))
 
 
-def _partials(bodies, Y, alpha, psid, psidd, parts, friction_slopes, first_turns=False):
+def _composite(a, b):
+    """The sum of two (momentum, force, (sym, spin)) of the forward pass."""
+    (HA, FA, (SA, KA)), (HB, FB, (SB, KB)) = a, b
+    return _add(HA, HB), _add(FA, FB), (tuple(x + y for x, y in zip(SA, SB)), add(KA, KB))
+
+
+def _partials(bodies, parent, lineage, Y, alpha, psid, psidd, parts, friction_slopes, first_turns=False):
     """(d tau / dq, d tau / dqd) from the forward pass (see the module); ``first_turns``:
     d tau / dq_0 is zero (see _turns_about_gravity)."""
     n = len(bodies)
     beta, G, H = [None] * n, [None] * n, [None] * n
     twice = [_scale(2.0, x) for x in psid]  # 2 psid_k
-    composite = None
-    for k in reversed(range(n)):
-        momentum, force, (sym, spin) = parts[k]
-        if composite is not None:
-            HC, F, SC, KC = composite
-            momentum, force = _add(momentum, HC), _add(force, F)
-            sym, spin = tuple(x + y for x, y in zip(sym, SC)), add(spin, KC)
-        composite = momentum, force, sym, spin
+    composites = _subtree_sums(parts, parent, _composite)
+    for k in range(n):
+        momentum, force, (sym, spin) = composites[k]
         twice_linear, S = scale(2.0, momentum[1]), bodies[k][0]
 
         def coriolis(x, sym=sym, spin=spin, twice_linear=twice_linear):  # BC_k x, x's angular part
@@ -263,11 +301,13 @@ def _partials(bodies, Y, alpha, psid, psidd, parts, friction_slopes, first_turns
         for k in range(n):
             if k == 0 and first_turns:
                 dq[j][k], dqd[j][k] = 0.0, _dot(alpha[j], twice[k]) + dot(beta[j], bodies[k][0][0])
-            elif k <= j:
+            elif k in lineage[j]:  # k is j or one of its ancestors
                 dq[j][k] = _dot(alpha[j], psidd[k]) + dot(beta[j], psid[k][0])
                 dqd[j][k] = _dot(alpha[j], twice[k]) + dot(beta[j], bodies[k][0][0])
-            else:
+            elif j in lineage[k]:  # k is in j's subtree
                 dq[j][k], dqd[j][k] = _dot(S, G[k]), _dot(S, H[k])
+            else:
+                dq[j][k], dqd[j][k] = 0.0, 0.0
         if friction_slopes is not None:
             dqd[j][j] = dqd[j][j] + friction_slopes[j]
     return dq, dqd

@@ -1,6 +1,8 @@
 """The recipes of the derivative kernels (see ``kernels.RECIPES``): the derivatives of the
-dynamics in closed form (``algorithms.analytical_derivatives``), the forward dynamics and
-M^-1 (``algorithms.derivatives``, ``algorithms.linear``) on an arm's links.
+dynamics in closed form (``algorithms.analytical_derivatives``: a chain's in the frame of
+one of its first links, a tree's each subtree on the base in its first link's; with mimic
+joints rnea on dual numbers through the coordinates), the forward dynamics and M^-1
+(``algorithms.derivatives``, ``algorithms.linear``) on an arm's links.
 
 Each is ``recipe(arm, cs, *groups, k, friction)`` with ``arm`` an ``ArmKernels``. The joint
 friction is part of these kernels: its coefficients follow, in ``k``, the inputs of the 13
@@ -36,10 +38,12 @@ def friction_terms(arm, k, qd, kind: str | None):
     return torques, [v + c * (1.0 - t * t) / s for v, c, t in zip(viscous, coulomb, shapes)]
 
 
-def _on_a_tree(arm) -> bool:
-    """Whether the arm is a tree (not a chain) or has mimic joints: its derivatives then
-    come from the definitions on dual numbers (``derivatives``, or ``_coordinate_partials``)."""
-    return arm.coupled is not None or any(link.parent is not None for link in arm.links)
+def _references(arm) -> range:
+    """The frames the analytical derivatives are tried in (see ``_shortest``): a chain's
+    first REFERENCES links', a tree's -1 (each subtree on the base in its first link's)."""
+    if any(link.parent is not None for link in arm.links):
+        return range(-1, 0)
+    return range(min(REFERENCES, arm.n))
 
 
 def _coordinate_partials(arm, links, cs, qd, qdd, gravity, slopes=None):
@@ -68,12 +72,6 @@ def _coordinate_forward(arm, links, cs, qd, tau, gravity, friction_torques=None)
     return times_vector(Minv, [t - b for t, b in zip(tau, bias)]), M, Minv
 
 
-def _partials(arm, links, cs, qd, qdd, gravity, slopes):
-    if arm.coupled is not None:
-        return _coordinate_partials(arm, links, cs, qd, qdd, gravity, slopes)
-    return derivatives.rnea_partials(links, cs, qd, qdd, gravity, slopes)
-
-
 def _forward(arm, links, cs, qd, tau, gravity, friction_torques):
     if arm.coupled is not None:
         return _coordinate_forward(arm, links, cs, qd, tau, gravity, friction_torques)
@@ -92,11 +90,12 @@ def _flat(*matrices) -> list:
 def rnea_derivatives(arm, cs, qd, qdd, k, friction=None):
     """[d tau / dq, d tau / dqd, M]."""
     links, terms = arm.links_with(k), friction_terms(arm, k, qd, friction)
-    if _on_a_tree(arm):
-        dq, dqd = _partials(arm, links, cs, qd, qdd, arm.gravity_of(k), terms and terms[1])
+    if arm.coupled is not None:
+        dq, dqd = _coordinate_partials(arm, links, cs, qd, qdd, arm.gravity_of(k), terms and terms[1])
         return _flat(dq, dqd, _mass_matrix(arm, links, cs))
     return _shortest(
-        lambda r: analytical.rnea_partials(links, cs, qd, qdd, arm.gravity_of(k), terms and terms[1], r), arm.n
+        lambda r: analytical.rnea_partials(links, cs, qd, qdd, arm.gravity_of(k), terms and terms[1], r),
+        _references(arm),
     )
 
 
@@ -109,14 +108,15 @@ def forward_dynamics(arm, cs, qd, tau, k, friction=None):
 def forward_dynamics_derivatives(arm, cs, qd, tau, k, friction=None):
     """[d qdd / dq, d qdd / dqd, M^-1]: on a tree -M^-1 d tau / d(q, qd) at qdd = FD(q, qd, tau)."""
     links, terms = arm.links_with(k), friction_terms(arm, k, qd, friction)
-    if _on_a_tree(arm):
+    if arm.coupled is not None:
         gravity = arm.gravity_of(k)
-        qdd, _, Minv = _forward(arm, links, cs, qd, tau, gravity, terms and terms[0])
-        dq, dqd = _partials(arm, links, cs, qd, qdd, gravity, terms and terms[1])
+        qdd, _, Minv = _coordinate_forward(arm, links, cs, qd, tau, gravity, terms and terms[0])
+        dq, dqd = _coordinate_partials(arm, links, cs, qd, qdd, gravity, terms and terms[1])
         minus = negated(Minv)
         return _flat(times(minus, dq), times(minus, dqd), Minv)
     return _shortest(
-        lambda r: analytical.forward_dynamics_partials(links, cs, qd, tau, arm.gravity_of(k), terms, r), arm.n
+        lambda r: analytical.forward_dynamics_partials(links, cs, qd, tau, arm.gravity_of(k), terms, r),
+        _references(arm),
     )
 
 
@@ -126,9 +126,9 @@ def inverse_mass_matrix(arm, cs, k):
     return [Minv[i][j] for i in range(arm.n) for j in range(i, arm.n)]
 
 
-def _shortest(matrices_in, n: int) -> list:
+def _shortest(matrices_in, references: range) -> list:
     """The matrices (flat, row by row) of ``matrices_in(r)`` computed in the frame of link r,
-    for the r of the first REFERENCES links whose traced code is the shortest: which one is
-    depends on where the arm's geometry has its zeros."""
-    candidates = [[x for matrix in matrices_in(r) for row in matrix for x in row] for r in range(min(REFERENCES, n))]
+    for the r of ``references`` whose traced code is the shortest: which one is depends on
+    where the arm's geometry has its zeros."""
+    candidates = [[x for matrix in matrices_in(r) for row in matrix for x in row] for r in references]
     return min(candidates, key=size)
