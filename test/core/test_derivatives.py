@@ -35,7 +35,7 @@ from irb140_dynamics.core.urdf import load_urdf
 from ..support import pinocchio_model
 from ..support.common import full_sweep, loaded_irb140, random_model, random_urdf_model
 from ..support.pinocchio_trees import pinocchio_state
-from ..support.two_arms import TWO_ARMS
+from ..support.two_arms import TWO_ARMS, _joint, _link
 from .test_urdf_any_chain import KINDS, chain_urdf
 from .test_urdf_corpus import FILES, chains
 
@@ -328,6 +328,42 @@ def test_bad_input_is_refused_naming_the_argument():
 
 
 # -- the closed forms against their definition -----------------------------------------------
+
+
+THREE_BRANCHES = f"""<robot name="three_branches"><link name="base"/>
+  {_joint("slide", "base", "s1", kind="prismatic", axis="1 0 0")}{_link("s1")}
+  {_joint("s2", "s1", "s2")}{_link("s2")}
+  {_joint("a1", "base", "a1", axis="0 0 1")}{_link("a1")}
+  {_joint("a2", "a1", "a2", axis="1 0 0")}{_link("a2")}
+  {_joint("a3", "a1", "a3")}{_link("a3")}
+  {_joint("b1", "base", "b1", axis="1 0 0")}{_link("b1")}
+</robot>"""
+
+
+def test_closed_forms_on_a_tree_are_the_recursions_on_dual_numbers():
+    """Three branches from the base, one sliding, one forking: the closed forms (each
+    subtree in its first link's frame) equal rnea's on dual numbers, and the forward
+    dynamics' -M^-1 times them; a chain's reference (a link's frame) is refused."""
+    model = load_urdf(THREE_BRANCHES).model
+    links, n = algorithms.chain(model), model.n
+    roots = [link for link, p in zip(links, model.parent) if p < 0]
+    assert len(roots) == 3 and any(link.prismatic for link in roots)
+    rng = np.random.default_rng(95)
+    for _ in range(3):
+        q, qd, qdd, tau = (x.tolist() for x in random_state(rng, n))
+        cs = [(x,) if link.prismatic else (math.cos(x), math.sin(x)) for link, x in zip(links, q)]
+        slopes, torques = rng.uniform(0.0, 2.0, n).tolist(), rng.uniform(-1.0, 1.0, n).tolist()
+        dq, dqd = derivatives.rnea_partials(links, cs, qd, qdd, model.gravity, slopes)
+        ours = analytical_derivatives.rnea_partials(links, cs, qd, qdd, model.gravity, slopes)
+        for x, y in zip(ours, (dq, dqd, mass_matrix(model, q))):
+            assert_agree(x, y, 1e-12, "tree")
+        qdd_fd, _, Minv = derivatives.forward_dynamics(links, cs, qd, tau, model.gravity, torques)
+        fd_dq, fd_dqd = derivatives.rnea_partials(links, cs, qd, qdd_fd, model.gravity, slopes)
+        ours = analytical_derivatives.forward_dynamics_partials(links, cs, qd, tau, model.gravity, (torques, slopes))
+        for x, y in zip(ours, (-np.array(Minv) @ fd_dq, -np.array(Minv) @ fd_dqd, Minv)):
+            assert_agree(x, y, 1e-10, "tree, forward")
+    with pytest.raises(ValueError, match="reference -1"):
+        analytical_derivatives.rnea_partials(links, cs, qd, qdd, model.gravity, reference=0)
 
 
 @pytest.mark.parametrize("kinds", list(KINDS), ids=list(KINDS))

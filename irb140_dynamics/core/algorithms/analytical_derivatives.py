@@ -25,16 +25,16 @@ and (k_i, l_i) = I_i v_i its momentum. Summed over the subtree (Y_j, BC_j compos
 (for k <= j, d S_j / dq_k = S_k x S_j cancels the S_k x* F_j of F_j's derivative).
 
 On a tree "k <= j" reads "k is j or one of its ancestors", "k > j" "k is in j's subtree",
-and tau_j does not depend on a joint k that is neither; the composites sum over subtrees.
-A tree's are computed with each subtree on the base in the frame of its first link
-(``reference`` -1).
+k - 1 is k's parent, and tau_j does not depend on a joint k that is neither j's ancestor
+nor in its subtree; the composites sum over subtrees. A tree's derivatives are computed
+with each subtree on the base in the frame of its first link (``reference`` -1).
 """
 
 from __future__ import annotations
 
 from irb140_dynamics.core.algorithms.linear import inverse, negated, times, times_vector
 from irb140_dynamics.core.algorithms.recursions import add, cross, dot, rotate, scale, steps, to_child, turned
-from irb140_dynamics.core.algorithms.topology import parents
+from irb140_dynamics.core.algorithms.topology import lineages, parents
 from irb140_dynamics.core.model.rigid_body import ZERO3, shift_inertia
 
 IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
@@ -158,14 +158,6 @@ def _motion(bodies, parent, qd, qdd, gravities):
     return psid, psidd, parts
 
 
-def _lineage(parent) -> list[set[int]]:
-    """Each link with its ancestors."""
-    out = []
-    for i, p in enumerate(parent):
-        out.append({i} | (out[p] if p >= 0 else set()))
-    return out
-
-
 def _subtree_sums(own, parent, plus):
     """Each link's ``own`` summed over its subtree, its own term first (a chain's: own_k
     plus the next link's sum)."""
@@ -217,11 +209,11 @@ def _sum_inertia(a, b):
     return a[0] + b[0], add(a[1], b[1]), tuple(x + y for x, y in zip(a[2], b[2]))
 
 
-def rnea_partials(links, cs, qd, qdd, gravity, friction_slopes=None, reference: int = 0):
+def rnea_partials(links, cs, qd, qdd, gravity, friction_slopes=None, reference: int | None = None):
     """(d tau / dq, d tau / dqd, M), each n rows of n (friction given by its slopes d tau_f,i /
-    d qd_i; armature on M's diagonal), computed in the frame of link ``reference``."""
-    parent = parents(links)
-    lineage = _lineage(parent)
+    d qd_i; armature on M's diagonal), computed in the frame of link ``reference`` (see
+    ``_reference``)."""
+    reference, parent, lineage = _reference(links, reference), parents(links), lineages(links)
     first_turns = _turns_about_gravity(links, gravity, lineage)
     bodies, gravities = _bodies(links, cs, gravity, reference)
     Y, alpha, M = _composite_inertias(bodies, [link.armature for link in links], parent, lineage)
@@ -230,11 +222,11 @@ def rnea_partials(links, cs, qd, qdd, gravity, friction_slopes=None, reference: 
     return dq, dqd, M
 
 
-def forward_dynamics_partials(links, cs, qd, tau, gravity, friction=None, reference: int = 0):
+def forward_dynamics_partials(links, cs, qd, tau, gravity, friction=None, reference: int | None = None):
     """(d qdd / dq, d qdd / dqd, M^-1) at qdd = FD(q, qd, tau); ``friction``: (torques,
     slopes) at qd, or None. The bias torques come from the same pass, at qdd = 0."""
-    n, parent = len(links), parents(links)
-    lineage = _lineage(parent)
+    n, parent, lineage = len(links), parents(links), lineages(links)
+    reference = _reference(links, reference)
     first_turns = _turns_about_gravity(links, gravity, lineage)
     bodies, gravities = _bodies(links, cs, gravity, reference)
     Y, alpha, M = _composite_inertias(bodies, [link.armature for link in links], parent, lineage)
@@ -257,6 +249,18 @@ def forward_dynamics_partials(links, cs, qd, tau, gravity, friction=None, refere
     dq, dqd = _partials(bodies, parent, lineage, Y, alpha, psid, psidd, parts, slopes, first_turns)
     negative = negated(Minv)  # once for both products
     return times(negative, dq), times(negative, dqd), Minv
+
+
+def _reference(links, reference: int | None) -> int:
+    """The frame of the computation: a chain's link ``reference`` (None: 0), a tree's -1
+    (each subtree on the base in its first link's; ValueError for another)."""
+    if not any(link.parent is not None for link in links):
+        return 0 if reference is None else reference
+    if reference not in (None, -1):
+        raise ValueError(
+            f"a tree's derivatives are computed with each subtree in its first link's frame (reference -1), not {reference}"
+        )
+    return -1
 
 
 def _turns_about_gravity(links, gravity, lineage) -> bool:

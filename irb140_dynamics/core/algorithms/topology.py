@@ -19,6 +19,14 @@ def children(links) -> list[list[int]]:
     return out
 
 
+def lineages(links) -> list[set[int]]:
+    """Each link with its ancestors, as a set."""
+    out: list[set[int]] = []
+    for i, p in enumerate(parents(links)):
+        out.append({i} | (out[p] if p >= 0 else set()))
+    return out
+
+
 def ancestors(links, i: int) -> list[int]:
     """Link i's ancestors, its parent first."""
     parent, out = parents(links), []

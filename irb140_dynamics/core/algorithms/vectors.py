@@ -32,7 +32,8 @@ def inertia_times(inertia, v):
 def swept(w, dw, v):
     """dw x v + w x (w x v), the acceleration of a point v fixed on a body turning at w, dw
     (less its origin's), by the 3 x 3 (dw~ + w~ w~) whose w~ w~ = w w^T - |w|^2 1 takes six
-    products of w's components: one body's sweeps of several points share them."""
+    products of w's components: one body's sweeps of several points share them (in a traced
+    kernel, where the tracer merges the repeated products)."""
     xx, yy, zz = w[0] * w[0], w[1] * w[1], w[2] * w[2]
     xy, xz, yz = w[0] * w[1], w[0] * w[2], w[1] * w[2]
     return (

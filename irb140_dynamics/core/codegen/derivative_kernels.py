@@ -106,7 +106,7 @@ def forward_dynamics(arm, cs, qd, tau, k, friction=None):
 
 
 def forward_dynamics_derivatives(arm, cs, qd, tau, k, friction=None):
-    """[d qdd / dq, d qdd / dqd, M^-1]: on a tree -M^-1 d tau / d(q, qd) at qdd = FD(q, qd, tau)."""
+    """[d qdd / dq, d qdd / dqd, M^-1]: with mimic joints -M^-1 d tau / d(q, qd) at qdd = FD(q, qd, tau)."""
     links, terms = arm.links_with(k), friction_terms(arm, k, qd, friction)
     if arm.coupled is not None:
         gravity = arm.gravity_of(k)

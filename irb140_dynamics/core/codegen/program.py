@@ -12,8 +12,9 @@ An operation is ``(op, args)``:
 - ``("in", (name,))``: an input, ``name`` = group and index, e.g. ``qd2``;
 - ``("+" | "-" | "*" | "/", (a, b))``, ``("neg", (a,))``, ``("tanh", (a,))``;
 - ``("cos" | "sin", (a, offset))``: cos or sin of input ``a`` plus the float ``offset``
-  (a joint angle: theta_i = q_i + theta_offset_i; offset 0.0 adds nothing); for a mimic
-  joint ``a`` is the operation multiplier * q_k.
+  (a joint angle: theta_i = q_i + theta_offset_i, the offset less its whole quarter turns,
+  which the tracer applies as a swap and signs: ``trace.quarter_turns``; offset 0.0 adds
+  nothing); for a mimic joint ``a`` is the operation multiplier * q_k.
 
 An operand is an int (the index of an earlier operation) or a float (a constant).
 """
@@ -73,15 +74,15 @@ def traced(
     _, outputs = trace(algorithm, inputs, angles, mimic_angles)
     groups = ((("q", len(angles)),) if angles is not None else ()) + tuple(inputs.items())
     builder = _Builder(mimic_angles)
-    if angles is not None:  # c_i and s_i are the cos and sin of q_i + the offset's rest
-        angles = [None if offset is None else quarter_turns(offset)[0] for offset in angles]
+    # c_i and s_i are the cos and sin of q_i + what is left of its offset (see trace.quarter_turns)
+    rests = None if angles is None else [None if offset is None else quarter_turns(offset)[0] for offset in angles]
     index: dict[Sym, int] = {}  # each node -> its operation (a merged one's: its first's)
     ops = builder.ops
     for x, first in merging(outputs):
         if first is not x:
             index[x] = index[first]
         elif x.op == "var":
-            index[x] = builder.variable(x.name, angles)
+            index[x] = builder.variable(x.name, rests)
         else:  # builder.add, inline: most of a program's operations come this way
             index[x] = len(ops)
             ops.append((x.op, tuple(index[a] if type(a) is Sym else float(a) for a in x.args)))

@@ -28,7 +28,7 @@ def constant(x: float) -> str:
 
 
 def angle_name(program: Program, k: int) -> str:
-    """The variable of the cos or sin operation k: c3 for cos(q3 + offset), as a joint's;
+    """The variable of the cos or sin operation k: c3 for the cos of q3 (plus its offset), a joint's;
     another one on the same q (a mimic joint's), or on an operation, gets its index too."""
     op, (a, offset) = program.ops[k]
     source_op, source_args = program.ops[a]

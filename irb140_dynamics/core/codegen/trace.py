@@ -141,14 +141,12 @@ QUARTER_TURN = math.pi / 2
 
 
 def quarter_turns(offset: float) -> tuple[float, int]:
-    """(rest, m) with offset = m * QUARTER_TURN + rest: an offset of a whole number of quarter
-    turns (m in -2..2, as the float pi / 2 times m) is (0.0, m), any other (offset, 0). The
-    angle of such a joint is then q itself, its cos and sin those of q turned m quarters
-    (exact: a swap and signs), where q + offset would be rounded and need an addition."""
-    for m in (1, -1, 2, -2):
-        if offset == m * QUARTER_TURN:
-            return 0.0, m
-    return offset, 0
+    """(rest, m) with offset = m * QUARTER_TURN + rest: an offset of a whole number m of
+    quarter turns (the float pi / 2 times m) is (0.0, m), any other (offset, 0). The angle
+    of such a joint is then q itself, its cos and sin those of q turned m quarters (exact: a
+    swap and signs), where q + offset would be rounded and need an addition."""
+    m = round(offset / QUARTER_TURN)
+    return (0.0, m) if m != 0 and offset == m * QUARTER_TURN else (offset, 0)
 
 
 def quarter_turned(c, s, m: int) -> tuple:

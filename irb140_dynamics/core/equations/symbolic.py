@@ -20,7 +20,6 @@ armature, and the payload's are named symbols (``Parameter``); otherwise the mod
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
 
@@ -30,6 +29,7 @@ from sympy.core.parameters import distribute
 from ..algorithms import recursions as algorithms
 from ..algorithms.mimic import Coordinates, coupling
 from ..algorithms.regressor import rigid_body_regressor
+from ..codegen.trace import quarter_turns
 from ..model.rigid_body import shift_inertia
 from ..regressor import JOINT_TERMS, LINK_PARAMETERS, PARAMETERS_PER_JOINT
 
@@ -73,12 +73,10 @@ def joint_symbols(n: int) -> tuple[tuple[sp.Symbol, ...], ...]:
 
 
 def angle_pair(q: sp.Symbol, offset: float):
-    """(cos, sin) of q + offset, an offset within an ulp of a multiple of pi/2 taken exactly."""
-    quarter = round(offset / (math.pi / 2))
-    if float(quarter * sp.pi / 2) == offset:
-        theta = q + quarter * sp.pi / 2
-    else:
-        theta = q + sp.Float(offset)
+    """(cos, sin) of q + offset, an offset of whole quarter turns (``trace.quarter_turns``,
+    as the kernels take it) exactly m pi / 2."""
+    rest, quarter = quarter_turns(offset)
+    theta = q + sp.Float(offset) if rest else q + quarter * sp.pi / 2
     return sp.cos(theta), sp.sin(theta)
 
 
