@@ -34,7 +34,7 @@ from __future__ import annotations
 
 from irb140_dynamics.core.algorithms.linear import inverse, negated, times, times_vector
 from irb140_dynamics.core.algorithms.recursions import add, cross, dot, rotate, scale, steps, to_child, turned
-from irb140_dynamics.core.algorithms.topology import lineages, parents
+from irb140_dynamics.core.algorithms.topology import is_chain, lineages, parents
 from irb140_dynamics.core.model.rigid_body import ZERO3, shift_inertia
 
 IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
@@ -254,7 +254,7 @@ def forward_dynamics_partials(links, cs, qd, tau, gravity, friction=None, refere
 def _reference(links, reference: int | None) -> int:
     """The frame of the computation: a chain's link ``reference`` (None: 0), a tree's -1
     (each subtree on the base in its first link's; ValueError for another)."""
-    if not any(link.parent is not None for link in links):
+    if is_chain(links):
         return 0 if reference is None else reference
     if reference not in (None, -1):
         raise ValueError(

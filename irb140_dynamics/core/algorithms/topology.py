@@ -10,6 +10,11 @@ def parents(links) -> list[int]:
     return [i - 1 if link.parent is None else link.parent for i, link in enumerate(links)]
 
 
+def is_chain(links) -> bool:
+    """Whether the links are a chain: none gives a parent (each one's is the link before)."""
+    return all(link.parent is None for link in links)
+
+
 def children(links) -> list[list[int]]:
     """Each link's children, in increasing order."""
     out = [[] for _ in links]

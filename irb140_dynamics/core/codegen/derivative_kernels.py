@@ -17,6 +17,7 @@ from irb140_dynamics.core.algorithms import analytical_derivatives as analytical
 from irb140_dynamics.core.algorithms import derivatives
 from irb140_dynamics.core.algorithms import recursions as algorithms
 from irb140_dynamics.core.algorithms.linear import inverse, negated, times, times_vector
+from irb140_dynamics.core.algorithms.topology import is_chain
 from irb140_dynamics.core.codegen.trace import size, tanh
 from irb140_dynamics.core.scalars.dual import Dual
 
@@ -41,9 +42,7 @@ def friction_terms(arm, k, qd, kind: str | None):
 def _references(arm) -> range:
     """The frames the analytical derivatives are tried in (see ``_shortest``): a chain's
     first REFERENCES links', a tree's -1 (each subtree on the base in its first link's)."""
-    if any(link.parent is not None for link in arm.links):
-        return range(-1, 0)
-    return range(min(REFERENCES, arm.n))
+    return range(min(REFERENCES, arm.n)) if is_chain(arm.links) else range(-1, 0)
 
 
 def _coordinate_partials(arm, links, cs, qd, qdd, gravity, slopes=None):
