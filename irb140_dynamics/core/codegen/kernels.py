@@ -26,6 +26,7 @@ from functools import cached_property, lru_cache, partial
 from irb140_dynamics import native_hook
 from irb140_dynamics.core.algorithms import recursions as algorithms
 from irb140_dynamics.core.algorithms.mimic import Coordinates, coupling
+from irb140_dynamics.core.algorithms.regrouping import regrouped
 from irb140_dynamics.core.codegen.array_code import compile_into
 from irb140_dynamics.core.codegen.program import Program, traced, with_friction
 from irb140_dynamics.core.codegen.python_code import compile_python
@@ -307,8 +308,10 @@ class ArmKernels(Coordinates):
     13 numbers k[layout[j]], or 0 where layout[j] is None (see ``inputs_of``)."""
 
     def __init__(self, links, flange, layout: tuple[int | None, ...], coupled=None, carrier: int = -1):
-        self.links = links
         self.carrier = carrier % len(links)  # the link the payload and a flange wrench are on
+        # every kernel gives joint-space quantities (or, the regressor, reads no inertia):
+        # the same from fewer nonzero inertial parameters
+        links = regrouped(links, fixed=self.carrier)
         self.flange = _Flange(flange)
         self.layout = layout
         self.inputs = 1 + max((j for j in layout if j is not None), default=-1)  # k's the 13 numbers take

@@ -1,0 +1,130 @@
+"""Fewer nonzero inertial parameters, the same joint torques: regrouping (Khalil and
+Kleinfinger's base parameters, 1987).
+
+A revolute joint turns link i about its axis b, through its joint origin o'_i. Part of the
+link's inertia neither changes under that turn nor resists it:
+
+- its mass m, as a point mass at o'_i (on the axis),
+- its first moment along the axis, (b . h') b about o'_i,
+- an inertia lam (1 - b b^T) about o'_i (no moment about b itself).
+
+That part moves exactly as if it were fixed to the parent link, so it can be added to the
+parent's inertia (in the parent's frame, about its origin) or, on the base, dropped. Every
+joint torque stays the same at every q, qd, qdd: tau, M, C, g, the momenta and their
+derivatives do not see the move; the wrenches inside the links do (no kernel outputs one).
+Link i is left with m = 0, no first moment along b, and, when b is a coordinate axis, one
+moment of inertia 0 (lam chosen so): its wrench in rnea takes fewer operations.
+
+Moving the mass can add products of inertia to the parent (a joint origin off two of the
+parent's axes), which costs more than it saves; so each link, from the tips to the base,
+moves the parts that leave it and its parent with the fewest operations (``_operations``).
+A prismatic link keeps its parameters (its children still move theirs into it); so does the
+link ``fixed`` (the payload's: its inertia is the kernels' input, not a constant), and a
+link whose parent is ``fixed`` moves nothing into it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from itertools import product
+
+import numpy as np
+
+from irb140_dynamics.core.algorithms.topology import parents
+from irb140_dynamics.core.model.rigid_body import shift_inertia
+
+_ENTRIES = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))  # the order of an Inertia6
+
+
+def regrouped(links, fixed: int | None = None) -> tuple:
+    """``links`` (see ``recursions.Link``, a tree or a chain) with the same joint torques
+    and fewer nonzero inertial parameters (see the module); ``fixed``: a link whose inertia
+    is not a constant."""
+    links, parent = list(links), parents(links)
+    added = [None] * len(links)  # (m, h, I) moved into each link by its children
+    for i in reversed(range(len(links))):
+        link = links[i]
+        own = _with(_parameters(link), added[i])
+        if i == fixed or link.prismatic or parent[i] == fixed:
+            links[i] = _replaced(link, own)
+            continue
+        if parent[i] < 0:  # onto the base: dropped
+            rest, _ = min(_choices(link, own), key=lambda choice: _operations(*choice[0]))
+        else:
+            above = _with(_parameters(links[parent[i]]), added[parent[i]])
+            before = _operations(*above)
+            rest, moved = min(
+                _choices(link, own),
+                key=lambda choice: _operations(*choice[0]) + _operations(*_with(above, choice[1])) - before,
+            )
+            added[parent[i]] = _with(added[parent[i]], moved)
+        links[i] = _replaced(link, rest)
+    return tuple(links)
+
+
+def _choices(link, own):
+    """(rest, moved) for each choice of what link i moves: its mass or not, its first moment
+    along b or not, lam 0 or the one that zeroes a moment of inertia across b (b a
+    coordinate axis). rest: (m, h, I) about o_i, in frame i; moved: about o_{i-1}, in the
+    parent's frame."""
+    m, h, inertia = own
+    b, p = np.array(link.b), np.array(link.p)
+    across = np.eye(3) - np.outer(b, b)
+    axis = [k for k in range(3) if abs(b[k]) == 1.0]
+    _, h_joint, inertia_joint = _shifted(m, h, inertia, p)  # about o'_i
+    R = _matrix_of(link.R0) @ _matrix_of(link.R1)  # frame i -> the parent's (any turn: the part is unchanged)
+    p0 = np.zeros(3) if link.p0 is None else np.array(link.p0)
+    for move_mass, move_along in product((False, True), repeat=2):
+        m_moved = m if move_mass else 0.0
+        h_moved = (b @ h_joint) * b if move_along else np.zeros(3)
+        m_rest, h_rest, inertia_rest = _shifted(m - m_moved, h_joint - h_moved, inertia_joint, -p)  # about o_i
+        if move_along and axis:
+            h_rest[axis[0]] = 0.0
+        for zeroed in [None] + ([(axis[0] + 1) % 3, (axis[0] + 2) % 3] if axis else []):
+            lam = 0.0 if zeroed is None else inertia_rest[zeroed, zeroed]
+            rest_inertia = inertia_rest - lam * across
+            if zeroed is not None:
+                rest_inertia[zeroed, zeroed] = 0.0
+            moved = _shifted(m_moved, R @ h_moved, R @ (lam * across) @ R.T, p0)
+            yield (m_rest, h_rest, rest_inertia), moved
+
+
+def _operations(m, h, inertia) -> int:
+    """About how many operations a link's wrench (rnea's force and moment) takes for its
+    nonzero parameters: m a (6), each h_k (10: its sweep and h x a), each moment of inertia
+    (4: I dw and I w), each product of inertia (8), and w x (I w) by columns once there is
+    one (9)."""
+    products = sum(inertia[j, k] != 0.0 for j, k in _ENTRIES[3:])
+    moments = sum(inertia[k, k] != 0.0 for k in range(3))
+    return 6 * (m != 0.0) + 10 * int(np.count_nonzero(h)) + 4 * moments + 8 * products + 9 * (products > 0)
+
+
+def _shifted(m, h, inertia, r):
+    """(m, h, I) about O - r (``shift_inertia``), as arrays."""
+    m, h, six = shift_inertia(m, tuple(h), tuple(inertia[j, k] for j, k in _ENTRIES), tuple(r))
+    return m, np.array(h), _matrix(six)
+
+
+def _parameters(link):
+    return link.m, np.array(link.h, dtype=float), _matrix(link.I)
+
+
+def _with(a, b):
+    """The sum of two (m, h, I); None adds nothing."""
+    if a is None or b is None:
+        return b if a is None else a
+    return a[0] + b[0], a[1] + b[1], a[2] + b[2]
+
+
+def _replaced(link, parameters):
+    m, h, inertia = parameters
+    return replace(link, m=float(m), h=tuple(float(x) for x in h), I=tuple(float(inertia[j, k]) for j, k in _ENTRIES))
+
+
+def _matrix(six) -> np.ndarray:
+    xx, yy, zz, xy, xz, yz = (float(x) for x in six)
+    return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+
+
+def _matrix_of(R) -> np.ndarray:
+    return np.eye(3) if R is None else np.array(R, dtype=float)
