@@ -8,7 +8,9 @@ import pytest
 
 from irb140_dynamics.core import irb140
 from irb140_dynamics.core.algorithms import recursions as algorithms
+from irb140_dynamics.core.algorithms import regrouping
 from irb140_dynamics.core.algorithms.regrouping import regrouped
+from irb140_dynamics.core.algorithms.topology import parents
 from irb140_dynamics.core.urdf import load_urdf
 
 from ..support.common import OFFSET_PAYLOAD, random_model, random_urdf_model
@@ -70,3 +72,29 @@ def test_a_turning_link_leaves_its_mass_its_axial_moment_and_a_moment_of_inertia
     for link in fewer[:-1]:
         assert link.m == 0.0 and link.h[2] == 0.0 and 0.0 in link.I[:2]
     assert fewer[-1] == about_z[-1]
+
+
+@pytest.mark.parametrize("name", ["irb140", "dh_n7", "urdf_n7", "tree_with_a_slide"])
+def test_every_choice_of_what_a_link_moves_keeps_the_torques(name):
+    """Each of a link's choices (its mass or not, its first moment along the axis or not, a
+    moment of inertia or not), not only the one taken: the DH rows' joint origins off
+    their links' origins (p . b = d) are where a kept mass leaves a first moment along the
+    axis."""
+    model = MODELS[name]()
+    links, parent = algorithms.chain(model), parents(algorithms.chain(model))
+    rng = np.random.default_rng(6)
+    n = len(links)
+    states = [(joint_inputs(rng, links), rng.uniform(-2, 2, n), rng.uniform(-5, 5, n)) for _ in range(3)]
+    expected = [algorithms.rnea(links, cs, qd, qdd, model.gravity) for cs, qd, qdd in states]
+    for i, link in enumerate(links):
+        if link.prismatic:
+            continue
+        for rest, moved in regrouping._choices(link, regrouping._parameters(link)):
+            changed = list(links)
+            changed[i] = regrouping._replaced(link, rest)
+            if parent[i] >= 0:
+                above = regrouping._with(regrouping._parameters(links[parent[i]]), moved)
+                changed[parent[i]] = regrouping._replaced(links[parent[i]], above)
+            for (cs, qd, qdd), tau in zip(states, expected):
+                same = algorithms.rnea(changed, cs, qd, qdd, model.gravity)
+                np.testing.assert_allclose(same, tau, rtol=0, atol=1e-12 * np.abs(tau).max())

@@ -12,8 +12,10 @@ That part moves exactly as if it were fixed to the parent link, so it can be add
 parent's inertia (in the parent's frame, about its origin) or, on the base, dropped. Every
 joint torque stays the same at every q, qd, qdd: tau, M, C, g, the momenta and their
 derivatives do not see the move; the wrenches inside the links do (no kernel outputs one).
-Link i is left with m = 0, no first moment along b, and, when b is a coordinate axis, one
-moment of inertia 0 (lam chosen so): its wrench in rnea takes fewer operations.
+Link i can be left with m = 0, no first moment along b, and, when b is a coordinate axis,
+one moment of inertia 0 (lam chosen so): its wrench in rnea takes fewer operations. The
+regrouped links are no bodies (zero masses, inertias that are not positive): only joint
+torques may be computed from them.
 
 Moving the mass can add products of inertia to the parent (a joint origin off two of the
 parent's axes), which costs more than it saves; so each link, from the tips to the base,
@@ -31,7 +33,7 @@ from itertools import product
 import numpy as np
 
 from irb140_dynamics.core.algorithms.topology import parents
-from irb140_dynamics.core.model.rigid_body import shift_inertia
+from irb140_dynamics.core.model.rigid_body import inertia_matrix, shift_inertia
 
 _ENTRIES = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))  # the order of an Inertia6
 
@@ -78,7 +80,7 @@ def _choices(link, own):
         m_moved = m if move_mass else 0.0
         h_moved = (b @ h_joint) * b if move_along else np.zeros(3)
         m_rest, h_rest, inertia_rest = _shifted(m - m_moved, h_joint - h_moved, inertia_joint, -p)  # about o_i
-        if move_along and axis:
+        if move_mass and move_along and axis:  # kept, the mass's moment -m (b . p) stays there
             h_rest[axis[0]] = 0.0
         for zeroed in [None] + ([(axis[0] + 1) % 3, (axis[0] + 2) % 3] if axis else []):
             lam = 0.0 if zeroed is None else inertia_rest[zeroed, zeroed]
@@ -102,11 +104,12 @@ def _operations(m, h, inertia) -> int:
 def _shifted(m, h, inertia, r):
     """(m, h, I) about O - r (``shift_inertia``), as arrays."""
     m, h, six = shift_inertia(m, tuple(h), tuple(inertia[j, k] for j, k in _ENTRIES), tuple(r))
-    return m, np.array(h), _matrix(six)
+    return m, np.array(h), inertia_matrix(six)
 
 
 def _parameters(link):
-    return link.m, np.array(link.h, dtype=float), _matrix(link.I)
+    """A link's (m, h, I), as arrays."""
+    return link.m, np.array(link.h, dtype=float), inertia_matrix([float(x) for x in link.I])
 
 
 def _with(a, b):
@@ -117,14 +120,11 @@ def _with(a, b):
 
 
 def _replaced(link, parameters):
+    """The link with the (m, h, I) of arrays as its floats."""
     m, h, inertia = parameters
     return replace(link, m=float(m), h=tuple(float(x) for x in h), I=tuple(float(inertia[j, k]) for j, k in _ENTRIES))
 
 
-def _matrix(six) -> np.ndarray:
-    xx, yy, zz, xy, xz, yz = (float(x) for x in six)
-    return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
-
-
 def _matrix_of(R) -> np.ndarray:
+    """A Link's rotation (None: identity) as an array."""
     return np.eye(3) if R is None else np.array(R, dtype=float)

@@ -305,7 +305,9 @@ class _Flange:
 class ArmKernels(Coordinates):
     """The traces of an arm (its links, the last one's inertia left out), each made once on
     first use; the last link's inertia and gravity come from the argument ``k``: each of the
-    13 numbers k[layout[j]], or 0 where layout[j] is None (see ``inputs_of``)."""
+    13 numbers k[layout[j]], or 0 where layout[j] is None (see ``inputs_of``). ``links``
+    are regrouped (``algorithms.regrouping``): joint torques come out the same, a link's
+    own wrench does not (``Kernels.links`` are the model's)."""
 
     def __init__(self, links, flange, layout: tuple[int | None, ...], coupled=None, carrier: int = -1):
         self.carrier = carrier % len(links)  # the link the payload and a flange wrench are on
