@@ -31,7 +31,7 @@ from irb140_dynamics.core.algorithms.regressor import (  # noqa: F401 (part of t
 )
 from irb140_dynamics.core.codegen.kernels import kernels_of
 from irb140_dynamics.core.model.joints import Friction
-from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, inertia_matrix
+from irb140_dynamics.core.model.rigid_body import ModelError, RigidBody, inertia_entries, inertia_matrix
 from irb140_dynamics.core.model.robot_model import RobotModel
 from irb140_dynamics.core.model.states import states
 
@@ -153,6 +153,4 @@ def parameters_body(field: str, pi10, post) -> RigidBody:
     I_c = I - m * (c @ c * np.eye(3) - np.outer(c, c))
     R = post.rotation()
     com = R.T @ (c - np.array(post.xyz))
-    I_link = R.T @ I_c @ R
-    inertia = (I_link[0, 0], I_link[1, 1], I_link[2, 2], I_link[0, 1], I_link[0, 2], I_link[1, 2])
-    return RigidBody.validated(field, m, tuple(com.tolist()), inertia)
+    return RigidBody.validated(field, m, tuple(com.tolist()), inertia_entries(R.T @ I_c @ R))

@@ -33,9 +33,9 @@ from itertools import product
 import numpy as np
 
 from irb140_dynamics.core.algorithms.topology import parents
-from irb140_dynamics.core.model.rigid_body import inertia_matrix, shift_inertia
+from irb140_dynamics.core.model.rigid_body import inertia_entries, inertia_matrix, shift_inertia
 
-_ENTRIES = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))  # the order of an Inertia6
+_PRODUCTS = ((0, 1), (0, 2), (1, 2))  # the products of inertia's entries
 
 
 def regrouped(links, fixed: int | None = None) -> tuple:
@@ -46,8 +46,10 @@ def regrouped(links, fixed: int | None = None) -> tuple:
     added = [None] * len(links)  # (m, h, I) moved into each link by its children
     for i in reversed(range(len(links))):
         link = links[i]
+        if i == fixed:  # not a constant: left as it is (nothing moves into it)
+            continue
         own = _with(_parameters(link), added[i])
-        if i == fixed or link.prismatic or parent[i] == fixed:
+        if link.prismatic or parent[i] == fixed:
             links[i] = _replaced(link, own)
             continue
         if parent[i] < 0:  # onto the base: dropped
@@ -96,14 +98,14 @@ def _operations(m, h, inertia) -> int:
     nonzero parameters: m a (6), each h_k (10: its sweep and h x a), each moment of inertia
     (4: I dw and I w), each product of inertia (8), and w x (I w) by columns once there is
     one (9)."""
-    products = sum(inertia[j, k] != 0.0 for j, k in _ENTRIES[3:])
+    products = sum(inertia[j, k] != 0.0 for j, k in _PRODUCTS)
     moments = sum(inertia[k, k] != 0.0 for k in range(3))
     return 6 * (m != 0.0) + 10 * int(np.count_nonzero(h)) + 4 * moments + 8 * products + 9 * (products > 0)
 
 
 def _shifted(m, h, inertia, r):
     """(m, h, I) about O - r (``shift_inertia``), as arrays."""
-    m, h, six = shift_inertia(m, tuple(h), tuple(inertia[j, k] for j, k in _ENTRIES), tuple(r))
+    m, h, six = shift_inertia(m, tuple(h), inertia_entries(inertia), tuple(r))
     return m, np.array(h), inertia_matrix(six)
 
 
@@ -122,7 +124,7 @@ def _with(a, b):
 def _replaced(link, parameters):
     """The link with the (m, h, I) of arrays as its floats."""
     m, h, inertia = parameters
-    return replace(link, m=float(m), h=tuple(float(x) for x in h), I=tuple(float(inertia[j, k]) for j, k in _ENTRIES))
+    return replace(link, m=float(m), h=tuple(float(x) for x in h), I=inertia_entries(inertia))
 
 
 def _matrix_of(R) -> np.ndarray:

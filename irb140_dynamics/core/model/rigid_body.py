@@ -99,6 +99,12 @@ def inertia_matrix(inertia: Sequence[float]) -> np.ndarray:
     return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
 
 
+def inertia_entries(matrix) -> Inertia6:
+    """The six entries (xx, yy, zz, xy, xz, yz) of a symmetric 3 x 3 inertia, as floats:
+    ``inertia_matrix`` undone."""
+    return tuple(float(matrix[j][k]) for j, k in ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)))
+
+
 def validate_inertia(field: str, inertia: Sequence[float], physical: bool = True) -> Inertia6:
     """Six finite numbers forming a physically possible inertia tensor (``physical`` False:
     six finite numbers within the cap), or ModelError."""
@@ -212,5 +218,4 @@ def placed(body: RigidBody, rotation, translation) -> RigidBody:
     """``body`` given in a frame F, expressed in the frame where F sits at (rotation, translation)."""
     R = np.asarray(rotation, dtype=float)
     com = R @ np.asarray(body.com) + np.asarray(translation, dtype=float)
-    I = R @ inertia_matrix(body.inertia) @ R.T
-    return RigidBody(body.mass, tuple(com.tolist()), (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]))
+    return RigidBody(body.mass, tuple(com.tolist()), inertia_entries(R @ inertia_matrix(body.inertia) @ R.T))
