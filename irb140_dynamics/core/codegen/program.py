@@ -21,6 +21,7 @@ An operand is an int (the index of an earlier operation) or a float (a constant)
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -70,7 +71,7 @@ def traced(
 ) -> Program:
     """``algorithm`` traced (see ``trace.trace``) and lowered to a Program: each operation
     once, the joint angles' cos and sin as operations on q (a mimic joint's on
-    multiplier * q_k)."""
+    multiplier * q_k), the negations taken into the operations that read them."""
     _, outputs = trace(algorithm, inputs, angles, mimic_angles)
     groups = ((("q", len(angles)),) if angles is not None else ()) + tuple(inputs.items())
     builder = _Builder(mimic_angles)
@@ -87,7 +88,75 @@ def traced(
             index[x] = len(ops)
             ops.append((x.op, tuple(index[a] if type(a) is Sym else float(a) for a in x.args)))
     results = tuple(index[out] if isinstance(out, Sym) else float(out) for out in outputs)
-    return Program(name, groups, tuple(builder.ops), results)
+    return Program(name, groups, *_negations_folded(builder.ops, results))
+
+
+def _negations_folded(ops, outputs) -> tuple[tuple, tuple]:
+    """(ops, outputs) computing the same values with each negation taken into the operations
+    that read it: y - x, where x - y is computed, becomes -(x - y), and a negated value is
+    added as a subtraction, multiplies a constant of the other sign, or passes its sign on
+    through a product, so no operation is spent on it ("neg" stays only on an output or
+    where tanh, or an angle, reads it). All exact in IEEE arithmetic (round to nearest is
+    symmetric), apart from the sign of a zero."""
+    new: list[tuple[str, tuple]] = []
+    done: dict[tuple, int] = {}
+    value: list[tuple] = []  # each old operation's (operand in new, sign)
+
+    def emit(op: str, args: tuple) -> tuple:
+        if op in "+*" and _order(args[1]) < _order(args[0]):
+            args = (args[1], args[0])
+        found = done.get((op, args))
+        if found is not None:
+            return found, 1
+        if op == "-" and ("-", args[::-1]) in done:  # b - a = -(a - b)
+            return done["-", args[::-1]], -1
+        new.append((op, args))
+        done[op, args] = len(new) - 1
+        return len(new) - 1, 1
+
+    def read(a) -> tuple:
+        return value[a] if isinstance(a, int) else (a, 1)
+
+    def whole(a) -> int | float:  # the value itself, negated where it is not
+        x, sign = read(a)
+        return x if sign == 1 else emit("neg", (x,))[0]
+
+    for op, args in ops:
+        if op == "in":
+            value.append(emit(op, args))
+        elif op in ANGLES:
+            value.append(emit(op, (whole(args[0]), *args[1:])))
+        elif op == "neg":
+            x, sign = read(args[0])
+            value.append((x, -sign))
+        elif op in ("+", "-"):
+            (a, sa), (b, sb) = read(args[0]), read(args[1])
+            sb = sb if op == "+" else -sb  # sa a + sb b
+            if sa == sb:
+                x, sign = emit("+", (a, b))
+                value.append((x, sign * sa))
+            else:
+                x, sign = emit("-", (a, b) if sa == 1 else (b, a))
+                value.append((x, sign))
+        elif op in ("*", "/"):
+            (a, sa), (b, sb) = read(args[0]), read(args[1])
+            if isinstance(b, float):  # x c with x = -y: y (-c)
+                b, sb = b * sa, 1.0
+                sa = 1
+            elif isinstance(a, float):
+                a, sa = a * sb, 1
+                sb = 1
+            x, sign = emit(op, (a, b))
+            value.append((x, sign * sa * sb))
+        else:  # tanh
+            value.append(emit(op, (whole(args[0]),)))
+    results = tuple(whole(out) if isinstance(out, int) else out for out in outputs)
+    return tuple(new), results
+
+
+def _order(a) -> tuple:
+    """A key putting a commuting operation's operands in one order: operations first."""
+    return (0, a, 0.0) if isinstance(a, int) else (1, a, math.copysign(1.0, a))
 
 
 class _Builder:
