@@ -140,12 +140,10 @@ def _negations_folded(ops, outputs) -> tuple[tuple, tuple]:
                 value.append((x, sign))
         elif op in ("*", "/"):
             (a, sa), (b, sb) = read(args[0]), read(args[1])
-            if isinstance(b, float):  # x c with x = -y: y (-c)
-                b, sb = b * sa, 1.0
-                sa = 1
+            if isinstance(b, float):  # (-y) c = y (-c); a constant's sign is its own (1)
+                b, sa = b * sa, 1
             elif isinstance(a, float):
-                a, sa = a * sb, 1
-                sb = 1
+                a, sb = a * sb, 1
             x, sign = emit(op, (a, b))
             value.append((x, sign * sa * sb))
         else:  # tanh
