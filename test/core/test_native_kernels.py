@@ -55,11 +55,10 @@ def arms() -> dict:
 
 
 def no_constants():
-    """The IRB-140 with a massless last link and no payload in zero gravity: its kernels'
-    ``k`` is empty."""
+    """The IRB-140 with massless links and no payload in zero gravity: its kernels' ``k`` is
+    empty (a link's inertia is an input of k where the payload's regrouping reaches it)."""
     model = irb140().with_gravity((0.0, 0.0, 0.0))
-    last = replace(model.joints[-1], link=RigidBody())
-    model = replace(model, joints=(*model.joints[:-1], last))
+    model = replace(model, joints=tuple(replace(joint, link=RigidBody()) for joint in model.joints))
     assert kernels_of(model).constants == ()
     return model
 

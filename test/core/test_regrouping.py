@@ -9,7 +9,7 @@ import pytest
 from irb140_dynamics.core import irb140
 from irb140_dynamics.core.algorithms import recursions as algorithms
 from irb140_dynamics.core.algorithms import regrouping
-from irb140_dynamics.core.algorithms.regrouping import regrouped
+from irb140_dynamics.core.algorithms.regrouping import affine, regrouped, with_numbers
 from irb140_dynamics.core.algorithms.topology import parents
 from irb140_dynamics.core.urdf import load_urdf
 
@@ -47,9 +47,8 @@ def nonzero(links) -> int:
 def test_the_same_torques_and_mass_matrix_from_fewer_parameters(name):
     model = MODELS[name]()
     links = algorithms.chain(model)
-    fewer = regrouped(links, fixed=model.carrier)
+    fewer = regrouped(links)
     assert nonzero(fewer) < nonzero(links)
-    assert fewer[model.carrier] == links[model.carrier]
     rng = np.random.default_rng(5)
     n = len(links)
     for _ in range(20):
@@ -63,15 +62,41 @@ def test_the_same_torques_and_mass_matrix_from_fewer_parameters(name):
 
 
 def test_a_turning_link_leaves_its_mass_its_axial_moment_and_a_moment_of_inertia_to_its_parent():
-    """Links turning about z with full inertias: each but the payload's keeps m = 0, h_z = 0
-    and I_xx or I_yy = 0 (the root's go to the base, the others' to a parent whose every
-    parameter is nonzero already)."""
+    """Links turning about z with full inertias: each keeps m = 0, h_z = 0 and I_xx or
+    I_yy = 0 (the root's go to the base, the others' to a parent whose every parameter is
+    nonzero already)."""
     links = algorithms.chain(random_urdf_model(np.random.default_rng(9), 7))
     about_z = tuple(replace(link, u=(0.0, 0.0, 1.0), b=(0.0, 0.0, 1.0), R0=None, R1=None) for link in links)
-    fewer = regrouped(about_z, fixed=len(links) - 1)
-    for link in fewer[:-1]:
+    for link in regrouped(about_z):
         assert link.m == 0.0 and link.h[2] == 0.0 and 0.0 in link.I[:2]
-    assert fewer[-1] == about_z[-1]
+
+
+@pytest.mark.parametrize("name", list(MODELS))
+def test_the_payloads_link_regroups_linearly_for_any_inertia(name):
+    """``affine``: the numbers the payload's link's inertia reaches, for inertias other than
+    the one its choices were made for (with zeros, symmetric, or none), give the torques and
+    M of the links with that inertia; the links' other numbers do not change with it."""
+    model = MODELS[name]()
+    links, at = algorithms.chain(model), model.carrier
+    regrouping = affine(links, at)
+    rng = np.random.default_rng(8)
+    n = len(links)
+    inertias = [rng.normal(0.0, 1.0, 10) for _ in range(3)]
+    inertias += [np.array([2.0, 0.0, 0.0, 0.3, 0.1, 0.1, 0.2, 0.0, 0.0, 0.0]), np.zeros(10)]
+    for x in inertias:
+        x = tuple(float(v) for v in x)
+        fewer = regrouping.links(regrouping.values(x))
+        assert {i for i, _ in regrouping.entries} >= {at}
+        assert all(fewer[i] == regrouping.base[i] for i in range(n) if i not in {i for i, _ in regrouping.entries})
+        with_x = tuple(with_numbers(link, x) if i == at else link for i, link in enumerate(links))
+        for _ in range(3):
+            cs = joint_inputs(rng, links)
+            qd, qdd = rng.uniform(-2, 2, n), rng.uniform(-5, 5, n)
+            tau = algorithms.rnea(with_x, cs, qd, qdd, model.gravity)
+            same = algorithms.rnea(fewer, cs, qd, qdd, model.gravity)
+            np.testing.assert_allclose(same, tau, rtol=0, atol=1e-12 * np.abs(tau).max())
+            M = np.array(algorithms.crba(with_x, cs))
+            np.testing.assert_allclose(algorithms.crba(fewer, cs), M, rtol=0, atol=1e-13 * np.abs(M).max())
 
 
 @pytest.mark.parametrize("name", ["irb140", "dh_n7", "urdf_n7", "tree_with_a_slide"])

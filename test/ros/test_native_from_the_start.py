@@ -32,10 +32,11 @@ def test_the_kernels_are_native_before_the_first_message_and_after_a_model_chang
         settings = harness.node.settings
         assert settings.kernels.native and all(natives(settings.model)), settings.kernels
         assert kernels_text(settings.kernels).startswith("kernels: native")
-        # a new arm (another link mass: other code), checked and compiled off the executor
-        harness.set_parameters([Parameter("joint_3.link.mass", value=21.5)])
+        # a new arm (another moment of inertia: other code), checked and compiled off the executor
+        inertia = [0.2, 0.328536, 0.328536, 0.0, 0.0, 0.0]
+        harness.set_parameters([Parameter("joint_2.link.inertia", value=inertia)])
         changed = harness.node.settings
-        assert changed.model.joints[2].link.mass == 21.5
+        assert list(changed.model.joints[1].link.inertia) == inertia
         assert changed.kernels is not settings.kernels and changed.kernels.native, changed.kernels
         assert all(natives(changed.model))
 
@@ -43,13 +44,15 @@ def test_the_kernels_are_native_before_the_first_message_and_after_a_model_chang
 @needs_a_compiler
 def test_a_compile_past_the_bound_leaves_the_python_form_answering_and_says_so(monkeypatch):
     monkeypatch.setattr(id_settings, "NATIVE_WAIT", 0.0)
-    mass = float(np.random.default_rng().uniform(30.0, 40.0))  # an arm no test has compiled yet
+    # an arm no test has compiled yet: a moment of inertia the payload's regrouping does not
+    # reach (a link's mass would be an input of k, the same code)
+    inertia = [float(np.random.default_rng().uniform(0.1, 0.6)), 0.328536, 0.328536, 0.0, 0.0, 0.0]
     with running(IdNode) as harness:
         gravity_torques = harness.listen(JointState, "gravity_torques")
         states = harness.publisher(JointState, "joint_states")
-        harness.set_parameters([Parameter("joint_2.link.mass", value=mass)])
+        harness.set_parameters([Parameter("joint_2.link.inertia", value=inertia)])
         settings = harness.node.settings
-        assert settings.model.joints[1].link.mass == mass
+        assert list(settings.model.joints[1].link.inertia) == inertia
         assert not settings.kernels.native and settings.kernels.compiling, settings.kernels
         assert "Python form for now" in kernels_text(settings.kernels)
         q = [0.1, -0.7, 0.4, 0.2, -0.3, 0.5]

@@ -19,15 +19,19 @@ torques may be computed from them.
 
 Moving the mass can add products of inertia to the parent (a joint origin off two of the
 parent's axes), which costs more than it saves; so each link, from the tips to the base,
-moves the parts that leave it and its parent with the fewest operations (``_operations``).
-A prismatic link keeps its parameters (its children still move theirs into it); so does the
-link ``fixed`` (the payload's: its inertia is the kernels' input, not a constant), and a
-link whose parent is ``fixed`` moves nothing into it.
+moves the parts that leave it and its parent with the fewest operations (``_operations``;
+of equal ones, the choice moving most: what a parent holds, it may move on). A prismatic
+link keeps its parameters (its children still move theirs into it).
+
+Once the choices are made, regrouping is linear in the links' inertial parameters: the
+payload's link, whose inertia the kernels take as an input, is regrouped as the others
+(``affine``), its moved parts reaching its parent and, through it, the links below.
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
+import math
+from dataclasses import dataclass, replace
 from itertools import product
 
 import numpy as np
@@ -36,34 +40,50 @@ from irb140_dynamics.core.algorithms.topology import parents
 from irb140_dynamics.core.model.rigid_body import inertia_entries, inertia_matrix, shift_inertia
 
 _PRODUCTS = ((0, 1), (0, 2), (1, 2))  # the products of inertia's entries
+# a link's m, h, I (10 numbers) with no zero and no two moments of inertia equal
+GENERIC = (1.3, 0.07, 0.11, 0.13, 0.5, 0.7, 0.9, 0.017, 0.019, 0.023)
 
 
-def regrouped(links, fixed: int | None = None) -> tuple:
+def regrouped(links, choices: tuple | None = None) -> tuple:
     """``links`` (see ``recursions.Link``, a tree or a chain) with the same joint torques
-    and fewer nonzero inertial parameters (see the module); ``fixed``: a link whose inertia
-    is not a constant."""
+    and fewer nonzero inertial parameters (see the module); ``choices``: what each link
+    moves (``choices_of``), None to choose for these links."""
+    return _regrouped(links, choices)[0]
+
+
+def choices_of(links) -> tuple:
+    """What ``regrouped`` moves from each link: an index into its choices (None: a prismatic
+    link, which moves nothing)."""
+    return _regrouped(links, None)[1]
+
+
+def _regrouped(links, choices) -> tuple[tuple, tuple]:
     links, parent = list(links), parents(links)
+    chosen = [None] * len(links)
     added = [None] * len(links)  # (m, h, I) moved into each link by its children
     for i in reversed(range(len(links))):
         link = links[i]
-        if i == fixed:  # not a constant: left as it is (nothing moves into it)
-            continue
         own = _with(_parameters(link), added[i])
-        if link.prismatic or parent[i] == fixed:
+        if link.prismatic:
             links[i] = _replaced(link, own)
             continue
-        if parent[i] < 0:  # onto the base: dropped
-            rest, _ = min(_choices(link, own), key=lambda choice: _operations(*choice[0]))
+        options = list(_choices(link, own))
+        if choices is not None:
+            chosen[i] = choices[i]
+        elif parent[i] < 0:  # onto the base: dropped
+            chosen[i] = min(reversed(range(len(options))), key=lambda j: _operations(*options[j][0]))
         else:
             above = _with(_parameters(links[parent[i]]), added[parent[i]])
             before = _operations(*above)
-            rest, moved = min(
-                _choices(link, own),
-                key=lambda choice: _operations(*choice[0]) + _operations(*_with(above, choice[1])) - before,
+            chosen[i] = min(
+                reversed(range(len(options))),
+                key=lambda j: _operations(*options[j][0]) + _operations(*_with(above, options[j][1])) - before,
             )
+        rest, moved = options[chosen[i]]
+        if parent[i] >= 0:
             added[parent[i]] = _with(added[parent[i]], moved)
         links[i] = _replaced(link, rest)
-    return tuple(links)
+    return tuple(links), tuple(chosen)
 
 
 def _choices(link, own):
@@ -95,12 +115,16 @@ def _choices(link, own):
 
 def _operations(m, h, inertia) -> int:
     """About how many operations a link's wrench (rnea's force and moment) takes for its
-    nonzero parameters: m a (6), each h_k (10: its sweep and h x a), each moment of inertia
-    (4: I dw and I w), each product of inertia (8), and w x (I w) by columns once there is
-    one (9)."""
+    nonzero parameters: m a (6), each h_k (10: its sweep and h x a); with products of
+    inertia, each moment of inertia 4 and each product 8 (I dw and I w) and w x (I w) 9;
+    without, each moment 2 (I dw) and each nonzero difference of two moments 2 (w x (I w) is
+    ((Izz - Iyy) w_y w_z, ...), see ``vectors.gyroscopic``)."""
     products = sum(inertia[j, k] != 0.0 for j, k in _PRODUCTS)
     moments = sum(inertia[k, k] != 0.0 for k in range(3))
-    return 6 * (m != 0.0) + 10 * int(np.count_nonzero(h)) + 4 * moments + 8 * products + 9 * (products > 0)
+    cost = 6 * (m != 0.0) + 10 * int(np.count_nonzero(h))
+    if products:
+        return cost + 4 * moments + 8 * products + 9
+    return cost + 2 * moments + 2 * sum(inertia[j, j] != inertia[k, k] for j, k in _PRODUCTS)
 
 
 def _shifted(m, h, inertia, r):
@@ -130,3 +154,57 @@ def _replaced(link, parameters):
 def _matrix_of(R) -> np.ndarray:
     """A Link's rotation (None: identity) as an array."""
     return np.eye(3) if R is None else np.array(R, dtype=float)
+
+
+@dataclass(frozen=True)
+class Affine:
+    """Links regrouped with one link's inertia x (its m, h, I: 10 numbers) left free: each
+    number x reaches is ``base``'s plus ``rows[e]`` . x, at ``entries[e]`` (the link's index,
+    the number's place among its m, h, I); ``base`` has x = 0."""
+
+    base: tuple
+    entries: tuple[tuple[int, int], ...]
+    rows: tuple[tuple[float, ...], ...]
+
+    def values(self, x) -> tuple[float, ...]:
+        """The entries' numbers (floats) for the inertia x, each sum correctly rounded
+        (math.fsum: a difference of equal moments is 0)."""
+        return tuple(
+            math.fsum((numbers_of(self.base[i])[j], *(c * v for c, v in zip(row, x))))
+            for (i, j), row in zip(self.entries, self.rows)
+        )
+
+    def links(self, values) -> tuple:
+        """``base`` with the entries' numbers (floats, or a kernel's inputs) put in."""
+        numbers = {i: list(numbers_of(self.base[i])) for i, _ in self.entries}
+        for (i, j), value in zip(self.entries, values):
+            numbers[i][j] = value
+        return tuple(with_numbers(link, numbers[i]) if i in numbers else link for i, link in enumerate(self.base))
+
+
+def affine(links, at: int, like=GENERIC) -> Affine:
+    """The regrouping of ``links`` with link ``at``'s inertia left free (see Affine), by the
+    choices made for ``like`` there (10 numbers: its zeros and equal moments of inertia
+    decide them). Linear in that inertia: each column is the regrouping of the unit inertia
+    alone (the other links' inertias 0), by the same choices."""
+    choices = choices_of(tuple(with_numbers(link, like) if i == at else link for i, link in enumerate(links)))
+    zero = (0.0,) * 10
+    base = regrouped(tuple(with_numbers(link, zero) if i == at else link for i, link in enumerate(links)), choices)
+    columns = []
+    for j in range(10):
+        unit = tuple(float(k == j) for k in range(10))
+        alone = tuple(with_numbers(link, unit if i == at else zero) for i, link in enumerate(links))
+        columns.append([numbers_of(link) for link in regrouped(alone, choices)])
+    entries = tuple((i, j) for i in range(len(links)) for j in range(10) if any(c[i][j] != 0.0 for c in columns))
+    rows = tuple(tuple(column[i][j] for column in columns) for i, j in entries)
+    return Affine(base, entries, rows)
+
+
+def numbers_of(link) -> tuple:
+    """A link's m, h, I as 10 numbers."""
+    return (link.m, *link.h, *link.I)
+
+
+def with_numbers(link, x):
+    """The link with its m, h, I from 10 numbers."""
+    return replace(link, m=x[0], h=tuple(x[1:4]), I=tuple(x[4:10]))

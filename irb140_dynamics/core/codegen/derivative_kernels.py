@@ -5,8 +5,8 @@ joints rnea on dual numbers through the coordinates), the forward dynamics and M
 (``algorithms.derivatives``, ``algorithms.linear``) on an arm's links.
 
 Each is ``recipe(arm, cs, *groups, k, friction)`` with ``arm`` an ``ArmKernels``. The joint
-friction is part of these kernels: its coefficients follow, in ``k``, the inputs of the 13
-numbers (payload, gravity; ``kernels.inputs_of``): viscous v (n), then, with ``friction`` "coulomb", the
+friction is part of these kernels: its coefficients follow, in ``k``, the inputs of the payload's
+and gravity's numbers (``kernels.inputs_of``): viscous v (n), then, with ``friction`` "coulomb", the
 Coulomb levels c (n) and the smoothing velocity v_s, as ``Kernels`` binds them; ``friction``
 None: none. Matrices are written row by row.
 """

@@ -3,11 +3,13 @@ the one the public verbs use (as Pinocchio keeps what a call needs in ``Data``, 
 its ``Model``).
 
 The payload (merged into the last link, or the ``flange_joint``'s) and gravity are not folded
-into the code: their 13 numbers (m, h, I about the origin of that link; g) are the kernels' last argument
-``k``, whose default is the model's own. Only the zero ones are folded (as the rest of the
-model is), so models that differ only in payload or gravity share their traced code
-(cached per arm and pattern of zeros, see ``_arm``): changing the payload mass, or moving
-it along the flange axis, traces nothing; the code is as short as a fully folded one.
+into the code: the kernels' last argument ``k`` holds gravity and the numbers that link's
+inertia (m, h, I about its origin) reaches once the links are regrouped (``_regrouping``:
+its own and those it moves into the links below), whose default is the model's own. Only
+the zero ones are folded (as the rest of the model is), so models that differ only in
+payload or gravity share their traced code (cached per arm and pattern of zeros, see
+``_arm``): changing the payload mass, or moving it along the flange axis, traces nothing;
+the code is as short as a fully folded one.
 
 The kernels' native form (C) is made by a compiler outside the core (see
 ``irb140_dynamics.native_hook``): ``prepare`` asks for it now, and a kernel whose arm's Python
@@ -26,7 +28,7 @@ from functools import cached_property, lru_cache, partial
 from irb140_dynamics import native_hook
 from irb140_dynamics.core.algorithms import recursions as algorithms
 from irb140_dynamics.core.algorithms.mimic import Coordinates, coupling
-from irb140_dynamics.core.algorithms.regrouping import regrouped
+from irb140_dynamics.core.algorithms.regrouping import GENERIC, Affine, affine
 from irb140_dynamics.core.codegen.array_code import compile_into
 from irb140_dynamics.core.codegen.program import Program, traced, with_friction
 from irb140_dynamics.core.codegen.python_code import compile_python
@@ -168,11 +170,15 @@ class Kernels:
         self.gravity = model.gravity
         at = model.carrier  # the payload's link: the last one's, or the flange_joint's
         carrier = links[at]
+        arm = links[:at] + (replace(carrier, m=0.0, h=ZERO3, I=ZERO6),) + links[at + 1 :]
         # plain floats: a NumPy scalar (a URDF inertial turned by NumPy) would make every
         # operation it enters several times slower
-        layout, self.constants = inputs_of(tuple(float(x) for x in (carrier.m, *carrier.h, *carrier.I, *model.gravity)))
-        arm = links[:at] + (replace(carrier, m=0.0, h=ZERO3, I=ZERO6),) + links[at + 1 :]
-        self._arm = _arm(arm, model.flange, layout, coupling(model), at)
+        x = tuple(float(v) for v in (carrier.m, *carrier.h, *carrier.I))
+        like = pattern_of(x)
+        regrouping = _regrouping(arm, at, like)
+        kinds = tuple(i if 4 <= j <= 6 else None for i, j in regrouping.entries)  # a link's moments of inertia
+        layout, self.constants = inputs_of(regrouping.values(x) + tuple(float(g) for g in model.gravity), kinds)
+        self._arm = _arm(arm, model.flange, layout, coupling(model), at, like)
         self._friction = model.friction
         self._made: dict[str, Kernel] = {}
         self._lock = threading.Lock()  # one kernel of a name, also when threads ask at once
@@ -271,15 +277,17 @@ def prepare(model, timeout: float | None = None, names: tuple[str, ...] = NATIVE
     return kernels_of(model).prepare(timeout, names)
 
 
-def inputs_of(numbers: tuple[float, ...]) -> tuple[tuple[int | None, ...], tuple[float, ...]]:
-    """(each of the 13 numbers' index in ``k``, None for the constant 0; k's values): an
-    input per nonzero number, but equal moments of inertia (Ixx, Iyy, Izz) take the same, so
-    that the traces fold their difference (the tracer's x - x = 0): a body symmetric about
-    its joint's axis turns at no cost (``rotations.turned_about``), and needs no angle."""
+def inputs_of(numbers: tuple[float, ...], kinds: tuple = ()) -> tuple[tuple[int | None, ...], tuple[float, ...]]:
+    """(each number's index in ``k``, None for the constant 0; k's values): an input per
+    nonzero number, but equal numbers of one kind (``kinds[j]``, not None: a link's moments of
+    inertia) take the same, so that the traces fold their difference (the tracer's
+    x - x = 0): a body symmetric about its joint's axis turns at no cost
+    (``rotations.turned_about``), and needs no angle."""
     layout: list[int | None] = []
     values: list[float] = []
     for j, x in enumerate(numbers):
-        same = [e for e in range(4, j) if j <= 6 and numbers[e] == x]
+        kind = kinds[j] if j < len(kinds) else None
+        same = [e for e in range(j) if kind is not None and kinds[e] == kind and numbers[e] == x]
         if x == 0.0:
             layout.append(None)
         elif same:
@@ -291,8 +299,25 @@ def inputs_of(numbers: tuple[float, ...]) -> tuple[tuple[int | None, ...], tuple
 
 
 @lru_cache(maxsize=ARMS_CACHED)
-def _arm(links, flange, layout: tuple[int | None, ...], coupled=None, carrier: int = -1) -> ArmKernels:
-    return ArmKernels(links, flange, layout, coupled, carrier)
+def _regrouping(links, at: int, like: tuple[float, ...]) -> Affine:
+    return affine(links, at, like)
+
+
+def pattern_of(x: tuple[float, ...]) -> tuple[float, ...]:
+    """The payload's link's inertia x (10 numbers) as regrouping's choices see it: GENERIC
+    where x is not 0, equal moments of inertia kept equal; so payloads that differ only in
+    their numbers regroup alike, and share their traced code."""
+    like = [0.0 if v == 0.0 else g for v, g in zip(x, GENERIC)]
+    for j in (5, 6):
+        same = [e for e in range(4, j) if x[e] == x[j] != 0.0]
+        if same:
+            like[j] = like[same[0]]
+    return tuple(like)
+
+
+@lru_cache(maxsize=ARMS_CACHED)
+def _arm(links, flange, layout: tuple[int | None, ...], coupled, carrier: int, like: tuple) -> ArmKernels:
+    return ArmKernels(links, flange, layout, coupled, carrier, like)
 
 
 @dataclass(frozen=True)
@@ -303,23 +328,24 @@ class _Flange:
 
 
 class ArmKernels(Coordinates):
-    """The traces of an arm (its links, the last one's inertia left out), each made once on
-    first use; the last link's inertia and gravity come from the argument ``k``: each of the
-    13 numbers k[layout[j]], or 0 where layout[j] is None (see ``inputs_of``). ``links``
-    are regrouped (``algorithms.regrouping``): joint torques come out the same, a link's
-    own wrench does not (``Kernels.links`` are the model's)."""
+    """The traces of an arm (its links, the carrier's inertia left out), each made once on
+    first use. ``links`` are regrouped (``algorithms.regrouping``): joint torques come out
+    the same, a link's own wrench does not (``Kernels.links`` are the model's); the numbers
+    the carrier's inertia reaches (``regrouping.entries``), then gravity, come from the
+    argument ``k``: the j-th is k[layout[j]], or 0 where layout[j] is None (see
+    ``inputs_of``)."""
 
-    def __init__(self, links, flange, layout: tuple[int | None, ...], coupled=None, carrier: int = -1):
+    def __init__(self, links, flange, layout: tuple[int | None, ...], coupled, carrier: int, like: tuple):
         self.carrier = carrier % len(links)  # the link the payload and a flange wrench are on
         # every kernel gives joint-space quantities (or, the regressor, reads no inertia):
         # the same from fewer nonzero inertial parameters
-        links = regrouped(links, fixed=self.carrier)
+        self.regrouping = _regrouping(links, self.carrier, like)
         self.flange = _Flange(flange)
         self.layout = layout
-        self.inputs = 1 + max((j for j in layout if j is not None), default=-1)  # k's the 13 numbers take
+        self.inputs = 1 + max((j for j in layout if j is not None), default=-1)  # k's length
         self._traces: dict[str, Trace] = {}
         self._lock = threading.RLock()  # one trace of a kernel, also when threads ask at once
-        Coordinates.__init__(self, links, coupled)
+        Coordinates.__init__(self, self.regrouping.base, coupled)
 
     def has(self, name: str) -> bool:
         return name in self._traces
@@ -351,17 +377,15 @@ class ArmKernels(Coordinates):
         return trace
 
     def _spread(self, k) -> tuple:
-        """The 13 numbers from their inputs in k."""
+        """The numbers (the carrier's entries, gravity) from their inputs in k."""
         return tuple(0.0 if j is None else k[j] for j in self.layout)
 
     def links_with(self, k):
-        """The links with the carrier's (the last one's) inertia from k."""
-        x = self._spread(k)
-        at = self.carrier
-        return self.links[:at] + (replace(self.links[at], m=x[0], h=x[1:4], I=x[4:10]),) + self.links[at + 1 :]
+        """The regrouped links with the numbers the carrier's inertia reaches from k."""
+        return self.regrouping.links(self._spread(k)[:-3])
 
     def gravity_of(self, k):
-        return self._spread(k)[10:13]
+        return self._spread(k)[-3:]
 
 
 def _friction_kind(name: str) -> tuple[str, str | None]:
