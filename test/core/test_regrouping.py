@@ -114,7 +114,7 @@ def test_every_choice_of_what_a_link_moves_keeps_the_torques(name):
     for i, link in enumerate(links):
         if link.prismatic:
             continue
-        for rest, moved in regrouping._choices(link, regrouping._parameters(link)):
+        for rest, moved in regrouping._choices(link, regrouping._parameters(link)).values():
             changed = list(links)
             changed[i] = regrouping._replaced(link, rest)
             if parent[i] >= 0:

@@ -67,16 +67,16 @@ def _regrouped(links, choices) -> tuple[tuple, tuple]:
         if link.prismatic:
             links[i] = _replaced(link, own)
             continue
-        options = list(_choices(link, own))
+        options = _choices(link, own, None if choices is None else choices[i])
         if choices is not None:
             chosen[i] = choices[i]
         elif parent[i] < 0:  # onto the base: dropped
-            chosen[i] = min(reversed(range(len(options))), key=lambda j: _operations(*options[j][0]))
+            chosen[i] = min(reversed(options), key=lambda j: _operations(*options[j][0]))
         else:
             above = _with(_parameters(links[parent[i]]), added[parent[i]])
             before = _operations(*above)
             chosen[i] = min(
-                reversed(range(len(options))),
+                reversed(options),
                 key=lambda j: _operations(*options[j][0]) + _operations(*_with(above, options[j][1])) - before,
             )
         rest, moved = options[chosen[i]]
@@ -86,11 +86,11 @@ def _regrouped(links, choices) -> tuple[tuple, tuple]:
     return tuple(links), tuple(chosen)
 
 
-def _choices(link, own):
-    """(rest, moved) for each choice of what link i moves: its mass or not, its first moment
-    along b or not, lam 0 or the one that zeroes a moment of inertia across b (b a
-    coordinate axis). rest: (m, h, I) about o_i, in frame i; moved: about o_{i-1}, in the
-    parent's frame."""
+def _choices(link, own, only: int | None = None) -> dict:
+    """{index: (rest, moved)} for each choice of what link i moves (the choice ``only``
+    alone, when given): its mass or not, its first moment along b or not, lam 0 or the one
+    that zeroes a moment of inertia across b (b a coordinate axis). rest: (m, h, I) about
+    o_i, in frame i; moved: about o_{i-1}, in the parent's frame."""
     m, h, inertia = own
     b, p = np.array(link.b), np.array(link.p)
     across = np.eye(3) - np.outer(b, b)
@@ -98,19 +98,27 @@ def _choices(link, own):
     _, h_joint, inertia_joint = _shifted(m, h, inertia, p)  # about o'_i
     R = _matrix_of(link.R0) @ _matrix_of(link.R1)  # frame i -> the parent's (any turn: the part is unchanged)
     p0 = np.zeros(3) if link.p0 is None else np.array(link.p0)
-    for move_mass, move_along in product((False, True), repeat=2):
+    zeroings = [None] + ([(axis[0] + 1) % 3, (axis[0] + 2) % 3] if axis else [])
+    options = {}
+    for pair, (move_mass, move_along) in enumerate(product((False, True), repeat=2)):
+        indices = range(pair * len(zeroings), (pair + 1) * len(zeroings))
+        if only is not None and only not in indices:
+            continue
         m_moved = m if move_mass else 0.0
         h_moved = (b @ h_joint) * b if move_along else np.zeros(3)
         m_rest, h_rest, inertia_rest = _shifted(m - m_moved, h_joint - h_moved, inertia_joint, -p)  # about o_i
         if move_mass and move_along and axis:  # kept, the mass's moment -m (b . p) stays there
             h_rest[axis[0]] = 0.0
-        for zeroed in [None] + ([(axis[0] + 1) % 3, (axis[0] + 2) % 3] if axis else []):
+        for index, zeroed in zip(indices, zeroings):
+            if only is not None and index != only:
+                continue
             lam = 0.0 if zeroed is None else inertia_rest[zeroed, zeroed]
             rest_inertia = inertia_rest - lam * across
             if zeroed is not None:
                 rest_inertia[zeroed, zeroed] = 0.0
             moved = _shifted(m_moved, R @ h_moved, R @ (lam * across) @ R.T, p0)
-            yield (m_rest, h_rest, rest_inertia), moved
+            options[index] = (m_rest, h_rest, rest_inertia), moved
+    return options
 
 
 def _operations(m, h, inertia) -> int:
