@@ -73,7 +73,6 @@ class Link:
     prismatic: bool = False
     e: Vector3 = ZERO3  # a prismatic joint's axis in frame i-1 (R0 u)
     parent: int | None = None  # the parent link's index, -1 the base; None: the link before (a chain)
-    carrier: bool = False  # the payload is merged into it (the kernels take its inertia as constants)
 
 
 def chain(model) -> tuple[Link, ...]:
@@ -87,7 +86,6 @@ def chain(model) -> tuple[Link, ...]:
             joint.armature,
             *_slide(joint),
             parent=None if parent == i - 1 else parent,
-            carrier=i == model.carrier,
         )
         for i, (joint, body, parent) in enumerate(zip(model.joints, model.bodies, model.parent))
     )

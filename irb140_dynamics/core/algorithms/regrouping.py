@@ -40,7 +40,8 @@ from irb140_dynamics.core.algorithms.topology import parents
 from irb140_dynamics.core.model.rigid_body import inertia_entries, inertia_matrix, shift_inertia
 
 _PRODUCTS = ((0, 1), (0, 2), (1, 2))  # the products of inertia's entries
-# a link's m, h, I (10 numbers) with no zero and no two moments of inertia equal
+MOMENTS = range(4, 7)  # the moments of inertia's places among a link's m, h, I (10 numbers)
+# a link's m, h, I with no zero and no two moments of inertia equal
 GENERIC = (1.3, 0.07, 0.11, 0.13, 0.5, 0.7, 0.9, 0.017, 0.019, 0.023)
 
 
@@ -71,13 +72,11 @@ def _regrouped(links, choices) -> tuple[tuple, tuple]:
         if choices is not None:
             chosen[i] = choices[i]
         elif parent[i] < 0:  # onto the base: dropped
-            chosen[i] = min(reversed(options), key=lambda j: _operations(*options[j][0]))
+            chosen[i] = _cheapest(options, lambda rest, moved: _operations(*rest))
         else:
-            above = _with(_parameters(links[parent[i]]), added[parent[i]])
-            before = _operations(*above)
-            chosen[i] = min(
-                reversed(options),
-                key=lambda j: _operations(*options[j][0]) + _operations(*_with(above, options[j][1])) - before,
+            above = _with(_parameters(links[parent[i]]), added[parent[i]])  # the parent's, so far
+            chosen[i] = _cheapest(
+                options, lambda rest, moved, above=above: _operations(*rest) + _operations(*_with(above, moved))
             )
         rest, moved = options[chosen[i]]
         if parent[i] >= 0:
@@ -86,11 +85,19 @@ def _regrouped(links, choices) -> tuple[tuple, tuple]:
     return tuple(links), tuple(chosen)
 
 
+def _cheapest(options: dict, cost) -> int:
+    """The index of the option (rest, moved) of least ``cost``; of equal ones the last: the
+    options run from moving nothing to moving the mass, the first moment along b and a
+    moment of inertia (``_choices``), and what a parent holds, it may move on."""
+    return min(reversed(options), key=lambda j: cost(*options[j]))
+
+
 def _choices(link, own, only: int | None = None) -> dict:
     """{index: (rest, moved)} for each choice of what link i moves (the choice ``only``
-    alone, when given): its mass or not, its first moment along b or not, lam 0 or the one
-    that zeroes a moment of inertia across b (b a coordinate axis). rest: (m, h, I) about
-    o_i, in frame i; moved: about o_{i-1}, in the parent's frame."""
+    alone, when given), in this order: its mass or not, then its first moment along b or
+    not, then lam 0 or the one that zeroes a moment of inertia across b (b a coordinate
+    axis; the first across, then the second). rest: (m, h, I) about o_i, in frame i; moved:
+    about o_{i-1}, in the parent's frame."""
     m, h, inertia = own
     b, p = np.array(link.b), np.array(link.p)
     across = np.eye(3) - np.outer(b, b)
@@ -175,8 +182,9 @@ class Affine:
     rows: tuple[tuple[float, ...], ...]
 
     def values(self, x) -> tuple[float, ...]:
-        """The entries' numbers (floats) for the inertia x, each sum correctly rounded
-        (math.fsum: a difference of equal moments is 0)."""
+        """The entries' numbers (floats) for the inertia x: each sum of the rounded products
+        correctly rounded (math.fsum), so that a difference of equal moments of inertia (their
+        coefficients +-1) is 0."""
         return tuple(
             math.fsum((numbers_of(self.base[i])[j], *(c * v for c, v in zip(row, x))))
             for (i, j), row in zip(self.entries, self.rows)
@@ -216,3 +224,15 @@ def numbers_of(link) -> tuple:
 def with_numbers(link, x):
     """The link with its m, h, I from 10 numbers."""
     return replace(link, m=x[0], h=tuple(x[1:4]), I=tuple(x[4:10]))
+
+
+def pattern_of(x) -> tuple[float, ...]:
+    """A link's inertia x (10 numbers) as the choices see it: GENERIC where x is not 0,
+    equal moments of inertia kept equal; inertias that differ only in their numbers, not in
+    these, regroup by the same choices."""
+    like = [0.0 if v == 0.0 else g for v, g in zip(x, GENERIC)]
+    for j in MOMENTS:
+        same = [e for e in MOMENTS if e < j and x[e] == x[j] != 0.0]
+        if same:
+            like[j] = like[same[0]]
+    return tuple(like)

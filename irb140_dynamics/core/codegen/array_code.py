@@ -11,7 +11,7 @@ NumPy ufunc call each with an ``out`` argument:
   user has run and taken by the next result (often in place), so that the working set of
   a chunk of states stays in the caches;
 - the last operation of each output writes straight into the caller's array ``out[j]``;
-- what depends only on the scalar arguments (the payload and gravity ``k``) is computed
+- what depends only on the scalar arguments (the payload's numbers and gravity ``k``) is computed
   once on floats;
 - an operation the tracer recorded more than once (on the same operands, or on swapped
   ones for + and *, which commute exactly) is done once;

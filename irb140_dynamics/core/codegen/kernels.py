@@ -28,7 +28,7 @@ from functools import cached_property, lru_cache, partial
 from irb140_dynamics import native_hook
 from irb140_dynamics.core.algorithms import recursions as algorithms
 from irb140_dynamics.core.algorithms.mimic import Coordinates, coupling
-from irb140_dynamics.core.algorithms.regrouping import GENERIC, Affine, affine
+from irb140_dynamics.core.algorithms.regrouping import MOMENTS, Affine, affine, pattern_of
 from irb140_dynamics.core.codegen.array_code import compile_into
 from irb140_dynamics.core.codegen.program import Program, traced, with_friction
 from irb140_dynamics.core.codegen.python_code import compile_python
@@ -61,7 +61,7 @@ class Trace:
 
 class Kernel:
     """One kernel of one model: its arm's ``Trace`` with ``k`` defaulting to the model's
-    ``constants`` (payload and gravity). ``scalar`` on floats, ``array`` on NumPy arrays,
+    ``constants`` (the numbers the payload's link's inertia reaches, and gravity). ``scalar`` on floats, ``array`` on NumPy arrays,
     ``into`` writing into given arrays; ``native``: None, or the same program compiled as C
     (put here by a compiler, see native_hook), a function of the argument groups but k as
     float64 arrays returning an array or None (then the Python form answers);
@@ -174,11 +174,10 @@ class Kernels:
         # plain floats: a NumPy scalar (a URDF inertial turned by NumPy) would make every
         # operation it enters several times slower
         x = tuple(float(v) for v in (carrier.m, *carrier.h, *carrier.I))
-        like = pattern_of(x)
-        regrouping = _regrouping(arm, at, like)
-        kinds = tuple(i if 4 <= j <= 6 else None for i, j in regrouping.entries)  # a link's moments of inertia
+        regrouping = _regrouping(arm, at, pattern_of(x))
+        kinds = tuple(i if j in MOMENTS else None for i, j in regrouping.entries)  # a link's moments of inertia
         layout, self.constants = inputs_of(regrouping.values(x) + tuple(float(g) for g in model.gravity), kinds)
-        self._arm = _arm(arm, model.flange, layout, coupling(model), at, like)
+        self._arm = _arm(regrouping, model.flange, layout, coupling(model), at)
         self._friction = model.friction
         self._made: dict[str, Kernel] = {}
         self._lock = threading.Lock()  # one kernel of a name, also when threads ask at once
@@ -287,7 +286,7 @@ def inputs_of(numbers: tuple[float, ...], kinds: tuple = ()) -> tuple[tuple[int 
     values: list[float] = []
     for j, x in enumerate(numbers):
         kind = kinds[j] if j < len(kinds) else None
-        same = [e for e in range(j) if kind is not None and kinds[e] == kind and numbers[e] == x]
+        same = [] if kind is None else [e for e in range(j) if kinds[e] == kind and numbers[e] == x]
         if x == 0.0:
             layout.append(None)
         elif same:
@@ -300,24 +299,14 @@ def inputs_of(numbers: tuple[float, ...], kinds: tuple = ()) -> tuple[tuple[int 
 
 @lru_cache(maxsize=ARMS_CACHED)
 def _regrouping(links, at: int, like: tuple[float, ...]) -> Affine:
+    """The arm's links regrouped with link ``at``'s inertia free (``regrouping.affine``), by
+    the choices made for ``like`` (``regrouping.pattern_of``): one per arm and pattern."""
     return affine(links, at, like)
 
 
-def pattern_of(x: tuple[float, ...]) -> tuple[float, ...]:
-    """The payload's link's inertia x (10 numbers) as regrouping's choices see it: GENERIC
-    where x is not 0, equal moments of inertia kept equal; so payloads that differ only in
-    their numbers regroup alike, and share their traced code."""
-    like = [0.0 if v == 0.0 else g for v, g in zip(x, GENERIC)]
-    for j in (5, 6):
-        same = [e for e in range(4, j) if x[e] == x[j] != 0.0]
-        if same:
-            like[j] = like[same[0]]
-    return tuple(like)
-
-
 @lru_cache(maxsize=ARMS_CACHED)
-def _arm(links, flange, layout: tuple[int | None, ...], coupled, carrier: int, like: tuple) -> ArmKernels:
-    return ArmKernels(links, flange, layout, coupled, carrier, like)
+def _arm(regrouping: Affine, flange, layout: tuple[int | None, ...], coupled, carrier: int) -> ArmKernels:
+    return ArmKernels(regrouping, flange, layout, coupled, carrier)
 
 
 @dataclass(frozen=True)
@@ -335,11 +324,11 @@ class ArmKernels(Coordinates):
     argument ``k``: the j-th is k[layout[j]], or 0 where layout[j] is None (see
     ``inputs_of``)."""
 
-    def __init__(self, links, flange, layout: tuple[int | None, ...], coupled, carrier: int, like: tuple):
-        self.carrier = carrier % len(links)  # the link the payload and a flange wrench are on
+    def __init__(self, regrouping: Affine, flange, layout: tuple[int | None, ...], coupled, carrier: int):
+        self.carrier = carrier  # the link the payload and a flange wrench are on
         # every kernel gives joint-space quantities (or, the regressor, reads no inertia):
         # the same from fewer nonzero inertial parameters
-        self.regrouping = _regrouping(links, self.carrier, like)
+        self.regrouping = regrouping
         self.flange = _Flange(flange)
         self.layout = layout
         self.inputs = 1 + max((j for j in layout if j is not None), default=-1)  # k's length

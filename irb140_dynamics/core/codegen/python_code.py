@@ -120,7 +120,7 @@ BOUND = "constants"  # the variable the last group defaults to in a bound functi
 def bound(source: str, name: str, *namespaces: dict) -> list[Callable[[tuple], Callable]]:
     """``bind(constants)`` in each namespace: the function ``name`` that ``source`` defines
     (its last parameter defaulting to the variable BOUND, see python_source) with that
-    parameter defaulting to ``constants``: one model's payload and gravity (see kernels).
+    parameter defaulting to ``constants``: one model's payload's numbers and gravity (see kernels).
     Each bound function is a plain function of its own, as fast to call as the code written
     out for that model. The source is compiled once."""
     wrapped = f"def bind({BOUND}):\n" + textwrap.indent(source, "    ") + f"    return {name}\n"

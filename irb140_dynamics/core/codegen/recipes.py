@@ -1,5 +1,5 @@
 """Every kernel by name (``RECIPES``): how each is traced from the algorithms, on an arm
-whose last link's inertia and gravity come from the argument ``k`` (see kernels.ArmKernels)."""
+whose payload's numbers and gravity come from the argument ``k`` (see kernels.ArmKernels)."""
 
 from __future__ import annotations
 
