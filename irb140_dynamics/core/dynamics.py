@@ -152,7 +152,12 @@ def forward_dynamics(model: RobotModel, q: ArrayLike, qd: ArrayLike, tau: ArrayL
         bias += model.friction.torques(args[1])
     M = _symmetric(np.array(kernels.mass_matrix.scalar(args[0])), n)
     with np.errstate(invalid="ignore", over="ignore"):
-        qdd = np.linalg.solve(M, np.array(tau_in, dtype=float) - bias)
+        try:
+            qdd = np.linalg.solve(M, np.array(tau_in, dtype=float) - bias)
+        except np.linalg.LinAlgError:
+            raise ValueError(
+                f"forward_dynamics: the mass matrix is singular at q={list(args[0])}: no inverse"
+            ) from None
     finite_result(qdd.tolist(), "forward_dynamics", q=q, qd=qd, tau=tau, **({} if f_ext is None else {"f_ext": f_ext}))
     return qdd
 
@@ -189,7 +194,10 @@ def forward_dynamics_batch(model: RobotModel, Q, QD, TAU) -> np.ndarray:
     bias = _with_friction(model, _run(kernels.rnea, q, qd, np.zeros_like(q)), qd)
     M = _run(kernels.mass_matrix, q)
     with np.errstate(over="ignore", invalid="ignore"):
-        QDD = np.linalg.solve(M, (tau.T - bias)[..., None])[..., 0]
+        try:
+            QDD = np.linalg.solve(M, (tau.T - bias)[..., None])[..., 0]
+        except np.linalg.LinAlgError:
+            raise ValueError("forward_dynamics_batch: the mass matrix is singular at a state: no inverse") from None
     return finite_results(QDD, "forward_dynamics_batch", "Q", "QD", "TAU")
 
 

@@ -12,6 +12,7 @@ example-robot-data that the corpus test compares.
 
 import math
 from collections import Counter
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,9 @@ import pytest
 
 from irb140_dynamics.core import (
     ModelError,
+    RigidBody,
     forward_dynamics,
+    forward_dynamics_batch,
     forward_dynamics_derivatives,
     inverse_mass_matrix,
     irb140,
@@ -34,6 +37,7 @@ from irb140_dynamics.core.urdf import load_urdf
 
 from ..support import pinocchio_model
 from ..support.common import full_sweep, loaded_irb140, random_model, random_urdf_model
+from ..support.paths import URDF_DATA
 from ..support.pinocchio_trees import pinocchio_state
 from ..support.two_arms import TWO_ARMS, _joint, _link
 from .test_urdf_any_chain import KINDS, chain_urdf
@@ -325,6 +329,28 @@ def test_bad_input_is_refused_naming_the_argument():
         inverse_mass_matrix(model, "q")
     with pytest.raises(ValueError, match="not finite.*too large"):
         rnea_derivatives(model, zeros, np.full(6, 1e200), zeros)
+
+
+@pytest.mark.parametrize("arm", ["irb140", "ur5"])
+def test_a_joint_moving_no_inertia_has_no_forward_dynamics_at_any_q(arm):
+    """The last link massless, a point payload on its axis: M is singular for every q. The
+    forward dynamics, its derivatives and M^-1 are refused, not numbers of 1e16 (M in
+    another frame than the joints' keeps a rounding residue where its pivot is 0)."""
+    if arm == "irb140":
+        model = irb140(payload=RigidBody(2.0))
+    else:
+        model = load_urdf((URDF_DATA / "ur5.urdf").read_text(), tip_link="tool0").model.with_payload(RigidBody(2.0))
+    model = replace(model, joints=(*model.joints[:-1], replace(model.joints[-1], link=RigidBody())))
+    q, zeros = np.linspace(0.1, 0.6, model.n), np.zeros(model.n)
+    assert mass_matrix(model, q)[-1, -1] == 0.0
+    for call in (
+        lambda: forward_dynamics_derivatives(model, q, zeros, zeros),
+        lambda: inverse_mass_matrix(model, q),
+        lambda: forward_dynamics(model, q, zeros, zeros),
+        lambda: forward_dynamics_batch(model, q[None], zeros[None], zeros[None]),
+    ):
+        with pytest.raises(ValueError, match="singular.*no inverse"):
+            call()
 
 
 # -- the closed forms against their definition -----------------------------------------------

@@ -107,6 +107,10 @@ def forward_dynamics(arm, cs, qd, tau, k, friction=None):
 def forward_dynamics_derivatives(arm, cs, qd, tau, k, friction=None):
     """[d qdd / dq, d qdd / dqd, M^-1]: with mimic joints -M^-1 d tau / d(q, qd) at qdd = FD(q, qd, tau)."""
     links, terms = arm.links_with(k), friction_terms(arm, k, qd, friction)
+    # M singular for every q is refused (SingularMatrix) as inverse_mass_matrix refuses it: in
+    # the joint frames a joint moving no inertia leaves a pivot of folded zero, where in link
+    # r's frame its M may keep a rounding residue (a pivot of 1e-17, M^-1 of 1e16)
+    inverse(_mass_matrix(arm, links, cs))
     if arm.coupled is not None:
         gravity = arm.gravity_of(k)
         qdd, _, Minv = _coordinate_forward(arm, links, cs, qd, tau, gravity, terms and terms[0])
