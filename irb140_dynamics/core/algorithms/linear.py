@@ -17,22 +17,7 @@ def inverse(M):
     """M^-1 of a symmetric positive definite M (rows), by M = L D L^T; the whole matrix,
     its entries below the diagonal the same values as those above."""
     n = len(M)
-    L = [[0.0] * n for _ in range(n)]
-    D = [0.0] * n
-    inverse_D = [0.0] * n
-    for j in range(n):
-        LD = [L[j][k] * D[k] for k in range(j)]  # L_jk D_k
-        d = M[j][j]
-        for k in range(j):
-            d = d - LD[k] * L[j][k]
-        if isinstance(d, float) and d == 0.0:  # a folded zero: so for every state
-            raise SingularMatrix(j)
-        D[j], inverse_D[j] = d, 1.0 / d
-        for i in range(j + 1, n):
-            x = M[i][j]
-            for k in range(j):
-                x = x - L[i][k] * LD[k]
-            L[i][j] = x * inverse_D[j]
+    L, inverse_D = factors(M)
     # U = L^-1 (unit lower triangular), column by column
     U = [[1.0 if i == j else 0.0 for j in range(n)] for i in range(n)]
     for j in range(n):
@@ -50,6 +35,30 @@ def inverse(M):
                 x = x + U[k][i] * (U[k][j] * inverse_D[k])
             Minv[i][j] = Minv[j][i] = x
     return Minv
+
+
+def factors(M):
+    """(L, D^-1) of M = L D L^T (L unit lower triangular, rows; D^-1 its pivots' inverses),
+    M symmetric positive definite. Raises SingularMatrix where a pivot is a folded zero (a
+    traced M whose joint moves no inertia: singular for every state)."""
+    n = len(M)
+    L = [[0.0] * n for _ in range(n)]
+    D = [0.0] * n
+    inverse_D = [0.0] * n
+    for j in range(n):
+        LD = [L[j][k] * D[k] for k in range(j)]  # L_jk D_k
+        d = M[j][j]
+        for k in range(j):
+            d = d - LD[k] * L[j][k]
+        if isinstance(d, float) and d == 0.0:  # a folded zero: so for every state
+            raise SingularMatrix(j)
+        D[j], inverse_D[j] = d, 1.0 / d
+        for i in range(j + 1, n):
+            x = M[i][j]
+            for k in range(j):
+                x = x - L[i][k] * LD[k]
+            L[i][j] = x * inverse_D[j]
+    return L, inverse_D
 
 
 def times(A, B):

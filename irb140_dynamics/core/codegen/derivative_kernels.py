@@ -16,7 +16,7 @@ from __future__ import annotations
 from irb140_dynamics.core.algorithms import analytical_derivatives as analytical
 from irb140_dynamics.core.algorithms import derivatives
 from irb140_dynamics.core.algorithms import recursions as algorithms
-from irb140_dynamics.core.algorithms.linear import inverse, negated, times, times_vector
+from irb140_dynamics.core.algorithms.linear import factors, inverse, negated, times, times_vector
 from irb140_dynamics.core.algorithms.topology import is_chain
 from irb140_dynamics.core.codegen.trace import size, tanh
 from irb140_dynamics.core.scalars.dual import Dual
@@ -110,7 +110,7 @@ def forward_dynamics_derivatives(arm, cs, qd, tau, k, friction=None):
     # M singular for every q is refused (SingularMatrix) as inverse_mass_matrix refuses it: in
     # the joint frames a joint moving no inertia leaves a pivot of folded zero, where in link
     # r's frame its M may keep a rounding residue (a pivot of 1e-17, M^-1 of 1e16)
-    inverse(_mass_matrix(arm, links, cs))
+    factors(_mass_matrix(arm, links, cs))
     if arm.coupled is not None:
         gravity = arm.gravity_of(k)
         qdd, _, Minv = _coordinate_forward(arm, links, cs, qd, tau, gravity, terms and terms[0])
