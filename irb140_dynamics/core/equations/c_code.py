@@ -84,6 +84,7 @@ def _traced_body(eq: Equations, name: str, body) -> list[str]:
         lines += taken or [f"    (void){arg};"]
     angles, assignments = sincos.batched(body.assignments)
     lines += angles
-    lines += [f"    const double {var} = {expr};" for var, expr in assignments]
+    scalar = [f"    const double {var} = {expr};" for var, expr in assignments]
+    lines += ["#if defined(SINCOS_PAIRS)", *body.paired, "#else", *scalar, "#endif"] if body.paired else scalar
     out = name if name != "regressor" else "Y"
     return lines + [f"    {out}[{k}] = {expr};" for k, expr in enumerate(body.outputs)]

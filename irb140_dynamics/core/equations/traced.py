@@ -11,9 +11,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from ..codegen import sincos
 from ..codegen.array_code import into_source
 from ..codegen.kernels import kernels_of
 from ..codegen.layout import upper_to_full, whole_matrix
+from ..codegen.pairs import paired_body
 from ..codegen.program import with_constants
 from ..codegen.python_code import statements
 from ..codegen.recipes import WITH_FRICTION
@@ -37,6 +39,7 @@ class Body:
     written: list[int]
     constants: dict[int, float]
     entries: list[int]
+    paired: list[str] | None = None
 
 
 def traced_bodies(model, names) -> dict[str, Body]:
@@ -60,5 +63,6 @@ def traced_bodies(model, names) -> dict[str, Body]:
             group: [(i, f"{group}{i}") for i in range(length) if f"{group}{i}" in used]
             for group, length in program.groups
         }
-        bodies[name] = Body(inputs, assignments, outputs, into, written, constants, entries)
+        paired = paired_body(program, sincos.batched(assignments)[1])
+        bodies[name] = Body(inputs, assignments, outputs, into, written, constants, entries, paired)
     return bodies
