@@ -10,13 +10,14 @@ from the SymPy derivation (``symbolic``).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 from ..codegen import sincos
 from ..codegen.array_code import into_source
 from ..codegen.kernels import kernels_of
 from ..codegen.layout import upper_to_full, whole_matrix
 from ..codegen.pairs import paired_body
-from ..codegen.program import with_constants
+from ..codegen.program import Program, with_constants
 from ..codegen.python_code import statements
 from ..codegen.recipes import WITH_FRICTION
 
@@ -39,7 +40,13 @@ class Body:
     written: list[int]
     constants: dict[int, float]
     entries: list[int]
-    paired: list[str] | None = None
+    program: Program  # the kernel's, k's numbers put in
+
+    @cached_property
+    def paired(self) -> list[str] | None:
+        """The C statements with operations in pairs of vectors (``codegen.pairs``), None
+        where no pair pays: searched when the C is written, not for the other forms."""
+        return paired_body(self.program, sincos.batched(self.assignments)[1])
 
 
 def traced_bodies(model, names) -> dict[str, Body]:
@@ -63,6 +70,5 @@ def traced_bodies(model, names) -> dict[str, Body]:
             group: [(i, f"{group}{i}") for i in range(length) if f"{group}{i}" in used]
             for group, length in program.groups
         }
-        paired = paired_body(program, sincos.batched(assignments)[1])
-        bodies[name] = Body(inputs, assignments, outputs, into, written, constants, entries, paired)
+        bodies[name] = Body(inputs, assignments, outputs, into, written, constants, entries, program)
     return bodies

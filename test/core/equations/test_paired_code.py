@@ -93,8 +93,6 @@ def test_the_tally_counts_each_candidate_as_the_whole_program_does(monkeypatch):
         return count
 
     monkeypatch.setattr(pairs._Tally, "count_with", checked)
-    kernels = kernels_of(generic_arm())
-    for name in ("rnea", "mass_matrix"):
-        kernel = kernels.kernel(name)
-        assert plan_pairs(with_constants(kernel.program, "k", kernel.constants))[0]
-    assert len(counted) > 100
+    kernel = kernels_of(generic_arm()).kernel("mass_matrix")
+    assert plan_pairs(with_constants(kernel.program, "k", kernel.constants))[0]
+    assert len(counted) > 50
