@@ -261,15 +261,20 @@ class _Tally:
         self.reading: dict[int, set] = {}  # operation -> the pairs whose operands it is
         self.operations = sum(counted)  # scalar operations and pairs
         self.taken = 0  # upper lanes read by a scalar operation or an output
-        self.count = self.operations
+
+    @property
+    def count(self) -> float:
+        """``_cost`` of the plan's pairs."""
+        return self.operations + BUILT * self.keys + TAKEN_OUT * self.taken
 
     def _vectors(self, pair) -> list:
         x, y, swapped = pair
         ay = self.plan.operands[y][::-1] if swapped else self.plan.operands[y]
         return [(u, v) for u, v in zip(self.plan.operands[x], ay) if type(u) is int or type(v) is int]
 
-    def _changes(self, grown) -> tuple[dict, Counter, dict]:
-        """(the lanes grown adds, the change of ``built``, each touched operation's readers)."""
+    def _changes(self, grown) -> tuple[dict, Counter, dict, int, int]:
+        """(the lanes grown adds, the change of ``built``, each touched operation's readers,
+        the change of ``keys``, the change of ``taken``) were the pairs ``grown`` added."""
         plan, lane = self.plan, self.plan.lane
         new = {}
         for p, (x, y, _) in enumerate(grown, start=len(plan.pairs)):
@@ -291,33 +296,25 @@ class _Tally:
                 for a in plan.operands[k]:
                     if type(a) is int:
                         readers[a] = readers.get(a, self.readers[a]) - 1
-        return new, built, readers
+        keys = sum((self.built[key] + d > 0) - (self.built[key] > 0) for key, d in built.items())
+        taken = sum(self._taken(both, a, r) - self._taken(lane, a, self.readers[a]) for a, r in readers.items())
+        return new, built, readers, keys, taken
 
-    def _taken(self, lane: dict, a: int, readers: int) -> int:
+    def _taken(self, lane, a: int, readers: int) -> int:
         return int(lane.get(a, (0, 0))[1] == 1 and (readers > 0 or a in self.outputs))
 
     def count_with(self, grown) -> float:
         """``_cost`` of the plan with the pairs ``grown`` added."""
-        new, built, readers = self._changes(grown)
-        both = ChainMap(new, self.plan.lane)
-        keys = sum((self.built[key] + d > 0) - (self.built[key] > 0) for key, d in built.items())
-        taken = sum(
-            self._taken(both, a, r) - self._taken(self.plan.lane, a, self.readers[a]) for a, r in readers.items()
-        )
+        *_, keys, taken = self._changes(grown)
         return self.operations - len(grown) + BUILT * (self.keys + keys) + TAKEN_OUT * (self.taken + taken)
 
     def add(self, grown) -> None:
         """The pairs ``grown`` added to the plan."""
         plan = self.plan
-        new, built, readers = self._changes(grown)
-        self.count = self.count_with(grown)
-        taken = sum(
-            self._taken(ChainMap(new, plan.lane), a, r) - self._taken(plan.lane, a, self.readers[a])
-            for a, r in readers.items()
-        )
-        self.taken += taken
+        new, built, readers, keys, taken = self._changes(grown)
         self.operations -= len(grown)
-        self.keys += sum((self.built[key] + d > 0) - (self.built[key] > 0) for key, d in built.items())
+        self.keys += keys
+        self.taken += taken
         self.built.update(built)
         for a, r in readers.items():
             self.readers[a] = r

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 from ..codegen import sincos
+from ..codegen.pairs import paired_body
 from .printing import DESCRIPTIONS, CPrinter, header_lines, used_names
 from .symbolic import Equations
 
@@ -85,6 +86,7 @@ def _traced_body(eq: Equations, name: str, body) -> list[str]:
     angles, assignments = sincos.batched(body.assignments)
     lines += angles
     scalar = [f"    const double {var} = {expr};" for var, expr in assignments]
-    lines += ["#if defined(SINCOS_PAIRS)", *body.paired, "#else", *scalar, "#endif"] if body.paired else scalar
+    paired = paired_body(body.program, assignments)  # operations in pairs of vectors, where they pay
+    lines += ["#if defined(SINCOS_PAIRS)", *paired, "#else", *scalar, "#endif"] if paired else scalar
     out = name if name != "regressor" else "Y"
     return lines + [f"    {out}[{k}] = {expr};" for k, expr in enumerate(body.outputs)]

@@ -10,13 +10,10 @@ from the SymPy derivation (``symbolic``).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from functools import cached_property
 
-from ..codegen import sincos
 from ..codegen.array_code import into_source
 from ..codegen.kernels import kernels_of
 from ..codegen.layout import upper_to_full, whole_matrix
-from ..codegen.pairs import paired_body
 from ..codegen.program import Program, with_constants
 from ..codegen.python_code import statements
 from ..codegen.recipes import WITH_FRICTION
@@ -40,13 +37,7 @@ class Body:
     written: list[int]
     constants: dict[int, float]
     entries: list[int]
-    program: Program  # the kernel's, k's numbers put in
-
-    @cached_property
-    def paired(self) -> list[str] | None:
-        """The C statements with operations in pairs of vectors (``codegen.pairs``), None
-        where no pair pays: searched when the C is written, not for the other forms."""
-        return paired_body(self.program, sincos.batched(self.assignments)[1])
+    program: Program  # the kernel's, k's numbers put in (the C writer pairs its operations)
 
 
 def traced_bodies(model, names) -> dict[str, Body]:
